@@ -1,0 +1,345 @@
+//! Command-line interface: clap structs hold the raw flags; [`main`] validates them into domain
+//! types (a [`Plan`], an output folder, [`ExecOptions`]) before any work starts.
+//!
+//! Exit status: 0 done (failed runs are rows, not errors), 2 bad input (sweep file, flags,
+//! an output folder of another sweep), 1 a runtime failure (I/O).
+
+use std::collections::HashSet;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Duration;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::exec::{self, ExecOptions};
+use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS};
+use crate::sink::{BatchPolicy, Manifest, Sink, SinkError};
+use crate::summary;
+use crate::sweep::{self, Plan, SweepError, SweepFile};
+
+#[derive(Debug, Parser)]
+#[command(name = "contact-sweep", version, about = "Parameter sweeps of dynamic Signorini-contact simulations, to Parquet and convergence tables")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Expand a sweep file and print its runs, without running anything.
+    Plan {
+        /// The sweep file (TOML, see README).
+        sweep: PathBuf,
+    },
+    /// Run a sweep: every run in parallel, results as Parquet under --out.
+    Run(RunArgs),
+    /// Write convergence, energy and speed-against-error tables for a results folder.
+    Summarize {
+        /// A folder written by `run`.
+        dir: PathBuf,
+    },
+    /// Print the output schema (runs and series columns) as Markdown.
+    Schema,
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The sweep file.
+    pub sweep: PathBuf,
+    /// Output folder (default: out/<sweep name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads; 1 runs the serial reference loop; 0 uses every core.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// Add to a folder holding results of another sweep (runs already present are skipped;
+    /// resuming is automatic when the folder holds the same sweep).
+    #[arg(long)]
+    pub resume: bool,
+    /// Stop a run after this many seconds (status `timeout`).
+    #[arg(long, value_name = "SECS")]
+    pub run_timeout: Option<f64>,
+    /// Keep every k-th time step in DIR/series (0: none); overrides the sweep's series_every.
+    #[arg(long, value_name = "K")]
+    pub series_every: Option<usize>,
+    /// Commit results every N runs (and at least every 2 seconds).
+    #[arg(long, default_value_t = 16, value_name = "N")]
+    pub batch: usize,
+    /// Do not write the summary tables at the end.
+    #[arg(long)]
+    pub no_summary: bool,
+}
+
+/// Bad input detected by the CLI itself.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// Map an error to the exit status.
+pub fn exit_code(e: &anyhow::Error) -> u8 {
+    for cause in e.chain() {
+        if cause.downcast_ref::<SweepError>().is_some() || cause.downcast_ref::<UsageError>().is_some() {
+            return 2;
+        }
+        if let Some(SinkError::ForeignSweep { .. }) = cause.downcast_ref::<SinkError>() {
+            return 2;
+        }
+    }
+    1
+}
+
+/// Validated `run` arguments.
+struct RunConfig {
+    plan: Plan,
+    out: PathBuf,
+    exec: ExecOptions,
+    resume: bool,
+    batch: BatchPolicy,
+    summary: bool,
+}
+
+impl RunArgs {
+    fn validate(self) -> Result<RunConfig> {
+        let sweep = SweepFile::load(&self.sweep)?;
+        let plan = sweep::expand(&sweep)?;
+        if let Some(t) = self.run_timeout {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(UsageError(format!("--run-timeout must be a positive number of seconds, got {t}")).into());
+            }
+        }
+        if self.batch == 0 {
+            return Err(UsageError("--batch must be at least 1".into()).into());
+        }
+        let out = self.out.unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
+        let series_every = self.series_every.unwrap_or(plan.sweep.series_every);
+        Ok(RunConfig {
+            exec: ExecOptions {
+                threads: self.threads,
+                run: RunOptions {
+                    series_every,
+                    timeout: self.run_timeout.map(Duration::from_secs_f64),
+                },
+            },
+            plan,
+            out,
+            resume: self.resume,
+            batch: BatchPolicy {
+                runs: self.batch,
+                seconds: 2.0,
+            },
+            summary: !self.no_summary,
+        })
+    }
+}
+
+/// Run a subcommand.
+pub fn main(cli: Cli) -> Result<ExitCode> {
+    match cli.command {
+        Command::Plan { sweep } => {
+            let sf = SweepFile::load(&sweep)?;
+            let plan = sweep::expand(&sf)?;
+            print!("{}", plan.summary());
+            println!();
+            print!("{}", plan_table(&plan));
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Run(args) => {
+            let cfg = args.validate()?;
+            run(cfg)
+        }
+        Command::Summarize { dir } => {
+            let s = summary::summarize(&dir)?;
+            print!("{}", s.terminal);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Schema => {
+            print!("{}", schema_markdown());
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+fn run(cfg: RunConfig) -> Result<ExitCode> {
+    let plan = &cfg.plan;
+    let dir = &cfg.out;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    if let Some(found) = Manifest::existing_sweep(dir)? {
+        if found != plan.sweep.name && !cfg.resume {
+            return Err(SinkError::ForeignSweep {
+                path: dir.clone(),
+                found,
+                expected: plan.sweep.name.clone(),
+            }
+            .into());
+        }
+    }
+    let (mut sink, done) = Sink::open(dir, cfg.batch)?;
+    let todo: Vec<&sweep::RunSpec> = plan.runs.iter().filter(|r| !done.contains(&r.run_id)).collect();
+    let skipped = plan.runs.len() - todo.len();
+    let threads = if cfg.exec.threads == 0 {
+        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+    } else {
+        cfg.exec.threads
+    };
+    let mut manifest = Manifest::begin(dir, plan, plan.runs.len(), skipped, threads)?;
+    eprint!("{}", plan.summary());
+    if skipped > 0 {
+        eprintln!("resuming in {}: {skipped} of {} runs already done", dir.display(), plan.runs.len());
+    }
+    let bar = ProgressBar::new(todo.len() as u64);
+    if std::io::stderr().is_terminal() {
+        bar.set_style(
+            ProgressStyle::with_template("{bar:30} {pos}/{len} runs  {msg}  ETA {eta}")
+                .expect("valid template"),
+        );
+    } else {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    let (mut failed, mut diverged) = (0usize, 0usize);
+    let result = exec::execute(&plan.sweep.name, &todo, &ExecOptions { threads, ..cfg.exec }, |res| {
+        match res.record.status.as_str() {
+            "ok" => {}
+            "diverged" => diverged += 1,
+            _ => failed += 1,
+        }
+        bar.set_message(format!("failed {failed}, diverged {diverged}"));
+        bar.inc(1);
+        sink.push(res)
+    });
+    let flushed = sink.flush();
+    bar.finish_and_clear();
+    manifest.finish(sink.written, result.is_err() || flushed.is_err())?;
+    result?;
+    flushed?;
+    eprintln!(
+        "{} runs written to {} ({} failed, {} diverged)",
+        sink.written,
+        dir.display(),
+        failed,
+        diverged
+    );
+    let ids: HashSet<&str> = plan.runs.iter().map(|r| r.run_id.as_str()).collect();
+    print!("{}", result_table(dir, plan, &ids)?);
+    if cfg.summary {
+        match summary::summarize(dir) {
+            Ok(s) => print!("{}", s.terminal),
+            Err(e) => eprintln!("summary not written: {e:#}"),
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn fmt_num(x: Option<f64>) -> String {
+    match x {
+        Some(v) if v.is_finite() => format!("{v:.4e}"),
+        Some(v) => format!("{v}"),
+        None => "—".into(),
+    }
+}
+
+/// The plan as a table of the parameters that vary between runs.
+fn plan_table(plan: &Plan) -> String {
+    let keys = plan.varying_keys();
+    let mut header: Vec<String> = vec!["#".into(), "run_id".into()];
+    header.extend(keys.iter().map(|k| k.name().to_string()));
+    let rows: Vec<Vec<String>> = plan
+        .runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let mut row = vec![i.to_string(), r.run_id.clone()];
+            row.extend(keys.iter().map(|k| {
+                r.params.get(k).map(|v| v.to_string()).unwrap_or_else(|| "—".into())
+            }));
+            row
+        })
+        .collect();
+    render(&header, &rows)
+}
+
+fn render(header: &[String], rows: &[Vec<String>]) -> String {
+    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in rows {
+        for (w, c) in width.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: &[String]| {
+        let mut s = String::new();
+        for (i, (c, w)) in cells.iter().zip(&width).enumerate() {
+            if i > 0 {
+                s.push_str("  ");
+            }
+            s.push_str(c);
+            s.push_str(&" ".repeat(w - c.chars().count()));
+        }
+        s.trim_end().to_string() + "\n"
+    };
+    let mut out = line(header);
+    out.push_str(&line(&width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>()));
+    for r in rows {
+        out.push_str(&line(r));
+    }
+    out
+}
+
+/// Per-run results of this sweep, in plan order, read back from the Parquet parts.
+fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> {
+    let df = crate::sink::read_runs(dir)?;
+    let get_str = |name: &str| -> Result<Vec<Option<String>>> {
+        Ok(df.column(name)?.str()?.iter().map(|s| s.map(String::from)).collect())
+    };
+    let get_f64 = |name: &str| -> Result<Vec<Option<f64>>> {
+        Ok(df.column(name)?.f64()?.iter().collect())
+    };
+    let run_ids = get_str("run_id")?;
+    let status = get_str("status")?;
+    let (e0, ef) = (get_f64("energy_initial")?, get_f64("energy_final")?);
+    let (l2, h1, sig) = (get_f64("err_u_l2l2")?, get_f64("err_u_l2h1")?, get_f64("err_sigma_l2")?);
+    let header: Vec<String> = ["#", "label", "h", "dt", "status", "E(T)/E0", "l2(τ;L2)", "l2(τ;H1)", "σ l2(τ)"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut rows = Vec::new();
+    for (i, r) in plan.runs.iter().enumerate() {
+        if !ids.contains(r.run_id.as_str()) {
+            continue;
+        }
+        let Some(j) = run_ids.iter().position(|x| x.as_deref() == Some(r.run_id.as_str())) else {
+            continue;
+        };
+        let ratio = e0[j].zip(ef[j]).map(|(a, b)| b / a);
+        let p = |k: sweep::Key| r.params.get(&k).map(|v| v.to_string()).unwrap_or_default();
+        rows.push(vec![
+            i.to_string(),
+            r.label.clone(),
+            p(sweep::Key::H),
+            p(sweep::Key::Dt),
+            status[j].clone().unwrap_or_default(),
+            ratio.map(|x| format!("{x:.4}")).unwrap_or_else(|| "—".into()),
+            fmt_num(l2[j]),
+            fmt_num(h1[j]),
+            fmt_num(sig[j]),
+        ]);
+    }
+    if rows.is_empty() {
+        bail!("no result rows found in {}", dir.display());
+    }
+    Ok(render(&header, &rows))
+}
+
+/// The schema of DIR/runs and DIR/series as Markdown tables (the README's are generated here).
+pub fn schema_markdown() -> String {
+    let mut s = String::from("### `DIR/runs/*.parquet` — one row per run\n\n| column | type | unit | meaning |\n|---|---|---|---|\n");
+    for (c, t, u, d) in RunRecord::COLUMNS {
+        s.push_str(&format!("| `{c}` | {t} | {u} | {d} |\n"));
+    }
+    s.push_str("\n### `DIR/series/*.parquet` — one row per stored time step\n\n| column | type | unit | meaning |\n|---|---|---|---|\n");
+    for (c, t, u, d) in SERIES_COLUMNS {
+        s.push_str(&format!("| `{c}` | {t} | {u} | {d} |\n"));
+    }
+    s
+}

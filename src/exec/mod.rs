@@ -1,0 +1,134 @@
+//! The executor: runs a plan's runs, serially (the reference path, a plain loop) or on a rayon
+//! pool, and hands each finished run to a callback in the calling thread (the sink).
+//!
+//! A run that panics becomes a row (`solver-failed`, "internal error: …"); the sweep goes on.
+//! Rows do not depend on the thread count: every run is a pure function of its spec, so the
+//! 1-thread and N-thread outputs are identical except the timing columns (tested).
+
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use crate::run::record::Timing;
+use crate::run::{self, Metrics, Outcome, RunOptions, RunRecord, SeriesRow, Status};
+use crate::sweep::RunSpec;
+
+/// A finished run: its row and its (possibly decimated) time series.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub record: RunRecord,
+    pub series: Vec<SeriesRow>,
+}
+
+/// How to execute.
+#[derive(Debug, Clone, Copy)]
+pub struct ExecOptions {
+    /// 1: the serial reference loop; N > 1: a rayon pool of N threads; 0: rayon's default.
+    pub threads: usize,
+    pub run: RunOptions,
+}
+
+/// Run one spec (with its timing repeats), never panicking.
+pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
+    let mut times = Vec::with_capacity(spec.repeats.max(1));
+    let mut outcome: Option<Outcome> = None;
+    for rep in 0..spec.repeats.max(1) {
+        // Only the first repeat keeps the series; the numbers are identical across repeats.
+        let o = RunOptions {
+            series_every: if rep == 0 { opts.series_every } else { 0 },
+            ..*opts
+        };
+        let start = Instant::now();
+        let res = catch_unwind(AssertUnwindSafe(|| run::simulate(&spec.config, &o)));
+        times.push(start.elapsed().as_secs_f64());
+        let out = res.unwrap_or_else(|payload| {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Outcome {
+                status: Status::SolverFailed,
+                message: Some(format!("internal error (panic): {what}")),
+                metrics: Metrics::default(),
+                series: Vec::new(),
+            }
+        });
+        let stop = out.status != Status::Ok;
+        if outcome.is_none() {
+            outcome = Some(out);
+        }
+        if stop {
+            break;
+        }
+    }
+    let mut sorted = times.clone();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    let median = if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        0.5 * (sorted[n / 2 - 1] + sorted[n / 2])
+    };
+    let mut out = outcome.expect("at least one repeat");
+    let timing = Timing {
+        median_s: median,
+        min_s: sorted[0],
+        max_s: sorted[n - 1],
+        repeats: n,
+    };
+    let record = RunRecord::new(sweep, spec, &out, timing);
+    RunResult {
+        record,
+        series: std::mem::take(&mut out.series),
+    }
+}
+
+/// Execute `runs`, calling `on_result` in this thread as each finishes (in plan order for the
+/// serial path, in completion order otherwise). Stops early if `on_result` returns an error.
+pub fn execute<E: Send>(
+    sweep: &str,
+    runs: &[&RunSpec],
+    opts: &ExecOptions,
+    mut on_result: impl FnMut(RunResult) -> Result<(), E>,
+) -> Result<(), E> {
+    if opts.threads == 1 {
+        for spec in runs {
+            on_result(run_one(sweep, spec, &opts.run))?;
+        }
+        return Ok(());
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads)
+        .build()
+        .expect("a rayon pool of N threads can be built");
+    let (tx, rx) = mpsc::channel::<RunResult>();
+    let run_opts = opts.run;
+    let cancel = AtomicBool::new(false);
+    std::thread::scope(|scope| {
+        let cancel = &cancel;
+        scope.spawn(move || {
+            pool.install(|| {
+                runs.par_iter().for_each_with(tx, |tx, spec| {
+                    // The consumer failed (e.g. the disk is full): start nothing new.
+                    if !cancel.load(Ordering::Relaxed) {
+                        let _ = tx.send(run_one(sweep, spec, &run_opts));
+                    }
+                });
+            });
+        });
+        let mut result = Ok(());
+        for res in rx.iter() {
+            if let Err(e) = on_result(res) {
+                cancel.store(true, Ordering::Relaxed);
+                result = Err(e);
+                break;
+            }
+        }
+        drop(rx);
+        result
+    })
+}

@@ -1,0 +1,538 @@
+//! The 1D engine: every contact treatment × mass variant × time scheme on the bar (SPEC §2–§4).
+//!
+//! Setup (once per run): assemble M, K, K_lin (tridiagonal), form A = M + c K_lin, factor it,
+//! and precompute z = A⁻¹q̃ and w = pᵀz — the contact condensed onto the contact node. A step is
+//! then one O(m) tridiagonal solve y = A⁻¹b, the exact scalar solve of
+//! s = pᵀy + p₀ + w φ(s) ([`crate::contact`]), and u^{n+1} = y + φ z. No allocation happens in
+//! the time loop: all vectors live in the [`Work`] and state buffers built at setup.
+//!
+//! A contact node without inertia (zero mass row) is quasi-static: its row of the step system
+//! is c·(K_lin u)₀ = c_f φ q₀ — the equation of the node at the scheme's evaluation time — and
+//! at t = 0 its value is given by the same equation (SPEC §2.2). With the explicit Newmark
+//! (c = 0) that row is replaced by K_lin row 0 itself.
+//!
+//! The hybrid scheme with the mixed method is 000 §5's scheme on the reduced system: node 0 is
+//! eliminated (u₀ = max(−g, u₁)), the contact element's energy (E/2h)[−(u₁+g)]₊² is split into
+//! its quadratic part (kept in K*, node 0 clamped at −g) and −(E/2h)[u₁+g]₊², whose force
+//! (E/h)[u₁+g]₊ e₁ is switched between midpoint and Crank–Nicolson on the sign of u₁^n + g.
+
+use std::time::Instant;
+
+use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::{Metrics, Outcome, RunOptions, Status};
+use crate::contact::{self, ContactLaw, ContactSolveError};
+use crate::scene::{BarExact, BarParams};
+use crate::space::bar1d::Pair;
+use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag, TridiagLu};
+use crate::time::{NewmarkParams, Scheme};
+
+/// A validated bar1d run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bar1dConfig {
+    pub bar: BarParams,
+    pub elements: usize,
+    pub dt: f64,
+    pub steps: usize,
+    pub method: ContactMethod,
+    pub mass: MassVariant,
+    pub scheme: Scheme,
+    /// Ensemble member: relative amplitude of a uniform perturbation of u⁰ and its seed.
+    pub perturbation: Option<(f64, u64)>,
+}
+
+/// Why a run stopped before its last step.
+enum Stop {
+    Solver(usize, ContactSolveError),
+    Diverged(Divergence),
+    Timeout(usize),
+}
+
+/// The per-run constant part: operators, factorisations, condensed contact.
+struct Engine {
+    sp: Bar1dSpace,
+    scheme: Scheme,
+    tau: f64,
+    reduced: bool,
+    /// Stiffness of the linear part in the right-hand side (K* on the reduced system).
+    klin: Tridiag,
+    a_lu: TridiagLu,
+    mass_lu: TridiagLu,
+    z: Vec<f64>,
+    w: f64,
+    /// The contact argument of the step (reduced: u₁ + g; Paoli–Schatzman: u₀/(1+e) + …).
+    p: Pair,
+    p0: f64,
+    factorizations: i64,
+}
+
+/// Vectors reused by every step.
+struct Work {
+    b: Vec<f64>,
+    y: Vec<f64>,
+    pred: Vec<f64>,
+}
+
+struct State {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    /// Contact argument at t^n (hybrid switches).
+    s_prev: f64,
+}
+
+impl Engine {
+    fn new(sp: Bar1dSpace, scheme: Scheme, tau: f64) -> Result<Self, String> {
+        let m = sp.m;
+        let (c, cf) = scheme.coefficients(tau);
+        let reduced = matches!(scheme, Scheme::Hybrid) && sp.method == ContactMethod::Mixed;
+        if reduced && !sp.massless_contact {
+            return Err("the hybrid scheme with the mixed method needs a massless contact node (000 §5)".into());
+        }
+        let mut klin = sp.stiffness_lin.clone();
+        if reduced {
+            klin.clear_row_col(0);
+        }
+        let mut a = sp.mass.axpy(c, &klin);
+        let mut qt = [cf * sp.q.0[0], cf * sp.q.0[1]];
+        if sp.massless_contact && !matches!(scheme, Scheme::Hybrid) {
+            // Quasi-static contact row at t^{n+1}: c (K u)₀ = c φ q₀ (or K row 0 itself if c = 0).
+            qt[0] = if c == 0.0 { sp.q.0[0] } else { c * sp.q.0[0] };
+            if c == 0.0 {
+                a.set_row(0, sp.stiffness_lin.row(0));
+            }
+        }
+        let (p, p0) = if reduced {
+            a.set_row(0, (0.0, 1.0, 0.0));
+            qt = [0.0, cf];
+            (Pair([0.0, 1.0]), sp.bar.gap)
+        } else if let Scheme::PaoliSchatzman(ps) = scheme {
+            (Pair([1.0 / (1.0 + ps.restitution), 0.0]), sp.bar.gap)
+        } else {
+            (sp.p, sp.p0)
+        };
+        let a_lu = a
+            .factor()
+            .ok_or("the iteration matrix M + cK is singular")?;
+        let mut mfree = sp.mass.clone();
+        if sp.massless_contact {
+            mfree.set_row(0, (0.0, 1.0, 0.0));
+        }
+        let mass_lu = mfree.factor().ok_or("the mass matrix of the free nodes is singular")?;
+        let mut z = vec![0.0; m];
+        z[0] = qt[0];
+        z[1] = qt[1];
+        a_lu.solve_in_place(&mut z);
+        let w = p.dot(&z);
+        Ok(Self {
+            sp,
+            scheme,
+            tau,
+            reduced,
+            klin,
+            a_lu,
+            mass_lu,
+            z,
+            w,
+            p,
+            p0,
+            factorizations: 2,
+        })
+    }
+
+    /// φ(s) of the state (not the step): σ_C for Nitsche and penalty, the multiplier graph for
+    /// the mixed method.
+    fn state_law(&self) -> ContactLaw {
+        match self.sp.method {
+            ContactMethod::Mixed => ContactLaw::Complementarity,
+            ContactMethod::Nitsche { gamma0, .. } => ContactLaw::PositivePart {
+                k: -1.0 / (gamma0 * self.sp.h),
+            },
+            ContactMethod::Penalty { gamma0 } => ContactLaw::PositivePart {
+                k: -self.sp.penalty_stiffness(gamma0),
+            },
+        }
+    }
+
+    fn step_law(&self, s_prev: f64) -> ContactLaw {
+        match (self.scheme, self.state_law()) {
+            (Scheme::Hybrid, _) if self.reduced => {
+                let k = self.sp.bar.young / self.sp.h;
+                ContactLaw::HybridReduced {
+                    k,
+                    s_prev,
+                    offset: -k * self.sp.bar.gap,
+                }
+            }
+            (Scheme::Hybrid, ContactLaw::PositivePart { k }) => {
+                ContactLaw::HybridNitsche { k, s_prev }
+            }
+            (_, law) => law,
+        }
+    }
+
+    /// Solve the quasi-static equation of the massless contact node for u₀ (t = 0):
+    /// K00 u₀ + K01 u₁ = φ q₀ with φ the state law of s = p·u + p₀. Returns φ.
+    fn quasi_static_node0(&self, u: &mut [f64]) -> Result<f64, ContactSolveError> {
+        let sp = &self.sp;
+        let (_, k00, k01) = sp.stiffness_lin.row(0);
+        if k00 <= 0.0 {
+            return Err(ContactSolveError::NonPositive { w: k00 });
+        }
+        let base = -k01 * u[1] / k00;
+        let s_free = sp.p.0[0] * base + sp.p.0[1] * u[1] + sp.p0;
+        let w = sp.p.0[0] * sp.q.0[0] / k00;
+        let sol = contact::solve(&self.state_law(), s_free, w)?;
+        u[0] = base + sol.phi * sp.q.0[0] / k00;
+        Ok(sol.phi)
+    }
+
+    /// Contact pressure to report for a state whose step returned `phi`.
+    fn sigma(&self, u: &[f64], phi: f64) -> f64 {
+        if self.sp.method == ContactMethod::Mixed && !self.reduced {
+            phi
+        } else {
+            self.sp.contact_pressure(u)
+        }
+    }
+
+    /// a = M⁻¹(φ q − K_lin u) on the nodes with inertia (a₀ = 0 on a massless node).
+    fn acceleration_into(&self, u: &[f64], phi: f64, a: &mut [f64]) {
+        self.sp.stiffness_lin.mul_into(u, a);
+        for x in a.iter_mut() {
+            *x = -*x;
+        }
+        a[0] += phi * self.sp.q.0[0];
+        a[1] += phi * self.sp.q.0[1];
+        if self.sp.massless_contact {
+            a[0] = 0.0;
+        }
+        self.mass_lu.solve_in_place(a);
+    }
+
+    /// Solve A y = b, the scalar contact problem, and set y ← y + φ z. Returns (s, φ).
+    fn solve_step(&self, wk: &mut Work, law: &ContactLaw, p0: f64) -> Result<(f64, f64), ContactSolveError> {
+        self.a_lu.solve_in_place(&mut wk.b);
+        std::mem::swap(&mut wk.b, &mut wk.y);
+        let s_free = self.p.dot(&wk.y) + p0;
+        let sol = contact::solve(law, s_free, self.w)?;
+        if sol.phi != 0.0 {
+            for (y, z) in wk.y.iter_mut().zip(&self.z) {
+                *y += sol.phi * z;
+            }
+        }
+        Ok((sol.s, sol.phi))
+    }
+
+    /// One step of a one-step scheme; returns φ of the step.
+    fn step(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
+        let tau = self.tau;
+        let m = self.sp.m;
+        let sp = &self.sp;
+        match self.scheme {
+            Scheme::Newmark(NewmarkParams { beta, .. }) => {
+                let k = tau * tau / 2.0 * (1.0 - 2.0 * beta);
+                for i in 0..m {
+                    wk.pred[i] = st.u[i] + tau * st.v[i] + k * st.a[i];
+                }
+                sp.mass.mul_into(&wk.pred, &mut wk.b);
+            }
+            Scheme::Theta(th) => {
+                let k = tau * tau * th.theta * (1.0 - th.theta);
+                for i in 0..m {
+                    wk.pred[i] = st.u[i] + tau * st.v[i] + k * st.a[i];
+                }
+                sp.mass.mul_into(&wk.pred, &mut wk.b);
+            }
+            Scheme::Hybrid => {
+                for i in 0..m {
+                    wk.pred[i] = st.u[i] + tau * st.v[i];
+                }
+                sp.mass.mul_into(&wk.pred, &mut wk.b);
+                self.klin.mul_into(&st.u, &mut wk.y);
+                let c = tau * tau / 4.0;
+                for i in 0..m {
+                    wk.b[i] -= c * wk.y[i];
+                }
+            }
+            Scheme::PaoliSchatzman(_) => unreachable!("two-step scheme"),
+        }
+        if sp.massless_contact {
+            // Massless row: only the contact force (and, for the hybrid, its own history).
+            if self.reduced || !matches!(self.scheme, Scheme::Hybrid) {
+                wk.b[0] = 0.0;
+            }
+        }
+        let law = self.step_law(st.s_prev);
+        let (s, phi) = self.solve_step(wk, &law, self.p0)?;
+        if self.reduced {
+            wk.y[0] = (-sp.bar.gap).max(wk.y[1]);
+        }
+        // Velocity and acceleration updates; wk.y holds u^{n+1}.
+        match self.scheme {
+            Scheme::Newmark(NewmarkParams { beta, gamma }) if beta > 0.0 => {
+                let ib = 1.0 / (beta * tau * tau);
+                for i in 0..m {
+                    let an = (wk.y[i] - wk.pred[i]) * ib;
+                    st.v[i] += tau * ((1.0 - gamma) * st.a[i] + gamma * an);
+                    st.a[i] = an;
+                }
+            }
+            Scheme::Newmark(NewmarkParams { gamma, .. }) => {
+                self.acceleration_into(&wk.y, phi, &mut wk.b);
+                for i in 0..m {
+                    st.v[i] += tau * ((1.0 - gamma) * st.a[i] + gamma * wk.b[i]);
+                    st.a[i] = wk.b[i];
+                }
+            }
+            Scheme::Theta(th) => {
+                let it = 1.0 / (tau * th.theta);
+                for i in 0..m {
+                    let vn = (wk.y[i] - st.u[i] - tau * (1.0 - th.theta) * st.v[i]) * it;
+                    let an = (vn - st.v[i] - tau * (1.0 - th.theta) * st.a[i]) * it;
+                    st.v[i] = vn;
+                    st.a[i] = an;
+                }
+            }
+            Scheme::Hybrid => {
+                for i in 0..m {
+                    st.v[i] = 2.0 * (wk.y[i] - st.u[i]) / tau - st.v[i];
+                }
+            }
+            Scheme::PaoliSchatzman(_) => unreachable!(),
+        }
+        if sp.massless_contact {
+            st.v[0] = (wk.y[0] - st.u[0]) / tau;
+            st.a[0] = 0.0;
+        }
+        std::mem::swap(&mut st.u, &mut wk.y);
+        st.s_prev = s;
+        Ok(phi)
+    }
+}
+
+/// Build the initial state: interpolated u⁰ (perturbed for ensembles), v⁰ = 0, the massless
+/// node at its quasi-static value, a⁰ from the equation at t = 0. Returns the state and σ_C⁰.
+fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), ContactSolveError> {
+    let sp = &eng.sp;
+    let m = sp.m;
+    let mut u: Vec<f64> = (0..m)
+        .map(|i| sp.bar.initial_displacement(i as f64 * sp.h))
+        .collect();
+    if let Some((delta, seed)) = cfg.perturbation {
+        let mut rng = fastrand::Rng::with_seed(seed);
+        for x in u.iter_mut() {
+            *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
+        }
+    }
+    let phi = if sp.massless_contact {
+        eng.quasi_static_node0(&mut u)?
+    } else {
+        match eng.state_law() {
+            ContactLaw::PositivePart { k } => k * (sp.p.dot(&u) + sp.p0).max(0.0),
+            _ => 0.0,
+        }
+    };
+    let mut a = vec![0.0; m];
+    eng.acceleration_into(&u, phi, &mut a);
+    let s_prev = eng.p.dot(&u) + eng.p0;
+    let sigma = if sp.method == ContactMethod::Mixed {
+        if sp.massless_contact { sp.contact_pressure(&u) } else { phi }
+    } else {
+        sp.contact_pressure(&u)
+    };
+    Ok((
+        State {
+            u,
+            v: vec![0.0; m],
+            a,
+            s_prev,
+        },
+        sigma,
+    ))
+}
+
+/// Observation helper shared by both loops.
+struct Recorder<'a> {
+    sp: &'a Bar1dSpace,
+    exact: Option<BarExact>,
+    tau: f64,
+    obs: Observer,
+}
+
+impl Recorder<'_> {
+    fn record(&mut self, step: usize, u: &[f64], v: &[f64], sigma: f64) -> Result<(), Divergence> {
+        let t = step as f64 * self.tau;
+        let (energy, energy_theta) = self.sp.energies(u, v);
+        let exact = self.exact.map(|ex| {
+            let (l2_sq, h1_semi_sq) = ex.error_sq(u, self.sp.h, t);
+            ExactValues {
+                u_contact: ex.u(0.0, t),
+                sigma_contact: ex.contact_stress(t),
+                energy: ex.energy(),
+                l2_sq,
+                h1_semi_sq,
+            }
+        });
+        self.obs.observe(
+            StepValues {
+                step,
+                t,
+                u_contact: u[0],
+                v_contact: v[0],
+                sigma_contact: sigma,
+                energy,
+                energy_theta,
+            },
+            exact,
+        )
+    }
+}
+
+/// How often the wall clock is read for the timeout (a read costs ~20 ns; a step ~m·10 ns).
+const CLOCK_EVERY: usize = 64;
+
+/// Run one bar1d simulation.
+pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
+    let start = Instant::now();
+    let mut metrics = Metrics {
+        dofs: cfg.elements as i64,
+        ..Metrics::default()
+    };
+    let fail = |status, msg: String, metrics: Metrics| Outcome {
+        status,
+        message: Some(msg),
+        metrics,
+        series: Vec::new(),
+    };
+    let sp = match Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method) {
+        Ok(sp) => sp,
+        Err(e) => return fail(Status::Invalid, e.to_string(), metrics),
+    };
+    metrics.mass_total = Some(sp.mass_total);
+    let tau = cfg.dt;
+    let (eng, starter) = match cfg.scheme {
+        Scheme::PaoliSchatzman(ps) => {
+            let nm = Scheme::Newmark(NewmarkParams {
+                beta: ps.beta,
+                gamma: 0.5,
+            });
+            match (Engine::new(sp.clone(), cfg.scheme, tau), Engine::new(sp.clone(), nm, tau)) {
+                (Ok(a), Ok(b)) => (a, Some(b)),
+                (Err(e), _) | (_, Err(e)) => return fail(Status::SolverFailed, e, metrics),
+            }
+        }
+        _ => match Engine::new(sp.clone(), cfg.scheme, tau) {
+            Ok(e) => (e, None),
+            Err(e) => return fail(Status::SolverFailed, e, metrics),
+        },
+    };
+    metrics.factorizations = eng.factorizations + starter.as_ref().map_or(0, |s| s.factorizations);
+    let m = sp.m;
+    let mut wk = Work {
+        b: vec![0.0; m],
+        y: vec![0.0; m],
+        pred: vec![0.0; m],
+    };
+    let mut rec = Recorder {
+        sp: &eng.sp,
+        exact: cfg.bar.exact(),
+        tau,
+        obs: Observer::new(tau, opts.series_every, cfg.steps),
+    };
+    let (mut st, sigma0) = match initial_state(&eng, cfg) {
+        Ok(x) => x,
+        Err(e) => {
+            metrics.solver_failures = 1;
+            return fail(Status::SolverFailed, format!("initial state (t = 0): {e}"), metrics);
+        }
+    };
+    let timed_out = |n: usize| {
+        n % CLOCK_EVERY == 0 && opts.timeout.is_some_and(|limit| start.elapsed() > limit)
+    };
+    let mut done = 0usize;
+    let stop = (|| -> Result<(), Stop> {
+        rec.record(0, &st.u, &st.v, sigma0).map_err(Stop::Diverged)?;
+        match &starter {
+            None => {
+                for n in 1..=cfg.steps {
+                    let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(n, e))?;
+                    metrics.iterations += 1;
+                    let sigma = eng.sigma(&st.u, phi);
+                    rec.record(n, &st.u, &st.v, sigma).map_err(Stop::Diverged)?;
+                    done = n;
+                    if timed_out(n) {
+                        return Err(Stop::Timeout(n));
+                    }
+                }
+            }
+            Some(first) => {
+                // U¹ from Newmark(β, ½); then U^{n+1} from (U^n, U^{n−1}) and v^n centred.
+                let mut prev = st.u.clone();
+                first.step(&mut st, &mut wk).map_err(|e| Stop::Solver(1, e))?;
+                metrics.iterations += 1;
+                let mut vn = vec![0.0; m];
+                let Scheme::PaoliSchatzman(ps) = cfg.scheme else { unreachable!() };
+                let e = ps.restitution;
+                for n in 1..=cfg.steps {
+                    // b = M(2Uⁿ − Uⁿ⁻¹) − τ²K((1−2β)Uⁿ + βUⁿ⁻¹)
+                    for i in 0..m {
+                        wk.pred[i] = 2.0 * st.u[i] - prev[i];
+                        vn[i] = (1.0 - 2.0 * ps.beta) * st.u[i] + ps.beta * prev[i];
+                    }
+                    eng.sp.mass.mul_into(&wk.pred, &mut wk.b);
+                    eng.klin.mul_into(&vn, &mut wk.y);
+                    for i in 0..m {
+                        wk.b[i] -= tau * tau * wk.y[i];
+                    }
+                    if eng.sp.massless_contact {
+                        wk.b[0] = 0.0;
+                    }
+                    let p0 = e * prev[0] / (1.0 + e) + eng.sp.bar.gap;
+                    let (_, lambda) = eng
+                        .solve_step(&mut wk, &ContactLaw::Complementarity, p0)
+                        .map_err(|err| Stop::Solver(n, err))?;
+                    metrics.iterations += 1;
+                    // wk.y = U^{n+1}; v^n = (U^{n+1} − U^{n−1}) / 2τ
+                    for i in 0..m {
+                        vn[i] = (wk.y[i] - prev[i]) / (2.0 * tau);
+                    }
+                    rec.record(n, &st.u, &vn, lambda).map_err(Stop::Diverged)?;
+                    done = n;
+                    std::mem::swap(&mut prev, &mut st.u);
+                    std::mem::swap(&mut st.u, &mut wk.y);
+                    if timed_out(n) {
+                        return Err(Stop::Timeout(n));
+                    }
+                }
+            }
+        }
+        Ok(())
+    })();
+    metrics.steps = done as i64;
+    let (status, message) = match stop {
+        Ok(()) => (Status::Ok, None),
+        Err(Stop::Solver(n, e)) => {
+            metrics.solver_failures = 1;
+            (
+                Status::SolverFailed,
+                Some(format!("step {n} (t = {:.6}): {e}", n as f64 * tau)),
+            )
+        }
+        Err(Stop::Diverged(d)) => (Status::Diverged, Some(d.0)),
+        Err(Stop::Timeout(n)) => (
+            Status::Timeout,
+            Some(format!(
+                "run timeout after {:.3} s at step {n} of {}",
+                start.elapsed().as_secs_f64(),
+                cfg.steps
+            )),
+        ),
+    };
+    rec.obs.finish(&mut metrics, status == Status::Ok);
+    Outcome {
+        status,
+        message,
+        metrics,
+        series: std::mem::take(&mut rec.obs.series),
+    }
+}

@@ -1,0 +1,235 @@
+//! Observables of a run: energies, contact quantities and error norms against the exact
+//! solution, accumulated step by step without storing the trajectory (SPEC §5).
+//!
+//! Sums and maxima run over n = 0 … N, both ends included (003 §4.1.2e):
+//! err_u_l2l2 = (τ Σ‖e^n‖²_L2)^½, err_u_l2h1 = (τ Σ‖e^n‖²_H1)^½ with the full H1 norm,
+//! err_u_linfl2 = max‖e^n‖_L2, err_sigma_l2 = (τ Σ(σ_C^n − σ(t^n))²)^½,
+//! err_energy_l2 = (τ Σ(E^n − E)²)^½, err_u_contact_max = max|u^n(0) − u(0, t^n)|.
+
+/// Scalar results of a run (SPEC §5). Energies are relative to E⁰, the energy of the initial
+/// (consistent) discrete state.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Metrics {
+    pub steps: i64,
+    pub dofs: i64,
+    pub iterations: i64,
+    pub factorizations: i64,
+    pub solver_failures: i64,
+    pub mass_total: Option<f64>,
+    pub energy_initial: Option<f64>,
+    pub energy_final: Option<f64>,
+    pub energy_drift: Option<f64>,
+    pub energy_max_dev: Option<f64>,
+    pub energy_max_increase: Option<f64>,
+    pub energy_theta_max_increase: Option<f64>,
+    pub contact_switches: i64,
+    pub err_u_l2l2: Option<f64>,
+    pub err_u_l2h1: Option<f64>,
+    pub err_u_linfl2: Option<f64>,
+    pub err_sigma_l2: Option<f64>,
+    pub err_energy_l2: Option<f64>,
+    pub err_u_contact_max: Option<f64>,
+}
+
+/// One row of the time series (SPEC §5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeriesRow {
+    pub step: i64,
+    pub t: f64,
+    pub u_contact: f64,
+    pub v_contact: f64,
+    pub sigma_contact: f64,
+    pub energy: f64,
+    pub energy_theta: Option<f64>,
+    pub u_contact_exact: Option<f64>,
+    pub sigma_contact_exact: Option<f64>,
+}
+
+/// The per-step values the observer needs.
+#[derive(Debug, Clone, Copy)]
+pub struct StepValues {
+    pub step: usize,
+    pub t: f64,
+    pub u_contact: f64,
+    pub v_contact: f64,
+    pub sigma_contact: f64,
+    pub energy: f64,
+    pub energy_theta: Option<f64>,
+}
+
+/// Exact values at a step, when the scene has a closed form.
+#[derive(Debug, Clone, Copy)]
+pub struct ExactValues {
+    pub u_contact: f64,
+    pub sigma_contact: f64,
+    pub energy: f64,
+    /// ‖e^n‖²_L2 and |e^n|²_H1.
+    pub l2_sq: f64,
+    pub h1_semi_sq: f64,
+}
+
+/// Why a run stops early at an observation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Divergence(pub String);
+
+/// Accumulates [`Metrics`] and the time series.
+#[derive(Debug)]
+pub struct Observer {
+    tau: f64,
+    every: usize,
+    last_step: usize,
+    e0: f64,
+    e0_theta: Option<f64>,
+    prev_e: f64,
+    prev_et: Option<f64>,
+    last_e: f64,
+    max_dev: f64,
+    max_inc: f64,
+    max_inc_theta: Option<f64>,
+    in_contact: bool,
+    switches: i64,
+    has_exact: bool,
+    sum_l2: f64,
+    sum_h1: f64,
+    max_l2: f64,
+    sum_sigma: f64,
+    sum_energy: f64,
+    max_contact: f64,
+    observed: usize,
+    pub series: Vec<SeriesRow>,
+}
+
+/// Energy bound above which a run is `diverged` (SPEC §5).
+pub const DIVERGENCE_FACTOR: f64 = 1e6;
+
+impl Observer {
+    pub fn new(tau: f64, series_every: usize, last_step: usize) -> Self {
+        let cap = if series_every == 0 {
+            0
+        } else {
+            last_step / series_every + 2
+        };
+        Self {
+            tau,
+            every: series_every,
+            last_step,
+            e0: f64::NAN,
+            e0_theta: None,
+            prev_e: f64::NAN,
+            prev_et: None,
+            last_e: f64::NAN,
+            max_dev: 0.0,
+            max_inc: f64::NEG_INFINITY,
+            max_inc_theta: None,
+            in_contact: false,
+            switches: 0,
+            has_exact: false,
+            sum_l2: 0.0,
+            sum_h1: 0.0,
+            max_l2: 0.0,
+            sum_sigma: 0.0,
+            sum_energy: 0.0,
+            max_contact: 0.0,
+            observed: 0,
+            series: Vec::with_capacity(cap),
+        }
+    }
+
+    /// Record one step. Returns the reason to stop if the run diverged.
+    pub fn observe(&mut self, v: StepValues, exact: Option<ExactValues>) -> Result<(), Divergence> {
+        let finite = v.energy.is_finite()
+            && v.u_contact.is_finite()
+            && v.sigma_contact.is_finite()
+            && v.energy_theta.is_none_or(f64::is_finite);
+        if !finite {
+            return Err(Divergence(format!(
+                "non-finite value at step {} (t = {:.6})",
+                v.step, v.t
+            )));
+        }
+        if self.observed == 0 {
+            self.e0 = v.energy;
+            self.e0_theta = v.energy_theta;
+            self.max_inc_theta = v.energy_theta.map(|_| f64::NEG_INFINITY);
+        } else {
+            self.max_inc = self.max_inc.max(v.energy - self.prev_e);
+            if let (Some(et), Some(prev), Some(m)) =
+                (v.energy_theta, self.prev_et, self.max_inc_theta.as_mut())
+            {
+                *m = m.max(et - prev);
+            }
+        }
+        self.observed += 1;
+        self.prev_e = v.energy;
+        self.prev_et = v.energy_theta;
+        self.last_e = v.energy;
+        self.max_dev = self.max_dev.max((v.energy - self.e0).abs());
+        let contact = v.sigma_contact < 0.0;
+        if contact != self.in_contact {
+            self.switches += 1;
+            self.in_contact = contact;
+        }
+        if let Some(x) = exact {
+            self.has_exact = true;
+            self.sum_l2 += x.l2_sq;
+            self.sum_h1 += x.l2_sq + x.h1_semi_sq;
+            self.max_l2 = self.max_l2.max(x.l2_sq.sqrt());
+            let ds = v.sigma_contact - x.sigma_contact;
+            self.sum_sigma += ds * ds;
+            let de = v.energy - x.energy;
+            self.sum_energy += de * de;
+            self.max_contact = self.max_contact.max((v.u_contact - x.u_contact).abs());
+        }
+        if self.every > 0 && (v.step % self.every == 0 || v.step == self.last_step) {
+            self.series.push(SeriesRow {
+                step: v.step as i64,
+                t: v.t,
+                u_contact: v.u_contact,
+                v_contact: v.v_contact,
+                sigma_contact: v.sigma_contact,
+                energy: v.energy,
+                energy_theta: v.energy_theta,
+                u_contact_exact: exact.map(|x| x.u_contact),
+                sigma_contact_exact: exact.map(|x| x.sigma_contact),
+            });
+        }
+        let scale = self.e0.abs().max(f64::MIN_POSITIVE);
+        if v.energy > DIVERGENCE_FACTOR * scale {
+            return Err(Divergence(format!(
+                "energy {:.3e} exceeded 1e6·E0 (E0 = {:.3e}) at step {} (t = {:.6})",
+                v.energy, self.e0, v.step, v.t
+            )));
+        }
+        Ok(())
+    }
+
+    /// Fill the metrics from what was observed. Error norms only for complete runs with a
+    /// closed form (a partial sum is not the norm the column names).
+    pub fn finish(&self, metrics: &mut Metrics, complete: bool) {
+        if self.observed == 0 {
+            return;
+        }
+        let e0 = self.e0;
+        metrics.energy_initial = Some(e0);
+        metrics.energy_final = Some(self.last_e);
+        metrics.energy_drift = Some((self.last_e - e0) / e0);
+        metrics.energy_max_dev = Some(self.max_dev / e0);
+        if self.observed > 1 {
+            metrics.energy_max_increase = Some(self.max_inc / e0);
+            metrics.energy_theta_max_increase = self
+                .max_inc_theta
+                .zip(self.e0_theta)
+                .map(|(m, e0t)| m / e0t);
+        }
+        metrics.contact_switches = self.switches;
+        if complete && self.has_exact {
+            let t = self.tau;
+            metrics.err_u_l2l2 = Some((t * self.sum_l2).sqrt());
+            metrics.err_u_l2h1 = Some((t * self.sum_h1).sqrt());
+            metrics.err_u_linfl2 = Some(self.max_l2);
+            metrics.err_sigma_l2 = Some((t * self.sum_sigma).sqrt());
+            metrics.err_energy_l2 = Some((t * self.sum_energy).sqrt());
+            metrics.err_u_contact_max = Some(self.max_contact);
+        }
+    }
+}

@@ -1,0 +1,264 @@
+//! The output schema, defined once: [`RunRecord`] is one row of `DIR/runs/*.parquet`,
+//! [`SeriesRow`](super::SeriesRow) one row of `DIR/series/*.parquet`. The sink derives the
+//! Parquet schema from these declarations ([`RunRecord::COLUMNS`], [`SERIES_COLUMNS`]), and the
+//! README's schema table is generated from the same docs (`contact-sweep schema`).
+
+use std::collections::BTreeMap;
+
+use super::{Outcome, SeriesRow};
+use crate::sweep::{Key, RunSpec, Value};
+
+/// A typed column ready for the sink.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ColumnData {
+    F64(Vec<Option<f64>>),
+    I64(Vec<Option<i64>>),
+    Str(Vec<Option<String>>),
+}
+
+/// Rust types that can fill a column.
+pub trait ColumnValue: Clone {
+    fn column(values: Vec<Self>) -> ColumnData;
+}
+
+impl ColumnValue for f64 {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::F64(v.into_iter().map(Some).collect())
+    }
+}
+impl ColumnValue for Option<f64> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::F64(v)
+    }
+}
+impl ColumnValue for i64 {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::I64(v.into_iter().map(Some).collect())
+    }
+}
+impl ColumnValue for Option<i64> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::I64(v)
+    }
+}
+impl ColumnValue for String {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::Str(v.into_iter().map(Some).collect())
+    }
+}
+impl ColumnValue for Option<String> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::Str(v)
+    }
+}
+
+macro_rules! schema {
+    ($(#[$meta:meta])* $name:ident, $consts:ident { $($field:ident : $ty:ty => $unit:literal, $doc:literal;)* }) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq)]
+        #[allow(non_snake_case)] // `T` is the column name of SPEC §7
+        pub struct $name {
+            $(#[doc = $doc] pub $field: $ty,)*
+        }
+
+        impl $name {
+            /// (column, type, unit, meaning) for every column, in order.
+            pub const $consts: &'static [(&'static str, &'static str, &'static str, &'static str)] = &[
+                $((stringify!($field), stringify!($ty), $unit, $doc),)*
+            ];
+
+            /// The rows as typed columns, in schema order.
+            pub fn to_columns(rows: &[$name]) -> Vec<(&'static str, ColumnData)> {
+                vec![$((
+                    stringify!($field),
+                    <$ty as ColumnValue>::column(rows.iter().map(|r| r.$field.clone()).collect()),
+                ),)*]
+            }
+        }
+    };
+}
+
+schema! {
+    /// One row of `DIR/runs`: the full parameter set of a run (null where a parameter does not
+    /// apply to its method) and what it measured (SPEC §5, §8).
+    RunRecord, COLUMNS {
+        run_id: String => "", "stable hash of the run's canonical parameters (same run, same id, everywhere)";
+        sweep: String => "", "name of the sweep that produced the row";
+        scene: String => "", "scene (bar1d, …)";
+        label: String => "", "human label: contact method · mass · scheme";
+        status: String => "", "ok | diverged | solver-failed | invalid | timeout";
+        message: Option<String> => "", "why the run did not end ok (null if ok)";
+        T: f64 => "s", "final time requested";
+        h: f64 => "m", "mesh size (derived from elements when the sweep gave elements)";
+        elements: i64 => "", "number of elements m (h = length/m)";
+        dt: f64 => "s", "time step τ (derived from courant when the sweep gave courant)";
+        courant: f64 => "", "Courant number ν = c0 τ / h";
+        space: String => "", "contact treatment: mixed | nitsche | penalty";
+        mass: String => "", "mass variant (SPEC §2.2)";
+        mass_weights: Option<String> => "", "user element weights w1,w2,… (mass = weights)";
+        scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid";
+        scheme_label: String => "", "preset name when the parameters are a preset's (crank-nicolson, backward-euler, …)";
+        nitsche_theta: Option<f64> => "", "Nitsche Θ";
+        nitsche_gamma0: Option<f64> => "", "Nitsche γ0 (γ_h = γ0 h)";
+        penalty_gamma0: Option<f64> => "", "penalty γ0 (κ = E γ0 / h)";
+        newmark_beta: Option<f64> => "", "Newmark / Paoli–Schatzman β";
+        newmark_gamma: Option<f64> => "", "Newmark γ";
+        theta_scheme: Option<f64> => "", "θ of the θ-scheme";
+        restitution: Option<f64> => "", "Paoli–Schatzman restitution e";
+        length: Option<f64> => "m", "bar length L";
+        young: Option<f64> => "Pa", "Young modulus E";
+        density: Option<f64> => "kg/m", "density ρ";
+        amplitude: Option<f64> => "m", "initial displacement amplitude a (u0 = a(1 − x/L))";
+        gap: Option<f64> => "m", "initial gap g";
+        lame_lambda: Option<f64> => "Pa", "Lamé λ (2D/3D scenes)";
+        lame_mu: Option<f64> => "Pa", "Lamé μ (2D/3D scenes)";
+        gravity: Option<f64> => "m/s²", "volume load (2D/3D scenes)";
+        ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
+        ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
+        wall_time_s: f64 => "s", "wall time of the run (median over repeats)";
+        wall_time_min_s: f64 => "s", "fastest of the repeats";
+        wall_time_max_s: f64 => "s", "slowest of the repeats";
+        repeats: i64 => "", "timing repeats (results are identical across repeats)";
+        steps: i64 => "", "time steps completed";
+        dofs: i64 => "", "unknowns of the space discretisation";
+        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step)";
+        factorizations: i64 => "", "matrix factorisations performed";
+        solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
+        contact_switches: i64 => "", "times the contact pressure switched on or off";
+        mass_total: Option<f64> => "kg", "1ᵀM1, the total mass the mass matrix represents";
+        energy_initial: Option<f64> => "J", "E⁰ of the consistent initial discrete state";
+        energy_final: Option<f64> => "J", "E^N";
+        energy_drift: Option<f64> => "", "(E^N − E⁰)/E⁰";
+        energy_max_dev: Option<f64> => "", "max_n |E^n − E⁰|/E⁰";
+        energy_max_increase: Option<f64> => "", "max_n (E^{n+1} − E^n)/E⁰";
+        energy_theta_max_increase: Option<f64> => "", "same for the augmented energy E_Θ (Nitsche)";
+        err_u_l2l2: Option<f64> => "m·s^½", "(τ Σ_n ‖u^n − u(t^n)‖²_L2)^½, n = 0…N";
+        err_u_l2h1: Option<f64> => "", "same with the full H1 norm";
+        err_u_linfl2: Option<f64> => "m^{3/2}", "max_n ‖u^n − u(t^n)‖_L2";
+        err_sigma_l2: Option<f64> => "", "l2(τ) error of the contact pressure σ_C";
+        err_energy_l2: Option<f64> => "", "l2(τ) error of the energy";
+        err_u_contact_max: Option<f64> => "m", "max_n |u^n(contact) − u(contact, t^n)|";
+        tool_version: String => "", "contact-sweep version that computed the row";
+    }
+}
+
+/// (column, type, unit, meaning) of the time series, in order.
+pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
+    ("run_id", "String", "", "run the row belongs to"),
+    ("step", "i64", "", "time step n"),
+    ("t", "f64", "s", "time t^n"),
+    ("u_contact", "f64", "m", "displacement of the contact node"),
+    ("v_contact", "f64", "m/s", "velocity of the contact node"),
+    ("sigma_contact", "f64", "Pa", "contact pressure σ_C (≤ 0 in contact)"),
+    ("energy", "f64", "J", "E^h (plus the penalty potential for penalty)"),
+    ("energy_theta", "Option<f64>", "J", "augmented energy E_Θ (Nitsche)"),
+    ("u_contact_exact", "Option<f64>", "m", "closed-form contact displacement"),
+    ("sigma_contact_exact", "Option<f64>", "Pa", "closed-form contact stress"),
+];
+
+/// The time series of a batch as typed columns.
+pub fn series_columns(rows: &[(String, SeriesRow)]) -> Vec<(&'static str, ColumnData)> {
+    let f = |g: fn(&SeriesRow) -> Option<f64>| ColumnData::F64(rows.iter().map(|(_, r)| g(r)).collect());
+    vec![
+        ("run_id", ColumnData::Str(rows.iter().map(|(id, _)| Some(id.clone())).collect())),
+        ("step", ColumnData::I64(rows.iter().map(|(_, r)| Some(r.step)).collect())),
+        ("t", f(|r| Some(r.t))),
+        ("u_contact", f(|r| Some(r.u_contact))),
+        ("v_contact", f(|r| Some(r.v_contact))),
+        ("sigma_contact", f(|r| Some(r.sigma_contact))),
+        ("energy", f(|r| Some(r.energy))),
+        ("energy_theta", f(|r| r.energy_theta)),
+        ("u_contact_exact", f(|r| r.u_contact_exact)),
+        ("sigma_contact_exact", f(|r| r.sigma_contact_exact)),
+    ]
+}
+
+/// Timing of a run over its repeats.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Timing {
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    pub repeats: usize,
+}
+
+impl RunRecord {
+    /// Assemble the row of a run.
+    pub fn new(sweep: &str, spec: &RunSpec, out: &Outcome, timing: Timing) -> RunRecord {
+        let p: &BTreeMap<Key, Value> = &spec.params;
+        let f = |k: Key| p.get(&k).and_then(Value::as_f64);
+        let s = |k: Key| p.get(&k).map(|v| v.to_string()).unwrap_or_default();
+        let m = &out.metrics;
+        let scene = match &spec.config {
+            crate::run::RunConfig::Bar1d(_) => "bar1d",
+        };
+        RunRecord {
+            run_id: spec.run_id.clone(),
+            sweep: sweep.to_string(),
+            scene: scene.to_string(),
+            label: spec.label.clone(),
+            status: out.status.as_str().to_string(),
+            message: out.message.clone(),
+            T: f(Key::T).unwrap_or(f64::NAN),
+            h: f(Key::H).unwrap_or(f64::NAN),
+            elements: p
+                .get(&Key::Elements)
+                .and_then(|v| match v {
+                    Value::Int(i) => Some(*i),
+                    _ => None,
+                })
+                .unwrap_or(0),
+            dt: f(Key::Dt).unwrap_or(f64::NAN),
+            courant: f(Key::Courant).unwrap_or(f64::NAN),
+            space: s(Key::Space),
+            mass: s(Key::Mass),
+            mass_weights: p.get(&Key::MassWeights).map(|v| match v {
+                Value::List(w) => w.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","),
+                other => other.to_string(),
+            }),
+            scheme: s(Key::Scheme),
+            scheme_label: spec.scheme_label.clone(),
+            nitsche_theta: f(Key::NitscheTheta),
+            nitsche_gamma0: f(Key::NitscheGamma0),
+            penalty_gamma0: f(Key::PenaltyGamma0),
+            newmark_beta: f(Key::NewmarkBeta),
+            newmark_gamma: f(Key::NewmarkGamma),
+            theta_scheme: f(Key::ThetaScheme),
+            restitution: f(Key::Restitution),
+            length: f(Key::Length),
+            young: f(Key::Young),
+            density: f(Key::Density),
+            amplitude: f(Key::Amplitude),
+            gap: f(Key::Gap),
+            lame_lambda: f(Key::LameLambda),
+            lame_mu: f(Key::LameMu),
+            gravity: f(Key::Gravity),
+            ensemble_sample: spec.sample.map(|(k, _)| k as i64),
+            ensemble_perturbation: spec.sample.map(|(_, p)| p),
+            wall_time_s: timing.median_s,
+            wall_time_min_s: timing.min_s,
+            wall_time_max_s: timing.max_s,
+            repeats: timing.repeats as i64,
+            steps: m.steps,
+            dofs: m.dofs,
+            iterations: m.iterations,
+            factorizations: m.factorizations,
+            solver_failures: m.solver_failures,
+            contact_switches: m.contact_switches,
+            mass_total: m.mass_total,
+            energy_initial: m.energy_initial,
+            energy_final: m.energy_final,
+            energy_drift: m.energy_drift,
+            energy_max_dev: m.energy_max_dev,
+            energy_max_increase: m.energy_max_increase,
+            energy_theta_max_increase: m.energy_theta_max_increase,
+            err_u_l2l2: m.err_u_l2l2,
+            err_u_l2h1: m.err_u_l2h1,
+            err_u_linfl2: m.err_u_linfl2,
+            err_sigma_l2: m.err_sigma_l2,
+            err_energy_l2: m.err_energy_l2,
+            err_u_contact_max: m.err_u_contact_max,
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        }
+    }
+}

@@ -1,0 +1,187 @@
+//! The impacting elastic bar of 000 §4 / 003 §4.1 and its closed-form solution.
+//!
+//! ρ u_tt − E u_xx = 0 on (0, L), clamped at x = L, Signorini at x = 0 with gap g,
+//! u(x, 0) = a (1 − x/L), u_t(x, 0) = 0.
+//!
+//! For g = 0 the solution is u(x, t) = 2a · U(x/L, c0 t/L) with U the reference solution for
+//! L = E = ρ = 1, a = ½ (SPEC §1.1): period 3, contact during s mod 3 ∈ [1, 2]. U is piecewise
+//! affine in (ξ, s); its kinks at a given time lie at ξ = f and ξ = 1 − f (f = s mod 1). Error
+//! norms are therefore integrated *exactly*: every element is split at those kinks and the
+//! difference between the P1 field and the exact field is affine on each piece.
+
+/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarParams {
+    pub length: f64,
+    pub young: f64,
+    pub density: f64,
+    pub amplitude: f64,
+    pub gap: f64,
+}
+
+impl Default for BarParams {
+    fn default() -> Self {
+        Self {
+            length: 1.0,
+            young: 1.0,
+            density: 1.0,
+            amplitude: 0.5,
+            gap: 0.0,
+        }
+    }
+}
+
+impl BarParams {
+    /// Wave speed c0 = sqrt(E/ρ).
+    pub fn wave_speed(&self) -> f64 {
+        (self.young / self.density).sqrt()
+    }
+
+    /// Initial displacement u0(x) = a (1 − x/L).
+    pub fn initial_displacement(&self, x: f64) -> f64 {
+        self.amplitude * (1.0 - x / self.length)
+    }
+
+    /// The closed form exists for a zero gap only.
+    pub fn exact(&self) -> Option<BarExact> {
+        (self.gap == 0.0).then_some(BarExact { p: *self })
+    }
+}
+
+/// Value and partial derivatives (∂ξ, ∂s) of the reference solution U.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct RefValue {
+    u: f64,
+    u_xi: f64,
+    u_s: f64,
+}
+
+/// Reference solution U(ξ, s) for L = E = ρ = 1, a = ½ (table of SPEC §1.1).
+fn reference(xi: f64, s: f64) -> RefValue {
+    let sp = s.rem_euclid(3.0);
+    let phase = sp.floor();
+    let f = sp - phase;
+    // Zone of (ξ, f): I f<ξ, f≤1−ξ; III f<ξ, f>1−ξ; II f≥ξ, f≤1−ξ; IV f≥ξ, f>1−ξ.
+    let left = f < xi; // I or III
+    let low = f <= 1.0 - xi; // I or II
+    let rv = |u, u_xi, u_s| RefValue { u, u_xi, u_s };
+    match (phase as i64, left, low) {
+        // before impact
+        (0, true, _) => rv(0.5 - xi / 2.0, -0.5, 0.0),
+        (0, false, _) => rv(0.5 - f / 2.0, 0.0, -0.5),
+        // in contact
+        (1, true, true) => rv(-f / 2.0, 0.0, -0.5),
+        (1, false, true) => rv(-xi / 2.0, -0.5, 0.0),
+        (1, true, false) => rv(-0.5 + xi / 2.0, 0.5, 0.0),
+        (1, false, false) => rv(-0.5 + f / 2.0, 0.0, 0.5),
+        // after impact
+        (_, _, true) => rv(f / 2.0, 0.0, 0.5),
+        (_, _, false) => rv(0.5 - xi / 2.0, -0.5, 0.0),
+    }
+}
+
+/// The exact solution of the bar for a zero gap, in physical units.
+#[derive(Debug, Clone, Copy)]
+pub struct BarExact {
+    p: BarParams,
+}
+
+impl BarExact {
+    fn scaled(&self, x: f64, t: f64) -> RefValue {
+        let p = &self.p;
+        reference(x / p.length, p.wave_speed() * t / p.length)
+    }
+
+    /// Period of the motion, 3L/c0.
+    pub fn period(&self) -> f64 {
+        3.0 * self.p.length / self.p.wave_speed()
+    }
+
+    /// u(x, t).
+    pub fn u(&self, x: f64, t: f64) -> f64 {
+        2.0 * self.p.amplitude * self.scaled(x, t).u
+    }
+
+    /// ∂u/∂x (x, t).
+    pub fn u_x(&self, x: f64, t: f64) -> f64 {
+        2.0 * self.p.amplitude / self.p.length * self.scaled(x, t).u_xi
+    }
+
+    /// ∂u/∂t (x, t).
+    pub fn u_t(&self, x: f64, t: f64) -> f64 {
+        2.0 * self.p.amplitude * self.p.wave_speed() / self.p.length * self.scaled(x, t).u_s
+    }
+
+    /// Contact stress σ(0, t) = E u_x(0, t): −aE/L in contact, 0 otherwise.
+    pub fn contact_stress(&self, t: f64) -> f64 {
+        self.p.young * self.u_x(0.0, t)
+    }
+
+    /// Exact (conserved) energy E a² / (2L).
+    pub fn energy(&self) -> f64 {
+        self.p.young * self.p.amplitude * self.p.amplitude / (2.0 * self.p.length)
+    }
+
+    /// Squared L2 norm and squared H1 seminorm of (u_h − u(·, t)) where u_h is the P1 field with
+    /// the nodal values `nodal` on the uniform mesh of spacing `h` (node `nodal.len()` is the
+    /// clamped end, value 0). Exact: elements are split at the kinks of u(·, t).
+    pub fn error_sq(&self, nodal: &[f64], h: f64, t: f64) -> (f64, f64) {
+        let l = self.p.length;
+        let s = self.p.wave_speed() * t / l;
+        let f = s.rem_euclid(3.0).fract();
+        let (k1, k2) = if f <= 0.5 { (f * l, (1.0 - f) * l) } else { ((1.0 - f) * l, f * l) };
+        let m = nodal.len();
+        let (mut l2, mut h1) = (0.0, 0.0);
+        for i in 0..m {
+            let (xa, xb) = (i as f64 * h, (i + 1) as f64 * h);
+            let ua = nodal[i];
+            let ub = if i + 1 < m { nodal[i + 1] } else { 0.0 };
+            let slope = (ub - ua) / h;
+            let mut pts = [xa, xb, xb, xb];
+            let mut np = 1;
+            for k in [k1, k2] {
+                if k > pts[np - 1] && k < xb {
+                    pts[np] = k;
+                    np += 1;
+                }
+            }
+            pts[np] = xb;
+            // The exact field is continuous, so its values at the piece ends determine the affine
+            // error on each piece; ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3.
+            let mut xl = pts[0];
+            let mut el = ua - self.u(xl, t);
+            for &xr in &pts[1..=np] {
+                let d = xr - xl;
+                if d <= 0.0 {
+                    continue;
+                }
+                let er = ua + slope * (xr - xa) - self.u(xr, t);
+                l2 += d * (el * el + el * er + er * er) / 3.0;
+                let de = (er - el) / d;
+                h1 += d * de * de;
+                xl = xr;
+                el = er;
+            }
+        }
+        (l2, h1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // The reference solution is piecewise affine with rational breakpoints: values are exact in
+    // binary floating point up to one rounding, hence the 1e-15 tolerances.
+    #[test]
+    fn reference_contact_phases() {
+        let e = BarParams::default().exact().unwrap();
+        assert!((e.u(0.0, 0.0) - 0.5).abs() < 1e-15);
+        assert!((e.u(0.0, 0.5) - 0.25).abs() < 1e-15);
+        assert_eq!(e.u(0.0, 1.5), 0.0);
+        assert!((e.contact_stress(1.5) + 0.5).abs() < 1e-15);
+        assert_eq!(e.contact_stress(0.5), 0.0);
+        assert!((e.u(0.0, 2.5) - 0.25).abs() < 1e-15);
+        assert!((e.u(0.0, 3.0) - 0.5).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,300 @@
+//! Crash-safe Parquet output (SPEC §8).
+//!
+//! Layout of DIR:
+//! - `runs/part-*.parquet` — rows of [`RunRecord`], one file per batch;
+//! - `series/part-*.parquet` — the time series of the same batch, same file name;
+//! - `manifest.json` — the sweep file's text, tool version, git commit, machine, sessions.
+//!
+//! A batch is committed by an atomic sequence: write `series/.tmp-NAME`, fsync, rename to
+//! `series/NAME`; then the same for `runs/NAME`; then fsync the folders. The runs part is the
+//! commit record: a run counts as done iff its row is in a runs part. After a SIGKILL at any
+//! moment the folder holds only complete Parquet files plus perhaps dot-named temporaries
+//! (ignored by polars' glob and by pyarrow's dataset) and a series part whose runs part never
+//! landed; [`Sink::open`] removes both, so `--resume` loses only the runs in flight and never
+//! duplicates a row. Batches are flushed every `batch_runs` runs or `batch_seconds`, whichever
+//! comes first, so a long sweep never holds much unsaved work.
+
+use std::collections::HashSet;
+use std::fs::{self, File};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime};
+
+use polars::prelude::*;
+
+pub mod manifest;
+
+pub use manifest::Manifest;
+
+use crate::exec::RunResult;
+use crate::run::record::{ColumnData, series_columns};
+use crate::run::{RunRecord, SeriesRow};
+
+/// Failures of the output folder.
+#[derive(Debug, thiserror::Error)]
+pub enum SinkError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: parquet: {source}")]
+    Parquet { path: PathBuf, source: PolarsError },
+    #[error("{path}: holds results of sweep `{found}`, not `{expected}`; choose another --out, or pass --resume to add this sweep's runs to it")]
+    ForeignSweep {
+        path: PathBuf,
+        found: String,
+        expected: String,
+    },
+    #[error("{path}: manifest is not valid JSON: {message}")]
+    Manifest { path: PathBuf, message: String },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SinkError + '_ {
+    move |source| SinkError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Build a DataFrame from typed columns.
+pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame> {
+    let height = match columns.first() {
+        Some((_, ColumnData::F64(v))) => v.len(),
+        Some((_, ColumnData::I64(v))) => v.len(),
+        Some((_, ColumnData::Str(v))) => v.len(),
+        None => 0,
+    };
+    let cols = columns
+        .into_iter()
+        .map(|(name, data)| match data {
+            ColumnData::F64(v) => Column::new(name.into(), &v),
+            ColumnData::I64(v) => Column::new(name.into(), &v),
+            ColumnData::Str(v) => Column::new(name.into(), &v),
+        })
+        .collect();
+    DataFrame::new(height, cols)
+}
+
+/// Write a DataFrame to `dir/name` atomically (temporary dot-file, fsync, rename).
+pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<(), SinkError> {
+    let tmp = dir.join(format!(".tmp-{name}"));
+    let dst = dir.join(name);
+    let file = File::create(&tmp).map_err(io(&tmp))?;
+    ParquetWriter::new(&file)
+        .with_compression(ParquetCompression::Zstd(None))
+        .finish(df)
+        .map_err(|source| SinkError::Parquet {
+            path: tmp.clone(),
+            source,
+        })?;
+    file.sync_all().map_err(io(&tmp))?;
+    drop(file);
+    fs::rename(&tmp, &dst).map_err(io(&dst))?;
+    Ok(())
+}
+
+fn sync_dir(dir: &Path) -> Result<(), SinkError> {
+    File::open(dir).and_then(|f| f.sync_all()).map_err(io(dir))
+}
+
+/// Write bytes atomically.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
+    let tmp = dir.join(format!(".tmp-{name}"));
+    let mut f = File::create(&tmp).map_err(io(&tmp))?;
+    f.write_all(bytes).map_err(io(&tmp))?;
+    f.sync_all().map_err(io(&tmp))?;
+    drop(f);
+    fs::rename(&tmp, path).map_err(io(path))?;
+    sync_dir(dir)
+}
+
+/// Read the run_id column of every committed runs part.
+pub fn committed_run_ids(runs_dir: &Path) -> Result<HashSet<String>, SinkError> {
+    let mut ids = HashSet::new();
+    for part in parquet_parts(runs_dir)? {
+        let file = File::open(&part).map_err(io(&part))?;
+        let df = ParquetReader::new(file)
+            .with_columns(Some(vec!["run_id".into()]))
+            .finish()
+            .map_err(|source| SinkError::Parquet {
+                path: part.clone(),
+                source,
+            })?;
+        let col = df.column("run_id").and_then(|c| c.str().cloned()).map_err(|source| {
+            SinkError::Parquet {
+                path: part.clone(),
+                source,
+            }
+        })?;
+        ids.extend(col.iter().flatten().map(String::from));
+    }
+    Ok(ids)
+}
+
+/// Committed `*.parquet` files of a folder (dot-files excluded), sorted.
+pub fn parquet_parts(dir: &Path) -> Result<Vec<PathBuf>, SinkError> {
+    let mut parts = Vec::new();
+    if !dir.exists() {
+        return Ok(parts);
+    }
+    for entry in fs::read_dir(dir).map_err(io(dir))? {
+        let p = entry.map_err(io(dir))?.path();
+        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+        if !name.starts_with('.') && name.ends_with(".parquet") {
+            parts.push(p);
+        }
+    }
+    parts.sort();
+    Ok(parts)
+}
+
+/// Batching policy.
+#[derive(Debug, Clone, Copy)]
+pub struct BatchPolicy {
+    pub runs: usize,
+    pub seconds: f64,
+}
+
+impl Default for BatchPolicy {
+    fn default() -> Self {
+        Self {
+            runs: 16,
+            seconds: 2.0,
+        }
+    }
+}
+
+/// The writer of one session into DIR.
+pub struct Sink {
+    runs_dir: PathBuf,
+    series_dir: PathBuf,
+    rows: Vec<RunRecord>,
+    series: Vec<(String, SeriesRow)>,
+    policy: BatchPolicy,
+    last_flush: Instant,
+    tag: String,
+    seq: usize,
+    pub written: usize,
+}
+
+impl Sink {
+    /// Prepare DIR: create folders, drop temporaries and uncommitted series parts, and return
+    /// the run ids already committed.
+    pub fn open(dir: &Path, policy: BatchPolicy) -> Result<(Sink, HashSet<String>), SinkError> {
+        let runs_dir = dir.join("runs");
+        let series_dir = dir.join("series");
+        fs::create_dir_all(&runs_dir).map_err(io(&runs_dir))?;
+        fs::create_dir_all(&series_dir).map_err(io(&series_dir))?;
+        for d in [&runs_dir, &series_dir] {
+            for entry in fs::read_dir(d).map_err(io(d))? {
+                let p = entry.map_err(io(d))?.path();
+                if p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with(".tmp-")) {
+                    fs::remove_file(&p).map_err(io(&p))?;
+                }
+            }
+        }
+        // A series part without its runs part belongs to a batch that never committed.
+        for part in parquet_parts(&series_dir)? {
+            let name = part.file_name().expect("a file");
+            if !runs_dir.join(name).exists() {
+                fs::remove_file(&part).map_err(io(&part))?;
+            }
+        }
+        let done = committed_run_ids(&runs_dir)?;
+        let stamp = SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .unwrap_or_default()
+            .as_millis();
+        Ok((
+            Sink {
+                runs_dir,
+                series_dir,
+                rows: Vec::new(),
+                series: Vec::new(),
+                policy,
+                last_flush: Instant::now(),
+                tag: format!("{stamp}-{}", std::process::id()),
+                seq: 0,
+                written: 0,
+            },
+            done,
+        ))
+    }
+
+    /// Add a finished run; flush if the batch is full or old.
+    pub fn push(&mut self, result: RunResult) -> Result<(), SinkError> {
+        let id = result.record.run_id.clone();
+        self.series.extend(result.series.into_iter().map(|r| (id.clone(), r)));
+        self.rows.push(result.record);
+        if self.rows.len() >= self.policy.runs
+            || self.last_flush.elapsed() >= Duration::from_secs_f64(self.policy.seconds)
+        {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Commit the pending batch (series first, then the runs part that commits it).
+    pub fn flush(&mut self) -> Result<(), SinkError> {
+        self.last_flush = Instant::now();
+        if self.rows.is_empty() {
+            return Ok(());
+        }
+        let name = format!("part-{}-{:05}.parquet", self.tag, self.seq);
+        self.seq += 1;
+        let mut sdf = frame(series_columns(&self.series)).map_err(|source| SinkError::Parquet {
+            path: self.series_dir.join(&name),
+            source,
+        })?;
+        write_parquet_atomic(&self.series_dir, &name, &mut sdf)?;
+        let mut rdf = frame(RunRecord::to_columns(&self.rows)).map_err(|source| {
+            SinkError::Parquet {
+                path: self.runs_dir.join(&name),
+                source,
+            }
+        })?;
+        write_parquet_atomic(&self.runs_dir, &name, &mut rdf)?;
+        sync_dir(&self.series_dir)?;
+        sync_dir(&self.runs_dir)?;
+        self.written += self.rows.len();
+        self.rows.clear();
+        self.series.clear();
+        Ok(())
+    }
+}
+
+/// Read every committed runs part of DIR into one frame (diagonal concat tolerates parts
+/// written by versions with other columns).
+pub fn read_runs(dir: &Path) -> Result<DataFrame, SinkError> {
+    read_parts(&dir.join("runs"))
+}
+
+/// Read every committed series part of DIR.
+pub fn read_series(dir: &Path) -> Result<DataFrame, SinkError> {
+    read_parts(&dir.join("series"))
+}
+
+fn read_parts(dir: &Path) -> Result<DataFrame, SinkError> {
+    let parts = parquet_parts(dir)?;
+    let mut frames = Vec::with_capacity(parts.len());
+    for p in &parts {
+        let file = File::open(p).map_err(io(p))?;
+        let df = ParquetReader::new(file).finish().map_err(|source| SinkError::Parquet {
+            path: p.clone(),
+            source,
+        })?;
+        frames.push(df.lazy());
+    }
+    if frames.is_empty() {
+        return Ok(DataFrame::empty());
+    }
+    concat_lf_diagonal(frames, UnionArgs::default())
+        .and_then(|lf| lf.collect())
+        .map_err(|source| SinkError::Parquet {
+            path: dir.to_path_buf(),
+            source,
+        })
+}

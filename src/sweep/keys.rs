@@ -1,0 +1,286 @@
+//! The parameter keys of SPEC §7: their types, value ranges and the methods they apply to.
+
+use std::fmt;
+
+/// A sweep parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Key {
+    T,
+    H,
+    Elements,
+    Dt,
+    Courant,
+    Space,
+    Mass,
+    Scheme,
+    MassWeights,
+    NitscheTheta,
+    NitscheGamma0,
+    PenaltyGamma0,
+    NewmarkBeta,
+    NewmarkGamma,
+    ThetaScheme,
+    Restitution,
+    Length,
+    Young,
+    Density,
+    Amplitude,
+    Gap,
+    LameLambda,
+    LameMu,
+    Gravity,
+}
+
+/// What a key's value must look like.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ValueType {
+    Float,
+    Int,
+    Str,
+    FloatList,
+}
+
+/// A parameter value as written (numbers as f64 unless the key is an integer).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Value {
+    Num(f64),
+    Int(i64),
+    Str(String),
+    List(Vec<f64>),
+}
+
+impl Value {
+    pub fn as_f64(&self) -> Option<f64> {
+        match self {
+            Value::Num(x) => Some(*x),
+            Value::Int(i) => Some(*i as f64),
+            _ => None,
+        }
+    }
+    pub fn as_str(&self) -> Option<&str> {
+        match self {
+            Value::Str(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+/// Canonical text of a number for hashing and comparison: 12 significant digits, so that
+/// `1`, `1.0` and a Courant-derived 0.015000000000000001 all read the same.
+pub fn canonical_number(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+    format!("{rounded:e}")
+}
+
+impl Value {
+    /// The text hashed into run ids and compared by filters.
+    pub fn canonical(&self) -> String {
+        match self {
+            Value::Num(x) => canonical_number(*x),
+            Value::Int(i) => i.to_string(),
+            Value::Str(s) => s.clone(),
+            Value::List(v) => {
+                let parts: Vec<String> = v.iter().map(|x| canonical_number(*x)).collect();
+                format!("[{}]", parts.join(","))
+            }
+        }
+    }
+}
+
+/// For people: numbers at up to 6 significant digits.
+impl fmt::Display for Value {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let num = |x: f64| {
+            let r: f64 = format!("{x:.5e}").parse().unwrap_or(x);
+            if r != 0.0 && (r.abs() < 1e-3 || r.abs() >= 1e6) {
+                format!("{r:e}")
+            } else {
+                format!("{r}")
+            }
+        };
+        match self {
+            Value::Num(x) => write!(f, "{}", num(*x)),
+            Value::Int(i) => write!(f, "{i}"),
+            Value::Str(s) => write!(f, "{s}"),
+            Value::List(v) => {
+                let parts: Vec<String> = v.iter().map(|x| num(*x)).collect();
+                write!(f, "[{}]", parts.join(","))
+            }
+        }
+    }
+}
+
+impl Key {
+    pub const ALL: [Key; 24] = [
+        Key::T,
+        Key::H,
+        Key::Elements,
+        Key::Dt,
+        Key::Courant,
+        Key::Space,
+        Key::Mass,
+        Key::Scheme,
+        Key::MassWeights,
+        Key::NitscheTheta,
+        Key::NitscheGamma0,
+        Key::PenaltyGamma0,
+        Key::NewmarkBeta,
+        Key::NewmarkGamma,
+        Key::ThetaScheme,
+        Key::Restitution,
+        Key::Length,
+        Key::Young,
+        Key::Density,
+        Key::Amplitude,
+        Key::Gap,
+        Key::LameLambda,
+        Key::LameMu,
+        Key::Gravity,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Key::T => "T",
+            Key::H => "h",
+            Key::Elements => "elements",
+            Key::Dt => "dt",
+            Key::Courant => "courant",
+            Key::Space => "space",
+            Key::Mass => "mass",
+            Key::Scheme => "scheme",
+            Key::MassWeights => "mass_weights",
+            Key::NitscheTheta => "nitsche_theta",
+            Key::NitscheGamma0 => "nitsche_gamma0",
+            Key::PenaltyGamma0 => "penalty_gamma0",
+            Key::NewmarkBeta => "newmark_beta",
+            Key::NewmarkGamma => "newmark_gamma",
+            Key::ThetaScheme => "theta_scheme",
+            Key::Restitution => "restitution",
+            Key::Length => "length",
+            Key::Young => "young",
+            Key::Density => "density",
+            Key::Amplitude => "amplitude",
+            Key::Gap => "gap",
+            Key::LameLambda => "lame_lambda",
+            Key::LameMu => "lame_mu",
+            Key::Gravity => "gravity",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Key> {
+        Key::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    pub fn value_type(self) -> ValueType {
+        match self {
+            Key::Elements => ValueType::Int,
+            Key::Space | Key::Mass | Key::Scheme => ValueType::Str,
+            Key::MassWeights => ValueType::FloatList,
+            _ => ValueType::Float,
+        }
+    }
+
+    /// Value-level range check (independent of the other parameters of a run).
+    pub fn check(self, v: &Value) -> Result<(), String> {
+        let finite = |x: f64| {
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(format!("must be a finite number, got {x}"))
+            }
+        };
+        let positive = |x: f64| {
+            finite(x)?;
+            if x > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("must be > 0, got {x}"))
+            }
+        };
+        let within = |x: f64, lo: f64, hi: f64| {
+            finite(x)?;
+            if (lo..=hi).contains(&x) {
+                Ok(())
+            } else {
+                Err(format!("must lie in [{lo}, {hi}], got {x}"))
+            }
+        };
+        match (self, v) {
+            (Key::Elements, Value::Int(i)) => {
+                if *i >= 2 {
+                    Ok(())
+                } else {
+                    Err(format!("must be an integer ≥ 2, got {i}"))
+                }
+            }
+            (Key::MassWeights, Value::List(w)) => {
+                if w.is_empty() {
+                    return Err("must list at least one weight (w1, w2, …)".into());
+                }
+                for (i, x) in w.iter().enumerate() {
+                    positive(*x).map_err(|e| format!("weight {} {e}", i + 1))?;
+                }
+                Ok(())
+            }
+            (Key::Space, Value::Str(s)) => match s.as_str() {
+                "mixed" | "nitsche" | "penalty" => Ok(()),
+                _ => Err(format!("unknown space `{s}` (expected mixed, nitsche or penalty)")),
+            },
+            (Key::Mass, Value::Str(s)) => {
+                if crate::space::MassVariant::NAMES.contains(&s.as_str()) {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown mass `{s}` (expected one of {})",
+                        crate::space::MassVariant::NAMES.join(", ")
+                    ))
+                }
+            }
+            (Key::Scheme, Value::Str(s)) => {
+                if SCHEME_NAMES.contains(&s.as_str()) {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown scheme `{s}` (expected one of {})",
+                        SCHEME_NAMES.join(", ")
+                    ))
+                }
+            }
+            (Key::T | Key::H | Key::Dt | Key::Courant, Value::Num(x)) => positive(*x),
+            (Key::NitscheGamma0 | Key::PenaltyGamma0, Value::Num(x)) => positive(*x),
+            (Key::Length | Key::Young | Key::Density | Key::Amplitude, Value::Num(x)) => {
+                positive(*x)
+            }
+            (Key::LameLambda | Key::LameMu, Value::Num(x)) => positive(*x),
+            (Key::Gap, Value::Num(x)) => {
+                finite(*x)?;
+                if *x >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must be ≥ 0, got {x}"))
+                }
+            }
+            (Key::NewmarkBeta, Value::Num(x)) => within(*x, 0.0, 0.5),
+            (Key::NewmarkGamma | Key::ThetaScheme | Key::Restitution, Value::Num(x)) => {
+                within(*x, 0.0, 1.0)
+            }
+            (Key::NitscheTheta | Key::Gravity, Value::Num(x)) => finite(*x).map(|_| ()),
+            _ => Err("wrong type".into()),
+        }
+    }
+}
+
+/// Scheme names and aliases accepted in sweep files (SPEC §3).
+pub const SCHEME_NAMES: [&str; 8] = [
+    "newmark",
+    "crank-nicolson",
+    "newmark-dissipative",
+    "central-difference",
+    "theta",
+    "backward-euler",
+    "paoli-schatzman",
+    "hybrid",
+];

@@ -1,0 +1,630 @@
+//! Sweep files (SPEC §7): parse, validate and expand into runs.
+//!
+//! A sweep file names a scene and a parameter space: `[fixed]` values, a cartesian `[grid]`
+//! (items may be bundles — inline tables setting several parameters at once), equal-length
+//! `[zip]` lists advanced together, and `exclude` filters. Everything is checked before
+//! anything runs: each problem is reported with the file, the key path, the line and the
+//! reason ([`SweepError`]). [`plan::expand`] turns the file into [`plan::Plan`]: deterministic
+//! order, meaningless combinations dropped, parameters that do not apply to a run's method
+//! removed and the resulting duplicates merged, each run keyed by a stable [`plan::RunSpec::run_id`].
+
+pub mod keys;
+pub mod plan;
+pub mod tree;
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+pub use keys::{Key, Value, ValueType};
+pub use plan::{Plan, RunSpec, expand};
+use tree::{Kind, Node};
+
+use crate::scene::SceneKind;
+
+/// Where a value was written: its key path in the file and its line.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Origin {
+    pub path: String,
+    pub line: Option<usize>,
+}
+
+/// One problem found in a sweep file.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Issue {
+    pub line: Option<usize>,
+    pub key: String,
+    pub reason: String,
+}
+
+impl Issue {
+    pub fn at(origin: &Origin, reason: impl Into<String>) -> Self {
+        Issue {
+            line: origin.line,
+            key: origin.path.clone(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// A sweep file that cannot be used; nothing has run.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    #[error("{file}: cannot read the sweep file: {source}")]
+    Read {
+        file: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}", render_issues(file, issues))]
+    Invalid { file: PathBuf, issues: Vec<Issue> },
+}
+
+fn render_issues(file: &Path, issues: &[Issue]) -> String {
+    let mut out = String::new();
+    for (i, is) in issues.iter().enumerate() {
+        if i > 0 {
+            out.push('\n');
+        }
+        let line = is.line.map(|l| format!(":{l}")).unwrap_or_default();
+        out.push_str(&format!(
+            "{}{}: key `{}`: {}",
+            file.display(),
+            line,
+            is.key,
+            is.reason
+        ));
+    }
+    out
+}
+
+/// A parameter value with its origin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    pub key: Key,
+    pub value: Value,
+    pub origin: Origin,
+}
+
+/// One axis of the grid (or the zipped lists): alternatives, each a set of entries.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    pub name: String,
+    pub items: Vec<Vec<Entry>>,
+}
+
+/// `ensemble = { perturbation, samples, seed }`: round-off sensitivity study.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ensemble {
+    pub perturbation: f64,
+    pub samples: usize,
+    pub seed: u64,
+}
+
+/// A parsed and value-checked sweep file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepFile {
+    pub path: PathBuf,
+    pub text: String,
+    pub name: String,
+    pub scene: SceneKind,
+    pub description: Option<String>,
+    pub fixed: Vec<Entry>,
+    pub grid: Vec<Axis>,
+    pub zip: Option<Axis>,
+    pub exclude: Vec<Vec<Entry>>,
+    pub repeats: usize,
+    pub ensemble: Option<Ensemble>,
+    /// Keep every k-th step in DIR/series (0: no time series).
+    pub series_every: usize,
+}
+
+const TOP_KEYS: [&str; 11] = [
+    "name",
+    "scene",
+    "description",
+    "exclude",
+    "fixed",
+    "grid",
+    "zip",
+    "reference",
+    "repeats",
+    "ensemble",
+    "series_every",
+];
+
+/// Collects issues while parsing.
+struct Checker {
+    scene: Option<SceneKind>,
+    issues: Vec<Issue>,
+}
+
+impl Checker {
+    fn issue(&mut self, path: &str, line: usize, reason: impl Into<String>) {
+        self.issues.push(Issue {
+            line: Some(line),
+            key: path.to_string(),
+            reason: reason.into(),
+        });
+    }
+
+    /// Convert a node to the value of `key`, checking type, range and scene acceptance.
+    fn value(&mut self, key: Key, node: &Node, path: &str) -> Option<Entry> {
+        if let Some(scene) = self.scene {
+            if !accepted(scene, key) {
+                self.issue(
+                    path,
+                    node.line,
+                    format!("`{}` is not a parameter of scene {}", key.name(), scene.name()),
+                );
+                return None;
+            }
+        }
+        let value = match (key.value_type(), &node.kind) {
+            (ValueType::Float, Kind::Float(x)) => Value::Num(*x),
+            (ValueType::Float, Kind::Int(i)) => Value::Num(*i as f64),
+            (ValueType::Int, Kind::Int(i)) => Value::Int(*i),
+            (ValueType::Str, Kind::Str(s)) => Value::Str(s.clone()),
+            (ValueType::FloatList, Kind::Array(items)) => {
+                let mut v = Vec::with_capacity(items.len());
+                for it in items {
+                    match it.kind {
+                        Kind::Float(x) => v.push(x),
+                        Kind::Int(i) => v.push(i as f64),
+                        ref k => {
+                            self.issue(
+                                path,
+                                it.line,
+                                format!("expected a list of numbers, found a {}", k.type_name()),
+                            );
+                            return None;
+                        }
+                    }
+                }
+                Value::List(v)
+            }
+            (t, k) => {
+                let want = match t {
+                    ValueType::Float => "a number",
+                    ValueType::Int => "an integer",
+                    ValueType::Str => "a string",
+                    ValueType::FloatList => "a list of numbers",
+                };
+                self.issue(path, node.line, format!("expected {want}, found a {}", k.type_name()));
+                return None;
+            }
+        };
+        if let Err(reason) = key.check(&value) {
+            self.issue(path, node.line, reason);
+            return None;
+        }
+        Some(Entry {
+            key,
+            value,
+            origin: Origin {
+                path: path.to_string(),
+                line: Some(node.line),
+            },
+        })
+    }
+
+    fn key(&mut self, name: &str, path: &str, line: usize) -> Option<Key> {
+        let k = Key::from_name(name);
+        if k.is_none() {
+            self.issue(path, line, format!("unknown parameter `{name}`{}", suggest(name)));
+        }
+        k
+    }
+
+    /// A bundle: an inline table of parameters.
+    fn bundle(&mut self, entries: &[(String, usize, Node)], path: &str) -> Vec<Entry> {
+        let mut out = Vec::new();
+        for (k, kl, v) in entries {
+            let p = format!("{path}.{k}");
+            if let Some(key) = self.key(k, &p, *kl) {
+                if out.iter().any(|e: &Entry| e.key == key) {
+                    self.issue(&p, *kl, "set twice in the same bundle");
+                }
+                if let Some(e) = self.value(key, v, &p) {
+                    out.push(e);
+                }
+            }
+        }
+        out
+    }
+
+    /// A list of alternatives for `[grid]` / `[zip]`.
+    fn axis(&mut self, section: &str, name: &str, line: usize, node: &Node) -> Option<Axis> {
+        let path = format!("{section}.{name}");
+        let Kind::Array(items) = &node.kind else {
+            self.issue(
+                &path,
+                line,
+                format!(
+                    "expected a list of values, found a {} (single values go in [fixed])",
+                    node.kind.type_name()
+                ),
+            );
+            return None;
+        };
+        if items.is_empty() {
+            self.issue(&path, line, "empty list: the sweep would have no runs");
+            return None;
+        }
+        let key = Key::from_name(name);
+        let all_bundles = items.iter().all(|i| matches!(i.kind, Kind::Table(_)));
+        if key.is_none() && !all_bundles {
+            self.issue(
+                &path,
+                line,
+                format!(
+                    "unknown parameter `{name}`{} (a label axis must list only bundles {{ … }})",
+                    suggest(name)
+                ),
+            );
+            return None;
+        }
+        let mut alts = Vec::new();
+        for (i, it) in items.iter().enumerate() {
+            let ip = format!("{path}[{i}]");
+            match (&it.kind, key) {
+                (Kind::Table(t), _) => alts.push(self.bundle(t, &ip)),
+                (_, Some(k)) if k.value_type() == ValueType::FloatList => {
+                    alts.push(self.value(k, it, &ip).into_iter().collect())
+                }
+                (Kind::Array(_), Some(_)) => {
+                    self.issue(&ip, it.line, "nested lists are not allowed here");
+                }
+                (_, Some(k)) => alts.push(self.value(k, it, &ip).into_iter().collect()),
+                (_, None) => unreachable!(),
+            }
+        }
+        Some(Axis {
+            name: name.to_string(),
+            items: alts,
+        })
+    }
+}
+
+/// Whether `scene` accepts `key`.
+pub fn accepted(scene: SceneKind, key: Key) -> bool {
+    let physics = [
+        Key::Length,
+        Key::Young,
+        Key::Density,
+        Key::Amplitude,
+        Key::Gap,
+        Key::LameLambda,
+        Key::LameMu,
+        Key::Gravity,
+    ];
+    !physics.contains(&key) || scene.physics_keys().contains(&key.name())
+}
+
+fn suggest(name: &str) -> String {
+    let lower = name.to_ascii_lowercase();
+    let near = Key::ALL
+        .iter()
+        .map(|k| k.name())
+        .chain(TOP_KEYS)
+        .find(|k| k.to_ascii_lowercase() == lower || edit_distance(k, name) <= 2);
+    near.map(|k| format!(" (did you mean `{k}`?)")).unwrap_or_default()
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            cur[j + 1] = (prev[j] + usize::from(ca != *cb))
+                .min(prev[j + 1] + 1)
+                .min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+impl SweepFile {
+    /// Read and check a sweep file.
+    pub fn load(path: &Path) -> Result<SweepFile, SweepError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Read {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        SweepFile::parse(path, &text)
+    }
+
+    /// Check a sweep file's text; `path` names it in messages.
+    pub fn parse(path: &Path, text: &str) -> Result<SweepFile, SweepError> {
+        let invalid = |issues: Vec<Issue>| SweepError::Invalid {
+            file: path.to_path_buf(),
+            issues,
+        };
+        let top = tree::parse(text).map_err(|e| {
+            invalid(vec![Issue {
+                line: e.line,
+                key: "(syntax)".into(),
+                reason: format!("invalid TOML: {}", e.message),
+            }])
+        })?;
+        let mut ck = Checker {
+            scene: None,
+            issues: Vec::new(),
+        };
+        let get = |name: &str| top.iter().find(|(k, _, _)| k == name);
+        for (k, line, _) in &top {
+            if !TOP_KEYS.contains(&k.as_str()) {
+                let hint = if Key::from_name(k).is_some() {
+                    " (parameters go in [fixed], [grid] or [zip])".to_string()
+                } else {
+                    suggest(k)
+                };
+                ck.issue(
+                    k,
+                    *line,
+                    format!("unknown top-level key{hint}; accepted: {}", TOP_KEYS.join(", ")),
+                );
+            }
+        }
+        let string = |ck: &mut Checker, name: &str| -> Option<(String, usize)> {
+            let (_, line, node) = get(name)?;
+            match &node.kind {
+                Kind::Str(s) => Some((s.clone(), *line)),
+                k => {
+                    ck.issue(name, *line, format!("expected a string, found a {}", k.type_name()));
+                    None
+                }
+            }
+        };
+        let name = match string(&mut ck, "name") {
+            Some((n, line)) => {
+                let ok = !n.is_empty()
+                    && n.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+                    && !n.starts_with('.');
+                if !ok {
+                    ck.issue(
+                        "name",
+                        line,
+                        "must be a non-empty folder-safe name (letters, digits, - _ .)",
+                    );
+                }
+                n
+            }
+            None => {
+                if get("name").is_none() {
+                    ck.issues.push(Issue {
+                        line: None,
+                        key: "name".into(),
+                        reason: "required key missing (the sweep's name, also its default output folder)".into(),
+                    });
+                }
+                String::new()
+            }
+        };
+        match string(&mut ck, "scene") {
+            Some((s, line)) => match SceneKind::NAMES.iter().find(|(n, _)| *n == s) {
+                Some((_, Some(kind))) => ck.scene = Some(*kind),
+                Some((_, None)) => ck.issue(
+                    "scene",
+                    line,
+                    format!("scene `{s}` is specified (SPEC §1) but not implemented in this version"),
+                ),
+                None => ck.issue(
+                    "scene",
+                    line,
+                    format!(
+                        "unknown scene `{s}` (expected one of {})",
+                        SceneKind::NAMES.map(|(n, _)| n).join(", ")
+                    ),
+                ),
+            },
+            None => {
+                if get("scene").is_none() {
+                    ck.issues.push(Issue {
+                        line: None,
+                        key: "scene".into(),
+                        reason: "required key missing (bar1d, bar2d, bar3d, disc2d or sphere3d)".into(),
+                    });
+                }
+            }
+        }
+        let description = string(&mut ck, "description").map(|(s, _)| s);
+        let table = |ck: &mut Checker, name: &str| -> Vec<(String, usize, Node)> {
+            match get(name) {
+                None => Vec::new(),
+                Some((_, _, Node { kind: Kind::Table(t), .. })) => t.clone(),
+                Some((_, line, node)) => {
+                    ck.issue(name, *line, format!("expected a table, found a {}", node.kind.type_name()));
+                    Vec::new()
+                }
+            }
+        };
+        let mut fixed = Vec::new();
+        for (k, line, v) in table(&mut ck, "fixed") {
+            let p = format!("fixed.{k}");
+            if let Some(key) = ck.key(&k, &p, line) {
+                if matches!(v.kind, Kind::Array(_)) && key.value_type() != ValueType::FloatList {
+                    ck.issue(&p, line, "[fixed] takes one value; put lists in [grid] or [zip]");
+                } else if let Some(e) = ck.value(key, &v, &p) {
+                    fixed.push(e);
+                }
+            }
+        }
+        let mut grid = Vec::new();
+        for (k, line, v) in table(&mut ck, "grid") {
+            if let Some(ax) = ck.axis("grid", &k, line, &v) {
+                grid.push(ax);
+            }
+        }
+        let zip_entries = table(&mut ck, "zip");
+        let mut zip_axes = Vec::new();
+        for (k, line, v) in &zip_entries {
+            if let Some(ax) = ck.axis("zip", k, *line, v) {
+                zip_axes.push((ax, *line));
+            }
+        }
+        let zip = if zip_axes.is_empty() {
+            None
+        } else {
+            let n = zip_axes[0].0.items.len();
+            for (ax, line) in &zip_axes[1..] {
+                if ax.items.len() != n {
+                    ck.issue(
+                        &format!("zip.{}", ax.name),
+                        *line,
+                        format!(
+                            "has {} values but zip.{} has {n}: zipped lists must have equal lengths",
+                            ax.items.len(),
+                            zip_axes[0].0.name
+                        ),
+                    );
+                }
+            }
+            let items = (0..n)
+                .map(|i| {
+                    zip_axes
+                        .iter()
+                        .flat_map(|(ax, _)| ax.items.get(i).cloned().unwrap_or_default())
+                        .collect()
+                })
+                .collect();
+            let names: Vec<&str> = zip_axes.iter().map(|(a, _)| a.name.as_str()).collect();
+            Some(Axis {
+                name: names.join("+"),
+                items,
+            })
+        };
+        let mut exclude = Vec::new();
+        if let Some((_, line, node)) = get("exclude") {
+            match &node.kind {
+                Kind::Array(items) => {
+                    for (i, it) in items.iter().enumerate() {
+                        let p = format!("exclude[{i}]");
+                        match &it.kind {
+                            Kind::Table(t) if !t.is_empty() => exclude.push(ck.bundle(t, &p)),
+                            _ => ck.issue(&p, it.line, "expected a non-empty inline table of parameters, e.g. { space = \"mixed\", scheme = \"hybrid\" }"),
+                        }
+                    }
+                }
+                k => ck.issue("exclude", *line, format!("expected a list of inline tables, found a {}", k.type_name())),
+            }
+        }
+        let int = |ck: &mut Checker, path: &str, node: &Node, min: i64| -> Option<i64> {
+            match node.kind {
+                Kind::Int(i) if i >= min => Some(i),
+                Kind::Int(i) => {
+                    ck.issue(path, node.line, format!("must be an integer ≥ {min}, got {i}"));
+                    None
+                }
+                ref k => {
+                    ck.issue(path, node.line, format!("expected an integer, found a {}", k.type_name()));
+                    None
+                }
+            }
+        };
+        let repeats = get("repeats")
+            .and_then(|(_, _, n)| int(&mut ck, "repeats", n, 1))
+            .unwrap_or(1) as usize;
+        let series_every = get("series_every")
+            .and_then(|(_, _, n)| int(&mut ck, "series_every", n, 0))
+            .unwrap_or(1) as usize;
+        let mut ensemble = None;
+        if let Some((_, line, node)) = get("ensemble") {
+            if let Kind::Table(t) = &node.kind {
+                let (mut pert, mut samples, mut seed) = (None, None, Some(0));
+                for (k, kl, v) in t {
+                    let p = format!("ensemble.{k}");
+                    match k.as_str() {
+                        "perturbation" => match v.kind {
+                            Kind::Float(x) if x >= 0.0 && x.is_finite() => pert = Some(x),
+                            Kind::Int(i) if i >= 0 => pert = Some(i as f64),
+                            _ => ck.issue(&p, *kl, "expected a finite number ≥ 0 (relative amplitude of the perturbation of u⁰)"),
+                        },
+                        "samples" => samples = int(&mut ck, &p, v, 1),
+                        "seed" => seed = int(&mut ck, &p, v, 0),
+                        _ => ck.issue(&p, *kl, "unknown key (expected perturbation, samples, seed)"),
+                    }
+                }
+                match (pert, samples, seed) {
+                    (Some(perturbation), Some(samples), Some(seed)) => {
+                        ensemble = Some(Ensemble {
+                            perturbation,
+                            samples: samples as usize,
+                            seed: seed as u64,
+                        })
+                    }
+                    _ => ck.issue("ensemble", *line, "needs perturbation and samples (seed optional)"),
+                }
+            } else {
+                ck.issue("ensemble", *line, "expected an inline table { perturbation, samples, seed }");
+            }
+        }
+        if let Some((_, line, _)) = get("reference") {
+            if ck.scene == Some(SceneKind::Bar1d) {
+                ck.issue(
+                    "reference",
+                    *line,
+                    "scene bar1d has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+                );
+            }
+        }
+        // A parameter may come from one place only: [fixed], one grid axis, or [zip].
+        let mut sources: Vec<(Key, Origin, String)> = Vec::new();
+        let mut note = |key: Key, origin: &Origin, source: String, ck: &mut Checker| {
+            if let Some((_, o, s)) = sources.iter().find(|(k, _, s)| *k == key && *s != source) {
+                ck.issues.push(Issue::at(
+                    origin,
+                    format!(
+                        "`{}` is also set by {} (line {}): a parameter may come from one place only",
+                        key.name(),
+                        o.path,
+                        o.line.unwrap_or(0)
+                    ),
+                ));
+                let _ = s;
+            } else if !sources.iter().any(|(k, _, s)| *k == key && *s == source) {
+                sources.push((key, origin.clone(), source));
+            }
+        };
+        for e in &fixed {
+            note(e.key, &e.origin, "fixed".into(), &mut ck);
+        }
+        for ax in grid.iter().chain(zip.iter()) {
+            for item in &ax.items {
+                for e in item {
+                    note(e.key, &e.origin, format!("axis {}", ax.name), &mut ck);
+                }
+            }
+        }
+        if ck.issues.is_empty() {
+            Ok(SweepFile {
+                path: path.to_path_buf(),
+                text: text.to_string(),
+                name,
+                scene: ck.scene.expect("checked"),
+                description,
+                fixed,
+                grid,
+                zip,
+                exclude,
+                repeats,
+                ensemble,
+                series_every,
+            })
+        } else {
+            let mut issues = ck.issues;
+            issues.sort();
+            issues.dedup();
+            Err(invalid(issues))
+        }
+    }
+}
+
+impl fmt::Display for Origin {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{} (line {l})", self.path),
+            None => write!(f, "{}", self.path),
+        }
+    }
+}

@@ -1,0 +1,647 @@
+//! Expansion of a sweep file into runs.
+//!
+//! Order: the zipped lists (if any) vary slowest, then the `[grid]` axes in file order, the last
+//! fastest. Each combination is resolved: scheme aliases become a family plus parameters
+//! (`crank-nicolson` = newmark with β = ¼, γ = ½), `courant` becomes dt = ν h / c0, `elements`
+//! becomes h = L/m, defaults are filled in, and a parameter that does not apply to the run's
+//! method (SPEC §3) is dropped. Combinations that are meaningless (Paoli–Schatzman with
+//! Nitsche, …) are left out with their reason. Runs whose canonical parameters coincide merge.
+//!
+//! `run_id` is the first 16 hex digits of SHA-256 over the canonical parameter text: scene plus
+//! every applicable parameter whose value differs from its default, sorted by key, numbers at 12
+//! significant digits. Adding an axis whose value is the default leaves ids unchanged, and the
+//! same run has the same id in every sweep, shard and machine.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write as _;
+
+use sha2::{Digest, Sha256};
+
+use super::keys::canonical_number;
+use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
+use crate::run::RunConfig;
+use crate::run::bar1d::Bar1dConfig;
+use crate::scene::{BarParams, SceneKind};
+use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag};
+use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
+
+/// One run of the plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    pub run_id: String,
+    /// Human label: method · mass · scheme.
+    pub label: String,
+    /// Every parameter column of the run (defaults filled, derived ones included, keys that do
+    /// not apply absent).
+    pub params: BTreeMap<Key, Value>,
+    pub scheme_label: String,
+    pub config: RunConfig,
+    pub repeats: usize,
+    /// Ensemble member (sample index, relative perturbation).
+    pub sample: Option<(usize, f64)>,
+}
+
+/// The expanded sweep.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    pub sweep: SweepFile,
+    pub runs: Vec<RunSpec>,
+    /// Number of raw combinations (before filters and merging).
+    pub combinations: usize,
+    pub excluded_by_filter: usize,
+    /// Meaningless combinations left out, by reason.
+    pub inapplicable: BTreeMap<String, usize>,
+    /// Combinations merged into an earlier identical run, by reason.
+    pub collapsed: BTreeMap<String, usize>,
+}
+
+/// Resolved parameters of one combination.
+struct Resolved {
+    params: BTreeMap<Key, Value>,
+    canonical: BTreeMap<Key, String>,
+    config: Bar1dConfig,
+    label: String,
+    scheme_label: String,
+    scheme_names: [String; 2],
+    dropped: Vec<String>,
+}
+
+enum Outcome {
+    Run(Box<Resolved>),
+    Inapplicable(String),
+    Invalid(Vec<Issue>),
+}
+
+/// Defaults of bar1d (SPEC §1.1, 003 §4.1).
+fn default_of(key: Key) -> Option<Value> {
+    Some(match key {
+        Key::T => Value::Num(12.0),
+        Key::Space => Value::Str("mixed".into()),
+        Key::Mass => Value::Str("consistent".into()),
+        Key::Scheme => Value::Str("crank-nicolson".into()),
+        Key::NitscheTheta => Value::Num(1.0),
+        Key::NewmarkBeta => Value::Num(0.25),
+        Key::NewmarkGamma => Value::Num(0.5),
+        Key::Restitution => Value::Num(1.0),
+        Key::Length | Key::Young | Key::Density => Value::Num(1.0),
+        Key::Amplitude => Value::Num(0.5),
+        Key::Gap => Value::Num(0.0),
+        _ => return None,
+    })
+}
+
+fn same(a: &Value, b: &Value) -> bool {
+    a.canonical() == b.canonical()
+}
+
+/// Resolve one combination of entries.
+fn resolve(entries: &[&Entry]) -> Outcome {
+    let mut issues = Vec::new();
+    let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
+    for e in entries {
+        user.insert(e.key, (e.value.clone(), e.origin.clone()));
+    }
+    let get = |k: Key| user.get(&k).map(|(v, _)| v.clone()).or_else(|| default_of(k));
+    let num = |k: Key| get(k).and_then(|v| v.as_f64());
+    let origin = |k: Key| {
+        user.get(&k).map(|(_, o)| o.clone()).unwrap_or(Origin {
+            path: format!("(default {})", k.name()),
+            line: None,
+        })
+    };
+    let mut dropped = Vec::new();
+    let mut params: BTreeMap<Key, Value> = BTreeMap::new();
+
+    // Scheme: family and its parameters (aliases fix them).
+    let scheme_name = get(Key::Scheme).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let preset: Option<(Scheme, &[Key])> = match scheme_name.as_str() {
+        "crank-nicolson" => Some((
+            Scheme::Newmark(NewmarkParams::crank_nicolson()),
+            &[Key::NewmarkBeta, Key::NewmarkGamma],
+        )),
+        "newmark-dissipative" => Some((
+            Scheme::Newmark(NewmarkParams::dissipative()),
+            &[Key::NewmarkBeta, Key::NewmarkGamma],
+        )),
+        "central-difference" => Some((
+            Scheme::Newmark(NewmarkParams::central_difference()),
+            &[Key::NewmarkBeta, Key::NewmarkGamma],
+        )),
+        "backward-euler" => Some((Scheme::Theta(ThetaParams::backward_euler()), &[Key::ThetaScheme])),
+        _ => None,
+    };
+    let scheme = match (preset, scheme_name.as_str()) {
+        (Some((s, fixed_keys)), _) => {
+            for k in fixed_keys {
+                if user.contains_key(k) {
+                    dropped.push(format!("{} is fixed by scheme = {scheme_name}", k.name()));
+                }
+            }
+            s
+        }
+        (None, "newmark") => Scheme::Newmark(NewmarkParams {
+            beta: num(Key::NewmarkBeta).unwrap(),
+            gamma: num(Key::NewmarkGamma).unwrap(),
+        }),
+        (None, "theta") => match num(Key::ThetaScheme) {
+            Some(theta) => Scheme::Theta(ThetaParams { theta }),
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Scheme),
+                    "scheme = theta needs theta_scheme (θ ∈ (0, 1]); backward-euler is θ = 1",
+                ));
+                Scheme::Theta(ThetaParams::backward_euler())
+            }
+        },
+        (None, "paoli-schatzman") => Scheme::PaoliSchatzman(PaoliSchatzmanParams {
+            beta: num(Key::NewmarkBeta).unwrap(),
+            restitution: num(Key::Restitution).unwrap(),
+        }),
+        (None, _) => Scheme::Hybrid,
+    };
+
+    let space_name = get(Key::Space).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let method = match space_name.as_str() {
+        "nitsche" => match num(Key::NitscheGamma0) {
+            Some(gamma0) => ContactMethod::Nitsche {
+                theta: num(Key::NitscheTheta).unwrap(),
+                gamma0,
+            },
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Space),
+                    "space = nitsche needs nitsche_gamma0 (γ0 > 0; the papers use 1e-6 … 1)",
+                ));
+                ContactMethod::Nitsche {
+                    theta: 1.0,
+                    gamma0: 1.0,
+                }
+            }
+        },
+        "penalty" => match num(Key::PenaltyGamma0) {
+            Some(gamma0) => ContactMethod::Penalty { gamma0 },
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Space),
+                    "space = penalty needs penalty_gamma0 (κ = E·penalty_gamma0/h)",
+                ));
+                ContactMethod::Penalty { gamma0: 1.0 }
+            }
+        },
+        _ => ContactMethod::Mixed,
+    };
+    let mass_name = get(Key::Mass).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let mass = if mass_name == "weights" {
+        match get(Key::MassWeights) {
+            Some(Value::List(w)) => MassVariant::Weights(w),
+            _ => {
+                issues.push(Issue::at(
+                    &origin(Key::Mass),
+                    "mass = weights needs mass_weights = [w1, w2, …]",
+                ));
+                MassVariant::Mod1
+            }
+        }
+    } else {
+        MassVariant::from_name(&mass_name).expect("checked")
+    };
+
+    // Applicability (SPEC §3): which keys this run uses.
+    let applies = |k: Key| -> Result<(), &'static str> {
+        let ok = match k {
+            Key::NitscheTheta | Key::NitscheGamma0 => space_name == "nitsche",
+            Key::PenaltyGamma0 => space_name == "penalty",
+            Key::NewmarkBeta => matches!(scheme, Scheme::Newmark(_) | Scheme::PaoliSchatzman(_)),
+            Key::NewmarkGamma => matches!(scheme, Scheme::Newmark(_)),
+            Key::ThetaScheme => matches!(scheme, Scheme::Theta(_)),
+            Key::Restitution => matches!(scheme, Scheme::PaoliSchatzman(_)),
+            Key::MassWeights => mass_name == "weights",
+            _ => true,
+        };
+        if ok {
+            return Ok(());
+        }
+        Err(match k {
+            Key::NitscheTheta | Key::NitscheGamma0 => "applies to space = nitsche only",
+            Key::PenaltyGamma0 => "applies to space = penalty only",
+            Key::NewmarkBeta => "applies to newmark and paoli-schatzman only",
+            Key::NewmarkGamma => "applies to newmark only",
+            Key::ThetaScheme => "applies to the theta scheme only",
+            Key::Restitution => "applies to paoli-schatzman only",
+            _ => "applies to mass = weights only",
+        })
+    };
+    for (k, _) in user.iter() {
+        if let Err(why) = applies(*k) {
+            dropped.push(format!("{} {why}", k.name()));
+        }
+    }
+
+    // Meaningless combinations (SPEC §3).
+    let massless = mass.massless_contact();
+    if matches!(scheme, Scheme::PaoliSchatzman(_)) && method != ContactMethod::Mixed {
+        return Outcome::Inapplicable("paoli-schatzman is defined for space = mixed only".into());
+    }
+    if matches!(scheme, Scheme::Hybrid) && method == ContactMethod::Mixed && !massless {
+        return Outcome::Inapplicable(
+            "hybrid with space = mixed needs a massless contact node (mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)".into(),
+        );
+    }
+    if scheme.is_explicit() && method == ContactMethod::Mixed && !massless {
+        return Outcome::Inapplicable(
+            "an explicit scheme cannot enforce the multiplier constraint on a contact node with mass".into(),
+        );
+    }
+
+    // Geometry and time step.
+    let bar = BarParams {
+        length: num(Key::Length).unwrap(),
+        young: num(Key::Young).unwrap(),
+        density: num(Key::Density).unwrap(),
+        amplitude: num(Key::Amplitude).unwrap(),
+        gap: num(Key::Gap).unwrap(),
+    };
+    let c0 = bar.wave_speed();
+    let elements = match (user.get(&Key::H), user.get(&Key::Elements)) {
+        (Some(_), Some((_, o))) => {
+            issues.push(Issue::at(o, "give either h or elements, not both"));
+            None
+        }
+        (Some((v, o)), None) => {
+            let h = v.as_f64().unwrap();
+            let ratio = bar.length / h;
+            let m = ratio.round();
+            if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
+                issues.push(Issue::at(
+                    o,
+                    format!(
+                        "h = {h} does not divide length = {} into at least 2 elements (L/h = {ratio}); use `elements` or an h with L/h a whole number",
+                        bar.length
+                    ),
+                ));
+                None
+            } else {
+                Some(m as usize)
+            }
+        }
+        (None, Some((v, _))) => match v {
+            Value::Int(i) => Some(*i as usize),
+            _ => None,
+        },
+        (None, None) => {
+            issues.push(Issue {
+                line: None,
+                key: "h".into(),
+                reason: "required: the mesh size h (or elements) is not set in [fixed], [grid] or [zip]".into(),
+            });
+            None
+        }
+    };
+    let h = elements.map(|m| bar.length / m as f64);
+    let dt = match (user.get(&Key::Dt), user.get(&Key::Courant), h) {
+        (Some(_), Some((_, o)), _) => {
+            issues.push(Issue::at(o, "give either dt or courant, not both"));
+            None
+        }
+        (Some((v, _)), None, _) => v.as_f64(),
+        (None, Some((v, _)), Some(h)) => v.as_f64().map(|nu| nu * h / c0),
+        (None, Some(_), None) => None,
+        (None, None, _) => {
+            issues.push(Issue {
+                line: None,
+                key: "dt".into(),
+                reason: "required: the time step dt (or courant) is not set in [fixed], [grid] or [zip]".into(),
+            });
+            None
+        }
+    };
+    let t_final = num(Key::T).unwrap();
+    if !issues.is_empty() {
+        return Outcome::Invalid(issues);
+    }
+    let (m, h, dt) = (elements.unwrap(), h.unwrap(), dt.unwrap());
+    let ratio = t_final / dt;
+    let steps = if (ratio - ratio.round()).abs() <= 1e-9 * ratio {
+        ratio.round() as usize
+    } else {
+        ratio.ceil() as usize
+    };
+    if steps == 0 || steps > 100_000_000 {
+        return Outcome::Invalid(vec![Issue::at(
+            &origin(if user.contains_key(&Key::Dt) { Key::Dt } else { Key::Courant }),
+            format!("T/dt = {ratio:.3e} steps is out of range (1 … 1e8)"),
+        )]);
+    }
+    let courant = c0 * dt / h;
+
+    // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
+    // assembled operators (contact-free and contact-active stiffness).
+    if let Some(bound) = scheme.explicit_stability_limit() {
+        let dt_origin = origin(if user.contains_key(&Key::Dt) { Key::Dt } else { Key::Courant });
+        if bound == 0.0 {
+            return Outcome::Invalid(vec![Issue::at(
+                &origin(Key::ThetaScheme),
+                "theta_scheme = 0 is forward Euler, unstable for every dt on the undamped wave equation",
+            )]);
+        }
+        match Bar1dSpace::new(bar, m, &mass, method) {
+            Ok(sp) => {
+                let omega2 = max_frequency_sq(&sp);
+                let dt_max = bound / omega2.sqrt();
+                if dt > dt_max * (1.0 + 1e-12) {
+                    return Outcome::Invalid(vec![Issue::at(
+                        &dt_origin,
+                        format!(
+                            "dt = {dt} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
+                            scheme.label(),
+                            c0 * dt_max / h
+                        ),
+                    )]);
+                }
+            }
+            Err(e) => return Outcome::Invalid(vec![Issue::at(&origin(Key::Mass), e.to_string())]),
+        }
+    }
+
+    // Columns and canonical text.
+    let mut canonical = BTreeMap::new();
+    let mut put = |k: Key, v: Value, always: bool| {
+        let is_default = default_of(k).is_some_and(|d| same(&d, &v));
+        if always || !is_default {
+            canonical.insert(k, v.canonical());
+        }
+        params.insert(k, v);
+    };
+    put(Key::T, Value::Num(t_final), false);
+    put(Key::Elements, Value::Int(m as i64), true);
+    put(Key::Dt, Value::Num(dt), true);
+    put(Key::Space, Value::Str(space_name.clone()), false);
+    put(Key::Mass, Value::Str(mass_name.clone()), false);
+    put(Key::Scheme, Value::Str(scheme.family().into()), true);
+    if let MassVariant::Weights(w) = &mass {
+        put(Key::MassWeights, Value::List(w.clone()), true);
+    }
+    match method {
+        ContactMethod::Nitsche { theta, gamma0 } => {
+            put(Key::NitscheTheta, Value::Num(theta), false);
+            put(Key::NitscheGamma0, Value::Num(gamma0), true);
+        }
+        ContactMethod::Penalty { gamma0 } => put(Key::PenaltyGamma0, Value::Num(gamma0), true),
+        ContactMethod::Mixed => {}
+    }
+    match scheme {
+        Scheme::Newmark(p) => {
+            put(Key::NewmarkBeta, Value::Num(p.beta), false);
+            put(Key::NewmarkGamma, Value::Num(p.gamma), false);
+        }
+        Scheme::Theta(p) => put(Key::ThetaScheme, Value::Num(p.theta), true),
+        Scheme::PaoliSchatzman(p) => {
+            put(Key::NewmarkBeta, Value::Num(p.beta), false);
+            put(Key::Restitution, Value::Num(p.restitution), false);
+        }
+        Scheme::Hybrid => {}
+    }
+    put(Key::Length, Value::Num(bar.length), false);
+    put(Key::Young, Value::Num(bar.young), false);
+    put(Key::Density, Value::Num(bar.density), false);
+    put(Key::Amplitude, Value::Num(bar.amplitude), false);
+    put(Key::Gap, Value::Num(bar.gap), false);
+    // Derived columns, not part of the identity.
+    params.insert(Key::H, Value::Num(h));
+    params.insert(Key::Courant, Value::Num(courant));
+
+    let space_label = match method {
+        ContactMethod::Mixed => "mixed".to_string(),
+        ContactMethod::Nitsche { theta, gamma0 } => format!("nitsche(Θ={theta}, γ0={gamma0:e})"),
+        ContactMethod::Penalty { gamma0 } => format!("penalty(γ0={gamma0:e})"),
+    };
+    let mass_label = match &mass {
+        MassVariant::Weights(w) => format!(
+            "weights[{}]",
+            w.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(",")
+        ),
+        other => other.name().to_string(),
+    };
+    let scheme_label = scheme.label();
+    Outcome::Run(Box::new(Resolved {
+        params,
+        canonical,
+        label: format!("{space_label} · {mass_label} · {scheme_label}"),
+        scheme_names: [scheme.family().to_string(), scheme_label.clone()],
+        scheme_label,
+        config: Bar1dConfig {
+            bar,
+            elements: m,
+            dt,
+            steps,
+            method,
+            mass,
+            scheme,
+            perturbation: None,
+        },
+        dropped,
+    }))
+}
+
+/// ω²_max of the linear part, with and without the contact stiffness active.
+fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
+    let free = sp.stiffness_lin.max_generalized_eigenvalue(&sp.mass);
+    let mut active: Tridiag = sp.stiffness_lin.clone();
+    match sp.method {
+        ContactMethod::Mixed => {
+            // u₀ = −g held: node 0 clamped.
+            active.set_row(0, (0.0, 1.0, 0.0));
+            active.lower[0] = 0.0;
+        }
+        ContactMethod::Nitsche { gamma0, .. } => {
+            let k = 1.0 / (gamma0 * sp.h);
+            let p = sp.p.0;
+            active.add_element(0, [[k * p[0] * p[0], k * p[0] * p[1]], [k * p[0] * p[1], k * p[1] * p[1]]]);
+        }
+        ContactMethod::Penalty { gamma0 } => active.diag[0] += sp.penalty_stiffness(gamma0),
+    }
+    free.max(active.max_generalized_eigenvalue(&sp.mass))
+}
+
+/// Whether an exclude filter matches a resolved run.
+fn matches_filter(filter: &[Entry], r: &Resolved) -> bool {
+    filter.iter().all(|e| match (e.key, &e.value) {
+        (Key::Scheme, Value::Str(s)) => {
+            r.scheme_names.contains(s)
+                || resolve_scheme_alias(s).is_some_and(|lab| r.scheme_names[1] == lab)
+        }
+        (Key::H, v) => r.params.get(&Key::H).is_some_and(|x| same(x, v)),
+        (Key::Courant, v) => r.params.get(&Key::Courant).is_some_and(|x| same(x, v)),
+        (k, v) => r.params.get(&k).is_some_and(|x| same(x, v)),
+    })
+}
+
+fn resolve_scheme_alias(name: &str) -> Option<&'static str> {
+    match name {
+        "crank-nicolson" => Some("crank-nicolson"),
+        "newmark-dissipative" => Some("newmark-dissipative"),
+        "central-difference" => Some("central-difference"),
+        "backward-euler" => Some("backward-euler"),
+        _ => None,
+    }
+}
+
+/// Hash of the canonical text.
+pub fn run_id(scene: SceneKind, canonical: &BTreeMap<Key, String>, extra: &str) -> String {
+    let mut text = format!("contact-sweep/run/v1\nscene={}\n", scene.name());
+    for (k, v) in canonical {
+        let _ = writeln!(text, "{}={v}", k.name());
+    }
+    text.push_str(extra);
+    let digest = Sha256::digest(text.as_bytes());
+    digest[..8].iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// Expand a checked sweep file into its plan. Errors found in any combination are reported
+/// together, once each, before anything runs.
+pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
+    let mut axes: Vec<&Axis> = Vec::new();
+    if let Some(z) = &sweep.zip {
+        axes.push(z);
+    }
+    axes.extend(sweep.grid.iter());
+    let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
+    let combinations: usize = sizes.iter().product();
+    let mut idx = vec![0usize; axes.len()];
+    let mut runs = Vec::new();
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut issues: Vec<Issue> = Vec::new();
+    let mut excluded_by_filter = 0;
+    let mut inapplicable: BTreeMap<String, usize> = BTreeMap::new();
+    let mut collapsed: BTreeMap<String, usize> = BTreeMap::new();
+    for _ in 0..combinations {
+        let mut entries: Vec<&Entry> = sweep.fixed.iter().collect();
+        for (a, &i) in axes.iter().zip(&idx) {
+            entries.extend(a.items[i].iter());
+        }
+        match resolve(&entries) {
+            Outcome::Invalid(mut is) => issues.append(&mut is),
+            Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
+            Outcome::Run(r) => {
+                if sweep.exclude.iter().any(|f| matches_filter(f, &r)) {
+                    excluded_by_filter += 1;
+                } else {
+                    let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
+                        None => vec![None],
+                        Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
+                    };
+                    for sample in samples {
+                        let extra = match (sample, sweep.ensemble) {
+                            (Some((k, p)), Some(e)) => format!(
+                                "ensemble={},{},{k}\n",
+                                canonical_number(p),
+                                e.seed
+                            ),
+                            _ => String::new(),
+                        };
+                        let id = run_id(sweep.scene, &r.canonical, &extra);
+                        if seen.contains_key(&id) {
+                            let why = if r.dropped.is_empty() {
+                                "identical parameters after alias resolution".to_string()
+                            } else {
+                                r.dropped.join("; ")
+                            };
+                            *collapsed.entry(why).or_default() += 1;
+                            continue;
+                        }
+                        seen.insert(id.clone(), runs.len());
+                        let mut config = r.config.clone();
+                        if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
+                            let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
+                            config.perturbation = Some((p, seed));
+                        }
+                        runs.push(RunSpec {
+                            run_id: id,
+                            label: r.label.clone(),
+                            params: r.params.clone(),
+                            scheme_label: r.scheme_label.clone(),
+                            config: RunConfig::Bar1d(config),
+                            repeats: sweep.repeats,
+                            sample,
+                        });
+                    }
+                }
+            }
+        }
+        // odometer, last axis fastest
+        for d in (0..idx.len()).rev() {
+            idx[d] += 1;
+            if idx[d] < sizes[d] {
+                break;
+            }
+            idx[d] = 0;
+        }
+    }
+    if !issues.is_empty() {
+        issues.sort();
+        issues.dedup();
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            issues,
+        });
+    }
+    if runs.is_empty() {
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            issues: vec![Issue {
+                line: None,
+                key: "grid".into(),
+                reason: format!(
+                    "the sweep expands to no runs ({combinations} combinations: {excluded_by_filter} excluded by filters, {} inapplicable)",
+                    inapplicable.values().sum::<usize>()
+                ),
+            }],
+        });
+    }
+    Ok(Plan {
+        sweep: sweep.clone(),
+        runs,
+        combinations,
+        excluded_by_filter,
+        inapplicable,
+        collapsed,
+    })
+}
+
+impl Plan {
+    /// Parameter keys whose value differs between runs (the plan table's columns).
+    pub fn varying_keys(&self) -> Vec<Key> {
+        Key::ALL
+            .into_iter()
+            .filter(|k| {
+                let first = self.runs[0].params.get(k).map(Value::canonical);
+                self.runs.iter().any(|r| r.params.get(k).map(Value::canonical) != first)
+            })
+            .collect()
+    }
+
+    /// Human summary: counts, merges and reasons.
+    pub fn summary(&self) -> String {
+        let mut s = format!(
+            "sweep `{}` (scene {}): {} combinations → {} runs",
+            self.sweep.name,
+            self.sweep.scene.name(),
+            self.combinations,
+            self.runs.len()
+        );
+        if self.sweep.ensemble.is_some() {
+            s.push_str(" (ensemble members included)");
+        }
+        s.push('\n');
+        if self.excluded_by_filter > 0 {
+            let _ = writeln!(s, "  {} excluded by `exclude` filters", self.excluded_by_filter);
+        }
+        for (why, n) in &self.inapplicable {
+            let _ = writeln!(s, "  {n} left out as meaningless: {why}");
+        }
+        for (why, n) in &self.collapsed {
+            let _ = writeln!(s, "  {n} collapsed into identical runs: {why}");
+        }
+        s
+    }
+}
