@@ -1,0 +1,83 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use contact_sweep::run::bar1d::Bar1dConfig;
+use contact_sweep::run::{Outcome, RunConfig, RunOptions, Status, simulate};
+use contact_sweep::scene::BarParams;
+use contact_sweep::space::{ContactMethod, MassVariant};
+use contact_sweep::time::Scheme;
+
+pub fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_contact-sweep")
+}
+
+/// Run the binary with `args` in `cwd`.
+pub fn cli(cwd: &Path, args: &[&str]) -> Output {
+    Command::new(bin())
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("the binary starts")
+}
+
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// Simulate the default bar (or `bar`) and return the outcome, asserting it completed.
+pub fn bar1d(
+    bar: BarParams,
+    elements: usize,
+    dt: f64,
+    t_final: f64,
+    method: ContactMethod,
+    mass: MassVariant,
+    scheme: Scheme,
+    series_every: usize,
+) -> Outcome {
+    let cfg = Bar1dConfig::new(bar, elements, dt, t_final, method, mass, scheme);
+    simulate(
+        &RunConfig::Bar1d(cfg),
+        &RunOptions {
+            series_every,
+            timeout: None,
+        },
+    )
+}
+
+pub fn ok(o: Outcome) -> Outcome {
+    assert_eq!(o.status, Status::Ok, "run did not end ok: {:?}", o.message);
+    o
+}
+
+pub fn nitsche(theta: f64, gamma0: f64) -> ContactMethod {
+    ContactMethod::Nitsche { theta, gamma0 }
+}
+
+/// E(T)/E⁰.
+pub fn energy_ratio(o: &Outcome) -> f64 {
+    o.metrics.energy_final.unwrap() / o.metrics.energy_initial.unwrap()
+}
+
+/// Assert that `x` rounds to the figure printed in SPEC §6. The figures come from two
+/// independent implementations that agree to 1e-11, so the only uncertainty is the rounding of
+/// the printed digits: half a unit in the last printed place.
+pub fn assert_printed(what: &str, x: f64, printed: &str) {
+    assert_printed_within(what, x, printed, 0.5)
+}
+
+/// As [`assert_printed`] with a tolerance of `units` in the last printed place.
+pub fn assert_printed_within(what: &str, x: f64, printed: &str, units: f64) {
+    let target: f64 = printed.parse().unwrap();
+    let digits_after_point = printed.split('.').nth(1).map_or(0, |d| d.len());
+    let half_ulp = units * 10f64.powi(-(digits_after_point as i32));
+    assert!(
+        (x - target).abs() <= half_ulp * (1.0 + 1e-9),
+        "{what}: computed {x:.6e}, SPEC §6 prints {printed} (tolerance ±{half_ulp:e})"
+    );
+}
