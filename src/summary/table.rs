@@ -1,0 +1,334 @@
+//! Output plumbing shared by the summary tables: a typed column builder that becomes a polars
+//! `DataFrame` (written as Parquet and CSV), and the text formatting of Markdown and LaTeX
+//! (booktabs) tables.
+//!
+//! Tables are built row by row because the per-group arithmetic is plain Rust; every column is
+//! declared up front so that a table with no rows still has its schema (a reader filtering an
+//! empty `impacts.parquet` must find the columns, not fail on them).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use polars::prelude::*;
+
+use super::runs::Cell;
+
+/// The type of a declared column.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Kind {
+    F64,
+    I64,
+    Str,
+    Bool,
+}
+
+#[derive(Debug, Clone)]
+enum Values {
+    F64(Vec<Option<f64>>),
+    I64(Vec<Option<i64>>),
+    Str(Vec<Option<String>>),
+    Bool(Vec<Option<bool>>),
+}
+
+impl Values {
+    fn new(kind: Kind) -> Self {
+        match kind {
+            Kind::F64 => Values::F64(Vec::new()),
+            Kind::I64 => Values::I64(Vec::new()),
+            Kind::Str => Values::Str(Vec::new()),
+            Kind::Bool => Values::Bool(Vec::new()),
+        }
+    }
+
+    fn len(&self) -> usize {
+        match self {
+            Values::F64(v) => v.len(),
+            Values::I64(v) => v.len(),
+            Values::Str(v) => v.len(),
+            Values::Bool(v) => v.len(),
+        }
+    }
+
+    fn push_null(&mut self) {
+        match self {
+            Values::F64(v) => v.push(None),
+            Values::I64(v) => v.push(None),
+            Values::Str(v) => v.push(None),
+            Values::Bool(v) => v.push(None),
+        }
+    }
+}
+
+/// A table under construction: declared columns, filled one row at a time. A column not set
+/// in a row is null in that row.
+#[derive(Debug, Clone)]
+pub(crate) struct Table {
+    names: Vec<String>,
+    values: Vec<Values>,
+    index: HashMap<String, usize>,
+    rows: usize,
+}
+
+impl Table {
+    pub(crate) fn new(columns: &[(String, Kind)]) -> Self {
+        let mut t = Table {
+            names: Vec::new(),
+            values: Vec::new(),
+            index: HashMap::new(),
+            rows: 0,
+        };
+        for (name, kind) in columns {
+            // A name declared twice keeps its first declaration (parameter columns are appended
+            // after the fixed ones and must not shadow them).
+            if !t.index.contains_key(name) {
+                t.index.insert(name.clone(), t.names.len());
+                t.names.push(name.clone());
+                t.values.push(Values::new(*kind));
+            }
+        }
+        t
+    }
+
+    pub(crate) fn rows(&self) -> usize {
+        self.rows
+    }
+
+    fn slot(&mut self, name: &str) -> &mut Values {
+        let i = *self
+            .index
+            .get(name)
+            .unwrap_or_else(|| panic!("summary table: column `{name}` was not declared"));
+        let rows = self.rows;
+        let v = &mut self.values[i];
+        assert_eq!(v.len(), rows, "summary table: column `{name}` set twice in one row");
+        v
+    }
+
+    pub(crate) fn f64(&mut self, name: &str, x: Option<f64>) {
+        match self.slot(name) {
+            // NaN is a missing value in every output (Parquet readers disagree on NaN, and a
+            // NaN in a Markdown table reads as a bug).
+            Values::F64(v) => v.push(x.filter(|x| !x.is_nan())),
+            _ => panic!("summary table: column `{name}` is not f64"),
+        }
+    }
+
+    pub(crate) fn i64(&mut self, name: &str, x: Option<i64>) {
+        match self.slot(name) {
+            Values::I64(v) => v.push(x),
+            _ => panic!("summary table: column `{name}` is not i64"),
+        }
+    }
+
+    pub(crate) fn str(&mut self, name: &str, x: Option<&str>) {
+        match self.slot(name) {
+            Values::Str(v) => v.push(x.map(str::to_string)),
+            _ => panic!("summary table: column `{name}` is not a string"),
+        }
+    }
+
+    pub(crate) fn bool(&mut self, name: &str, x: Option<bool>) {
+        match self.slot(name) {
+            Values::Bool(v) => v.push(x),
+            _ => panic!("summary table: column `{name}` is not bool"),
+        }
+    }
+
+    pub(crate) fn cell(&mut self, name: &str, c: &Cell) {
+        match c {
+            Cell::F64(x) => self.f64(name, *x),
+            Cell::I64(x) => self.i64(name, *x),
+            Cell::Str(x) => self.str(name, x.as_deref()),
+        }
+    }
+
+    /// Close the current row: columns not set are null.
+    pub(crate) fn end_row(&mut self) {
+        for v in &mut self.values {
+            if v.len() == self.rows {
+                v.push_null();
+            }
+        }
+        self.rows += 1;
+    }
+
+    pub(crate) fn to_frame(&self) -> PolarsResult<DataFrame> {
+        let cols = self
+            .names
+            .iter()
+            .zip(&self.values)
+            .map(|(n, v)| {
+                let name: PlSmallStr = n.as_str().into();
+                match v {
+                    Values::F64(x) => Column::new(name, x),
+                    Values::I64(x) => Column::new(name, x),
+                    Values::Str(x) => Column::new(name, x),
+                    Values::Bool(x) => Column::new(name, x),
+                }
+            })
+            .collect();
+        DataFrame::new(self.rows, cols)
+    }
+}
+
+/// Write `table` as `dir/stem.parquet` and `dir/stem.csv`, both atomically. Returns the paths.
+pub(crate) fn write_table(dir: &Path, stem: &str, table: &Table) -> anyhow::Result<Vec<PathBuf>> {
+    let mut df = table
+        .to_frame()
+        .with_context(|| format!("building {stem} table"))?;
+    let parquet = format!("{stem}.parquet");
+    crate::sink::write_parquet_atomic(dir, &parquet, &mut df)?;
+    let mut csv = Vec::new();
+    CsvWriter::new(&mut csv)
+        .finish(&mut df)
+        .with_context(|| format!("{}: csv", dir.join(format!("{stem}.csv")).display()))?;
+    let csv_path = dir.join(format!("{stem}.csv"));
+    crate::sink::write_atomic(&csv_path, &csv)?;
+    Ok(vec![dir.join(parquet), csv_path])
+}
+
+/// Write text atomically; returns the path.
+pub(crate) fn write_text(dir: &Path, name: &str, text: &str) -> anyhow::Result<PathBuf> {
+    let path = dir.join(name);
+    crate::sink::write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// Alignment of a Markdown column.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Align {
+    Left,
+    Right,
+}
+
+/// A GitHub-flavoured Markdown table. `|` inside cells is escaped.
+pub(crate) fn markdown(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
+    let esc = |s: &str| s.replace('|', "\\|");
+    let mut out = String::new();
+    out.push_str("| ");
+    out.push_str(&header.iter().map(|h| esc(h)).collect::<Vec<_>>().join(" | "));
+    out.push_str(" |\n|");
+    for i in 0..header.len() {
+        out.push_str(match align.get(i).copied().unwrap_or(Align::Right) {
+            Align::Left => ":---|",
+            Align::Right => "---:|",
+        });
+    }
+    out.push('\n');
+    for r in rows {
+        out.push_str("| ");
+        out.push_str(&r.iter().map(|c| esc(c)).collect::<Vec<_>>().join(" | "));
+        out.push_str(" |\n");
+    }
+    out
+}
+
+/// A plain-text table for the terminal: columns padded to their widest cell (counted in
+/// characters, the labels carry Θ, γ, ·).
+pub(crate) fn plain(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
+    let n = header.len();
+    let mut width = vec![0usize; n];
+    for r in std::iter::once(header).chain(rows.iter().map(|r| r.as_slice())) {
+        for (i, c) in r.iter().enumerate().take(n) {
+            width[i] = width[i].max(c.chars().count());
+        }
+    }
+    let line = |r: &[String]| {
+        let mut s = String::from(" ");
+        for (i, c) in r.iter().enumerate().take(n) {
+            let pad = width[i] - c.chars().count();
+            match align.get(i).copied().unwrap_or(Align::Right) {
+                Align::Left => {
+                    s.push_str(c);
+                    s.push_str(&" ".repeat(pad));
+                }
+                Align::Right => {
+                    s.push_str(&" ".repeat(pad));
+                    s.push_str(c);
+                }
+            }
+            s.push_str("  ");
+        }
+        s.trim_end().to_string() + "\n"
+    };
+    let mut out = line(header);
+    for r in rows {
+        out.push_str(&line(r));
+    }
+    out
+}
+
+/// `1.2346e-2`: four significant decimals, enough to recompute a rate to about 1e-4.
+pub(crate) fn sci(x: Option<f64>) -> String {
+    match x {
+        Some(x) if x.is_finite() => format!("{x:.4e}"),
+        Some(x) => format!("{x}"),
+        None => String::new(),
+    }
+}
+
+/// A rate or slope: two decimals, as deal.II's ConvergenceTable prints them.
+pub(crate) fn rate(x: Option<f64>) -> String {
+    match x {
+        Some(x) if x.is_finite() => format!("{x:.2}"),
+        Some(x) => format!("{x}"),
+        None => String::new(),
+    }
+}
+
+/// LaTeX-safe text: the ASCII specials and the non-ASCII characters of the run labels.
+pub(crate) fn tex(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '\\' => out.push_str("\\textbackslash{}"),
+            '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '~' => out.push_str("\\textasciitilde{}"),
+            '^' => out.push_str("\\textasciicircum{}"),
+            '·' => out.push_str("$\\cdot$"),
+            'Θ' => out.push_str("$\\Theta$"),
+            'θ' => out.push_str("$\\theta$"),
+            'γ' => out.push_str("$\\gamma$"),
+            'β' => out.push_str("$\\beta$"),
+            'τ' => out.push_str("$\\tau$"),
+            'ν' => out.push_str("$\\nu$"),
+            'σ' => out.push_str("$\\sigma$"),
+            '≤' => out.push_str("$\\le$"),
+            '→' => out.push_str("$\\to$"),
+            '−' => out.push('-'),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// A number in LaTeX: `$1.2346\cdot10^{-2}$`.
+pub(crate) fn tex_sci(x: Option<f64>) -> String {
+    match x {
+        Some(x) if x.is_finite() && x != 0.0 => {
+            let s = format!("{x:.4e}");
+            let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
+            if e == "0" {
+                format!("${m}$")
+            } else {
+                format!("${m}\\cdot10^{{{e}}}$")
+            }
+        }
+        Some(x) if x == 0.0 => "$0$".into(),
+        Some(x) => tex(&format!("{x}")),
+        None => String::new(),
+    }
+}
+
+/// A rate in LaTeX (math minus sign).
+pub(crate) fn tex_rate(x: Option<f64>) -> String {
+    match x {
+        Some(x) if x.is_finite() => format!("${x:.2}$"),
+        Some(x) => tex(&format!("{x}")),
+        None => String::new(),
+    }
+}
