@@ -21,7 +21,11 @@ use crate::summary;
 use crate::sweep::{self, Plan, SweepError, SweepFile};
 
 #[derive(Debug, Parser)]
-#[command(name = "contact-sweep", version, about = "Parameter sweeps of dynamic Signorini-contact simulations, to Parquet and convergence tables")]
+#[command(
+    name = "contact-sweep",
+    version,
+    about = "Parameter sweeps of dynamic Signorini-contact simulations, to Parquet and convergence tables"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -60,7 +64,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub resume: bool,
     /// Stop a run after this many seconds (status `timeout`).
-    #[arg(long, value_name = "SECS")]
+    #[arg(long, value_name = "SECS", allow_negative_numbers = true)]
     pub run_timeout: Option<f64>,
     /// Keep every k-th time step in DIR/series (0: none); overrides the sweep's series_every.
     #[arg(long, value_name = "K")]
@@ -81,7 +85,9 @@ pub struct UsageError(pub String);
 /// Map an error to the exit status.
 pub fn exit_code(e: &anyhow::Error) -> u8 {
     for cause in e.chain() {
-        if cause.downcast_ref::<SweepError>().is_some() || cause.downcast_ref::<UsageError>().is_some() {
+        if cause.downcast_ref::<SweepError>().is_some()
+            || cause.downcast_ref::<UsageError>().is_some()
+        {
             return 2;
         }
         if let Some(SinkError::ForeignSweep { .. }) = cause.downcast_ref::<SinkError>() {
@@ -105,15 +111,20 @@ impl RunArgs {
     fn validate(self) -> Result<RunConfig> {
         let sweep = SweepFile::load(&self.sweep)?;
         let plan = sweep::expand(&sweep)?;
-        if let Some(t) = self.run_timeout {
-            if !(t.is_finite() && t > 0.0) {
-                return Err(UsageError(format!("--run-timeout must be a positive number of seconds, got {t}")).into());
-            }
+        if let Some(t) = self.run_timeout
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(UsageError(format!(
+                "--run-timeout must be a positive number of seconds, got {t}"
+            ))
+            .into());
         }
         if self.batch == 0 {
             return Err(UsageError("--batch must be at least 1".into()).into());
         }
-        let out = self.out.unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
+        let out = self
+            .out
+            .unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
         let series_every = self.series_every.unwrap_or(plan.sweep.series_every);
         Ok(RunConfig {
             exec: ExecOptions {
@@ -166,28 +177,39 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     let plan = &cfg.plan;
     let dir = &cfg.out;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    if let Some(found) = Manifest::existing_sweep(dir)? {
-        if found != plan.sweep.name && !cfg.resume {
-            return Err(SinkError::ForeignSweep {
-                path: dir.clone(),
-                found,
-                expected: plan.sweep.name.clone(),
-            }
-            .into());
+    if let Some(found) = Manifest::existing_sweep(dir)?
+        && found != plan.sweep.name
+        && !cfg.resume
+    {
+        return Err(SinkError::ForeignSweep {
+            path: dir.clone(),
+            found,
+            expected: plan.sweep.name.clone(),
         }
+        .into());
     }
     let (mut sink, done) = Sink::open(dir, cfg.batch)?;
-    let todo: Vec<&sweep::RunSpec> = plan.runs.iter().filter(|r| !done.contains(&r.run_id)).collect();
+    let todo: Vec<&sweep::RunSpec> = plan
+        .runs
+        .iter()
+        .filter(|r| !done.contains(&r.run_id))
+        .collect();
     let skipped = plan.runs.len() - todo.len();
     let threads = if cfg.exec.threads == 0 {
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
     } else {
         cfg.exec.threads
     };
     let mut manifest = Manifest::begin(dir, plan, plan.runs.len(), skipped, threads)?;
     eprint!("{}", plan.summary());
     if skipped > 0 {
-        eprintln!("resuming in {}: {skipped} of {} runs already done", dir.display(), plan.runs.len());
+        eprintln!(
+            "resuming in {}: {skipped} of {} runs already done",
+            dir.display(),
+            plan.runs.len()
+        );
     }
     let bar = ProgressBar::new(todo.len() as u64);
     if std::io::stderr().is_terminal() {
@@ -199,16 +221,24 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
     let (mut failed, mut diverged) = (0usize, 0usize);
-    let result = exec::execute(&plan.sweep.name, &todo, &ExecOptions { threads, ..cfg.exec }, |res| {
-        match res.record.status.as_str() {
-            "ok" => {}
-            "diverged" => diverged += 1,
-            _ => failed += 1,
-        }
-        bar.set_message(format!("failed {failed}, diverged {diverged}"));
-        bar.inc(1);
-        sink.push(res)
-    });
+    let result = exec::execute(
+        &plan.sweep.name,
+        &todo,
+        &ExecOptions {
+            threads,
+            ..cfg.exec
+        },
+        |res| {
+            match res.record.status.as_str() {
+                "ok" => {}
+                "diverged" => diverged += 1,
+                _ => failed += 1,
+            }
+            bar.set_message(format!("failed {failed}, diverged {diverged}"));
+            bar.inc(1);
+            sink.push(res)
+        },
+    );
     let flushed = sink.flush();
     bar.finish_and_clear();
     manifest.finish(sink.written, result.is_err() || flushed.is_err())?;
@@ -252,7 +282,10 @@ fn plan_table(plan: &Plan) -> String {
         .map(|(i, r)| {
             let mut row = vec![i.to_string(), r.run_id.clone()];
             row.extend(keys.iter().map(|k| {
-                r.params.get(k).map(|v| v.to_string()).unwrap_or_else(|| "—".into())
+                r.params
+                    .get(k)
+                    .map(|v| v.to_string())
+                    .unwrap_or_else(|| "—".into())
             }));
             row
         })
@@ -279,7 +312,9 @@ fn render(header: &[String], rows: &[Vec<String>]) -> String {
         s.trim_end().to_string() + "\n"
     };
     let mut out = line(header);
-    out.push_str(&line(&width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>()));
+    out.push_str(&line(
+        &width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
+    ));
     for r in rows {
         out.push_str(&line(r));
     }
@@ -290,25 +325,46 @@ fn render(header: &[String], rows: &[Vec<String>]) -> String {
 fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> {
     let df = crate::sink::read_runs(dir)?;
     let get_str = |name: &str| -> Result<Vec<Option<String>>> {
-        Ok(df.column(name)?.str()?.iter().map(|s| s.map(String::from)).collect())
+        Ok(df
+            .column(name)?
+            .str()?
+            .iter()
+            .map(|s| s.map(String::from))
+            .collect())
     };
-    let get_f64 = |name: &str| -> Result<Vec<Option<f64>>> {
-        Ok(df.column(name)?.f64()?.iter().collect())
-    };
+    let get_f64 =
+        |name: &str| -> Result<Vec<Option<f64>>> { Ok(df.column(name)?.f64()?.iter().collect()) };
     let run_ids = get_str("run_id")?;
     let status = get_str("status")?;
     let (e0, ef) = (get_f64("energy_initial")?, get_f64("energy_final")?);
-    let (l2, h1, sig) = (get_f64("err_u_l2l2")?, get_f64("err_u_l2h1")?, get_f64("err_sigma_l2")?);
-    let header: Vec<String> = ["#", "label", "h", "dt", "status", "E(T)/E0", "l2(τ;L2)", "l2(τ;H1)", "σ l2(τ)"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let (l2, h1, sig) = (
+        get_f64("err_u_l2l2")?,
+        get_f64("err_u_l2h1")?,
+        get_f64("err_sigma_l2")?,
+    );
+    let header: Vec<String> = [
+        "#",
+        "label",
+        "h",
+        "dt",
+        "status",
+        "E(T)/E0",
+        "l2(τ;L2)",
+        "l2(τ;H1)",
+        "σ l2(τ)",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let mut rows = Vec::new();
     for (i, r) in plan.runs.iter().enumerate() {
         if !ids.contains(r.run_id.as_str()) {
             continue;
         }
-        let Some(j) = run_ids.iter().position(|x| x.as_deref() == Some(r.run_id.as_str())) else {
+        let Some(j) = run_ids
+            .iter()
+            .position(|x| x.as_deref() == Some(r.run_id.as_str()))
+        else {
             continue;
         };
         let ratio = e0[j].zip(ef[j]).map(|(a, b)| b / a);
@@ -319,7 +375,9 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
             p(sweep::Key::H),
             p(sweep::Key::Dt),
             status[j].clone().unwrap_or_default(),
-            ratio.map(|x| format!("{x:.4}")).unwrap_or_else(|| "—".into()),
+            ratio
+                .map(|x| format!("{x:.4}"))
+                .unwrap_or_else(|| "—".into()),
             fmt_num(l2[j]),
             fmt_num(h1[j]),
             fmt_num(sig[j]),
@@ -333,7 +391,9 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
 
 /// The schema of DIR/runs and DIR/series as Markdown tables (the README's are generated here).
 pub fn schema_markdown() -> String {
-    let mut s = String::from("### `DIR/runs/*.parquet` — one row per run\n\n| column | type | unit | meaning |\n|---|---|---|---|\n");
+    let mut s = String::from(
+        "### `DIR/runs/*.parquet` — one row per run\n\n| column | type | unit | meaning |\n|---|---|---|---|\n",
+    );
     for (c, t, u, d) in RunRecord::COLUMNS {
         s.push_str(&format!("| `{c}` | {t} | {u} | {d} |\n"));
     }

@@ -18,7 +18,15 @@ const CN: Scheme = Scheme::Newmark(NewmarkParams {
 fn exact_solution_at_kinks_and_across_periods() {
     let ex = BarParams::default().exact().unwrap();
     // Contact node: ½ − t/2 before impact, 0 in contact (t ∈ [1, 2]), (t−2)/2 after.
-    for (t, u) in [(0.0, 0.5), (0.5, 0.25), (1.0, 0.0), (1.5, 0.0), (2.0, 0.0), (2.5, 0.25), (3.0, 0.5)] {
+    for (t, u) in [
+        (0.0, 0.5),
+        (0.5, 0.25),
+        (1.0, 0.0),
+        (1.5, 0.0),
+        (2.0, 0.0),
+        (2.5, 0.25),
+        (3.0, 0.5),
+    ] {
         assert!((ex.u(0.0, t) - u).abs() < 1e-14, "u(0,{t})");
         // periodic with period 3
         assert!((ex.u(0.0, t + 3.0) - u).abs() < 1e-14);
@@ -56,7 +64,11 @@ fn exact_solution_conserves_energy_and_satisfies_the_wave_equation() {
             let x = (i as f64 + 0.5) * dx;
             e += 0.5 * (p.density * ex.u_t(x, t).powi(2) + p.young * ex.u_x(x, t).powi(2)) * dx;
         }
-        assert!((e - ex.energy()).abs() < 2e-5 * ex.energy(), "t={t}: {e} vs {}", ex.energy());
+        assert!(
+            (e - ex.energy()).abs() < 2e-5 * ex.energy(),
+            "t={t}: {e} vs {}",
+            ex.energy()
+        );
     }
     // u_t from a central difference (u is affine in t between kinks).
     let (x, t, d) = (0.37, 0.9, 1e-7);
@@ -86,8 +98,14 @@ fn error_norms_are_integrated_exactly() {
             bl2 += (uh - ex.u(x, t)).powi(2) * dx;
             bh1 += (duh - ex.u_x(x, t)).powi(2) * dx;
         }
-        assert!((l2 - bl2).abs() < 1e-5 * bl2.max(1e-3), "t={t}: L2² {l2} vs {bl2}");
-        assert!((h1 - bh1).abs() < 1e-5 * bh1.max(1e-3), "t={t}: H1² {h1} vs {bh1}");
+        assert!(
+            (l2 - bl2).abs() < 1e-5 * bl2.max(1e-3),
+            "t={t}: L2² {l2} vs {bl2}"
+        );
+        assert!(
+            (h1 - bh1).abs() < 1e-5 * bh1.max(1e-3),
+            "t={t}: H1² {h1} vs {bh1}"
+        );
     }
 }
 
@@ -107,22 +125,57 @@ fn non_default_bar_scales_exactly_onto_the_default() {
     let mut rates = Vec::new();
     for (m, nu) in [(20usize, 1.0), (40, 1.0), (80, 1.0), (40, 0.5)] {
         let dt_hat = nu / m as f64;
-        let d = ok(bar1d(BarParams::default(), m, dt_hat, 12.0, ContactMethod::Mixed, MassVariant::Mod3, CN, 1));
-        let s = ok(bar1d(p, m, dt_hat * p.length / c0, 12.0 * p.length / c0, ContactMethod::Mixed, MassVariant::Mod3, CN, 1));
+        let d = ok(bar1d(
+            BarParams::default(),
+            m,
+            dt_hat,
+            12.0,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+            1,
+        ));
+        let s = ok(bar1d(
+            p,
+            m,
+            dt_hat * p.length / c0,
+            12.0 * p.length / c0,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+            1,
+        ));
         assert_eq!(d.metrics.steps, s.metrics.steps);
         let (a, l) = (p.amplitude, p.length);
         // err_u_l2l2 = 2a·sqrt(L·L/c0)·êrr (u scales by 2a, dx by L, τ by L/c0).
         let f_l2 = 2.0 * a * (l * l / c0).sqrt();
         let rel = |x: f64, y: f64| (x - y).abs() / y.abs();
-        assert!(rel(s.metrics.err_u_l2l2.unwrap(), f_l2 * d.metrics.err_u_l2l2.unwrap()) < 1e-10);
-        assert!(rel(s.metrics.err_u_contact_max.unwrap(), 2.0 * a * d.metrics.err_u_contact_max.unwrap()) < 1e-9);
+        assert!(
+            rel(
+                s.metrics.err_u_l2l2.unwrap(),
+                f_l2 * d.metrics.err_u_l2l2.unwrap()
+            ) < 1e-10
+        );
+        assert!(
+            rel(
+                s.metrics.err_u_contact_max.unwrap(),
+                2.0 * a * d.metrics.err_u_contact_max.unwrap()
+            ) < 1e-9
+        );
         // σ = E u_x scales by 2aE/L, τ by L/c0.
         let f_sig = 2.0 * a * p.young / l * (l / c0).sqrt();
-        assert!(rel(s.metrics.err_sigma_l2.unwrap(), f_sig * d.metrics.err_sigma_l2.unwrap()) < 1e-9);
+        assert!(
+            rel(
+                s.metrics.err_sigma_l2.unwrap(),
+                f_sig * d.metrics.err_sigma_l2.unwrap()
+            ) < 1e-9
+        );
         // Contact displacement time series, step by step, against the exact solution.
         for (rs, rd) in s.series.iter().zip(&d.series) {
             assert!((rs.u_contact - 2.0 * a * rd.u_contact).abs() < 1e-12);
-            assert!((rs.u_contact_exact.unwrap() - 2.0 * a * rd.u_contact_exact.unwrap()).abs() < 1e-14);
+            assert!(
+                (rs.u_contact_exact.unwrap() - 2.0 * a * rd.u_contact_exact.unwrap()).abs() < 1e-14
+            );
         }
         if nu == 1.0 {
             rates.push((l / m as f64, s.metrics.err_u_l2l2.unwrap()));
@@ -145,8 +198,20 @@ fn mass_totals_reported_per_run() {
         (MassVariant::Mod3, 1.0),
         (MassVariant::Weights(vec![1.5, 1.0]), 1.0 - h + 0.5 * h),
     ] {
-        let o = ok(bar1d(BarParams::default(), m, 0.05, 1.0, ContactMethod::Mixed, mass.clone(), CN, 0));
+        let o = ok(bar1d(
+            BarParams::default(),
+            m,
+            0.05,
+            1.0,
+            ContactMethod::Mixed,
+            mass.clone(),
+            CN,
+            0,
+        ));
         // A sum of 4m entries of size ≤ h: round-off ≤ 4m·ε ≈ 1e-14.
-        assert!((o.metrics.mass_total.unwrap() - total).abs() < 1e-14, "{mass:?}");
+        assert!(
+            (o.metrics.mass_total.unwrap() - total).abs() < 1e-14,
+            "{mass:?}"
+        );
     }
 }

@@ -20,24 +20,74 @@ const CN: Scheme = Scheme::Newmark(NewmarkParams {
 
 /// 003 §4.1.2a–b setting: h = 0.01, τ = 0.015 (ν = 1.5), T = 12.
 fn fig(method: ContactMethod, mass: MassVariant, scheme: Scheme) -> contact_sweep::run::Outcome {
-    bar1d(BarParams::default(), 100, 0.015, 12.0, method, mass, scheme, 1)
+    bar1d(
+        BarParams::default(),
+        100,
+        0.015,
+        12.0,
+        method,
+        mass,
+        scheme,
+        1,
+    )
 }
 
 #[test]
 fn fig2_fig3_table_of_spec_6() {
     let n = nitsche(1.0, 1e-6);
     let cases = [
-        ("backward Euler", n, MassVariant::Consistent, Scheme::Theta(ThetaParams::backward_euler()), ["0.1823", "0.2375", "0.6282"]),
-        ("Newmark γ=1, β=½", n, MassVariant::Consistent, Scheme::Newmark(NewmarkParams::dissipative()), ["0.3792", "0.1625", "0.5009"]),
-        ("Newmark γ=β=½", n, MassVariant::Consistent, Scheme::Newmark(NewmarkParams { beta: 0.5, gamma: 0.5 }), ["0.9994", "0.03820", "0.4628"]),
-        ("Nitsche-Hybrid", n, MassVariant::Consistent, Scheme::Hybrid, ["0.9890", "0.02791", "0.3915"]),
-        ("mixed + mod3 + CN", ContactMethod::Mixed, MassVariant::Mod3, CN, ["0.9957", "0.02608", "0.3748"]),
+        (
+            "backward Euler",
+            n,
+            MassVariant::Consistent,
+            Scheme::Theta(ThetaParams::backward_euler()),
+            ["0.1823", "0.2375", "0.6282"],
+        ),
+        (
+            "Newmark γ=1, β=½",
+            n,
+            MassVariant::Consistent,
+            Scheme::Newmark(NewmarkParams::dissipative()),
+            ["0.3792", "0.1625", "0.5009"],
+        ),
+        (
+            "Newmark γ=β=½",
+            n,
+            MassVariant::Consistent,
+            Scheme::Newmark(NewmarkParams {
+                beta: 0.5,
+                gamma: 0.5,
+            }),
+            ["0.9994", "0.03820", "0.4628"],
+        ),
+        (
+            "Nitsche-Hybrid",
+            n,
+            MassVariant::Consistent,
+            Scheme::Hybrid,
+            ["0.9890", "0.02791", "0.3915"],
+        ),
+        (
+            "mixed + mod3 + CN",
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+            ["0.9957", "0.02608", "0.3748"],
+        ),
     ];
     for (what, method, mass, scheme, [e, l2, h1]) in cases {
         let o = ok(fig(method, mass, scheme));
         assert_printed(&format!("{what} E(T)/E0"), energy_ratio(&o), e);
-        assert_printed(&format!("{what} l2(τ;L2)"), o.metrics.err_u_l2l2.unwrap(), l2);
-        assert_printed(&format!("{what} l2(τ;H1)"), o.metrics.err_u_l2h1.unwrap(), h1);
+        assert_printed(
+            &format!("{what} l2(τ;L2)"),
+            o.metrics.err_u_l2l2.unwrap(),
+            l2,
+        );
+        assert_printed(
+            &format!("{what} l2(τ;H1)"),
+            o.metrics.err_u_l2h1.unwrap(),
+            h1,
+        );
     }
 }
 
@@ -46,7 +96,11 @@ fn crank_nicolson_with_consistent_mass_is_ill_posed_energy_grows() {
     for method in [ContactMethod::Mixed, nitsche(1.0, 1e-6)] {
         let o = ok(fig(method, MassVariant::Consistent, CN));
         // Behaviour only (SPEC §6): growth by more than 5 % and at least one increasing step.
-        assert!(energy_ratio(&o) > 1.05, "{method:?}: E(T)/E0 = {}", energy_ratio(&o));
+        assert!(
+            energy_ratio(&o) > 1.05,
+            "{method:?}: E(T)/E0 = {}",
+            energy_ratio(&o)
+        );
         assert!(o.metrics.energy_max_increase.unwrap() > 0.0);
     }
 }
@@ -60,7 +114,11 @@ fn gamma0_tenth_theta_variants() {
     }
     let hy = [(1.0, "0.9855"), (0.0, "0.9876"), (-1.0, "0.9896")];
     for (theta, e) in hy {
-        let o = ok(fig(nitsche(theta, 0.1), MassVariant::Consistent, Scheme::Hybrid));
+        let o = ok(fig(
+            nitsche(theta, 0.1),
+            MassVariant::Consistent,
+            Scheme::Hybrid,
+        ));
         assert_printed(&format!("hybrid Θ={theta}"), energy_ratio(&o), e);
     }
 }
@@ -71,7 +129,10 @@ fn gamma0_one_symmetric_is_unphysical_but_augmented_energy_holds() {
         let o = ok(fig(nitsche(1.0, 1.0), MassVariant::Consistent, scheme));
         // E^h peaks about 231·E0 in each contact phase (SPEC §6): max |E − E0|/E0 ≈ 230.
         let peak = 1.0 + o.metrics.energy_max_dev.unwrap();
-        assert!((200.0..260.0).contains(&peak), "{scheme:?}: peak E/E0 = {peak}");
+        assert!(
+            (200.0..260.0).contains(&peak),
+            "{scheme:?}: peak E/E0 = {peak}"
+        );
         // …while E_Θ stays within 1 %.
         let et0 = o.series[0].energy_theta.unwrap();
         let dev = o
@@ -96,7 +157,11 @@ fn gamma0_three_symmetric_diverges_before_any_contact() {
     let msg = o.message.unwrap();
     assert!(msg.contains("exceeded 1e6"), "{msg}");
     // The first impact is at t = 1 (SPEC §1.1): A_Θγ is indefinite, growth starts at once.
-    assert!((o.metrics.steps as f64) * 0.015 < 1.0, "diverged at step {}", o.metrics.steps);
+    assert!(
+        (o.metrics.steps as f64) * 0.015 < 1.0,
+        "diverged at step {}",
+        o.metrics.steps
+    );
 }
 
 #[test]
@@ -109,7 +174,11 @@ fn large_gamma0_non_symmetric_stays_finite() {
         (-1.0, 100.0, "6.02"),
     ] {
         let o = ok(fig(nitsche(theta, gamma0), MassVariant::Consistent, CN));
-        assert_printed(&format!("CN Θ={theta} γ0={gamma0}"), energy_ratio(&o), printed);
+        assert_printed(
+            &format!("CN Θ={theta} γ0={gamma0}"),
+            energy_ratio(&o),
+            printed,
+        );
     }
     // Nitsche-Hybrid with Θ = −1 blows up after the first impact for γ0 ≥ 3.
     let o = fig(nitsche(-1.0, 3.0), MassVariant::Consistent, Scheme::Hybrid);
@@ -133,7 +202,16 @@ fn zero_contact_mass_removes_oscillations() {
 
 /// 000 §4.2: Δx = 1/6, Δt = 1/100.
 fn p000(mass: MassVariant, scheme: Scheme, t: f64) -> contact_sweep::run::Outcome {
-    ok(bar1d(BarParams::default(), 6, 0.01, t, ContactMethod::Mixed, mass, scheme, 0))
+    ok(bar1d(
+        BarParams::default(),
+        6,
+        0.01,
+        t,
+        ContactMethod::Mixed,
+        mass,
+        scheme,
+        0,
+    ))
 }
 
 #[test]
@@ -144,7 +222,11 @@ fn paper000_mass_redistribution_errors() {
         (MassVariant::Mod3, "0.04349"),
     ] {
         let o = p000(mass.clone(), CN, 3.0);
-        assert_printed(&format!("{mass:?} CN l2(τ;L2) at T=3"), o.metrics.err_u_l2l2.unwrap(), printed);
+        assert_printed(
+            &format!("{mass:?} CN l2(τ;L2) at T=3"),
+            o.metrics.err_u_l2l2.unwrap(),
+            printed,
+        );
         assert_printed("E0", o.metrics.energy_initial.unwrap(), "0.10417");
     }
     // mod3 < mod2 < mod1 also for backward Euler and the hybrid, at T = 3, 6, 12.
@@ -162,7 +244,11 @@ fn paper000_mass_redistribution_errors() {
 #[test]
 fn paper000_paoli_schatzman_runs_with_every_redistribution() {
     for mass in [MassVariant::Mod1, MassVariant::Mod2, MassVariant::Mod3] {
-        let o = p000(mass.clone(), Scheme::PaoliSchatzman(PaoliSchatzmanParams::paper()), 12.0);
+        let o = p000(
+            mass.clone(),
+            Scheme::PaoliSchatzman(PaoliSchatzmanParams::paper()),
+            12.0,
+        );
         // (β, e) = (¼, 1) conserves energy up to the O(τ) velocity reconstruction: within 1 %.
         let r = energy_ratio(&o);
         assert!((r - 1.0).abs() < 0.01, "{mass:?}: E(T)/E0 = {r}");
@@ -173,25 +259,81 @@ fn paper000_paoli_schatzman_runs_with_every_redistribution() {
 fn fig10_ladder_h_equals_tau() {
     let levels = [4usize, 16, 64, 256];
     let cases: [(&str, ContactMethod, MassVariant, Scheme, [&str; 4]); 4] = [
-        ("mixed+CN", ContactMethod::Mixed, MassVariant::Consistent, CN, ["2.373", "1.470", "3.166", "4.610"]),
-        ("Nitsche-Hybrid", nitsche(1.0, 1e-6), MassVariant::Consistent, Scheme::Hybrid, ["0.7243", "0.5428", "0.3664", "0.2347"]),
-        ("mod3+CN", ContactMethod::Mixed, MassVariant::Mod3, CN, ["0.7641", "0.5186", "0.3337", "0.2224"]),
-        ("zero-contact+CN", ContactMethod::Mixed, MassVariant::ZeroContact, CN, ["1.534", "0.7234", "0.3667", "0.2155"]),
+        (
+            "mixed+CN",
+            ContactMethod::Mixed,
+            MassVariant::Consistent,
+            CN,
+            ["2.373", "1.470", "3.166", "4.610"],
+        ),
+        (
+            "Nitsche-Hybrid",
+            nitsche(1.0, 1e-6),
+            MassVariant::Consistent,
+            Scheme::Hybrid,
+            ["0.7243", "0.5428", "0.3664", "0.2347"],
+        ),
+        (
+            "mod3+CN",
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+            ["0.7641", "0.5186", "0.3337", "0.2224"],
+        ),
+        (
+            "zero-contact+CN",
+            ContactMethod::Mixed,
+            MassVariant::ZeroContact,
+            CN,
+            ["1.534", "0.7234", "0.3667", "0.2155"],
+        ),
     ];
     for (what, method, mass, scheme, printed) in cases {
         for (m, p) in levels.iter().zip(printed) {
             let h = 1.0 / *m as f64;
-            let o = ok(bar1d(BarParams::default(), *m, h, 12.0, method, mass.clone(), scheme, 0));
+            let o = ok(bar1d(
+                BarParams::default(),
+                *m,
+                h,
+                12.0,
+                method,
+                mass.clone(),
+                scheme,
+                0,
+            ));
             // One unit in the last place: SPEC's 2.373 for mixed+CN at h = 1/4 is the double
             // rounding of 2.37249 (→ 2.3725 → 2.373); every other figure matches to ±½ unit.
-            assert_printed_within(&format!("{what} h=1/{m}"), o.metrics.err_u_l2h1.unwrap(), p, 1.0);
+            assert_printed_within(
+                &format!("{what} h=1/{m}"),
+                o.metrics.err_u_l2h1.unwrap(),
+                p,
+                1.0,
+            );
         }
     }
     // Nitsche + CN (γ0 = 1e-6) is "nearly the same" as mixed + CN: within 1 % at every level.
     for m in levels {
         let h = 1.0 / m as f64;
-        let a = ok(bar1d(BarParams::default(), m, h, 12.0, ContactMethod::Mixed, MassVariant::Consistent, CN, 0));
-        let b = ok(bar1d(BarParams::default(), m, h, 12.0, nitsche(1.0, 1e-6), MassVariant::Consistent, CN, 0));
+        let a = ok(bar1d(
+            BarParams::default(),
+            m,
+            h,
+            12.0,
+            ContactMethod::Mixed,
+            MassVariant::Consistent,
+            CN,
+            0,
+        ));
+        let b = ok(bar1d(
+            BarParams::default(),
+            m,
+            h,
+            12.0,
+            nitsche(1.0, 1e-6),
+            MassVariant::Consistent,
+            CN,
+            0,
+        ));
         let (x, y) = (a.metrics.err_u_l2h1.unwrap(), b.metrics.err_u_l2h1.unwrap());
         assert!((x - y).abs() < 0.01 * x, "h=1/{m}: mixed {x}, Nitsche {y}");
     }

@@ -113,6 +113,12 @@ fn backward_euler_augmented_energy_non_increasing() {
             0,
         ));
         let inc = o.metrics.energy_theta_max_increase.unwrap();
-        assert!(inc <= TOL, "m={} dt={} γ0={}: {inc:e}", d.elements, d.dt, d.gamma0);
+        assert!(
+            inc <= TOL,
+            "m={} dt={} γ0={}: {inc:e}",
+            d.elements,
+            d.dt,
+            d.gamma0
+        );
     }
 }

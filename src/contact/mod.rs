@@ -54,17 +54,16 @@ impl ContactLaw {
                 if s_prev > 0.0 {
                     // midpoint: k[(s_prev + s)/2]₊
                     let b = -s_prev;
-                    ([pc(-INF, b, 0.0, 0.0), pc(b, INF, k / 2.0, k * s_prev / 2.0)], 2)
+                    (
+                        [pc(-INF, b, 0.0, 0.0), pc(b, INF, k / 2.0, k * s_prev / 2.0)],
+                        2,
+                    )
                 } else {
                     // Crank–Nicolson ([s_prev]₊ = 0) and the H(0) = ½ average coincide: k[s]₊/2
                     ([pc(-INF, 0.0, 0.0, 0.0), pc(0.0, INF, k / 2.0, 0.0)], 2)
                 }
             }
-            ContactLaw::HybridReduced {
-                k,
-                s_prev,
-                offset,
-            } => {
+            ContactLaw::HybridReduced { k, s_prev, offset } => {
                 if s_prev < 0.0 {
                     let b = -s_prev;
                     (
@@ -86,11 +85,17 @@ impl ContactLaw {
 /// Why the scalar contact equation could not be solved.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
 pub enum ContactSolveError {
-    #[error("the contact equation has no solution (well-posedness condition of 003 §2.2.3 violated: 1 − w·φ' ≤ 0 on a branch, w = {w:.3e})")]
+    #[error(
+        "the contact equation has no solution (well-posedness condition of 003 §2.2.3 violated: 1 − w·φ' ≤ 0 on a branch, w = {w:.3e})"
+    )]
     NoSolution { w: f64 },
-    #[error("the contact equation has several solutions (well-posedness condition of 003 §2.2.3 violated: 1 − w·φ' ≤ 0 on a branch, w = {w:.3e})")]
+    #[error(
+        "the contact equation has several solutions (well-posedness condition of 003 §2.2.3 violated: 1 − w·φ' ≤ 0 on a branch, w = {w:.3e})"
+    )]
     Multiple { w: f64 },
-    #[error("the condensed contact operator is not positive (w = {w:.3e}); the multiplier is undetermined")]
+    #[error(
+        "the condensed contact operator is not positive (w = {w:.3e}); the multiplier is undetermined"
+    )]
     NonPositive { w: f64 },
 }
 
@@ -106,7 +111,10 @@ pub fn solve(law: &ContactLaw, s_free: f64, w: f64) -> Result<ContactSolution, C
     if let ContactLaw::Complementarity = law {
         // s = s_free + w λ with λ ≤ 0 ⊥ s ≥ 0; unique iff w < 0 (A SPD gives w = −(A⁻¹)₀₀ < 0).
         if s_free >= 0.0 {
-            return Ok(ContactSolution { s: s_free, phi: 0.0 });
+            return Ok(ContactSolution {
+                s: s_free,
+                phi: 0.0,
+            });
         }
         if w >= 0.0 || !w.is_finite() {
             return Err(ContactSolveError::NonPositive { w });
@@ -183,7 +191,10 @@ mod tests {
 
     #[test]
     fn hybrid_switch_is_continuous_at_its_breakpoint() {
-        let law = ContactLaw::HybridNitsche { k: -4.0, s_prev: 0.2 };
+        let law = ContactLaw::HybridNitsche {
+            k: -4.0,
+            s_prev: 0.2,
+        };
         // With w = 0 the solution is s_free itself and φ = k[(0.2 + s)/2]₊.
         let r = solve(&law, 0.1, 0.0).unwrap();
         assert!((r.phi + 4.0 * 0.15).abs() < 1e-15);

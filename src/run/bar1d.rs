@@ -111,7 +111,10 @@ impl Engine {
         let (c, cf) = scheme.coefficients(tau);
         let reduced = matches!(scheme, Scheme::Hybrid) && sp.method == ContactMethod::Mixed;
         if reduced && !sp.massless_contact {
-            return Err("the hybrid scheme with the mixed method needs a massless contact node (000 §5)".into());
+            return Err(
+                "the hybrid scheme with the mixed method needs a massless contact node (000 §5)"
+                    .into(),
+            );
         }
         let mut klin = sp.stiffness_lin.clone();
         if reduced {
@@ -142,7 +145,9 @@ impl Engine {
         if sp.massless_contact {
             mfree.set_row(0, (0.0, 1.0, 0.0));
         }
-        let mass_lu = mfree.factor().ok_or("the mass matrix of the free nodes is singular")?;
+        let mass_lu = mfree
+            .factor()
+            .ok_or("the mass matrix of the free nodes is singular")?;
         let mut z = vec![0.0; m];
         z[0] = qt[0];
         z[1] = qt[1];
@@ -235,7 +240,12 @@ impl Engine {
     }
 
     /// Solve A y = b, the scalar contact problem, and set y ← y + φ z. Returns (s, φ).
-    fn solve_step(&self, wk: &mut Work, law: &ContactLaw, p0: f64) -> Result<(f64, f64), ContactSolveError> {
+    fn solve_step(
+        &self,
+        wk: &mut Work,
+        law: &ContactLaw,
+        p0: f64,
+    ) -> Result<(f64, f64), ContactSolveError> {
         self.a_lu.solve_in_place(&mut wk.b);
         std::mem::swap(&mut wk.b, &mut wk.y);
         let s_free = self.p.dot(&wk.y) + p0;
@@ -289,7 +299,11 @@ impl Engine {
         }
         let law = self.step_law(st.s_prev);
         let incremental = matches!(self.scheme, Scheme::Hybrid);
-        let p0 = if incremental { self.p0 + self.p.dot(&st.u) } else { self.p0 };
+        let p0 = if incremental {
+            self.p0 + self.p.dot(&st.u)
+        } else {
+            self.p0
+        };
         let (s, phi) = self.solve_step(wk, &law, p0)?;
         if incremental {
             // wk.y = Δu: velocity first, then u^{n+1} = uⁿ + Δu.
@@ -366,7 +380,11 @@ fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), Contac
     eng.acceleration_into(&u, phi, &mut a);
     let s_prev = eng.p.dot(&u) + eng.p0;
     let sigma = if sp.method == ContactMethod::Mixed {
-        if sp.massless_contact { sp.contact_pressure(&u) } else { phi }
+        if sp.massless_contact {
+            sp.contact_pressure(&u)
+        } else {
+            phi
+        }
     } else {
         sp.contact_pressure(&u)
     };
@@ -446,7 +464,10 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                 beta: ps.beta,
                 gamma: 0.5,
             });
-            match (Engine::new(sp.clone(), cfg.scheme, tau), Engine::new(sp.clone(), nm, tau)) {
+            match (
+                Engine::new(sp.clone(), cfg.scheme, tau),
+                Engine::new(sp.clone(), nm, tau),
+            ) {
                 (Ok(a), Ok(b)) => (a, Some(b)),
                 (Err(e), _) | (_, Err(e)) => return fail(Status::SolverFailed, e, metrics),
             }
@@ -473,15 +494,20 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(x) => x,
         Err(e) => {
             metrics.solver_failures = 1;
-            return fail(Status::SolverFailed, format!("initial state (t = 0): {e}"), metrics);
+            return fail(
+                Status::SolverFailed,
+                format!("initial state (t = 0): {e}"),
+                metrics,
+            );
         }
     };
     let timed_out = |n: usize| {
-        n % CLOCK_EVERY == 0 && opts.timeout.is_some_and(|limit| start.elapsed() > limit)
+        n.is_multiple_of(CLOCK_EVERY) && opts.timeout.is_some_and(|limit| start.elapsed() > limit)
     };
     let mut done = 0usize;
     let stop = (|| -> Result<(), Stop> {
-        rec.record(0, &st.u, &st.v, sigma0).map_err(Stop::Diverged)?;
+        rec.record(0, &st.u, &st.v, sigma0)
+            .map_err(Stop::Diverged)?;
         match &starter {
             None => {
                 for n in 1..=cfg.steps {
@@ -498,10 +524,14 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
             Some(first) => {
                 // U¹ from Newmark(β, ½); then U^{n+1} from (U^n, U^{n−1}) and v^n centred.
                 let mut prev = st.u.clone();
-                first.step(&mut st, &mut wk).map_err(|e| Stop::Solver(1, e))?;
+                first
+                    .step(&mut st, &mut wk)
+                    .map_err(|e| Stop::Solver(1, e))?;
                 metrics.iterations += 1;
                 let mut vn = vec![0.0; m];
-                let Scheme::PaoliSchatzman(ps) = cfg.scheme else { unreachable!() };
+                let Scheme::PaoliSchatzman(ps) = cfg.scheme else {
+                    unreachable!()
+                };
                 let e = ps.restitution;
                 for n in 1..=cfg.steps {
                     // b = M(2Uⁿ − Uⁿ⁻¹) − τ²K((1−2β)Uⁿ + βUⁿ⁻¹)

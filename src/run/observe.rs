@@ -104,11 +104,7 @@ pub const DIVERGENCE_FACTOR: f64 = 1e6;
 
 impl Observer {
     pub fn new(tau: f64, series_every: usize, last_step: usize) -> Self {
-        let cap = if series_every == 0 {
-            0
-        } else {
-            last_step / series_every + 2
-        };
+        let cap = last_step.checked_div(series_every).map_or(0, |n| n + 2);
         Self {
             tau,
             every: series_every,
@@ -180,7 +176,7 @@ impl Observer {
             self.sum_energy += de * de;
             self.max_contact = self.max_contact.max((v.u_contact - x.u_contact).abs());
         }
-        if self.every > 0 && (v.step % self.every == 0 || v.step == self.last_step) {
+        if self.every > 0 && (v.step.is_multiple_of(self.every) || v.step == self.last_step) {
             self.series.push(SeriesRow {
                 step: v.step as i64,
                 t: v.t,

@@ -149,19 +149,52 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
     ("t", "f64", "s", "time t^n"),
     ("u_contact", "f64", "m", "displacement of the contact node"),
     ("v_contact", "f64", "m/s", "velocity of the contact node"),
-    ("sigma_contact", "f64", "Pa", "contact pressure σ_C (≤ 0 in contact)"),
-    ("energy", "f64", "J", "E^h (plus the penalty potential for penalty)"),
-    ("energy_theta", "Option<f64>", "J", "augmented energy E_Θ (Nitsche)"),
-    ("u_contact_exact", "Option<f64>", "m", "closed-form contact displacement"),
-    ("sigma_contact_exact", "Option<f64>", "Pa", "closed-form contact stress"),
+    (
+        "sigma_contact",
+        "f64",
+        "Pa",
+        "contact pressure σ_C (≤ 0 in contact)",
+    ),
+    (
+        "energy",
+        "f64",
+        "J",
+        "E^h (plus the penalty potential for penalty)",
+    ),
+    (
+        "energy_theta",
+        "Option<f64>",
+        "J",
+        "augmented energy E_Θ (Nitsche)",
+    ),
+    (
+        "u_contact_exact",
+        "Option<f64>",
+        "m",
+        "closed-form contact displacement",
+    ),
+    (
+        "sigma_contact_exact",
+        "Option<f64>",
+        "Pa",
+        "closed-form contact stress",
+    ),
 ];
 
 /// The time series of a batch as typed columns.
 pub fn series_columns(rows: &[(String, SeriesRow)]) -> Vec<(&'static str, ColumnData)> {
-    let f = |g: fn(&SeriesRow) -> Option<f64>| ColumnData::F64(rows.iter().map(|(_, r)| g(r)).collect());
+    let f = |g: fn(&SeriesRow) -> Option<f64>| {
+        ColumnData::F64(rows.iter().map(|(_, r)| g(r)).collect())
+    };
     vec![
-        ("run_id", ColumnData::Str(rows.iter().map(|(id, _)| Some(id.clone())).collect())),
-        ("step", ColumnData::I64(rows.iter().map(|(_, r)| Some(r.step)).collect())),
+        (
+            "run_id",
+            ColumnData::Str(rows.iter().map(|(id, _)| Some(id.clone())).collect()),
+        ),
+        (
+            "step",
+            ColumnData::I64(rows.iter().map(|(_, r)| Some(r.step)).collect()),
+        ),
         ("t", f(|r| Some(r.t))),
         ("u_contact", f(|r| Some(r.u_contact))),
         ("v_contact", f(|r| Some(r.v_contact))),
@@ -213,7 +246,11 @@ impl RunRecord {
             space: s(Key::Space),
             mass: s(Key::Mass),
             mass_weights: p.get(&Key::MassWeights).map(|v| match v {
-                Value::List(w) => w.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(","),
+                Value::List(w) => w
+                    .iter()
+                    .map(|x| x.to_string())
+                    .collect::<Vec<_>>()
+                    .join(","),
                 other => other.to_string(),
             }),
             scheme: s(Key::Scheme),

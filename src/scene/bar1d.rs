@@ -93,7 +93,11 @@ impl BarExact {
     fn scaled_time(&self, t: f64) -> f64 {
         let s = self.p.wave_speed() * t / self.p.length;
         let r = s.round();
-        if (s - r).abs() <= 1e-12 * r.abs().max(1.0) { r } else { s }
+        if (s - r).abs() <= 1e-12 * r.abs().max(1.0) {
+            r
+        } else {
+            s
+        }
     }
 
     fn scaled(&self, x: f64, t: f64) -> RefValue {
@@ -137,7 +141,11 @@ impl BarExact {
         let l = self.p.length;
         let s = self.scaled_time(t);
         let f = s.rem_euclid(3.0).fract();
-        let (k1, k2) = if f <= 0.5 { (f * l, (1.0 - f) * l) } else { ((1.0 - f) * l, f * l) };
+        let (k1, k2) = if f <= 0.5 {
+            (f * l, (1.0 - f) * l)
+        } else {
+            ((1.0 - f) * l, f * l)
+        };
         let m = nodal.len();
         let (mut l2, mut h1) = (0.0, 0.0);
         for i in 0..m {

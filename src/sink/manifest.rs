@@ -107,7 +107,10 @@ impl Manifest {
 
     /// Close the session with its end time and the number of rows written.
     pub fn finish(&mut self, written: usize, interrupted: bool) -> Result<(), SinkError> {
-        if let Some(last) = self.doc["sessions"].as_array_mut().and_then(|a| a.last_mut()) {
+        if let Some(last) = self.doc["sessions"]
+            .as_array_mut()
+            .and_then(|a| a.last_mut())
+        {
             last["finished"] = Json::from(now());
             last["runs_written"] = Json::from(written);
             last["interrupted"] = Json::from(interrupted);

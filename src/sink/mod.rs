@@ -33,14 +33,16 @@ use crate::run::{RunRecord, SeriesRow};
 /// Failures of the output folder.
 #[derive(Debug, thiserror::Error)]
 pub enum SinkError {
-    #[error("{path}: {source}")]
+    #[error("{path}")]
     Io {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path}: parquet: {source}")]
+    #[error("{path}: parquet")]
     Parquet { path: PathBuf, source: PolarsError },
-    #[error("{path}: holds results of sweep `{found}`, not `{expected}`; choose another --out, or pass --resume to add this sweep's runs to it")]
+    #[error(
+        "{path}: holds results of sweep `{found}`, not `{expected}`; choose another --out, or pass --resume to add this sweep's runs to it"
+    )]
     ForeignSweep {
         path: PathBuf,
         found: String,
@@ -123,12 +125,13 @@ pub fn committed_run_ids(runs_dir: &Path) -> Result<HashSet<String>, SinkError> 
                 path: part.clone(),
                 source,
             })?;
-        let col = df.column("run_id").and_then(|c| c.str().cloned()).map_err(|source| {
-            SinkError::Parquet {
+        let col = df
+            .column("run_id")
+            .and_then(|c| c.str().cloned())
+            .map_err(|source| SinkError::Parquet {
                 path: part.clone(),
                 source,
-            }
-        })?;
+            })?;
         ids.extend(col.iter().flatten().map(String::from));
     }
     Ok(ids)
@@ -191,7 +194,10 @@ impl Sink {
         for d in [&runs_dir, &series_dir] {
             for entry in fs::read_dir(d).map_err(io(d))? {
                 let p = entry.map_err(io(d))?.path();
-                if p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with(".tmp-")) {
+                if p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with(".tmp-"))
+                {
                     fs::remove_file(&p).map_err(io(&p))?;
                 }
             }
@@ -227,7 +233,8 @@ impl Sink {
     /// Add a finished run; flush if the batch is full or old.
     pub fn push(&mut self, result: RunResult) -> Result<(), SinkError> {
         let id = result.record.run_id.clone();
-        self.series.extend(result.series.into_iter().map(|r| (id.clone(), r)));
+        self.series
+            .extend(result.series.into_iter().map(|r| (id.clone(), r)));
         self.rows.push(result.record);
         if self.rows.len() >= self.policy.runs
             || self.last_flush.elapsed() >= Duration::from_secs_f64(self.policy.seconds)
@@ -250,12 +257,11 @@ impl Sink {
             source,
         })?;
         write_parquet_atomic(&self.series_dir, &name, &mut sdf)?;
-        let mut rdf = frame(RunRecord::to_columns(&self.rows)).map_err(|source| {
-            SinkError::Parquet {
+        let mut rdf =
+            frame(RunRecord::to_columns(&self.rows)).map_err(|source| SinkError::Parquet {
                 path: self.runs_dir.join(&name),
                 source,
-            }
-        })?;
+            })?;
         write_parquet_atomic(&self.runs_dir, &name, &mut rdf)?;
         sync_dir(&self.series_dir)?;
         sync_dir(&self.runs_dir)?;
@@ -282,10 +288,12 @@ fn read_parts(dir: &Path) -> Result<DataFrame, SinkError> {
     let mut frames = Vec::with_capacity(parts.len());
     for p in &parts {
         let file = File::open(p).map_err(io(p))?;
-        let df = ParquetReader::new(file).finish().map_err(|source| SinkError::Parquet {
-            path: p.clone(),
-            source,
-        })?;
+        let df = ParquetReader::new(file)
+            .finish()
+            .map_err(|source| SinkError::Parquet {
+                path: p.clone(),
+                source,
+            })?;
         frames.push(df.lazy());
     }
     if frames.is_empty() {

@@ -87,9 +87,11 @@ impl Bar1dSpace {
                 MassVariant::SingularDynamic | MassVariant::NodeNeighbour => cons(1.0),
                 MassVariant::Lumped => [[rho * h / 2.0, 0.0], [0.0, rho * h / 2.0]],
                 MassVariant::Mod1 => cons(if el == 0 { 0.0 } else { 1.0 }),
-                MassVariant::Mod2 => {
-                    cons(if el == 0 { 0.0 } else { m as f64 / (m as f64 - 1.0) })
-                }
+                MassVariant::Mod2 => cons(if el == 0 {
+                    0.0
+                } else {
+                    m as f64 / (m as f64 - 1.0)
+                }),
                 MassVariant::Mod3 => cons(match el {
                     0 => 0.0,
                     1 => 2.0,
@@ -251,8 +253,13 @@ mod tests {
     #[test]
     fn mod3_and_node_neighbour_entries_match_spec() {
         let h = 0.1;
-        let s = Bar1dSpace::new(BarParams::default(), 10, &MassVariant::Mod3, ContactMethod::Mixed)
-            .unwrap();
+        let s = Bar1dSpace::new(
+            BarParams::default(),
+            10,
+            &MassVariant::Mod3,
+            ContactMethod::Mixed,
+        )
+        .unwrap();
         assert!((s.mass.diag[1] - 2.0 * h / 3.0).abs() < 1e-15);
         assert!((s.mass.upper[1] - h / 3.0).abs() < 1e-15);
         assert_eq!(s.mass.row(0), (0.0, 0.0, 0.0));

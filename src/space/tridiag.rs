@@ -54,7 +54,11 @@ impl Tridiag {
     /// Row i as (A[i][i-1], A[i][i], A[i][i+1]) with zeros outside.
     pub fn row(&self, i: usize) -> (f64, f64, f64) {
         let l = if i > 0 { self.lower[i - 1] } else { 0.0 };
-        let u = if i + 1 < self.len() { self.upper[i] } else { 0.0 };
+        let u = if i + 1 < self.len() {
+            self.upper[i]
+        } else {
+            0.0
+        };
         (l, self.diag[i], u)
     }
 

@@ -9,5 +9,7 @@ pub struct Summary {
 /// Summarize DIR.
 pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     let df = crate::sink::read_runs(dir)?;
-    Ok(Summary { terminal: format!("{} runs in {}\n", df.height(), dir.display()) })
+    Ok(Summary {
+        terminal: format!("{} runs in {}\n", df.height(), dir.display()),
+    })
 }

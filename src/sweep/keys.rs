@@ -227,7 +227,9 @@ impl Key {
             }
             (Key::Space, Value::Str(s)) => match s.as_str() {
                 "mixed" | "nitsche" | "penalty" => Ok(()),
-                _ => Err(format!("unknown space `{s}` (expected mixed, nitsche or penalty)")),
+                _ => Err(format!(
+                    "unknown space `{s}` (expected mixed, nitsche or penalty)"
+                )),
             },
             (Key::Mass, Value::Str(s)) => {
                 if crate::space::MassVariant::NAMES.contains(&s.as_str()) {

@@ -49,7 +49,7 @@ impl Issue {
 /// A sweep file that cannot be used; nothing has run.
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
-    #[error("{file}: cannot read the sweep file: {source}")]
+    #[error("{file}: cannot read the sweep file")]
     Read {
         file: PathBuf,
         source: std::io::Error,
@@ -148,15 +148,19 @@ impl Checker {
 
     /// Convert a node to the value of `key`, checking type, range and scene acceptance.
     fn value(&mut self, key: Key, node: &Node, path: &str) -> Option<Entry> {
-        if let Some(scene) = self.scene {
-            if !accepted(scene, key) {
-                self.issue(
-                    path,
-                    node.line,
-                    format!("`{}` is not a parameter of scene {}", key.name(), scene.name()),
-                );
-                return None;
-            }
+        if let Some(scene) = self.scene
+            && !accepted(scene, key)
+        {
+            self.issue(
+                path,
+                node.line,
+                format!(
+                    "`{}` is not a parameter of scene {}",
+                    key.name(),
+                    scene.name()
+                ),
+            );
+            return None;
         }
         let value = match (key.value_type(), &node.kind) {
             (ValueType::Float, Kind::Float(x)) => Value::Num(*x),
@@ -188,7 +192,11 @@ impl Checker {
                     ValueType::Str => "a string",
                     ValueType::FloatList => "a list of numbers",
                 };
-                self.issue(path, node.line, format!("expected {want}, found a {}", k.type_name()));
+                self.issue(
+                    path,
+                    node.line,
+                    format!("expected {want}, found a {}", k.type_name()),
+                );
                 return None;
             }
         };
@@ -209,7 +217,11 @@ impl Checker {
     fn key(&mut self, name: &str, path: &str, line: usize) -> Option<Key> {
         let k = Key::from_name(name);
         if k.is_none() {
-            self.issue(path, line, format!("unknown parameter `{name}`{}", suggest(name)));
+            self.issue(
+                path,
+                line,
+                format!("unknown parameter `{name}`{}", suggest(name)),
+            );
         }
         k
     }
@@ -306,7 +318,8 @@ fn suggest(name: &str) -> String {
         .map(|k| k.name())
         .chain(TOP_KEYS)
         .find(|k| k.to_ascii_lowercase() == lower || edit_distance(k, name) <= 2);
-    near.map(|k| format!(" (did you mean `{k}`?)")).unwrap_or_default()
+    near.map(|k| format!(" (did you mean `{k}`?)"))
+        .unwrap_or_default()
 }
 
 fn edit_distance(a: &str, b: &str) -> usize {
@@ -362,7 +375,10 @@ impl SweepFile {
                 ck.issue(
                     k,
                     *line,
-                    format!("unknown top-level key{hint}; accepted: {}", TOP_KEYS.join(", ")),
+                    format!(
+                        "unknown top-level key{hint}; accepted: {}",
+                        TOP_KEYS.join(", ")
+                    ),
                 );
             }
         }
@@ -371,7 +387,11 @@ impl SweepFile {
             match &node.kind {
                 Kind::Str(s) => Some((s.clone(), *line)),
                 k => {
-                    ck.issue(name, *line, format!("expected a string, found a {}", k.type_name()));
+                    ck.issue(
+                        name,
+                        *line,
+                        format!("expected a string, found a {}", k.type_name()),
+                    );
                     None
                 }
             }
@@ -379,7 +399,8 @@ impl SweepFile {
         let name = match string(&mut ck, "name") {
             Some((n, line)) => {
                 let ok = !n.is_empty()
-                    && n.chars().all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+                    && n.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
                     && !n.starts_with('.');
                 if !ok {
                     ck.issue(
@@ -407,7 +428,9 @@ impl SweepFile {
                 Some((_, None)) => ck.issue(
                     "scene",
                     line,
-                    format!("scene `{s}` is specified (SPEC §1) but not implemented in this version"),
+                    format!(
+                        "scene `{s}` is specified (SPEC §1) but not implemented in this version"
+                    ),
                 ),
                 None => ck.issue(
                     "scene",
@@ -423,7 +446,8 @@ impl SweepFile {
                     ck.issues.push(Issue {
                         line: None,
                         key: "scene".into(),
-                        reason: "required key missing (bar1d, bar2d, bar3d, disc2d or sphere3d)".into(),
+                        reason: "required key missing (bar1d, bar2d, bar3d, disc2d or sphere3d)"
+                            .into(),
                     });
                 }
             }
@@ -432,9 +456,20 @@ impl SweepFile {
         let table = |ck: &mut Checker, name: &str| -> Vec<(String, usize, Node)> {
             match get(name) {
                 None => Vec::new(),
-                Some((_, _, Node { kind: Kind::Table(t), .. })) => t.clone(),
+                Some((
+                    _,
+                    _,
+                    Node {
+                        kind: Kind::Table(t),
+                        ..
+                    },
+                )) => t.clone(),
                 Some((_, line, node)) => {
-                    ck.issue(name, *line, format!("expected a table, found a {}", node.kind.type_name()));
+                    ck.issue(
+                        name,
+                        *line,
+                        format!("expected a table, found a {}", node.kind.type_name()),
+                    );
                     Vec::new()
                 }
             }
@@ -444,7 +479,11 @@ impl SweepFile {
             let p = format!("fixed.{k}");
             if let Some(key) = ck.key(&k, &p, line) {
                 if matches!(v.kind, Kind::Array(_)) && key.value_type() != ValueType::FloatList {
-                    ck.issue(&p, line, "[fixed] takes one value; put lists in [grid] or [zip]");
+                    ck.issue(
+                        &p,
+                        line,
+                        "[fixed] takes one value; put lists in [grid] or [zip]",
+                    );
                 } else if let Some(e) = ck.value(key, &v, &p) {
                     fixed.push(e);
                 }
@@ -506,18 +545,33 @@ impl SweepFile {
                         }
                     }
                 }
-                k => ck.issue("exclude", *line, format!("expected a list of inline tables, found a {}", k.type_name())),
+                k => ck.issue(
+                    "exclude",
+                    *line,
+                    format!(
+                        "expected a list of inline tables, found a {}",
+                        k.type_name()
+                    ),
+                ),
             }
         }
         let int = |ck: &mut Checker, path: &str, node: &Node, min: i64| -> Option<i64> {
             match node.kind {
                 Kind::Int(i) if i >= min => Some(i),
                 Kind::Int(i) => {
-                    ck.issue(path, node.line, format!("must be an integer ≥ {min}, got {i}"));
+                    ck.issue(
+                        path,
+                        node.line,
+                        format!("must be an integer ≥ {min}, got {i}"),
+                    );
                     None
                 }
                 ref k => {
-                    ck.issue(path, node.line, format!("expected an integer, found a {}", k.type_name()));
+                    ck.issue(
+                        path,
+                        node.line,
+                        format!("expected an integer, found a {}", k.type_name()),
+                    );
                     None
                 }
             }
@@ -553,20 +607,28 @@ impl SweepFile {
                             seed: seed as u64,
                         })
                     }
-                    _ => ck.issue("ensemble", *line, "needs perturbation and samples (seed optional)"),
+                    _ => ck.issue(
+                        "ensemble",
+                        *line,
+                        "needs perturbation and samples (seed optional)",
+                    ),
                 }
             } else {
-                ck.issue("ensemble", *line, "expected an inline table { perturbation, samples, seed }");
-            }
-        }
-        if let Some((_, line, _)) = get("reference") {
-            if ck.scene == Some(SceneKind::Bar1d) {
                 ck.issue(
-                    "reference",
+                    "ensemble",
                     *line,
-                    "scene bar1d has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+                    "expected an inline table { perturbation, samples, seed }",
                 );
             }
+        }
+        if let Some((_, line, _)) = get("reference")
+            && ck.scene == Some(SceneKind::Bar1d)
+        {
+            ck.issue(
+                "reference",
+                *line,
+                "scene bar1d has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+            );
         }
         // A parameter may come from one place only: [fixed], one grid axis, or [zip].
         let mut sources: Vec<(Key, Origin, String)> = Vec::new();

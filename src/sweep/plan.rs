@@ -101,7 +101,11 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     for e in entries {
         user.insert(e.key, (e.value.clone(), e.origin.clone()));
     }
-    let get = |k: Key| user.get(&k).map(|(v, _)| v.clone()).or_else(|| default_of(k));
+    let get = |k: Key| {
+        user.get(&k)
+            .map(|(v, _)| v.clone())
+            .or_else(|| default_of(k))
+    };
     let num = |k: Key| get(k).and_then(|v| v.as_f64());
     let origin = |k: Key| {
         user.get(&k).map(|(_, o)| o.clone()).unwrap_or(Origin {
@@ -113,7 +117,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     let mut params: BTreeMap<Key, Value> = BTreeMap::new();
 
     // Scheme: family and its parameters (aliases fix them).
-    let scheme_name = get(Key::Scheme).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let scheme_name = get(Key::Scheme)
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap();
     let preset: Option<(Scheme, &[Key])> = match scheme_name.as_str() {
         "crank-nicolson" => Some((
             Scheme::Newmark(NewmarkParams::crank_nicolson()),
@@ -127,7 +133,10 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             Scheme::Newmark(NewmarkParams::central_difference()),
             &[Key::NewmarkBeta, Key::NewmarkGamma],
         )),
-        "backward-euler" => Some((Scheme::Theta(ThetaParams::backward_euler()), &[Key::ThetaScheme])),
+        "backward-euler" => Some((
+            Scheme::Theta(ThetaParams::backward_euler()),
+            &[Key::ThetaScheme],
+        )),
         _ => None,
     };
     let scheme = match (preset, scheme_name.as_str()) {
@@ -144,6 +153,12 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             gamma: num(Key::NewmarkGamma).unwrap(),
         }),
         (None, "theta") => match num(Key::ThetaScheme) {
+            Some(0.0) => {
+                return Outcome::Invalid(vec![Issue::at(
+                    &origin(Key::ThetaScheme),
+                    "theta_scheme = 0 is forward Euler, unstable for every dt on the undamped wave equation",
+                )]);
+            }
             Some(theta) => Scheme::Theta(ThetaParams { theta }),
             None => {
                 issues.push(Issue::at(
@@ -160,7 +175,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         (None, _) => Scheme::Hybrid,
     };
 
-    let space_name = get(Key::Space).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let space_name = get(Key::Space)
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap();
     let method = match space_name.as_str() {
         "nitsche" => match num(Key::NitscheGamma0) {
             Some(gamma0) => ContactMethod::Nitsche {
@@ -190,7 +207,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         },
         _ => ContactMethod::Mixed,
     };
-    let mass_name = get(Key::Mass).and_then(|v| v.as_str().map(String::from)).unwrap();
+    let mass_name = get(Key::Mass)
+        .and_then(|v| v.as_str().map(String::from))
+        .unwrap();
     let mass = if mass_name == "weights" {
         match get(Key::MassWeights) {
             Some(Value::List(w)) => MassVariant::Weights(w),
@@ -292,7 +311,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             issues.push(Issue {
                 line: None,
                 key: "h".into(),
-                reason: "required: the mesh size h (or elements) is not set in [fixed], [grid] or [zip]".into(),
+                reason:
+                    "required: the mesh size h (or elements) is not set in [fixed], [grid] or [zip]"
+                        .into(),
             });
             None
         }
@@ -310,7 +331,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             issues.push(Issue {
                 line: None,
                 key: "dt".into(),
-                reason: "required: the time step dt (or courant) is not set in [fixed], [grid] or [zip]".into(),
+                reason:
+                    "required: the time step dt (or courant) is not set in [fixed], [grid] or [zip]"
+                        .into(),
             });
             None
         }
@@ -328,7 +351,11 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     };
     if steps == 0 || steps > 100_000_000 {
         return Outcome::Invalid(vec![Issue::at(
-            &origin(if user.contains_key(&Key::Dt) { Key::Dt } else { Key::Courant }),
+            &origin(if user.contains_key(&Key::Dt) {
+                Key::Dt
+            } else {
+                Key::Courant
+            }),
             format!("T/dt = {ratio:.3e} steps is out of range (1 … 1e8)"),
         )]);
     }
@@ -337,13 +364,11 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
     if let Some(bound) = scheme.explicit_stability_limit() {
-        let dt_origin = origin(if user.contains_key(&Key::Dt) { Key::Dt } else { Key::Courant });
-        if bound == 0.0 {
-            return Outcome::Invalid(vec![Issue::at(
-                &origin(Key::ThetaScheme),
-                "theta_scheme = 0 is forward Euler, unstable for every dt on the undamped wave equation",
-            )]);
-        }
+        let dt_origin = origin(if user.contains_key(&Key::Dt) {
+            Key::Dt
+        } else {
+            Key::Courant
+        });
         match Bar1dSpace::new(bar, m, &mass, method) {
             Ok(sp) => {
                 let omega2 = max_frequency_sq(&sp);
@@ -418,7 +443,10 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     let mass_label = match &mass {
         MassVariant::Weights(w) => format!(
             "weights[{}]",
-            w.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(",")
+            w.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(",")
         ),
         other => other.name().to_string(),
     };
@@ -456,7 +484,13 @@ fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
         ContactMethod::Nitsche { gamma0, .. } => {
             let k = 1.0 / (gamma0 * sp.h);
             let p = sp.p.0;
-            active.add_element(0, [[k * p[0] * p[0], k * p[0] * p[1]], [k * p[0] * p[1], k * p[1] * p[1]]]);
+            active.add_element(
+                0,
+                [
+                    [k * p[0] * p[0], k * p[0] * p[1]],
+                    [k * p[0] * p[1], k * p[1] * p[1]],
+                ],
+            );
         }
         ContactMethod::Penalty { gamma0 } => active.diag[0] += sp.penalty_stiffness(gamma0),
     }
@@ -532,11 +566,9 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
                     };
                     for sample in samples {
                         let extra = match (sample, sweep.ensemble) {
-                            (Some((k, p)), Some(e)) => format!(
-                                "ensemble={},{},{k}\n",
-                                canonical_number(p),
-                                e.seed
-                            ),
+                            (Some((k, p)), Some(e)) => {
+                                format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
+                            }
                             _ => String::new(),
                         };
                         let id = run_id(sweep.scene, &r.canonical, &extra);
@@ -615,7 +647,9 @@ impl Plan {
             .into_iter()
             .filter(|k| {
                 let first = self.runs[0].params.get(k).map(Value::canonical);
-                self.runs.iter().any(|r| r.params.get(k).map(Value::canonical) != first)
+                self.runs
+                    .iter()
+                    .any(|r| r.params.get(k).map(Value::canonical) != first)
             })
             .collect()
     }
@@ -634,7 +668,11 @@ impl Plan {
         }
         s.push('\n');
         if self.excluded_by_filter > 0 {
-            let _ = writeln!(s, "  {} excluded by `exclude` filters", self.excluded_by_filter);
+            let _ = writeln!(
+                s,
+                "  {} excluded by `exclude` filters",
+                self.excluded_by_filter
+            );
         }
         for (why, n) in &self.inapplicable {
             let _ = writeln!(s, "  {n} left out as meaningless: {why}");

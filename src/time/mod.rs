@@ -137,9 +137,7 @@ impl Scheme {
     /// forward Euler (θ = 0) is never stable for an undamped system (bound 0).
     pub fn explicit_stability_limit(&self) -> Option<f64> {
         match self {
-            Scheme::Newmark(p) if p.beta == 0.0 => {
-                Some(1.0 / (p.gamma / 2.0).max(1e-300).sqrt())
-            }
+            Scheme::Newmark(p) if p.beta == 0.0 => Some(1.0 / (p.gamma / 2.0).max(1e-300).sqrt()),
             Scheme::PaoliSchatzman(p) if p.beta == 0.0 => Some(2.0),
             Scheme::Theta(p) if p.theta == 0.0 => Some(0.0),
             _ => None,

@@ -29,7 +29,8 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-/// Simulate the default bar (or `bar`) and return the outcome, asserting it completed.
+/// Simulate a bar1d run (the argument list mirrors Bar1dConfig::new plus the series decimation).
+#[allow(clippy::too_many_arguments)]
 pub fn bar1d(
     bar: BarParams,
     elements: usize,

@@ -1,0 +1,595 @@
+//! Convergence tables: observed rates, least-squares slopes and flags per refinement path and
+//! error column (the maths is in the module header of [`super`]).
+
+use std::fmt::Write as _;
+
+use super::runs::{ERRORS, RefPath, Runs, group_heading};
+use super::table::{self, Align, Kind, Table};
+
+/// Pair rates spread over more than this: the errors are not yet in the asymptotic regime
+/// (a constant rate p gives spread 0; 0.3 is well above the wobble of a clean ladder,
+/// e.g. SPEC §6 Nitsche-Hybrid 0.43/0.57/0.64, and below a change of regime).
+pub const PRE_ASYMPTOTIC_SPREAD: f64 = 0.3;
+/// LSQ slope over the finest (up to) three usable levels below this: stagnating (includes
+/// negative slopes, i.e. errors growing under refinement).
+pub const STAGNATION_SLOPE: f64 = 0.1;
+/// Finest usable error at most this times the coarsest usable error: round-off floor. No
+/// convergence study on a ladder of a few levels reduces an error by twelve orders of
+/// magnitude (order 2 over 1/4 … 1/1024 is 6e-6); only cancellation to machine precision does.
+pub const ROUNDOFF_RELATIVE: f64 = 1e-12;
+/// Finest usable error below this (absolute): round-off floor. The scenes are O(1) in SI
+/// units (L = 1 m, amplitudes ≥ 1e-3), so an error of 1e-13 is ~1e-13 relative — a few hundred
+/// ulps, where further refinement only measures rounding.
+pub const ROUNDOFF_ABSOLUTE: f64 = 1e-13;
+
+/// The observed rate between a coarser level (x_c, e_c) and a finer one (x_f, e_f):
+/// log(e_c/e_f) / log(x_c/x_f), from the actual ratio of the refinement values.
+pub fn observed_rate(e_coarse: f64, e_fine: f64, x_coarse: f64, x_fine: f64) -> f64 {
+    (e_coarse / e_fine).ln() / (x_coarse / x_fine).ln()
+}
+
+/// Least-squares slope p of log e = log C + p log x over the given points:
+/// p = Σ(ξ_i − ξ̄)(η_i − η̄) / Σ(ξ_i − ξ̄)², ξ = log x, η = log e. `None` with fewer than two
+/// points or no spread in x.
+pub fn lsq_slope(x: &[f64], e: &[f64]) -> Option<f64> {
+    let n = x.len().min(e.len());
+    if n < 2 {
+        return None;
+    }
+    let xi: Vec<f64> = x[..n].iter().map(|v| v.ln()).collect();
+    let eta: Vec<f64> = e[..n].iter().map(|v| v.ln()).collect();
+    let mx = xi.iter().sum::<f64>() / n as f64;
+    let me = eta.iter().sum::<f64>() / n as f64;
+    let sxx: f64 = xi.iter().map(|a| (a - mx) * (a - mx)).sum();
+    let sxe: f64 = xi.iter().zip(&eta).map(|(a, b)| (a - mx) * (b - me)).sum();
+    if sxx <= 0.0 || !sxx.is_finite() {
+        return None;
+    }
+    Some(sxe / sxx)
+}
+
+/// One level of a path as the fit sees it.
+#[derive(Debug, Clone)]
+pub(crate) struct LevelIn<'a> {
+    pub x: f64,
+    pub status: &'a str,
+    pub value: Option<f64>,
+}
+
+/// The fit's verdict on one level.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LevelFit {
+    /// Used in the rates and fits.
+    pub used: bool,
+    /// Why not (status, no value, zero error).
+    pub excluded: Option<String>,
+    /// Rate of the pair (previous used level, this level); attached to the finer level.
+    pub rate: Option<f64>,
+    /// Index of the coarser level of that pair (≠ level − 1 when a level was skipped).
+    pub rate_from: Option<usize>,
+}
+
+/// Rates, slopes and flags of one error column along one path.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Fit {
+    pub levels: Vec<LevelFit>,
+    pub used: usize,
+    pub slope_all: Option<f64>,
+    pub slope_fine3: Option<f64>,
+    pub fine_levels: usize,
+    pub spread: Option<f64>,
+    pub pre_asymptotic: bool,
+    pub stagnating: bool,
+    pub roundoff: bool,
+    pub failed: usize,
+}
+
+impl Fit {
+    /// The flags as words ("-" when none).
+    pub(crate) fn flags(&self) -> String {
+        let mut f = Vec::new();
+        if self.used < 2 {
+            f.push("no fit (< 2 usable levels)".to_string());
+        }
+        if self.pre_asymptotic {
+            f.push("pre-asymptotic".into());
+        }
+        if self.stagnating {
+            f.push("stagnating".into());
+        }
+        if self.roundoff {
+            f.push("round-off floor".into());
+        }
+        if self.failed > 0 {
+            f.push(format!(
+                "{} failed level{}",
+                self.failed,
+                if self.failed == 1 { "" } else { "s" }
+            ));
+        }
+        if f.is_empty() { "-".into() } else { f.join(", ") }
+    }
+}
+
+/// Fit one error column along one path, levels ordered coarse → fine.
+pub(crate) fn fit(levels: &[LevelIn]) -> Fit {
+    let mut out = Fit {
+        levels: vec![LevelFit::default(); levels.len()],
+        ..Fit::default()
+    };
+    let mut xs = Vec::new();
+    let mut es = Vec::new();
+    let mut prev: Option<usize> = None;
+    let mut zero = false;
+    for (i, l) in levels.iter().enumerate() {
+        let lf = &mut out.levels[i];
+        if l.status != "ok" {
+            out.failed += 1;
+            lf.excluded = Some(format!("status {}", l.status));
+            continue;
+        }
+        match l.value {
+            None => lf.excluded = Some("no value".into()),
+            Some(v) if !v.is_finite() => lf.excluded = Some("non-finite".into()),
+            // An exact zero has no logarithm: the error is at (or below) the floor.
+            Some(v) if v <= 0.0 => {
+                zero = true;
+                lf.excluded = Some("zero error".into());
+            }
+            Some(v) => {
+                lf.used = true;
+                if let Some(p) = prev {
+                    let (xp, ep) = (levels[p].x, levels[p].value.expect("used"));
+                    lf.rate = Some(observed_rate(ep, v, xp, l.x));
+                    lf.rate_from = Some(p);
+                }
+                prev = Some(i);
+                xs.push(l.x);
+                es.push(v);
+            }
+        }
+    }
+    out.used = xs.len();
+    out.slope_all = lsq_slope(&xs, &es);
+    let k = xs.len().min(3);
+    out.fine_levels = k;
+    out.slope_fine3 = lsq_slope(&xs[xs.len() - k..], &es[es.len() - k..]);
+    let rates: Vec<f64> = out.levels.iter().filter_map(|l| l.rate).collect();
+    if rates.len() >= 2 {
+        let max = rates.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = rates.iter().copied().fold(f64::INFINITY, f64::min);
+        out.spread = Some(max - min);
+        out.pre_asymptotic = max - min > PRE_ASYMPTOTIC_SPREAD;
+    }
+    out.stagnating = out.slope_fine3.is_some_and(|s| s < STAGNATION_SLOPE);
+    if let (Some(&coarse), Some(&finest)) = (es.first(), es.last()) {
+        out.roundoff = finest <= ROUNDOFF_RELATIVE * coarse || finest < ROUNDOFF_ABSOLUTE;
+    }
+    out.roundoff |= zero;
+    out
+}
+
+/// The error columns of a path: those with a value at some level.
+fn path_errors(runs: &Runs, p: &RefPath) -> Vec<usize> {
+    (0..runs.errors.len())
+        .filter(|&e| {
+            p.levels
+                .iter()
+                .any(|&(_, i)| runs.runs[i].errors[e].is_some_and(|v| !v.is_nan()))
+        })
+        .collect()
+}
+
+/// Errors printed on the terminal (the rest is in the files).
+const TERMINAL_ERRORS: &[&str] = &["err_u_l2l2", "err_u_l2h1", "err_sigma_l2"];
+
+/// The message when nothing can be fitted.
+pub const NO_REFINEMENT: &str = "no refinement axis: every group has a single (h, dt) level";
+
+/// The convergence section: long table, Markdown, LaTeX and the terminal lines.
+pub(crate) struct Section {
+    pub table: Table,
+    pub markdown: String,
+    pub latex: String,
+    pub terminal: String,
+}
+
+fn columns(runs: &Runs) -> Vec<(String, Kind)> {
+    let mut c: Vec<(String, Kind)> = [
+        ("group", Kind::I64),
+        ("group_title", Kind::Str),
+        ("path", Kind::I64),
+        ("fixed", Kind::Str),
+        ("fixed_value", Kind::F64),
+        ("refined", Kind::Str),
+        ("levels", Kind::I64),
+        ("level", Kind::I64),
+        ("run_id", Kind::Str),
+        ("label", Kind::Str),
+        ("status", Kind::Str),
+        ("message", Kind::Str),
+        ("h", Kind::F64),
+        ("dt", Kind::F64),
+        ("courant", Kind::F64),
+        ("elements", Kind::I64),
+        ("refinement", Kind::F64),
+        ("error", Kind::Str),
+        ("value", Kind::F64),
+        ("used_in_fit", Kind::Bool),
+        ("excluded", Kind::Str),
+        ("rate", Kind::F64),
+        ("rate_from_level", Kind::I64),
+        ("slope_all", Kind::F64),
+        ("fit_levels", Kind::I64),
+        ("slope_finest3", Kind::F64),
+        ("finest_levels", Kind::I64),
+        ("rate_spread", Kind::F64),
+        ("pre_asymptotic", Kind::Bool),
+        ("stagnating", Kind::Bool),
+        ("roundoff_floor", Kind::Bool),
+        ("failed_levels", Kind::I64),
+        ("flags", Kind::Str),
+    ]
+    .iter()
+    .map(|(n, k)| (n.to_string(), *k))
+    .collect();
+    c.extend(runs.param_columns());
+    c
+}
+
+fn short_flags(f: &Fit) -> String {
+    let mut s = Vec::new();
+    if f.used < 2 {
+        s.push("no fit".to_string());
+    }
+    if f.pre_asymptotic {
+        s.push("pre-asym".into());
+    }
+    if f.stagnating {
+        s.push("stagnating".into());
+    }
+    if f.roundoff {
+        s.push("round-off".into());
+    }
+    if f.failed > 0 {
+        s.push(format!("{} failed", f.failed));
+    }
+    if s.is_empty() { "-".into() } else { s.join(", ") }
+}
+
+/// LaTeX column head of an error column.
+fn tex_error(name: &str) -> &'static str {
+    match name {
+        "err_u_l2l2" => "$u$: $l^2(\\tau;L^2)$",
+        "err_u_l2h1" => "$u$: $l^2(\\tau;H^1)$",
+        "err_u_linfl2" => "$u$: $l^\\infty(L^2)$",
+        "err_sigma_l2" => "$\\sigma_C$: $l^2(\\tau)$",
+        "err_energy_l2" => "$E$: $l^2(\\tau)$",
+        "err_u_contact_max" => "$u_C$: max",
+        _ => "error",
+    }
+}
+
+/// Build the convergence section.
+pub(crate) fn section(runs: &Runs) -> Section {
+    let mut t = Table::new(&columns(runs));
+    let mut md = String::new();
+    let mut tex = String::new();
+    let mut term_rows: Vec<Vec<String>> = Vec::new();
+
+    md.push_str("# Convergence\n\n");
+    let _ = writeln!(
+        md,
+        "Runs grouped by every parameter except the refinement axes (h/elements, dt/courant); \
+         within a group a refinement path holds courant, dt or h fixed and has ≥ 2 levels, \
+         ordered coarse → fine. rate = log(e_prev/e)/log(x_prev/x) from the actual ratios of \
+         the refined axis x (h or dt), against the previous usable level (†: a level was \
+         skipped). Slopes: least squares of log e against log x over all usable levels and \
+         over the finest three. Flags: pre-asymptotic (pair rates spread > {PRE_ASYMPTOTIC_SPREAD}), \
+         stagnating (slope over the finest three < {STAGNATION_SLOPE}), round-off floor (finest \
+         error ≤ {ROUNDOFF_RELATIVE:e}·coarsest, or < {ROUNDOFF_ABSOLUTE:e}, or exactly 0). \
+         Levels whose status is not ok are kept, marked ✗, and excluded from rates and fits.\n"
+    );
+    tex.push_str(
+        "% Convergence tables written by `contact-sweep summarize` (one table per refinement path).\n\
+         % Needs \\usepackage{booktabs}.\n\n",
+    );
+
+    let single = runs.groups.iter().filter(|g| g.levels < 2).count();
+    let multi_without_path: Vec<usize> = (0..runs.groups.len())
+        .filter(|&g| runs.groups[g].levels >= 2 && !runs.paths.iter().any(|p| p.group == g))
+        .collect();
+
+    let mut terminal = String::new();
+    if runs.paths.is_empty() {
+        if multi_without_path.is_empty() {
+            let _ = writeln!(md, "**{NO_REFINEMENT}** ({} groups).\n", runs.groups.len());
+            let _ = writeln!(tex, "% {NO_REFINEMENT}");
+            let _ = writeln!(
+                terminal,
+                "convergence: {NO_REFINEMENT} ({} groups) — no rates to compute",
+                runs.groups.len()
+            );
+        } else {
+            let msg = "no refinement path: no group holds courant, dt or h fixed over ≥ 2 levels";
+            let _ = writeln!(md, "**{msg}**.\n");
+            let _ = writeln!(tex, "% {msg}");
+            let _ = writeln!(terminal, "convergence: {msg}");
+        }
+    } else if runs.errors.is_empty() {
+        let msg = "no error columns with values (no reference solution): rates cannot be computed";
+        let _ = writeln!(md, "**{msg}**.\n");
+        let _ = writeln!(terminal, "convergence: {msg}");
+    }
+    if single > 0 && !runs.paths.is_empty() {
+        let _ = writeln!(
+            md,
+            "{single} of {} groups have a single (h, dt) level and are not in these tables.\n",
+            runs.groups.len()
+        );
+    }
+    for &g in &multi_without_path {
+        let _ = writeln!(
+            md,
+            "- {}: {} (h, dt) levels but neither courant, dt nor h is held fixed over two of them — not fitted.",
+            group_heading(runs, g),
+            runs.groups[g].levels
+        );
+    }
+    if !multi_without_path.is_empty() {
+        md.push('\n');
+    }
+
+    for (pi, p) in runs.paths.iter().enumerate() {
+        let g = p.group;
+        let errs = path_errors(runs, p);
+        let heading = format!("{} — {} (path {})", group_heading(runs, g), p.fixed.describe(), pi + 1);
+        let _ = writeln!(md, "## {heading}\n");
+        let first = &runs.runs[runs.groups[g].runs[0]];
+        let params: Vec<String> = runs
+            .params
+            .iter()
+            .zip(&first.params)
+            .filter_map(|((n, _), c)| c.show().map(|v| format!("{n}={v}")))
+            .collect();
+        let _ = writeln!(md, "Parameters: {}\n", params.join(", "));
+        if errs.is_empty() {
+            md.push_str("No error column has a value on this path (no reference solution).\n\n");
+            continue;
+        }
+        let fits: Vec<(usize, Fit)> = errs
+            .iter()
+            .map(|&e| {
+                let lv: Vec<LevelIn> = p
+                    .levels
+                    .iter()
+                    .map(|&(x, i)| LevelIn {
+                        x,
+                        status: &runs.runs[i].status,
+                        value: runs.runs[i].errors[e],
+                    })
+                    .collect();
+                (e, fit(&lv))
+            })
+            .collect();
+
+        // Long table rows.
+        for (e, f) in &fits {
+            for (li, &(x, ri)) in p.levels.iter().enumerate() {
+                let r = &runs.runs[ri];
+                let lf = &f.levels[li];
+                t.i64("group", Some(g as i64 + 1));
+                t.str("group_title", Some(&runs.groups[g].title));
+                t.i64("path", Some(pi as i64 + 1));
+                t.str("fixed", Some(p.fixed.name()));
+                t.f64("fixed_value", Some(p.fixed.value()));
+                t.str("refined", Some(p.fixed.refined()));
+                t.i64("levels", Some(p.levels.len() as i64));
+                t.i64("level", Some(li as i64));
+                t.str("run_id", Some(&r.run_id));
+                t.str("label", Some(&r.label));
+                t.str("status", Some(&r.status));
+                t.str("message", r.message.as_deref());
+                t.f64("h", r.h);
+                t.f64("dt", r.dt);
+                t.f64("courant", r.courant);
+                t.i64("elements", r.elements);
+                t.f64("refinement", Some(x));
+                t.str("error", Some(runs.errors[*e]));
+                t.f64("value", r.errors[*e]);
+                t.bool("used_in_fit", Some(lf.used));
+                t.str("excluded", lf.excluded.as_deref());
+                t.f64("rate", lf.rate);
+                t.i64("rate_from_level", lf.rate_from.map(|v| v as i64));
+                t.f64("slope_all", f.slope_all);
+                t.i64("fit_levels", Some(f.used as i64));
+                t.f64("slope_finest3", f.slope_fine3);
+                t.i64("finest_levels", Some(f.fine_levels as i64));
+                t.f64("rate_spread", f.spread);
+                t.bool("pre_asymptotic", Some(f.pre_asymptotic));
+                t.bool("stagnating", Some(f.stagnating));
+                t.bool("roundoff_floor", Some(f.roundoff));
+                t.i64("failed_levels", Some(f.failed as i64));
+                t.str("flags", Some(&f.flags()));
+                for ((n, _), c) in runs.params.iter().zip(&r.params) {
+                    t.cell(n, c);
+                }
+                t.end_row();
+            }
+        }
+
+        // Markdown: one table per path, deal.II ConvergenceTable style.
+        let mut header: Vec<String> = vec!["level".into(), "h".into(), "dt".into(), "status".into()];
+        let mut align = vec![Align::Right, Align::Right, Align::Right, Align::Left];
+        for (e, _) in &fits {
+            header.push(runs.errors[*e].into());
+            header.push("rate".into());
+            align.extend([Align::Right, Align::Right]);
+        }
+        let mut rows: Vec<Vec<String>> = Vec::new();
+        let mut skipped = false;
+        for (li, &(_, ri)) in p.levels.iter().enumerate() {
+            let r = &runs.runs[ri];
+            let mut row = vec![
+                li.to_string(),
+                table::sci(r.h),
+                table::sci(r.dt),
+                if r.ok() { r.status.clone() } else { format!("{} ✗", r.status) },
+            ];
+            for (e, f) in &fits {
+                let lf = &f.levels[li];
+                let v = table::sci(r.errors[*e]);
+                row.push(if lf.used || v.is_empty() { v } else { format!("({v}) ✗") });
+                let mut rt = table::rate(lf.rate);
+                if lf.rate_from.is_some_and(|from| from + 1 != li) {
+                    rt.push_str(" †");
+                    skipped = true;
+                }
+                row.push(rt);
+            }
+            rows.push(row);
+        }
+        let mut lsq_all = vec!["LSQ slope, all usable levels".to_string(), String::new(), String::new(), String::new()];
+        let mut lsq_fine = vec!["LSQ slope, finest 3".to_string(), String::new(), String::new(), String::new()];
+        let mut spread = vec!["rate spread".to_string(), String::new(), String::new(), String::new()];
+        let mut flags = vec!["flags".to_string(), String::new(), String::new(), String::new()];
+        for (_, f) in &fits {
+            lsq_all.extend([format!("({} levels)", f.used), table::rate(f.slope_all)]);
+            lsq_fine.extend([format!("({} levels)", f.fine_levels), table::rate(f.slope_fine3)]);
+            spread.extend([String::new(), table::rate(f.spread)]);
+            flags.extend([f.flags(), String::new()]);
+        }
+        rows.extend([lsq_all, lsq_fine, spread, flags]);
+        md.push_str(&table::markdown(&header, &align, &rows));
+        md.push('\n');
+        if skipped {
+            md.push_str("†: rate against the previous usable level (a level in between is excluded).\n\n");
+        }
+        let excluded: Vec<String> = p
+            .levels
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, ri))| !runs.runs[*ri].ok())
+            .map(|(li, (_, ri))| {
+                let r = &runs.runs[*ri];
+                format!(
+                    "- level {li} ({}): {}{}",
+                    r.run_id,
+                    r.status,
+                    r.message.as_ref().map(|m| format!(" — {m}")).unwrap_or_default()
+                )
+            })
+            .collect();
+        if !excluded.is_empty() {
+            md.push_str("Excluded from the fits:\n");
+            md.push_str(&excluded.join("\n"));
+            md.push_str("\n\n");
+        }
+
+        // LaTeX (booktabs).
+        let _ = writeln!(tex, "\\begin{{table}}[htbp]\n  \\centering");
+        let _ = writeln!(tex, "  \\caption{{{}}}", table::tex(&heading));
+        let _ = writeln!(tex, "  \\begin{{tabular}}{{rrl{}}}", "rr".repeat(fits.len()));
+        let _ = writeln!(tex, "    \\toprule");
+        let mut head = vec!["$h$".to_string(), "$\\tau$".into(), "status".into()];
+        for (e, _) in &fits {
+            head.push(tex_error(runs.errors[*e]).into());
+            head.push("rate".into());
+        }
+        let _ = writeln!(tex, "    {} \\\\", head.join(" & "));
+        let _ = writeln!(tex, "    \\midrule");
+        for (li, &(_, ri)) in p.levels.iter().enumerate() {
+            let r = &runs.runs[ri];
+            let mut row = vec![table::tex_sci(r.h), table::tex_sci(r.dt), table::tex(&r.status)];
+            for (e, f) in &fits {
+                let lf = &f.levels[li];
+                let v = table::tex_sci(r.errors[*e]);
+                row.push(if lf.used || v.is_empty() { v } else { format!("({v})") });
+                let mut rt = table::tex_rate(lf.rate);
+                if lf.rate_from.is_some_and(|from| from + 1 != li) {
+                    rt.push_str("$^\\dagger$");
+                }
+                row.push(rt);
+            }
+            let _ = writeln!(tex, "    {} \\\\", row.join(" & "));
+        }
+        let _ = writeln!(tex, "    \\midrule");
+        let tex_line = |name: &str, cells: Vec<String>| format!("    \\multicolumn{{3}}{{l}}{{{name}}} & {} \\\\\n", cells.join(" & "));
+        tex.push_str(&tex_line(
+            "LSQ slope, all",
+            fits.iter().flat_map(|(_, f)| [String::new(), table::tex_rate(f.slope_all)]).collect(),
+        ));
+        tex.push_str(&tex_line(
+            "LSQ slope, finest 3",
+            fits.iter().flat_map(|(_, f)| [String::new(), table::tex_rate(f.slope_fine3)]).collect(),
+        ));
+        tex.push_str(&tex_line(
+            "flags",
+            fits.iter()
+                .map(|(_, f)| format!("\\multicolumn{{2}}{{l}}{{\\footnotesize {}}}", table::tex(&f.flags())))
+                .collect(),
+        ));
+        let _ = writeln!(tex, "    \\bottomrule\n  \\end{{tabular}}\n\\end{{table}}\n");
+
+        // Terminal: the LSQ slopes of the main error columns.
+        let mut shown: Vec<&(usize, Fit)> = fits
+            .iter()
+            .filter(|(e, _)| TERMINAL_ERRORS.contains(&runs.errors[*e]))
+            .collect();
+        if shown.is_empty() {
+            shown = fits.iter().take(1).collect();
+        }
+        for (e, f) in shown {
+            term_rows.push(vec![
+                (g + 1).to_string(),
+                runs.groups[g].title.clone(),
+                p.fixed.short(),
+                format!("{}/{}", f.used, p.levels.len()),
+                runs.errors[*e].to_string(),
+                table::rate(f.slope_all),
+                table::rate(f.slope_fine3),
+                short_flags(f),
+            ]);
+        }
+    }
+
+    if !term_rows.is_empty() {
+        let _ = writeln!(
+            terminal,
+            "convergence: {} refinement path{} in {} group{} (LSQ slopes of log e vs log h or dt; all columns in convergence.md)",
+            runs.paths.len(),
+            if runs.paths.len() == 1 { "" } else { "s" },
+            runs.groups.len(),
+            if runs.groups.len() == 1 { "" } else { "s" },
+        );
+        let header: Vec<String> = ["#", "method", "path", "used", "error", "slope", "finest3", "flags"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let align = [
+            Align::Right,
+            Align::Left,
+            Align::Left,
+            Align::Right,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Left,
+        ];
+        terminal.push_str(&table::plain(&header, &align, &term_rows));
+        if single > 0 {
+            let _ = writeln!(
+                terminal,
+                " ({single} of {} groups have a single (h, dt) level)",
+                runs.groups.len()
+            );
+        }
+    }
+    debug_assert!(ERRORS.len() == 6);
+    Section {
+        table: t,
+        markdown: md,
+        latex: tex,
+        terminal,
+    }
+}

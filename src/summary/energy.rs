@@ -1,0 +1,577 @@
+//! Energy tables: per run and per group (drift, largest deviation, largest one-step increase,
+//! with growth / decay flags), and for bar1d the energy lost at each impact, read from the
+//! time series.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fmt::Write as _;
+
+use anyhow::Context as _;
+use polars::prelude::*;
+
+use super::runs::{Run, Runs};
+use super::table::{self, Align, Kind, Table};
+
+/// A one-step increase of the energy above this fraction of E⁰ is growth. SPEC §6: the
+/// schemes that provably do not gain energy stay below 1e-12·E⁰ (worst seen 5e-13), so 1e-10
+/// leaves two decades for rounding and flags nothing a proof forbids; a scheme that gains
+/// energy does so by ≥ 1e-4·E⁰ per contact phase.
+pub const ENERGY_TOL: f64 = 1e-10;
+
+/// How the energy E^h of a run behaved.
+fn behaviour(r: &Run) -> Option<&'static str> {
+    let inc = r.energy_max_increase?;
+    Some(if inc > ENERGY_TOL {
+        "growth"
+    } else if r.energy_max_dev.is_some_and(|d| d <= ENERGY_TOL) {
+        // Never more than the tolerance away from E⁰: conserved (a drift of −1e-15 is not
+        // decay).
+        "conserved"
+    } else if r.energy_drift.is_some_and(|d| d < 0.0) {
+        "monotone decay"
+    } else {
+        // No step gains more than the tolerance, yet E^N ≥ E⁰: many tiny gains.
+        "slow growth (every step ≤ tol)"
+    })
+}
+
+/// One contact phase of a run.
+#[derive(Debug, Clone)]
+struct Impact {
+    first: usize,
+    last: usize,
+    before: Option<usize>,
+    after: Option<usize>,
+}
+
+/// The rows of one run's series, ordered by step.
+#[derive(Debug, Default, Clone)]
+struct Series {
+    step: Vec<i64>,
+    t: Vec<Option<f64>>,
+    sigma: Vec<Option<f64>>,
+    energy: Vec<Option<f64>>,
+    theta: Vec<Option<f64>>,
+}
+
+impl Series {
+    /// Largest gap between recorded steps: 1 for a complete series, k for `series_every = k`.
+    fn stride(&self) -> i64 {
+        self.step.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(1).max(1)
+    }
+
+    /// Contact phases: maximal runs of consecutive rows with σ_C < 0.
+    fn impacts(&self) -> Vec<Impact> {
+        let n = self.step.len();
+        let contact = |i: usize| self.sigma[i].is_some_and(|s| s < 0.0);
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < n {
+            if contact(i) {
+                let first = i;
+                while i + 1 < n && contact(i + 1) {
+                    i += 1;
+                }
+                out.push(Impact {
+                    first,
+                    last: i,
+                    before: first.checked_sub(1),
+                    after: (i + 1 < n).then_some(i + 1),
+                });
+            }
+            i += 1;
+        }
+        out
+    }
+}
+
+/// The series of the bar1d runs, keyed by run_id; `Err(reason)` when there are none.
+fn read_series(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
+    let wanted: HashMap<&str, ()> = runs
+        .runs
+        .iter()
+        .filter(|r| r.param(runs, "scene").as_deref() == Some("bar1d"))
+        .map(|r| (r.run_id.as_str(), ()))
+        .collect();
+    if wanted.is_empty() {
+        return Ok(Err("no bar1d runs".into()));
+    }
+    let raw = crate::sink::read_series(dir)?;
+    if raw.height() == 0 {
+        return Ok(Err("no time series in series/ (series_every = 0?)".into()));
+    }
+    let schema = raw.schema().clone();
+    let need = ["run_id", "step", "t", "sigma_contact", "energy"];
+    if let Some(m) = need.iter().find(|c| schema.get(c).is_none()) {
+        return Ok(Err(format!("the series have no `{m}` column")));
+    }
+    let mut exprs = vec![
+        col("run_id").cast(DataType::String),
+        col("step").cast(DataType::Int64),
+        col("t").cast(DataType::Float64),
+        col("sigma_contact").cast(DataType::Float64),
+        col("energy").cast(DataType::Float64),
+    ];
+    let has_theta = schema.get("energy_theta").is_some();
+    if has_theta {
+        exprs.push(col("energy_theta").cast(DataType::Float64));
+    }
+    // Lazy: keep the needed columns only, drop rows without a key, order by run and step.
+    let df = raw
+        .lazy()
+        .select(exprs)
+        .filter(col("run_id").is_not_null().and(col("step").is_not_null()))
+        .sort(["run_id", "step"], SortMultipleOptions::default())
+        .collect()
+        .with_context(|| format!("{}: reading the time series", dir.join("series").display()))?;
+    let ids = df.column("run_id")?.str()?.clone();
+    let steps = df.column("step")?.i64()?.clone();
+    let ts = df.column("t")?.f64()?.clone();
+    let sig = df.column("sigma_contact")?.f64()?.clone();
+    let en = df.column("energy")?.f64()?.clone();
+    let th = if has_theta {
+        Some(df.column("energy_theta")?.f64()?.clone())
+    } else {
+        None
+    };
+    let mut out: HashMap<String, Series> = HashMap::new();
+    for i in 0..df.height() {
+        let (Some(id), Some(step)) = (ids.get(i), steps.get(i)) else {
+            continue;
+        };
+        if !wanted.contains_key(id) {
+            continue;
+        }
+        let s = out.entry(id.to_string()).or_default();
+        // The same run committed twice (two shards) repeats its rows: keep the first.
+        if s.step.last() == Some(&step) {
+            continue;
+        }
+        s.step.push(step);
+        s.t.push(ts.get(i));
+        s.sigma.push(sig.get(i));
+        s.energy.push(en.get(i));
+        s.theta.push(th.as_ref().and_then(|c| c.get(i)));
+    }
+    Ok(Ok(out))
+}
+
+/// The energy section's outputs.
+pub(crate) struct Section {
+    pub runs: Table,
+    pub groups: Table,
+    pub impacts: Table,
+    pub markdown: String,
+    pub terminal: String,
+}
+
+fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
+    let mut c: Vec<(String, Kind)> = list.iter().map(|(n, k)| (n.to_string(), *k)).collect();
+    c.extend(runs.param_columns());
+    c
+}
+
+fn minmax(v: impl Iterator<Item = Option<f64>>) -> (Option<f64>, Option<f64>) {
+    let mut lo: Option<f64> = None;
+    let mut hi: Option<f64> = None;
+    for x in v.flatten().filter(|x| x.is_finite()) {
+        lo = Some(lo.map_or(x, |l| l.min(x)));
+        hi = Some(hi.map_or(x, |h| h.max(x)));
+    }
+    (lo, hi)
+}
+
+fn range(lo: Option<f64>, hi: Option<f64>) -> String {
+    match (lo, hi) {
+        (Some(a), Some(b)) if a == b => table::sci(Some(a)),
+        (Some(a), Some(b)) => format!("{} … {}", table::sci(Some(a)), table::sci(Some(b))),
+        _ => String::new(),
+    }
+}
+
+/// Build the energy section.
+pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Section> {
+    let series = read_series(dir, runs)?;
+    let mut per_run = Table::new(&cols(
+        &[
+            ("group", Kind::I64),
+            ("group_title", Kind::Str),
+            ("run_id", Kind::Str),
+            ("label", Kind::Str),
+            ("status", Kind::Str),
+            ("h", Kind::F64),
+            ("dt", Kind::F64),
+            ("courant", Kind::F64),
+            ("energy_initial", Kind::F64),
+            ("energy_final", Kind::F64),
+            ("energy_drift", Kind::F64),
+            ("energy_max_dev", Kind::F64),
+            ("energy_max_increase", Kind::F64),
+            ("energy_theta_max_increase", Kind::F64),
+            ("energy_growth", Kind::Bool),
+            ("energy_theta_growth", Kind::Bool),
+            ("monotone_decay", Kind::Bool),
+            ("conserved", Kind::Bool),
+            ("behaviour", Kind::Str),
+            ("impacts", Kind::I64),
+            ("impact_loss_total", Kind::F64),
+            ("series_decimated", Kind::Bool),
+            ("series_stride", Kind::I64),
+        ],
+        runs,
+    ));
+    let mut impacts = Table::new(&cols(
+        &[
+            ("group", Kind::I64),
+            ("group_title", Kind::Str),
+            ("run_id", Kind::Str),
+            ("label", Kind::Str),
+            ("status", Kind::Str),
+            ("h", Kind::F64),
+            ("dt", Kind::F64),
+            ("impact", Kind::I64),
+            ("step_first", Kind::I64),
+            ("step_last", Kind::I64),
+            ("t_first", Kind::F64),
+            ("t_last", Kind::F64),
+            ("step_before", Kind::I64),
+            ("step_after", Kind::I64),
+            ("energy_e0", Kind::F64),
+            ("energy_before", Kind::F64),
+            ("energy_after", Kind::F64),
+            ("energy_loss_rel", Kind::F64),
+            ("energy_theta_before", Kind::F64),
+            ("energy_theta_after", Kind::F64),
+            ("energy_theta_loss_rel", Kind::F64),
+            ("phase_complete", Kind::Bool),
+            ("series_decimated", Kind::Bool),
+            ("series_stride", Kind::I64),
+        ],
+        runs,
+    ));
+
+    let mut run_rows_md: Vec<Vec<String>> = Vec::new();
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    let mut decimated_runs = 0usize;
+    let mut impact_count = 0usize;
+    let mut runs_with_series = 0usize;
+    // Per run: (number of impacts, total relative loss over complete phases).
+    let mut run_impacts: Vec<Option<(usize, f64, bool, i64)>> = vec![None; runs.runs.len()];
+
+    for (ri, r) in runs.runs.iter().enumerate() {
+        let Ok(map) = &series else { break };
+        let Some(s) = map.get(&r.run_id) else { continue };
+        if s.step.is_empty() {
+            continue;
+        }
+        runs_with_series += 1;
+        let stride = s.stride();
+        let decimated = stride > 1;
+        decimated_runs += decimated as usize;
+        // E⁰: the run's initial energy (SPEC §5); the first recorded energy if the row lacks it.
+        let e0 = r
+            .energy_initial
+            .filter(|e| e.is_finite() && *e != 0.0)
+            .or(s.energy[0]);
+        let e0_theta = s.theta[0];
+        let mut total = 0.0;
+        let list = s.impacts();
+        for (k, ph) in list.iter().enumerate() {
+            let complete = ph.before.is_some() && ph.after.is_some();
+            let eb = ph.before.and_then(|i| s.energy[i]);
+            let ea = ph.after.and_then(|i| s.energy[i]);
+            let loss = match (eb, ea, e0) {
+                (Some(b), Some(a), Some(e0)) => Some((b - a) / e0),
+                _ => None,
+            };
+            if let Some(l) = loss {
+                total += l;
+            }
+            let tb = ph.before.and_then(|i| s.theta[i]);
+            let ta = ph.after.and_then(|i| s.theta[i]);
+            let tloss = match (tb, ta, e0_theta) {
+                (Some(b), Some(a), Some(e0)) if e0 != 0.0 => Some((b - a) / e0),
+                _ => None,
+            };
+            impacts.i64("group", Some(r.group as i64 + 1));
+            impacts.str("group_title", Some(&runs.groups[r.group].title));
+            impacts.str("run_id", Some(&r.run_id));
+            impacts.str("label", Some(&r.label));
+            impacts.str("status", Some(&r.status));
+            impacts.f64("h", r.h);
+            impacts.f64("dt", r.dt);
+            impacts.i64("impact", Some(k as i64 + 1));
+            impacts.i64("step_first", Some(s.step[ph.first]));
+            impacts.i64("step_last", Some(s.step[ph.last]));
+            impacts.f64("t_first", s.t[ph.first]);
+            impacts.f64("t_last", s.t[ph.last]);
+            impacts.i64("step_before", ph.before.map(|i| s.step[i]));
+            impacts.i64("step_after", ph.after.map(|i| s.step[i]));
+            impacts.f64("energy_e0", e0);
+            impacts.f64("energy_before", eb);
+            impacts.f64("energy_after", ea);
+            impacts.f64("energy_loss_rel", loss);
+            impacts.f64("energy_theta_before", tb);
+            impacts.f64("energy_theta_after", ta);
+            impacts.f64("energy_theta_loss_rel", tloss);
+            impacts.bool("phase_complete", Some(complete));
+            impacts.bool("series_decimated", Some(decimated));
+            impacts.i64("series_stride", Some(stride));
+            for ((n, _), c) in runs.params.iter().zip(&r.params) {
+                impacts.cell(n, c);
+            }
+            impacts.end_row();
+        }
+        impact_count += list.len();
+        run_impacts[ri] = Some((list.len(), total, decimated, stride));
+    }
+
+    for (ri, r) in runs.runs.iter().enumerate() {
+        let b = behaviour(r);
+        if r.ok() {
+            *counts.entry(b.unwrap_or("unknown")).or_default() += 1;
+        }
+        per_run.i64("group", Some(r.group as i64 + 1));
+        per_run.str("group_title", Some(&runs.groups[r.group].title));
+        per_run.str("run_id", Some(&r.run_id));
+        per_run.str("label", Some(&r.label));
+        per_run.str("status", Some(&r.status));
+        per_run.f64("h", r.h);
+        per_run.f64("dt", r.dt);
+        per_run.f64("courant", r.courant);
+        per_run.f64("energy_initial", r.energy_initial);
+        per_run.f64("energy_final", r.energy_final);
+        per_run.f64("energy_drift", r.energy_drift);
+        per_run.f64("energy_max_dev", r.energy_max_dev);
+        per_run.f64("energy_max_increase", r.energy_max_increase);
+        per_run.f64("energy_theta_max_increase", r.energy_theta_max_increase);
+        per_run.bool("energy_growth", r.energy_max_increase.map(|x| x > ENERGY_TOL));
+        per_run.bool(
+            "energy_theta_growth",
+            r.energy_theta_max_increase.map(|x| x > ENERGY_TOL),
+        );
+        per_run.bool("monotone_decay", b.map(|b| b == "monotone decay"));
+        per_run.bool("conserved", b.map(|b| b == "conserved"));
+        per_run.str("behaviour", b);
+        let imp = run_impacts[ri];
+        per_run.i64("impacts", imp.map(|i| i.0 as i64));
+        per_run.f64("impact_loss_total", imp.map(|i| i.1));
+        per_run.bool("series_decimated", imp.map(|i| i.2));
+        per_run.i64("series_stride", imp.map(|i| i.3));
+        for ((n, _), c) in runs.params.iter().zip(&r.params) {
+            per_run.cell(n, c);
+        }
+        per_run.end_row();
+        run_rows_md.push(vec![
+            (r.group + 1).to_string(),
+            r.label.clone(),
+            table::sci(r.h),
+            table::sci(r.dt),
+            r.status.clone(),
+            table::sci(r.energy_drift),
+            table::sci(r.energy_max_dev),
+            table::sci(r.energy_max_increase),
+            table::sci(r.energy_theta_max_increase),
+            b.unwrap_or("").to_string(),
+            imp.map(|i| i.0.to_string()).unwrap_or_default(),
+            imp.map(|i| table::sci(Some(i.1))).unwrap_or_default(),
+            imp.map(|i| if i.2 { format!("every {}", i.3) } else { "no".into() })
+                .unwrap_or_default(),
+        ]);
+    }
+
+    // Per group, across refinement: ranges over the ok runs (a diverged run's energy is
+    // where it stopped, not a property of the method).
+    let mut groups = Table::new(&cols(
+        &[
+            ("group", Kind::I64),
+            ("group_title", Kind::Str),
+            ("label", Kind::Str),
+            ("runs", Kind::I64),
+            ("ok_runs", Kind::I64),
+            ("energy_drift_min", Kind::F64),
+            ("energy_drift_max", Kind::F64),
+            ("energy_max_dev_min", Kind::F64),
+            ("energy_max_dev_max", Kind::F64),
+            ("energy_max_increase_min", Kind::F64),
+            ("energy_max_increase_max", Kind::F64),
+            ("energy_theta_max_increase_min", Kind::F64),
+            ("energy_theta_max_increase_max", Kind::F64),
+            ("growth_runs", Kind::I64),
+            ("theta_growth_runs", Kind::I64),
+            ("monotone_decay_runs", Kind::I64),
+            ("conserved_runs", Kind::I64),
+        ],
+        runs,
+    ));
+    let mut group_rows_md: Vec<Vec<String>> = Vec::new();
+    for (gi, g) in runs.groups.iter().enumerate() {
+        let ok: Vec<&Run> = g.runs.iter().map(|&i| &runs.runs[i]).filter(|r| r.ok()).collect();
+        let drift = minmax(ok.iter().map(|r| r.energy_drift));
+        let dev = minmax(ok.iter().map(|r| r.energy_max_dev));
+        let inc = minmax(ok.iter().map(|r| r.energy_max_increase));
+        let th = minmax(ok.iter().map(|r| r.energy_theta_max_increase));
+        let count = |f: &dyn Fn(&Run) -> bool| ok.iter().filter(|r| f(r)).count();
+        let growth = count(&|r| behaviour(r) == Some("growth"));
+        let tgrowth = count(&|r| r.energy_theta_max_increase.is_some_and(|x| x > ENERGY_TOL));
+        let decay = count(&|r| behaviour(r) == Some("monotone decay"));
+        let conserved = count(&|r| behaviour(r) == Some("conserved"));
+        let first = &runs.runs[g.runs[0]];
+        groups.i64("group", Some(gi as i64 + 1));
+        groups.str("group_title", Some(&g.title));
+        groups.str("label", Some(&first.label));
+        groups.i64("runs", Some(g.runs.len() as i64));
+        groups.i64("ok_runs", Some(ok.len() as i64));
+        groups.f64("energy_drift_min", drift.0);
+        groups.f64("energy_drift_max", drift.1);
+        groups.f64("energy_max_dev_min", dev.0);
+        groups.f64("energy_max_dev_max", dev.1);
+        groups.f64("energy_max_increase_min", inc.0);
+        groups.f64("energy_max_increase_max", inc.1);
+        groups.f64("energy_theta_max_increase_min", th.0);
+        groups.f64("energy_theta_max_increase_max", th.1);
+        groups.i64("growth_runs", Some(growth as i64));
+        groups.i64("theta_growth_runs", Some(tgrowth as i64));
+        groups.i64("monotone_decay_runs", Some(decay as i64));
+        groups.i64("conserved_runs", Some(conserved as i64));
+        for ((n, _), c) in runs.params.iter().zip(&first.params) {
+            groups.cell(n, c);
+        }
+        groups.end_row();
+        group_rows_md.push(vec![
+            (gi + 1).to_string(),
+            g.title.clone(),
+            format!("{}/{}", ok.len(), g.runs.len()),
+            range(drift.0, drift.1),
+            range(dev.0, dev.1),
+            range(inc.0, inc.1),
+            range(th.0, th.1),
+            growth.to_string(),
+            decay.to_string(),
+            conserved.to_string(),
+        ]);
+    }
+
+    let mut md = String::from("# Energy\n\n");
+    let _ = writeln!(
+        md,
+        "Relative to E⁰ (the run's initial discrete energy): drift = (E^N − E⁰)/E⁰, max dev = \
+         max |E^n − E⁰|/E⁰, max increase = max (E^(n+1) − E^n)/E⁰ (E_Θ for the Θ column). \
+         Behaviour: growth (max increase > {ENERGY_TOL:e}), conserved (max dev ≤ {ENERGY_TOL:e}), \
+         monotone decay (no growth, not conserved, drift < 0). Group ranges are over the ok runs.\n"
+    );
+    md.push_str("## Per group (across refinement)\n\n");
+    let gh: Vec<String> = [
+        "#",
+        "group",
+        "ok/runs",
+        "drift",
+        "max dev",
+        "max increase",
+        "max increase E_Θ",
+        "growth",
+        "decay",
+        "conserved",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let mut ga = vec![Align::Right, Align::Left];
+    ga.extend([Align::Right; 8]);
+    md.push_str(&table::markdown(&gh, &ga, &group_rows_md));
+    md.push_str("\n## Per run\n\n");
+    match &series {
+        Ok(_) => {
+            let _ = writeln!(
+                md,
+                "Impacts (bar1d): contact phases = maximal runs of recorded steps with σ_C < 0; \
+                 loss = (E just before − E just after)/E⁰ summed over complete phases; full list \
+                 in impacts.parquet. {impact_count} contact phases in {runs_with_series} runs with \
+                 series{}.\n",
+                if decimated_runs > 0 {
+                    format!(
+                        "; {decimated_runs} series are decimated (phase ends resolved to the \
+                         recording stride only, energy change outside contact within the stride \
+                         is attributed to the impact)"
+                    )
+                } else {
+                    String::new()
+                }
+            );
+        }
+        Err(why) => {
+            let _ = writeln!(md, "Impacts: not computed ({why}).\n");
+        }
+    }
+    let rh: Vec<String> = [
+        "#",
+        "label",
+        "h",
+        "dt",
+        "status",
+        "drift",
+        "max dev",
+        "max increase",
+        "max increase E_Θ",
+        "behaviour",
+        "impacts",
+        "impact loss",
+        "decimated",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let mut ra = vec![Align::Right, Align::Left, Align::Right, Align::Right, Align::Left];
+    ra.extend([Align::Right; 4]);
+    ra.extend([Align::Left, Align::Right, Align::Right, Align::Left]);
+    md.push_str(&table::markdown(&rh, &ra, &run_rows_md));
+
+    let ok_runs = runs.runs.iter().filter(|r| r.ok()).count();
+    let mut terminal = format!("energy: {ok_runs} ok runs —");
+    let parts: Vec<String> = counts.iter().map(|(k, v)| format!(" {v} {k}")).collect();
+    terminal.push_str(&parts.join(","));
+    terminal.push('\n');
+    if let Some(worst) = runs
+        .runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter(|r| r.energy_max_increase.is_some_and(|x| x.is_finite()))
+        .max_by(|a, b| {
+            a.energy_max_increase
+                .unwrap_or(f64::NEG_INFINITY)
+                .total_cmp(&b.energy_max_increase.unwrap_or(f64::NEG_INFINITY))
+        })
+        .filter(|r| r.energy_max_increase.is_some_and(|x| x > ENERGY_TOL))
+    {
+        let _ = writeln!(
+            terminal,
+            "  largest one-step gain {} E⁰: {} (h = {}, dt = {})",
+            table::sci(worst.energy_max_increase),
+            worst.label,
+            table::sci(worst.h),
+            table::sci(worst.dt)
+        );
+    }
+    match &series {
+        Ok(_) => {
+            let _ = writeln!(
+                terminal,
+                "  impacts: {impact_count} contact phases in {runs_with_series} bar1d runs with series{}",
+                if decimated_runs > 0 {
+                    format!(" ({decimated_runs} decimated)")
+                } else {
+                    String::new()
+                }
+            );
+        }
+        Err(why) => {
+            let _ = writeln!(terminal, "  impacts: not computed ({why})");
+        }
+    }
+    Ok(Section {
+        runs: per_run,
+        groups,
+        impacts,
+        markdown: md,
+        terminal,
+    })
+}

@@ -1,0 +1,616 @@
+//! Loading `DIR/runs` into plain rows, and grouping them into method groups and refinement
+//! paths.
+//!
+//! Only the columns this module knows are read (by name, cast to the type this version
+//! expects); anything else in the Parquet — columns of another version — is ignored and
+//! listed, never an error. A known column of an unusable type (a list, a struct) is treated as
+//! absent.
+
+use std::collections::{BTreeMap, HashSet};
+use std::path::Path;
+
+use anyhow::{Context as _, bail};
+use polars::prelude::*;
+
+use super::table::Kind;
+
+/// Parameter columns (SPEC §7, §8) that identify a method group, in output order. The
+/// refinement axes ([`REFINEMENT`]) and the derived `label` are not among them: `label` is a
+/// function of these parameters and is carried, not grouped by.
+pub(crate) const PARAMS: &[(&str, Kind)] = &[
+    ("sweep", Kind::Str),
+    ("scene", Kind::Str),
+    ("space", Kind::Str),
+    ("mass", Kind::Str),
+    ("mass_weights", Kind::Str),
+    ("scheme", Kind::Str),
+    ("scheme_label", Kind::Str),
+    ("nitsche_theta", Kind::F64),
+    ("nitsche_gamma0", Kind::F64),
+    ("penalty_gamma0", Kind::F64),
+    ("newmark_beta", Kind::F64),
+    ("newmark_gamma", Kind::F64),
+    ("theta_scheme", Kind::F64),
+    ("restitution", Kind::F64),
+    ("length", Kind::F64),
+    ("young", Kind::F64),
+    ("density", Kind::F64),
+    ("amplitude", Kind::F64),
+    ("gap", Kind::F64),
+    ("lame_lambda", Kind::F64),
+    ("lame_mu", Kind::F64),
+    ("gravity", Kind::F64),
+    ("T", Kind::F64),
+    ("ensemble_sample", Kind::I64),
+    ("ensemble_perturbation", Kind::F64),
+];
+
+/// The parameters already spelled out in a run's `label` (contact method · mass · scheme);
+/// the other parameters are added to a group's title when they vary across the folder.
+const IN_LABEL: &[&str] = &[
+    "space",
+    "mass",
+    "mass_weights",
+    "scheme",
+    "scheme_label",
+    "nitsche_theta",
+    "nitsche_gamma0",
+    "penalty_gamma0",
+    "newmark_beta",
+    "newmark_gamma",
+    "theta_scheme",
+    "restitution",
+];
+
+/// The refinement axes: `h` (or `elements`), `dt` (or `courant`).
+pub(crate) const REFINEMENT: &[(&str, Kind)] = &[
+    ("h", Kind::F64),
+    ("elements", Kind::I64),
+    ("dt", Kind::F64),
+    ("courant", Kind::F64),
+];
+
+/// The error columns of SPEC §5, in output order.
+pub(crate) const ERRORS: &[&str] = &[
+    "err_u_l2l2",
+    "err_u_l2h1",
+    "err_u_linfl2",
+    "err_sigma_l2",
+    "err_energy_l2",
+    "err_u_contact_max",
+];
+
+/// Measured columns read besides parameters and errors.
+const MEASURED: &[(&str, Kind)] = &[
+    ("run_id", Kind::Str),
+    ("label", Kind::Str),
+    ("status", Kind::Str),
+    ("message", Kind::Str),
+    ("wall_time_s", Kind::F64),
+    ("wall_time_min_s", Kind::F64),
+    ("wall_time_max_s", Kind::F64),
+    ("repeats", Kind::I64),
+    ("steps", Kind::I64),
+    ("dofs", Kind::I64),
+    ("energy_initial", Kind::F64),
+    ("energy_final", Kind::F64),
+    ("energy_drift", Kind::F64),
+    ("energy_max_dev", Kind::F64),
+    ("energy_max_increase", Kind::F64),
+    ("energy_theta_max_increase", Kind::F64),
+];
+
+/// One parameter value.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Cell {
+    F64(Option<f64>),
+    I64(Option<i64>),
+    Str(Option<String>),
+}
+
+impl Cell {
+    /// The grouping key of a value. Floats are rounded to 11 significant digits so that a
+    /// value recomputed in another order (a Courant number derived as c0·dt/h) still matches;
+    /// parameters of a sweep differ far above that.
+    pub(crate) fn key(&self) -> String {
+        match self {
+            Cell::F64(Some(x)) if x.is_finite() => format!("{x:.10e}"),
+            Cell::F64(Some(x)) => format!("{x}"),
+            Cell::I64(Some(i)) => i.to_string(),
+            Cell::Str(Some(s)) => format!("'{s}'"),
+            _ => "null".into(),
+        }
+    }
+
+    /// The value as a person reads it (shortest round-trip form of floats).
+    pub(crate) fn show(&self) -> Option<String> {
+        match self {
+            Cell::F64(x) => x.map(|x| format!("{x}")),
+            Cell::I64(x) => x.map(|x| x.to_string()),
+            Cell::Str(x) => x.clone(),
+        }
+    }
+}
+
+/// The key of a refinement value (same rounding as [`Cell::key`]).
+pub(crate) fn float_key(x: f64) -> String {
+    format!("{x:.10e}")
+}
+
+/// One row of `DIR/runs`, reduced to what the summary uses.
+#[derive(Debug, Clone)]
+pub(crate) struct Run {
+    pub run_id: String,
+    pub label: String,
+    pub status: String,
+    pub message: Option<String>,
+    /// Aligned with [`Runs::params`].
+    pub params: Vec<Cell>,
+    pub h: Option<f64>,
+    pub elements: Option<i64>,
+    pub dt: Option<f64>,
+    pub courant: Option<f64>,
+    /// Aligned with [`Runs::errors`].
+    pub errors: Vec<Option<f64>>,
+    pub wall_time_s: Option<f64>,
+    pub wall_time_min_s: Option<f64>,
+    pub wall_time_max_s: Option<f64>,
+    pub repeats: Option<i64>,
+    pub steps: Option<i64>,
+    pub dofs: Option<i64>,
+    pub energy_initial: Option<f64>,
+    pub energy_final: Option<f64>,
+    pub energy_drift: Option<f64>,
+    pub energy_max_dev: Option<f64>,
+    pub energy_max_increase: Option<f64>,
+    pub energy_theta_max_increase: Option<f64>,
+    /// Index into [`Runs::groups`].
+    pub group: usize,
+}
+
+impl Run {
+    pub(crate) fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+
+    pub(crate) fn param(&self, runs: &Runs, name: &str) -> Option<String> {
+        runs.params
+            .iter()
+            .position(|(n, _)| *n == name)
+            .and_then(|i| self.params[i].show())
+    }
+}
+
+/// A method group: runs equal in every parameter except the refinement axes.
+#[derive(Debug, Clone)]
+pub(crate) struct Group {
+    /// Title: the label plus the parameters that vary across the folder but are not in it.
+    pub title: String,
+    /// Run indices.
+    pub runs: Vec<usize>,
+    /// Distinct (h, dt) levels.
+    pub levels: usize,
+}
+
+/// What is fixed along a refinement path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Fixed {
+    Courant(f64),
+    Dt(f64),
+    H(f64),
+}
+
+impl Fixed {
+    pub(crate) fn name(&self) -> &'static str {
+        match self {
+            Fixed::Courant(_) => "courant",
+            Fixed::Dt(_) => "dt",
+            Fixed::H(_) => "h",
+        }
+    }
+
+    pub(crate) fn value(&self) -> f64 {
+        match *self {
+            Fixed::Courant(x) | Fixed::Dt(x) | Fixed::H(x) => x,
+        }
+    }
+
+    /// The refined axis: h when Courant or dt is held, dt when h is held.
+    pub(crate) fn refined(&self) -> &'static str {
+        match self {
+            Fixed::Courant(_) | Fixed::Dt(_) => "h",
+            Fixed::H(_) => "dt",
+        }
+    }
+
+    pub(crate) fn describe(&self) -> String {
+        match self {
+            Fixed::Courant(x) => format!("courant = {x} fixed, h refined"),
+            Fixed::Dt(x) => format!("dt = {x} fixed, h refined"),
+            Fixed::H(x) => format!("h = {x} fixed, dt refined"),
+        }
+    }
+
+    pub(crate) fn short(&self) -> String {
+        match self {
+            Fixed::Courant(x) => format!("ν={x}, h↓"),
+            Fixed::Dt(x) => format!("dt={x}, h↓"),
+            Fixed::H(x) => format!("h={x}, dt↓"),
+        }
+    }
+}
+
+/// A refinement path: ≥ 2 distinct levels of one group along one axis, coarse → fine.
+#[derive(Debug, Clone)]
+pub(crate) struct RefPath {
+    pub group: usize,
+    pub fixed: Fixed,
+    /// (refinement value x = h or dt, run index), x strictly decreasing.
+    pub levels: Vec<(f64, usize)>,
+}
+
+/// The runs of a folder.
+#[derive(Debug, Clone)]
+pub(crate) struct Runs {
+    /// Parameter columns present in the Parquet.
+    pub params: Vec<(&'static str, Kind)>,
+    /// Error columns present with at least one value.
+    pub errors: Vec<&'static str>,
+    pub runs: Vec<Run>,
+    pub groups: Vec<Group>,
+    pub paths: Vec<RefPath>,
+    /// Columns of the Parquet this version does not know (ignored).
+    pub ignored: Vec<String>,
+    /// Duplicate rows of one run_id dropped (a run committed by two shards).
+    pub duplicates: usize,
+    /// The folder had no `status` column: every run counted as ok.
+    pub status_assumed: bool,
+}
+
+impl Runs {
+    /// Parameter columns as declared output columns.
+    pub(crate) fn param_columns(&self) -> Vec<(String, Kind)> {
+        self.params.iter().map(|(n, k)| (n.to_string(), *k)).collect()
+    }
+
+    /// Parameters that vary across the folder, excluding those in the label.
+    fn varying(&self) -> Vec<usize> {
+        (0..self.params.len())
+            .filter(|&i| !IN_LABEL.contains(&self.params[i].0))
+            .filter(|&i| {
+                let keys: HashSet<String> = self.runs.iter().map(|r| r.params[i].key()).collect();
+                keys.len() > 1
+            })
+            .collect()
+    }
+}
+
+fn dtype(kind: Kind) -> DataType {
+    match kind {
+        Kind::F64 => DataType::Float64,
+        Kind::I64 => DataType::Int64,
+        Kind::Str => DataType::String,
+        Kind::Bool => DataType::Boolean,
+    }
+}
+
+/// Whether a stored column can be read (a non-strict cast turns unparsable values into nulls;
+/// nested types are not read).
+fn castable(found: &DataType) -> bool {
+    // Every scalar type casts to every kind read here (numbers to text for string columns,
+    // text to numbers for numeric ones, unparsable → null).
+    found.is_primitive_numeric() || found.is_bool() || found.is_string() || found.is_null()
+}
+
+fn f64s(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<f64>>>> {
+    match df.column(name) {
+        Ok(c) => Ok(Some(c.f64()?.iter().collect())),
+        Err(_) => Ok(None),
+    }
+}
+
+fn i64s(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<i64>>>> {
+    match df.column(name) {
+        Ok(c) => Ok(Some(c.i64()?.iter().collect())),
+        Err(_) => Ok(None),
+    }
+}
+
+fn strs(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<String>>>> {
+    match df.column(name) {
+        Ok(c) => Ok(Some(
+            c.str()?.iter().map(|s| s.map(str::to_string)).collect(),
+        )),
+        Err(_) => Ok(None),
+    }
+}
+
+/// Read and group the runs of `dir`.
+pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
+    if !dir.is_dir() {
+        bail!("{}: no such folder (expected a results folder with runs/)", dir.display());
+    }
+    let raw = crate::sink::read_runs(dir)?;
+    if raw.height() == 0 {
+        bail!(
+            "{}: no runs to summarize: {} holds no committed *.parquet part (is this a contact-sweep output folder?)",
+            dir.display(),
+            dir.join("runs").display()
+        );
+    }
+    let schema = raw.schema().clone();
+    let known: Vec<(&'static str, Kind)> = MEASURED
+        .iter()
+        .chain(PARAMS)
+        .chain(REFINEMENT)
+        .copied()
+        .chain(ERRORS.iter().map(|e| (*e, Kind::F64)))
+        .collect();
+    let mut ignored: Vec<String> = Vec::new();
+    for (name, found) in schema.iter() {
+        let usable = known
+            .iter()
+            .find(|(n, _)| *n == name.as_str())
+            .is_some_and(|_| castable(found));
+        if !usable {
+            ignored.push(name.to_string());
+        }
+    }
+    // Select the known columns with the types this version expects; the rest is dropped
+    // before anything else looks at it.
+    let exprs: Vec<Expr> = known
+        .iter()
+        .filter(|(n, _)| schema.get(n).is_some_and(castable))
+        .map(|(n, k)| col(*n).cast(dtype(*k)))
+        .collect();
+    let df = raw
+        .lazy()
+        .select(exprs)
+        .collect()
+        .with_context(|| format!("{}: reading the runs table", dir.join("runs").display()))?;
+    let n = df.height();
+
+    let run_id = strs(&df, "run_id")?;
+    let label = strs(&df, "label")?;
+    let status = strs(&df, "status")?;
+    let status_assumed = status.is_none();
+    let message = strs(&df, "message")?;
+    let get_f = |name: &str| -> anyhow::Result<Vec<Option<f64>>> {
+        Ok(f64s(&df, name)?.unwrap_or_else(|| vec![None; n]))
+    };
+    let get_i = |name: &str| -> anyhow::Result<Vec<Option<i64>>> {
+        Ok(i64s(&df, name)?.unwrap_or_else(|| vec![None; n]))
+    };
+
+    let params: Vec<(&'static str, Kind)> = PARAMS
+        .iter()
+        .filter(|(name, _)| df.column(name).is_ok())
+        .copied()
+        .collect();
+    let mut param_values: Vec<Vec<Cell>> = Vec::with_capacity(params.len());
+    for (name, kind) in &params {
+        let v: Vec<Cell> = match kind {
+            Kind::F64 => get_f(name)?.into_iter().map(Cell::F64).collect(),
+            Kind::I64 => get_i(name)?.into_iter().map(Cell::I64).collect(),
+            _ => strs(&df, name)?
+                .unwrap_or_else(|| vec![None; n])
+                .into_iter()
+                .map(Cell::Str)
+                .collect(),
+        };
+        param_values.push(v);
+    }
+    let mut errors: Vec<&'static str> = Vec::new();
+    let mut error_values: Vec<Vec<Option<f64>>> = Vec::new();
+    for e in ERRORS {
+        if let Some(v) = f64s(&df, e)? {
+            if v.iter().any(|x| x.is_some_and(|x| !x.is_nan())) {
+                errors.push(e);
+                error_values.push(v);
+            }
+        }
+    }
+    let (h, elements, dt, courant) = (get_f("h")?, get_i("elements")?, get_f("dt")?, get_f("courant")?);
+    let (wt, wt_min, wt_max) = (
+        get_f("wall_time_s")?,
+        get_f("wall_time_min_s")?,
+        get_f("wall_time_max_s")?,
+    );
+    let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
+    let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
+        get_f("energy_initial")?,
+        get_f("energy_final")?,
+        get_f("energy_drift")?,
+        get_f("energy_max_dev")?,
+        get_f("energy_max_increase")?,
+        get_f("energy_theta_max_increase")?,
+    );
+    let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
+
+    let mut seen: HashSet<String> = HashSet::new();
+    let mut duplicates = 0;
+    let mut runs = Vec::with_capacity(n);
+    for i in 0..n {
+        // A run without an id (another version) still counts; it gets its row number.
+        let id = run_id
+            .as_ref()
+            .and_then(|v| v[i].clone())
+            .unwrap_or_else(|| format!("row-{i}"));
+        if !seen.insert(id.clone()) {
+            // The same run committed twice (two shards, a re-run): same id, same parameters.
+            duplicates += 1;
+            continue;
+        }
+        let params_i: Vec<Cell> = param_values.iter().map(|v| v[i].clone()).collect();
+        let lbl = label.as_ref().and_then(|v| v[i].clone()).unwrap_or_else(|| {
+            // No label column: compose one from the method parameters that exist.
+            let pick = |name: &str| {
+                params
+                    .iter()
+                    .position(|(n, _)| *n == name)
+                    .and_then(|j| params_i[j].show())
+            };
+            [pick("space"), pick("mass"), pick("scheme_label").or(pick("scheme"))]
+                .into_iter()
+                .flatten()
+                .collect::<Vec<_>>()
+                .join(" · ")
+        });
+        runs.push(Run {
+            run_id: id,
+            label: lbl,
+            status: match &status {
+                Some(v) => v[i].clone().unwrap_or_else(|| "unknown".into()),
+                None => "ok".into(),
+            },
+            message: message.as_ref().and_then(|v| v[i].clone()),
+            params: params_i,
+            h: finite(h[i]).filter(|x| *x > 0.0),
+            elements: elements[i].filter(|m| *m > 0),
+            dt: finite(dt[i]).filter(|x| *x > 0.0),
+            courant: finite(courant[i]).filter(|x| *x > 0.0),
+            errors: error_values.iter().map(|v| v[i]).collect(),
+            wall_time_s: finite(wt[i]),
+            wall_time_min_s: finite(wt_min[i]),
+            wall_time_max_s: finite(wt_max[i]),
+            repeats: repeats[i],
+            steps: steps[i],
+            dofs: dofs[i],
+            energy_initial: e_init[i],
+            energy_final: e_fin[i],
+            energy_drift: drift[i],
+            energy_max_dev: max_dev[i],
+            energy_max_increase: max_inc[i],
+            energy_theta_max_increase: theta_inc[i],
+            group: 0,
+        });
+    }
+    let mut out = Runs {
+        params,
+        errors,
+        runs,
+        groups: Vec::new(),
+        paths: Vec::new(),
+        ignored,
+        duplicates,
+        status_assumed,
+    };
+    group(&mut out);
+    Ok(out)
+}
+
+/// Group the runs and find the refinement paths of every group.
+fn group(r: &mut Runs) {
+    let varying = r.varying();
+    let mut by_key: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+    for (i, run) in r.runs.iter().enumerate() {
+        let key = run.params.iter().map(Cell::key).collect::<Vec<_>>().join("|");
+        by_key.entry(key).or_default().push(i);
+    }
+    let mut groups: Vec<(String, String, Vec<usize>)> = by_key
+        .into_iter()
+        .map(|(key, idx)| {
+            let first = &r.runs[idx[0]];
+            let extra: Vec<String> = varying
+                .iter()
+                .filter_map(|&j| first.params[j].show().map(|v| format!("{}={v}", r.params[j].0)))
+                .collect();
+            let title = if extra.is_empty() {
+                first.label.clone()
+            } else {
+                format!("{} [{}]", first.label, extra.join(", "))
+            };
+            (title, key, idx)
+        })
+        .collect();
+    // Deterministic order: by title, then by the full key.
+    groups.sort_by(|a, b| (&a.0, &a.1).cmp(&(&b.0, &b.1)));
+    // Two groups with the same title (a parameter the label does not show and that does not
+    // vary as a whole) get a number so the tables stay distinguishable.
+    let mut count: BTreeMap<String, usize> = BTreeMap::new();
+    for g in &groups {
+        *count.entry(g.0.clone()).or_default() += 1;
+    }
+    let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+    for (gi, (title, _, idx)) in groups.into_iter().enumerate() {
+        let title = if count[&title] > 1 {
+            let k = seen.entry(title.clone()).or_default();
+            *k += 1;
+            format!("{title} (#{k})")
+        } else {
+            title
+        };
+        let levels: HashSet<(String, String)> = idx
+            .iter()
+            .map(|&i| {
+                let run = &r.runs[i];
+                (opt_key(run.h), opt_key(run.dt))
+            })
+            .collect();
+        for &i in &idx {
+            r.runs[i].group = gi;
+        }
+        r.paths.extend(paths_of(&r.runs, gi, &idx));
+        r.groups.push(Group {
+            title,
+            runs: idx,
+            levels: levels.len(),
+        });
+    }
+}
+
+fn opt_key(x: Option<f64>) -> String {
+    x.map(float_key).unwrap_or_else(|| "null".into())
+}
+
+/// The refinement paths of one group: Courant held (h refined), dt held (h refined), h held
+/// (dt refined); each with ≥ 2 distinct levels.
+fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
+    let mut out = Vec::new();
+    type Axis = fn(&Run) -> Option<f64>;
+    let axes: [(Axis, Axis, fn(f64) -> Fixed); 3] = [
+        (|r| r.courant, |r| r.h, Fixed::Courant),
+        (|r| r.dt, |r| r.h, Fixed::Dt),
+        (|r| r.h, |r| r.dt, Fixed::H),
+    ];
+    for (held, refined, make) in axes {
+        let mut sub: BTreeMap<String, (f64, Vec<usize>)> = BTreeMap::new();
+        for &i in idx {
+            if let (Some(f), Some(_)) = (held(&runs[i]), refined(&runs[i])) {
+                sub.entry(float_key(f)).or_insert((f, Vec::new())).1.push(i);
+            }
+        }
+        let mut found: Vec<RefPath> = Vec::new();
+        for (_, (f, members)) in sub {
+            // One run per level; should two share a level (they cannot after dropping
+            // duplicate run ids, unless another version hashed differently), an ok one wins.
+            let mut levels: BTreeMap<String, (f64, usize)> = BTreeMap::new();
+            for i in members {
+                let x = refined(&runs[i]).expect("filtered above");
+                let e = levels.entry(float_key(x)).or_insert((x, i));
+                if !runs[e.1].ok() && runs[i].ok() {
+                    *e = (x, i);
+                }
+            }
+            if levels.len() < 2 {
+                continue;
+            }
+            let mut lv: Vec<(f64, usize)> = levels.into_values().collect();
+            // Coarse → fine.
+            lv.sort_by(|a, b| b.0.total_cmp(&a.0));
+            found.push(RefPath {
+                group,
+                fixed: make(f),
+                levels: lv,
+            });
+        }
+        found.sort_by(|a, b| a.fixed.value().total_cmp(&b.fixed.value()));
+        out.extend(found);
+    }
+    out
+}
+
+/// Title of a group with its index, as the tables show it.
+pub(crate) fn group_heading(runs: &Runs, g: usize) -> String {
+    format!("group {}: {}", g + 1, runs.groups[g].title)
+}

@@ -1,0 +1,229 @@
+//! Bad sweep files: each is refused before anything runs, with exit status 2, a message naming
+//! the file and the key (and the line where the parser gives one), no panic, and no output
+//! folder created.
+
+mod common;
+
+use common::{cli, write};
+
+/// (file body, key the message must name, a phrase of the reason)
+const CASES: &[(&str, &str, &str)] = &[
+    (
+        "name = \"x\"\nscene = \"bar1d\"\nnmae = 1\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "nmae",
+        "unknown top-level key",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nnitsche_gama0 = [1.0]\n",
+        "grid.nitsche_gama0",
+        "did you mean `nitsche_gamma0`",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = \"0.1\"\ndt = 0.1\n",
+        "fixed.h",
+        "expected a number, found a string",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = -0.01\ndt = 0.1\n",
+        "fixed.h",
+        "must be > 0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.0\n",
+        "fixed.dt",
+        "must be > 0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nspace = \"nitsche\"\n[grid]\nnitsche_gamma0 = [1e-6, 0.0]\n",
+        "grid.nitsche_gamma0[1]",
+        "must be > 0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"weights\"\nmass_weights = [2.0, -1.0]\n",
+        "fixed.mass_weights",
+        "weight 2 must be > 0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"weights\"\nmass_weights = [nan]\n",
+        "fixed.mass_weights",
+        "finite",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"newmark\"\nnewmark_beta = 0.7\n",
+        "fixed.newmark_beta",
+        "must lie in [0, 0.5]",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"newmark\"\nnewmark_gamma = 1.5\n",
+        "fixed.newmark_gamma",
+        "must lie in [0, 1]",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"theta\"\ntheta_scheme = 2.0\n",
+        "fixed.theta_scheme",
+        "must lie in [0, 1]",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"paoli-schatzman\"\nrestitution = -0.1\n",
+        "fixed.restitution",
+        "must lie in [0, 1]",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.01\ndt = 0.02\nmass = \"mod3\"\nscheme = \"central-difference\"\n",
+        "fixed.dt",
+        "above the CFL limit",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[zip]\nh = [0.1, 0.05]\ndt = [0.1, 0.05, 0.025]\n",
+        "zip.dt",
+        "equal lengths",
+    ),
+    (
+        "scene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "name",
+        "required key missing",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar9d\"\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "scene",
+        "unknown scene",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = = 0.1\n",
+        "(syntax)",
+        "invalid TOML",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.3\ndt = 0.1\n",
+        "fixed.h",
+        "does not divide length",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nlame_mu = 0.5\n",
+        "fixed.lame_mu",
+        "not a parameter of scene bar1d",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\nelements = 10\ndt = 0.1\n",
+        "fixed.elements",
+        "either h or elements",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"crank-nicholson\"\n",
+        "fixed.scheme",
+        "unknown scheme",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\ndt = 0.1\n[grid]\nh = 0.1\n",
+        "grid.h",
+        "expected a list of values",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\ndt = 0.1\n[grid]\nh = []\n",
+        "grid.h",
+        "empty list",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"theta\"\n",
+        "fixed.scheme",
+        "needs theta_scheme",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nspace = \"nitsche\"\n",
+        "fixed.space",
+        "needs nitsche_gamma0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nh = [0.1, 0.2]\n",
+        "grid.h[0]",
+        "from one place only",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\nreference = { h = 0.01 }\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "reference",
+        "closed-form",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"theta\"\ntheta_scheme = 0.0\n",
+        "fixed.theta_scheme",
+        "forward Euler",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\n",
+        "dt",
+        "required",
+    ),
+    (
+        "name = \"../evil\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "name",
+        "folder-safe",
+    ),
+];
+
+#[test]
+fn every_bad_sweep_is_refused_with_the_key_and_exit_2() {
+    assert!(CASES.len() >= 12);
+    let tmp = tempfile::tempdir().unwrap();
+    for (i, (body, key, reason)) in CASES.iter().enumerate() {
+        let file = format!("bad{i}.toml");
+        write(tmp.path(), &file, body);
+        let out_dir = format!("out{i}");
+        for cmd in ["plan", "run"] {
+            let mut args = vec![cmd, file.as_str()];
+            if cmd == "run" {
+                args.extend(["--out", out_dir.as_str()]);
+            }
+            let o = cli(tmp.path(), &args);
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "case {i} ({cmd}): exit {:?}, stderr:\n{err}",
+                o.status.code()
+            );
+            assert!(!err.contains("panicked"), "case {i}: panic\n{err}");
+            assert!(err.contains(&file), "case {i}: file not named\n{err}");
+            assert!(
+                err.contains(&format!("`{key}`")),
+                "case {i}: key `{key}` not named\n{err}"
+            );
+            assert!(
+                err.contains(reason),
+                "case {i}: reason `{reason}` missing\n{err}"
+            );
+            assert!(
+                !tmp.path().join(&out_dir).exists(),
+                "case {i}: output written for a bad sweep"
+            );
+        }
+    }
+}
+
+#[test]
+fn line_numbers_are_reported_where_the_parser_knows_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nnewmark_beta = 0.9\n",
+    );
+    let o = cli(tmp.path(), &["plan", "s.toml"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("s.toml:6: key `fixed.newmark_beta`"), "{err}");
+}
+
+#[test]
+fn unreadable_file_and_bad_flags_exit_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = cli(tmp.path(), &["plan", "missing.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.toml"));
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.5\ndt = 0.5\nT = 1.0\n",
+    );
+    let o = cli(tmp.path(), &["run", "s.toml", "--run-timeout", "-3"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--run-timeout"));
+}

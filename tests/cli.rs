@@ -1,0 +1,310 @@
+//! End to end: the binary on sweep files, the Parquet it writes, determinism across thread
+//! counts, crash safety (SIGKILL mid-sweep, then resume), timeouts, foreign output folders.
+
+mod common;
+
+use std::collections::HashSet;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::{bin, cli, write};
+use contact_sweep::sink::{parquet_parts, read_runs, read_series};
+use polars::prelude::*;
+
+fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn quickstart_runs_and_prints_errors_against_the_exact_solution() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("qs");
+    let o = cli(
+        repo(),
+        &[
+            "run",
+            "sweeps/quickstart.toml",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        stdout.contains("l2(τ;L2)") && stdout.contains("l2(τ;H1)"),
+        "{stdout}"
+    );
+    let df = read_runs(&out).unwrap();
+    assert!(df.height() >= 50, "quickstart has {} runs", df.height());
+    // Every run has its errors against the closed form, and its derived columns filled.
+    for c in [
+        "err_u_l2l2",
+        "err_u_l2h1",
+        "err_sigma_l2",
+        "h",
+        "dt",
+        "courant",
+        "T",
+    ] {
+        assert_eq!(df.column(c).unwrap().null_count(), 0, "{c} has nulls");
+    }
+    let status = df.column("status").unwrap().str().unwrap().clone();
+    assert!(status.iter().all(|s| s == Some("ok")));
+    let series = read_series(&out).unwrap();
+    assert!(series.height() > 1000);
+    assert!(out.join("manifest.json").exists());
+}
+
+/// Rows sorted by run_id, without the timing columns.
+fn rows_without_timing(dir: &Path, series: bool) -> DataFrame {
+    let df = if series {
+        read_series(dir)
+    } else {
+        read_runs(dir)
+    }
+    .unwrap();
+    let keep: Vec<String> = df
+        .get_column_names()
+        .into_iter()
+        .map(|s| s.to_string())
+        .filter(|c| !c.starts_with("wall_time"))
+        .collect();
+    let by: Vec<&str> = if series {
+        vec!["run_id", "step"]
+    } else {
+        vec!["run_id"]
+    };
+    df.select(keep)
+        .unwrap()
+        .sort(by, SortMultipleOptions::default())
+        .unwrap()
+}
+
+#[test]
+fn one_and_two_threads_give_identical_rows() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = repo().join("sweeps/quickstart.toml");
+    let (a, b) = (tmp.path().join("t1"), tmp.path().join("t2"));
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let o = cli(
+            tmp.path(),
+            &[
+                "run",
+                sweep.to_str().unwrap(),
+                "--out",
+                dir.to_str().unwrap(),
+                "--threads",
+                threads,
+                "--no-summary",
+            ],
+        );
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    for series in [false, true] {
+        let (x, y) = (
+            rows_without_timing(&a, series),
+            rows_without_timing(&b, series),
+        );
+        assert_eq!(x.height(), y.height());
+        assert!(
+            x.equals_missing(&y),
+            "serial and parallel rows differ (series = {series})"
+        );
+    }
+}
+
+/// A sweep long enough to be killed in the middle: 240 runs of a few tens of ms.
+const LONG: &str = r#"
+name = "long"
+scene = "bar1d"
+series_every = 50
+[fixed]
+T = 12.0
+courant = 1.0
+[grid]
+h = [0.005, 0.0025, 0.004, 0.002]
+method = [
+  { space = "mixed", mass = "mod3", scheme = "crank-nicolson" },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "hybrid" },
+  { space = "mixed", mass = "zero-contact", scheme = "backward-euler" },
+]
+amplitude = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]
+"#;
+
+#[test]
+fn sigkill_mid_sweep_then_resume_loses_nothing_and_duplicates_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(tmp.path(), "long.toml", LONG);
+    let out = tmp.path().join("out");
+    let mut child = Command::new(bin())
+        .args([
+            "run",
+            sweep.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            "2",
+            "--batch",
+            "1",
+            "--no-summary",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until a few batches are committed, then kill without warning.
+    let start = Instant::now();
+    loop {
+        let parts = parquet_parts(&out.join("runs"))
+            .map(|p| p.len())
+            .unwrap_or(0);
+        if parts >= 5 {
+            break;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "no progress");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the sweep finished before it could be killed"
+    );
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    // Whatever is on disk is readable.
+    let partial = read_runs(&out).unwrap();
+    assert!(
+        partial.height() >= 5 && partial.height() < 240,
+        "{} rows",
+        partial.height()
+    );
+    // Resume (automatic: same sweep) completes the sweep.
+    let o = cli(
+        tmp.path(),
+        &["run", "long.toml", "--out", "out", "--no-summary"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("resuming"), "{err}");
+    let runs = read_runs(&out).unwrap();
+    assert_eq!(runs.height(), 240);
+    let ids: HashSet<String> = runs
+        .column("run_id")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .flatten()
+        .map(String::from)
+        .collect();
+    assert_eq!(ids.len(), 240, "duplicate rows after resume");
+    // The series has exactly one copy of every (run, step).
+    let series = read_series(&out).unwrap();
+    let uniq = series
+        .select(["run_id", "step"])
+        .unwrap()
+        .unique_stable(None, UniqueKeepStrategy::First, None)
+        .unwrap();
+    assert_eq!(uniq.height(), series.height(), "duplicate series rows");
+    let sids: HashSet<String> = series
+        .column("run_id")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .flatten()
+        .map(String::from)
+        .collect();
+    assert_eq!(sids, ids, "every run has its series, and no orphan series");
+    // A third invocation has nothing left to do.
+    let o = cli(
+        tmp.path(),
+        &["run", "long.toml", "--out", "out", "--no-summary"],
+    );
+    assert!(String::from_utf8_lossy(&o.stderr).contains("240 of 240 runs already done"));
+    assert_eq!(read_runs(&out).unwrap().height(), 240);
+}
+
+#[test]
+fn timeouts_and_failures_are_rows_not_aborts() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"t\"\nscene = \"bar1d\"\n[fixed]\ncourant = 1.0\nspace = \"nitsche\"\n[grid]\nnitsche_gamma0 = [1e-6, 3.0]\nh = [0.25, 0.0002]\n",
+    );
+    let o = cli(
+        tmp.path(),
+        &[
+            "run",
+            "s.toml",
+            "--out",
+            "o",
+            "--run-timeout",
+            "0.05",
+            "--no-summary",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let df = read_runs(&tmp.path().join("o")).unwrap();
+    let status: Vec<String> = df
+        .column("status")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .flatten()
+        .map(String::from)
+        .collect();
+    assert_eq!(df.height(), 4);
+    // h = 2e-4 at ν = 1: 60 000 steps of 5 000 nodes, far beyond 50 ms.
+    assert!(status.iter().any(|s| s == "timeout"), "{status:?}");
+    // γ0 = 3 with Θ = 1 at ν = 1 violates the well-posedness condition of 003 §2.2.3 at the
+    // first step: the condensed contact equation has two solutions, reported, not guessed.
+    assert_eq!(
+        status.iter().filter(|s| *s == "solver-failed").count(),
+        2,
+        "{status:?}"
+    );
+    let msgs = df.column("message").unwrap().str().unwrap().clone();
+    assert!(msgs.iter().flatten().any(|m| m.contains("timeout")));
+    assert!(msgs.iter().flatten().any(|m| m.contains("well-posedness")));
+}
+
+#[test]
+fn a_folder_of_another_sweep_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "a.toml",
+        "name = \"a\"\nscene = \"bar1d\"\n[fixed]\nh = 0.5\ndt = 0.5\nT = 1.0\n",
+    );
+    write(
+        tmp.path(),
+        "b.toml",
+        "name = \"b\"\nscene = \"bar1d\"\n[fixed]\nh = 0.25\ndt = 0.5\nT = 1.0\n",
+    );
+    assert!(
+        cli(tmp.path(), &["run", "a.toml", "--out", "d", "--no-summary"])
+            .status
+            .success()
+    );
+    let o = cli(tmp.path(), &["run", "b.toml", "--out", "d", "--no-summary"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("holds results of sweep `a`"));
+    assert_eq!(
+        read_runs(&tmp.path().join("d")).unwrap().height(),
+        1,
+        "nothing of b written"
+    );
+    // With --resume the runs of b are added.
+    assert!(
+        cli(
+            tmp.path(),
+            &["run", "b.toml", "--out", "d", "--resume", "--no-summary"]
+        )
+        .status
+        .success()
+    );
+    assert_eq!(read_runs(&tmp.path().join("d")).unwrap().height(), 2);
+}

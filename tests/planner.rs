@@ -1,0 +1,196 @@
+//! The planner (SPEC §7): product, zip, bundles, exclude, applicability collapse, courant,
+//! and run ids that are stable and canonical.
+
+use std::path::Path;
+
+use contact_sweep::sweep::{self, Key, Plan, SweepFile, Value};
+
+fn plan(text: &str) -> Plan {
+    let sf = SweepFile::parse(Path::new("test.toml"), text).unwrap_or_else(|e| panic!("{e}"));
+    sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn num(p: &Plan, i: usize, k: Key) -> f64 {
+    p.runs[i].params[&k].as_f64().unwrap()
+}
+
+fn ids(p: &Plan) -> Vec<String> {
+    p.runs.iter().map(|r| r.run_id.clone()).collect()
+}
+
+const HEAD: &str = "name = \"t\"\nscene = \"bar1d\"\n";
+
+#[test]
+fn grid_is_a_cartesian_product_last_axis_fastest() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nT = 1.0\n[grid]\nh = [0.5, 0.25]\ndt = [0.1, 0.05, 0.025]\n"
+    ));
+    assert_eq!(p.combinations, 6);
+    assert_eq!(p.runs.len(), 6);
+    let pairs: Vec<(f64, f64)> = (0..6)
+        .map(|i| (num(&p, i, Key::H), num(&p, i, Key::Dt)))
+        .collect();
+    assert_eq!(
+        pairs,
+        vec![
+            (0.5, 0.1),
+            (0.5, 0.05),
+            (0.5, 0.025),
+            (0.25, 0.1),
+            (0.25, 0.05),
+            (0.25, 0.025)
+        ]
+    );
+}
+
+#[test]
+fn zip_advances_together_and_crosses_the_grid() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nT = 1.0\n[zip]\nh = [0.5, 0.25, 0.125]\ndt = [0.5, 0.25, 0.125]\n[grid]\nmass = [\"mod1\", \"mod3\"]\n"
+    ));
+    assert_eq!(p.runs.len(), 6);
+    for i in 0..6 {
+        assert_eq!(
+            num(&p, i, Key::H),
+            num(&p, i, Key::Dt),
+            "zipped pairs stay paired"
+        );
+    }
+    // zip varies slowest
+    assert_eq!(num(&p, 0, Key::H), 0.5);
+    assert_eq!(num(&p, 1, Key::H), 0.5);
+    assert_eq!(p.runs[1].params[&Key::Mass], Value::Str("mod3".into()));
+}
+
+#[test]
+fn bundles_set_several_parameters_and_label_axes_are_not_parameters() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nT = 1.0\nh = 0.1\ndt = 0.1\n[grid]\nmethod = [\n  {{ space = \"nitsche\", nitsche_gamma0 = 0.1, nitsche_theta = -1.0 }},\n  {{ space = \"mixed\", mass = \"mod3\" }},\n]\nscheme = [\"backward-euler\", {{ scheme = \"newmark\", newmark_beta = 0.5, newmark_gamma = 1.0 }}]\n"
+    ));
+    assert_eq!(p.runs.len(), 4);
+    let r = &p.runs[0];
+    assert_eq!(r.params[&Key::Space], Value::Str("nitsche".into()));
+    assert_eq!(r.params[&Key::NitscheTheta], Value::Num(-1.0));
+    assert_eq!(r.params[&Key::Scheme], Value::Str("theta".into()));
+    assert_eq!(r.params[&Key::ThetaScheme], Value::Num(1.0));
+    let r = &p.runs[1];
+    assert_eq!(r.params[&Key::NewmarkBeta], Value::Num(0.5));
+    assert_eq!(r.params[&Key::NewmarkGamma], Value::Num(1.0));
+    assert_eq!(r.scheme_label, "newmark-dissipative");
+    assert!(!p.runs[2].params.contains_key(&Key::NitscheGamma0));
+}
+
+#[test]
+fn exclude_filters_match_resolved_values_and_aliases() {
+    let p = plan(&format!(
+        "{HEAD}exclude = [ {{ space = \"mixed\", scheme = \"crank-nicolson\" }}, {{ h = 0.25, mass = \"mod1\" }} ]\n[fixed]\nT = 1.0\ndt = 0.05\n[grid]\nh = [0.5, 0.25]\nmass = [\"mod1\", \"mod3\"]\nscheme = [\"crank-nicolson\", \"hybrid\", {{ scheme = \"newmark\", newmark_beta = 0.25, newmark_gamma = 0.5 }}]\n"
+    ));
+    // 12 combinations; the CN alias and the explicit (¼, ½) bundle are the same scheme, so 8
+    // are excluded by the first filter, the hybrid at h = 0.25 with mod1 by the second.
+    assert_eq!(p.combinations, 12);
+    assert_eq!(p.excluded_by_filter, 9);
+    assert_eq!(p.runs.len(), 3);
+    assert!(
+        p.runs
+            .iter()
+            .all(|r| r.params[&Key::Scheme] == Value::Str("hybrid".into()))
+    );
+}
+
+#[test]
+fn inapplicable_parameters_collapse_with_their_reason() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nT = 1.0\nh = 0.1\ndt = 0.1\n[grid]\nspace = [\"mixed\", \"nitsche\"]\nnitsche_gamma0 = [1e-6, 0.1, 1.0]\n"
+    ));
+    // mixed × 3 γ0 collapse into one run; nitsche keeps 3.
+    assert_eq!(p.combinations, 6);
+    assert_eq!(p.runs.len(), 4);
+    let reasons: Vec<(&String, &usize)> = p.collapsed.iter().collect();
+    assert_eq!(reasons.len(), 1);
+    assert!(
+        reasons[0]
+            .0
+            .contains("nitsche_gamma0 applies to space = nitsche only"),
+        "{reasons:?}"
+    );
+    assert_eq!(*reasons[0].1, 2);
+    assert!(p.summary().contains("2 collapsed"));
+}
+
+#[test]
+fn meaningless_combinations_are_left_out_with_reason() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nT = 1.0\nh = 0.1\ndt = 0.1\nnitsche_gamma0 = 1e-6\n[grid]\nspace = [\"mixed\", \"nitsche\"]\nmass = [\"consistent\", \"mod3\"]\nscheme = [\"paoli-schatzman\", \"hybrid\"]\n"
+    ));
+    // PS with Nitsche (2) and hybrid with mixed + consistent (1) are meaningless.
+    assert_eq!(p.runs.len(), 5);
+    assert_eq!(p.inapplicable.values().sum::<usize>(), 3);
+    assert!(
+        p.inapplicable
+            .keys()
+            .any(|k| k.contains("paoli-schatzman is defined for space = mixed only"))
+    );
+    assert!(
+        p.inapplicable
+            .keys()
+            .any(|k| k.contains("massless contact node"))
+    );
+}
+
+#[test]
+fn courant_and_elements_derive_dt_and_h_and_keep_ids() {
+    let a = plan(&format!("{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n"));
+    let b = plan(&format!("{HEAD}[fixed]\nelements = 100\ncourant = 1.5\n"));
+    assert_eq!(num(&b, 0, Key::Dt), 1.5 * 0.01);
+    assert_eq!(num(&a, 0, Key::Courant), 1.5);
+    assert_eq!(
+        ids(&a),
+        ids(&b),
+        "the same run, however its discretisation was written"
+    );
+}
+
+#[test]
+fn run_ids_are_canonical_and_stable() {
+    let base = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n[grid]\nmass = [\"mod3\", \"consistent\"]\n"
+    ));
+    // 1 vs 1.0, explicit defaults, a default-valued extra axis, another sweep name and order:
+    let other = plan(
+        "name = \"another\"\nscene = \"bar1d\"\n[fixed]\nT = 12\ndt = 0.015\nlength = 1\n[grid]\ngap = [0.0]\nmass = [\"consistent\", \"mod3\"]\nh = [0.01]\nscheme = [\"crank-nicolson\"]\n",
+    );
+    let mut a = ids(&base);
+    let mut b = ids(&other);
+    a.sort();
+    b.sort();
+    assert_eq!(a, b);
+    // Changing a value changes the id.
+    let c = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\ngap = 0.1\n[grid]\nmass = [\"mod3\", \"consistent\"]\n"
+    ));
+    assert!(ids(&c).iter().all(|id| !a.contains(id)));
+    // Frozen: the id of the 003 default CN run must never change across versions (it names
+    // rows in users' folders; resume and cross-sweep joins depend on it).
+    assert_eq!(base.runs[1].run_id, "35050bcfa8862a8f");
+}
+
+#[test]
+fn aliases_and_explicit_parameters_are_the_same_run() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nscheme = [\"crank-nicolson\", {{ scheme = \"newmark\", newmark_beta = 0.25, newmark_gamma = 0.5 }}, \"backward-euler\", {{ scheme = \"theta\", theta_scheme = 1.0 }}]\n"
+    ));
+    assert_eq!(p.runs.len(), 2);
+    assert_eq!(p.collapsed.values().sum::<usize>(), 2);
+}
+
+#[test]
+fn ensembles_expand_into_distinct_members() {
+    let p = plan(&format!(
+        "{HEAD}ensemble = {{ perturbation = 1e-14, samples = 4, seed = 7 }}\n[fixed]\nh = 0.1\ndt = 0.1\n"
+    ));
+    assert_eq!(p.runs.len(), 4);
+    let mut v = ids(&p);
+    v.dedup();
+    assert_eq!(v.len(), 4);
+    assert_eq!(p.runs[3].sample, Some((3, 1e-14)));
+}
