@@ -122,6 +122,7 @@ fn read_series(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Result<Hash
         .filter(col("run_id").is_not_null().and(col("step").is_not_null()))
         .sort(["run_id", "step"], SortMultipleOptions::default())
         .collect()
+        .map_err(anyhow::Error::new)
         .with_context(|| format!("{}: reading the time series", dir.join("series").display()))?;
     let ids = df.column("run_id")?.str()?.clone();
     let steps = df.column("step")?.i64()?.clone();

@@ -1,15 +1,149 @@
-//! Summaries of a results folder (placeholder until the summary tables land).
-use std::path::Path;
+//! Summaries of a results folder: `contact-sweep summarize DIR` turns `DIR/runs` (and, for the
+//! impacts, `DIR/series`) into the tables of a paper under `DIR/summary/` (SPEC §8, issue 4).
+//!
+//! # Groups and refinement paths
+//! Runs are grouped by every parameter column except the refinement axes (h/elements,
+//! dt/courant); `label` is derived from the parameters and carried, not grouped by. Columns
+//! this version does not know are ignored. Inside a group a *refinement path* holds one axis
+//! fixed — the Courant number (h refined, τ ∝ h), dt (h refined) or h (dt refined) — and needs
+//! ≥ 2 distinct levels; levels are ordered coarse → fine by the refined value x (h or dt).
+//!
+//! # Observed rates
+//! For consecutive usable levels (x_i, e_i), (x_j, e_j) of a path (j the next usable level
+//! after i, so a failed level in between is spanned),
+//!
+//! ```text
+//!     p_ij = log(e_i / e_j) / log(x_i / x_j)
+//! ```
+//!
+//! from the *actual* ratio x_i/x_j — never log 2: ladders like h = 1/4, 1/12, 1/24 have ratios
+//! 3 and 2, and a halving assumption would misreport the first rate by a factor log 3/log 2.
+//! If e ≈ C x^p, every p_ij equals p.
+//!
+//! # Least-squares slopes
+//! The slope p of the straight line log e = log C + p log x fitted to all usable levels,
+//!
+//! ```text
+//!     p = Σ (ξ_k − ξ̄)(η_k − η̄) / Σ (ξ_k − ξ̄)²,   ξ = log x, η = log e,
+//! ```
+//!
+//! and the same over the finest (up to) three usable levels. A pair rate hangs on two errors
+//! and is noisy; the fit over all levels summarises the ladder, the fit over the finest three
+//! is the best estimate of the *asymptotic* order (coarse levels may be pre-asymptotic).
+//!
+//! # Flags (thresholds in [`convergence`])
+//! - pre-asymptotic: the pair rates spread (max − min) by more than 0.3;
+//! - stagnating: the finest-three slope is below 0.1 (includes errors growing, slope < 0);
+//! - round-off floor: the finest usable error is ≤ 1e-12 × the coarsest, or below 1e-13
+//!   absolutely, or an ok level has error exactly 0 — refinement then measures rounding;
+//! - failed levels: status ≠ ok. Such levels stay in the tables, marked, and are excluded from
+//!   rates and fits (as are ok levels without a finite positive error), because a diverged
+//!   run's "error" is where it stopped, not a discretisation error.
+//!
+//! # Energy, speed against error
+//! See [`energy`] (drift, growth/decay flags with tolerance 1e-10·E⁰, energy lost per impact
+//! from the time series) and [`work`] (Pareto front in (error, wall time) and (error,
+//! steps × dofs); cost to reach ε by log-log interpolation between consecutive levels, the
+//! same power-law model as the rates).
+//!
+//! # Files (all written atomically: temporary dot-file, fsync, rename)
+//! `convergence.{parquet,csv,md,tex}`, `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
+//! `impacts.{parquet,csv}`, `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+
+pub mod convergence;
+pub mod energy;
+mod runs;
+mod table;
+pub mod work;
+
+pub use convergence::{NO_REFINEMENT, lsq_slope, observed_rate};
+pub use work::{loglog_cost, pareto_front};
 
 /// What `summarize` produced.
+#[derive(Debug, Clone)]
 pub struct Summary {
+    /// The compact report for the terminal.
     pub terminal: String,
+    /// `DIR/summary`.
+    pub dir: PathBuf,
+    /// Every file written, in order.
+    pub files: Vec<PathBuf>,
+    /// Runs read (after dropping duplicate run ids).
+    pub runs: usize,
+    /// Method groups (runs equal in every parameter except the refinement axes).
+    pub groups: usize,
+    /// Refinement paths found (0: no refinement axis).
+    pub refinement_paths: usize,
+    /// Columns of `DIR/runs` this version does not know (ignored).
+    pub ignored_columns: Vec<String>,
 }
 
-/// Summarize DIR.
+/// Summarize DIR: read `DIR/runs` (and `DIR/series`), write the tables under `DIR/summary/`.
+///
+/// Errors: DIR missing or without runs (the message names the folder), or an I/O failure.
+/// A folder without a refinement axis is not an error: the convergence section says so.
 pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
-    let df = crate::sink::read_runs(dir)?;
+    let runs = runs::load(dir)?;
+    let out = dir.join("summary");
+    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
+    let mut files = Vec::new();
+
+    let conv = convergence::section(&runs);
+    files.extend(table::write_table(&out, "convergence", &conv.table)?);
+    files.push(table::write_text(&out, "convergence.md", &conv.markdown)?);
+    files.push(table::write_text(&out, "convergence.tex", &conv.latex)?);
+
+    let en = energy::section(dir, &runs)?;
+    files.extend(table::write_table(&out, "energy", &en.runs)?);
+    files.extend(table::write_table(&out, "energy_groups", &en.groups)?);
+    files.extend(table::write_table(&out, "impacts", &en.impacts)?);
+    files.push(table::write_text(&out, "energy.md", &en.markdown)?);
+
+    let wp = work::section(&runs);
+    files.extend(table::write_table(&out, "work_precision", &wp.table)?);
+    files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
+    files.push(table::write_text(&out, "work_precision.md", &wp.markdown)?);
+
+    let mut terminal = format!(
+        "{} runs ({} ok) in {} groups from {}\n",
+        runs.runs.len(),
+        runs.runs.iter().filter(|r| r.ok()).count(),
+        runs.groups.len(),
+        dir.display()
+    );
+    if runs.duplicates > 0 {
+        terminal.push_str(&format!(
+            "  ({} duplicate rows of the same run_id dropped)\n",
+            runs.duplicates
+        ));
+    }
+    if !runs.ignored.is_empty() {
+        terminal.push_str(&format!(
+            "  (columns not known to this version, ignored: {})\n",
+            runs.ignored.join(", ")
+        ));
+    }
+    if runs.status_assumed {
+        terminal.push_str("  (no status column: every run counted as ok)\n");
+    }
+    terminal.push_str(&conv.terminal);
+    terminal.push_str(&en.terminal);
+    terminal.push_str(&wp.terminal);
+    terminal.push_str(&format!(
+        "tables: {} (convergence, energy, impacts, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
+        out.display()
+    ));
     Ok(Summary {
-        terminal: format!("{} runs in {}\n", df.height(), dir.display()),
+        terminal,
+        dir: out,
+        files,
+        runs: runs.runs.len(),
+        groups: runs.groups.len(),
+        refinement_paths: runs.paths.len(),
+        ignored_columns: runs.ignored,
     })
 }

@@ -367,6 +367,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         .lazy()
         .select(exprs)
         .collect()
+        .map_err(anyhow::Error::new)
         .with_context(|| format!("{}: reading the runs table", dir.join("runs").display()))?;
     let n = df.height();
 

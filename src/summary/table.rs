@@ -90,10 +90,6 @@ impl Table {
         t
     }
 
-    pub(crate) fn rows(&self) -> usize {
-        self.rows
-    }
-
     fn slot(&mut self, name: &str) -> &mut Values {
         let i = *self
             .index
@@ -176,12 +172,14 @@ impl Table {
 pub(crate) fn write_table(dir: &Path, stem: &str, table: &Table) -> anyhow::Result<Vec<PathBuf>> {
     let mut df = table
         .to_frame()
+        .map_err(anyhow::Error::new)
         .with_context(|| format!("building {stem} table"))?;
     let parquet = format!("{stem}.parquet");
     crate::sink::write_parquet_atomic(dir, &parquet, &mut df)?;
     let mut csv = Vec::new();
     CsvWriter::new(&mut csv)
         .finish(&mut df)
+        .map_err(anyhow::Error::new)
         .with_context(|| format!("{}: csv", dir.join(format!("{stem}.csv")).display()))?;
     let csv_path = dir.join(format!("{stem}.csv"));
     crate::sink::write_atomic(&csv_path, &csv)?;

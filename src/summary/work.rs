@@ -1,0 +1,503 @@
+//! Speed against error: every run's error against its cost (median wall time with the
+//! spread over repeats, and work = steps × dofs), the Pareto front, and the cost a method
+//! family needs to reach an error ε.
+
+use std::fmt::Write as _;
+
+use super::runs::{Fixed, Runs};
+use super::table::{self, Align, Kind, Table};
+
+/// The Pareto front of (cost, error) points, both minimised: `true` where no other point is
+/// at least as good in both and strictly better in one. O(n log n): sort by cost, sweep.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .0
+            .total_cmp(&points[b].0)
+            .then(points[a].1.total_cmp(&points[b].1))
+    });
+    let mut front = vec![false; points.len()];
+    // Smallest error among points strictly cheaper than the current cost.
+    let mut best = f64::INFINITY;
+    let mut i = 0;
+    while i < order.len() {
+        let cost = points[order[i]].0;
+        let mut j = i;
+        while j < order.len() && points[order[j]].0 == cost {
+            j += 1;
+        }
+        // Equal cost: only the smallest error can survive, and only if nothing cheaper is at
+        // least as accurate.
+        let emin = points[order[i]].1;
+        for &k in &order[i..j] {
+            front[k] = points[k].1 == emin && emin < best;
+        }
+        best = best.min(emin);
+        i = j;
+    }
+    front
+}
+
+/// log-log interpolation: the cost at error ε on the segment (e_a, c_a)–(e_b, c_b),
+/// log c = log c_a + (log ε − log e_a)/(log e_b − log e_a) · (log c_b − log c_a).
+pub fn loglog_cost(eps: f64, (e_a, c_a): (f64, f64), (e_b, c_b): (f64, f64)) -> Option<f64> {
+    if !(e_a > 0.0 && e_b > 0.0 && c_a > 0.0 && c_b > 0.0 && eps > 0.0) {
+        return None;
+    }
+    let de = e_b.ln() - e_a.ln();
+    let s = if de == 0.0 { 0.0 } else { (eps.ln() - e_a.ln()) / de };
+    Some((c_a.ln() + s * (c_b.ln() - c_a.ln())).exp())
+}
+
+/// The output of the section.
+pub(crate) struct Section {
+    pub table: Table,
+    pub cost: Table,
+    pub markdown: String,
+    pub terminal: String,
+}
+
+fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
+    let mut c: Vec<(String, Kind)> = list.iter().map(|(n, k)| (n.to_string(), *k)).collect();
+    c.extend(runs.param_columns());
+    c
+}
+
+/// An error value usable on a log scale.
+fn usable(v: Option<f64>) -> Option<f64> {
+    v.filter(|v| v.is_finite() && *v > 0.0)
+}
+
+fn work_of(steps: Option<i64>, dofs: Option<i64>) -> Option<i64> {
+    steps?.checked_mul(dofs?).filter(|w| *w > 0)
+}
+
+/// A crossing of ε along one refinement path.
+#[derive(Debug, Clone)]
+struct Crossing {
+    path: usize,
+    fixed: Fixed,
+    coarse: usize,
+    fine: usize,
+    wall: Option<f64>,
+    work: Option<f64>,
+}
+
+/// Build the speed-against-error section.
+pub(crate) fn section(runs: &Runs) -> Section {
+    let mut t = Table::new(&cols(
+        &[
+            ("family", Kind::I64),
+            ("family_title", Kind::Str),
+            ("run_id", Kind::Str),
+            ("label", Kind::Str),
+            ("status", Kind::Str),
+            ("h", Kind::F64),
+            ("dt", Kind::F64),
+            ("courant", Kind::F64),
+            ("steps", Kind::I64),
+            ("dofs", Kind::I64),
+            ("work", Kind::I64),
+            ("wall_time_s", Kind::F64),
+            ("wall_time_min_s", Kind::F64),
+            ("wall_time_max_s", Kind::F64),
+            ("repeats", Kind::I64),
+            ("error", Kind::Str),
+            ("value", Kind::F64),
+            ("pareto_wall", Kind::Bool),
+            ("pareto_work", Kind::Bool),
+        ],
+        runs,
+    ));
+    let mut cost = Table::new(&cols(
+        &[
+            ("family", Kind::I64),
+            ("family_title", Kind::Str),
+            ("label", Kind::Str),
+            ("error", Kind::Str),
+            ("epsilon", Kind::F64),
+            ("reached", Kind::Str),
+            ("wall_time_s", Kind::F64),
+            ("work", Kind::F64),
+            ("cost_is_upper_bound", Kind::Bool),
+            ("path", Kind::I64),
+            ("fixed", Kind::Str),
+            ("fixed_value", Kind::F64),
+            ("run_coarse", Kind::Str),
+            ("run_fine", Kind::Str),
+            ("value_coarse", Kind::F64),
+            ("value_fine", Kind::F64),
+        ],
+        runs,
+    ));
+    let mut md = String::from("# Speed against error\n\n");
+    let _ = writeln!(
+        md,
+        "Cost: wall_time_s is the median over the run's timing repeats ([min, max] shown); work = \
+         steps × dofs. Pareto front: ok runs not dominated in (error, wall time) — no other run \
+         at most as slow and at most as inaccurate, strictly better in one. Cost to reach ε \
+         (ε = the powers of ten inside the error range of the folder): log-log interpolation \
+         of cost against error between consecutive usable levels of a refinement path of the \
+         family, first crossing from coarse to fine, cheapest path; \"below\" = the family's \
+         cheapest run is already below ε (its cost is an upper bound), \"not reached\" = no \
+         level gets below ε.\n"
+    );
+    let mut terminal = String::new();
+    let n = runs.runs.len();
+    let family = |i: usize| runs.runs[i].group;
+
+    for (e, &ename) in runs.errors.iter().enumerate() {
+        // Candidates: ok runs with a usable error.
+        let cand: Vec<usize> = (0..n)
+            .filter(|&i| runs.runs[i].ok() && usable(runs.runs[i].errors[e]).is_some())
+            .collect();
+        let wall_pts: Vec<usize> = cand
+            .iter()
+            .copied()
+            .filter(|&i| runs.runs[i].wall_time_s.is_some())
+            .collect();
+        let work_pts: Vec<usize> = cand
+            .iter()
+            .copied()
+            .filter(|&i| work_of(runs.runs[i].steps, runs.runs[i].dofs).is_some())
+            .collect();
+        let mut on_wall: Vec<Option<bool>> = vec![None; n];
+        let mut on_work: Vec<Option<bool>> = vec![None; n];
+        let pts: Vec<(f64, f64)> = wall_pts
+            .iter()
+            .map(|&i| {
+                let r = &runs.runs[i];
+                (r.wall_time_s.unwrap_or(f64::NAN), r.errors[e].unwrap_or(f64::NAN))
+            })
+            .collect();
+        for (k, f) in pareto_front(&pts).into_iter().enumerate() {
+            on_wall[wall_pts[k]] = Some(f);
+        }
+        let pts: Vec<(f64, f64)> = work_pts
+            .iter()
+            .map(|&i| {
+                let r = &runs.runs[i];
+                (
+                    work_of(r.steps, r.dofs).unwrap_or(0) as f64,
+                    r.errors[e].unwrap_or(f64::NAN),
+                )
+            })
+            .collect();
+        for (k, f) in pareto_front(&pts).into_iter().enumerate() {
+            on_work[work_pts[k]] = Some(f);
+        }
+        // Rows: every run (failed ones too, with pareto null), ordered by family then cost.
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| {
+            family(a).cmp(&family(b)).then(
+                runs.runs[b]
+                    .h
+                    .unwrap_or(0.0)
+                    .total_cmp(&runs.runs[a].h.unwrap_or(0.0))
+                    .then(runs.runs[b].dt.unwrap_or(0.0).total_cmp(&runs.runs[a].dt.unwrap_or(0.0))),
+            )
+        });
+        for &i in &order {
+            let r = &runs.runs[i];
+            t.i64("family", Some(r.group as i64 + 1));
+            t.str("family_title", Some(&runs.groups[r.group].title));
+            t.str("run_id", Some(&r.run_id));
+            t.str("label", Some(&r.label));
+            t.str("status", Some(&r.status));
+            t.f64("h", r.h);
+            t.f64("dt", r.dt);
+            t.f64("courant", r.courant);
+            t.i64("steps", r.steps);
+            t.i64("dofs", r.dofs);
+            t.i64("work", work_of(r.steps, r.dofs));
+            t.f64("wall_time_s", r.wall_time_s);
+            t.f64("wall_time_min_s", r.wall_time_min_s);
+            t.f64("wall_time_max_s", r.wall_time_max_s);
+            t.i64("repeats", r.repeats);
+            t.str("error", Some(ename));
+            t.f64("value", r.errors[e]);
+            t.bool("pareto_wall", on_wall[i]);
+            t.bool("pareto_work", on_work[i]);
+            for ((nm, _), c) in runs.params.iter().zip(&r.params) {
+                t.cell(nm, c);
+            }
+            t.end_row();
+        }
+
+        // Markdown: the Pareto front (wall time).
+        let _ = writeln!(md, "## {ename}\n\n### Pareto front (error against wall time)\n");
+        let mut front: Vec<usize> = wall_pts
+            .iter()
+            .copied()
+            .filter(|&i| on_wall[i] == Some(true))
+            .collect();
+        front.sort_by(|&a, &b| {
+            runs.runs[a]
+                .wall_time_s
+                .unwrap_or(0.0)
+                .total_cmp(&runs.runs[b].wall_time_s.unwrap_or(0.0))
+        });
+        let header: Vec<String> = ["#", "family", "h", "dt", ename, "wall time [min, max] s", "work", "repeats"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let align = [
+            Align::Right,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Right,
+            Align::Right,
+            Align::Right,
+            Align::Right,
+        ];
+        let wall_cell = |i: usize| {
+            let r = &runs.runs[i];
+            format!(
+                "{} [{}, {}]",
+                table::sci(r.wall_time_s),
+                table::sci(r.wall_time_min_s),
+                table::sci(r.wall_time_max_s)
+            )
+        };
+        let rows: Vec<Vec<String>> = front
+            .iter()
+            .map(|&i| {
+                let r = &runs.runs[i];
+                vec![
+                    (r.group + 1).to_string(),
+                    runs.groups[r.group].title.clone(),
+                    table::sci(r.h),
+                    table::sci(r.dt),
+                    table::sci(r.errors[e]),
+                    wall_cell(i),
+                    work_of(r.steps, r.dofs).map(|w| w.to_string()).unwrap_or_default(),
+                    r.repeats.map(|x| x.to_string()).unwrap_or_default(),
+                ]
+            })
+            .collect();
+        if rows.is_empty() {
+            md.push_str("No ok run with a timed, positive error.\n\n");
+        } else {
+            md.push_str(&table::markdown(&header, &align, &rows));
+            md.push('\n');
+        }
+
+        // Cost to reach ε.
+        let values: Vec<f64> = cand.iter().filter_map(|&i| usable(runs.runs[i].errors[e])).collect();
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let decades: Vec<f64> = if values.is_empty() {
+            Vec::new()
+        } else {
+            let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
+            (a..=b).rev().take(40).map(|k| 10f64.powi(k)).collect()
+        };
+        let _ = writeln!(md, "### Cost to reach ε (wall time in s; work in steps × dofs)\n");
+        if decades.is_empty() {
+            md.push_str("The errors span less than a decade: no power of ten inside their range.\n\n");
+        }
+        let mut cost_rows: Vec<Vec<String>> = Vec::new();
+        for (gi, g) in runs.groups.iter().enumerate() {
+            let fam_vals: Vec<(usize, f64)> = g
+                .runs
+                .iter()
+                .filter(|&&i| runs.runs[i].ok())
+                .filter_map(|&i| usable(runs.runs[i].errors[e]).map(|v| (i, v)))
+                .collect();
+            if fam_vals.is_empty() || decades.is_empty() {
+                continue;
+            }
+            let mut md_row = vec![(gi + 1).to_string(), g.title.clone()];
+            for &eps in &decades {
+                let mut best: Option<Crossing> = None;
+                for (pi, p) in runs.paths.iter().enumerate().filter(|(_, p)| p.group == gi) {
+                    let used: Vec<usize> = p
+                        .levels
+                        .iter()
+                        .map(|&(_, i)| i)
+                        .filter(|&i| runs.runs[i].ok() && usable(runs.runs[i].errors[e]).is_some())
+                        .collect();
+                    for w in used.windows(2) {
+                        let (a, b) = (&runs.runs[w[0]], &runs.runs[w[1]]);
+                        let (ea, eb) = (a.errors[e].unwrap_or(0.0), b.errors[e].unwrap_or(0.0));
+                        if (ea - eps) * (eb - eps) > 0.0 {
+                            continue;
+                        }
+                        let wall = match (a.wall_time_s, b.wall_time_s) {
+                            (Some(ca), Some(cb)) => loglog_cost(eps, (ea, ca), (eb, cb)),
+                            _ => None,
+                        };
+                        let work = match (work_of(a.steps, a.dofs), work_of(b.steps, b.dofs)) {
+                            (Some(ca), Some(cb)) => loglog_cost(eps, (ea, ca as f64), (eb, cb as f64)),
+                            _ => None,
+                        };
+                        let c = Crossing {
+                            path: pi,
+                            fixed: p.fixed,
+                            coarse: w[0],
+                            fine: w[1],
+                            wall,
+                            work,
+                        };
+                        // Cheapest path: by wall time, by work when untimed.
+                        let key = |c: &Crossing| c.wall.or(c.work).unwrap_or(f64::INFINITY);
+                        if best.as_ref().is_none_or(|b| key(&c) < key(b)) {
+                            best = Some(c);
+                        }
+                        // First crossing along this path only.
+                        break;
+                    }
+                }
+                let first = &runs.runs[g.runs[0]];
+                cost.i64("family", Some(gi as i64 + 1));
+                cost.str("family_title", Some(&g.title));
+                cost.str("label", Some(&first.label));
+                cost.str("error", Some(ename));
+                cost.f64("epsilon", Some(eps));
+                let cell = if let Some(c) = &best {
+                    cost.str("reached", Some("interpolated"));
+                    cost.f64("wall_time_s", c.wall);
+                    cost.f64("work", c.work);
+                    cost.bool("cost_is_upper_bound", Some(false));
+                    cost.i64("path", Some(c.path as i64 + 1));
+                    cost.str("fixed", Some(c.fixed.name()));
+                    cost.f64("fixed_value", Some(c.fixed.value()));
+                    cost.str("run_coarse", Some(&runs.runs[c.coarse].run_id));
+                    cost.str("run_fine", Some(&runs.runs[c.fine].run_id));
+                    cost.f64("value_coarse", runs.runs[c.coarse].errors[e]);
+                    cost.f64("value_fine", runs.runs[c.fine].errors[e]);
+                    match (c.wall, c.work) {
+                        (Some(w), Some(k)) => format!("{} s / {:.3e}", table::sci(Some(w)), k),
+                        (Some(w), None) => format!("{} s", table::sci(Some(w))),
+                        (None, Some(k)) => format!("{k:.3e}"),
+                        _ => "?".into(),
+                    }
+                } else if fam_vals.iter().all(|&(_, v)| v <= eps) {
+                    // Already below ε at the family's cheapest run.
+                    let cheapest = fam_vals
+                        .iter()
+                        .map(|&(i, _)| i)
+                        .min_by(|&a, &b| {
+                            let k = |i: usize| {
+                                let r = &runs.runs[i];
+                                r.wall_time_s
+                                    .or(work_of(r.steps, r.dofs).map(|w| w as f64))
+                                    .unwrap_or(f64::INFINITY)
+                            };
+                            k(a).total_cmp(&k(b))
+                        })
+                        .expect("non-empty");
+                    let r = &runs.runs[cheapest];
+                    cost.str("reached", Some("below"));
+                    cost.f64("wall_time_s", r.wall_time_s);
+                    cost.f64("work", work_of(r.steps, r.dofs).map(|w| w as f64));
+                    cost.bool("cost_is_upper_bound", Some(true));
+                    cost.str("run_fine", Some(&r.run_id));
+                    cost.f64("value_fine", r.errors[e]);
+                    format!("≤ {} s", table::sci(r.wall_time_s))
+                } else if fam_vals.iter().all(|&(_, v)| v > eps) {
+                    cost.str("reached", Some("not reached"));
+                    "not reached".into()
+                } else {
+                    // Values on both sides of ε but no refinement path joins them.
+                    cost.str("reached", Some("no path"));
+                    "no path".into()
+                };
+                for ((nm, _), c) in runs.params.iter().zip(&first.params) {
+                    cost.cell(nm, c);
+                }
+                cost.end_row();
+                md_row.push(cell);
+            }
+            cost_rows.push(md_row);
+        }
+        if !decades.is_empty() && !cost_rows.is_empty() {
+            let mut header: Vec<String> = vec!["#".into(), "family".into()];
+            header.extend(decades.iter().map(|d| format!("ε = {d:.0e}")));
+            let mut align = vec![Align::Right, Align::Left];
+            align.extend(decades.iter().map(|_| Align::Right));
+            md.push_str(&table::markdown(&header, &align, &cost_rows));
+            md.push('\n');
+        }
+
+        // Markdown: every run (error against cost), by family.
+        let _ = writeln!(md, "### All runs\n");
+        let header: Vec<String> = ["#", "label", "h", "dt", "status", ename, "wall time [min, max] s", "work", "front"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let align = [
+            Align::Right,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Left,
+            Align::Right,
+            Align::Right,
+            Align::Right,
+            Align::Left,
+        ];
+        let rows: Vec<Vec<String>> = order
+            .iter()
+            .map(|&i| {
+                let r = &runs.runs[i];
+                let front = match (on_wall[i], on_work[i]) {
+                    (Some(true), Some(true)) => "wall, work",
+                    (Some(true), _) => "wall",
+                    (_, Some(true)) => "work",
+                    _ => "",
+                };
+                vec![
+                    (r.group + 1).to_string(),
+                    r.label.clone(),
+                    table::sci(r.h),
+                    table::sci(r.dt),
+                    r.status.clone(),
+                    table::sci(r.errors[e]),
+                    wall_cell(i),
+                    work_of(r.steps, r.dofs).map(|w| w.to_string()).unwrap_or_default(),
+                    front.to_string(),
+                ]
+            })
+            .collect();
+        md.push_str(&table::markdown(&header, &align, &rows));
+        md.push('\n');
+
+        // Terminal: the front of the first (main) error column only.
+        if terminal.is_empty() {
+            let _ = writeln!(
+                terminal,
+                "work-precision ({ename} against wall time): {} runs on the Pareto front of {}",
+                front.len(),
+                wall_pts.len()
+            );
+            for &i in front.iter().take(8) {
+                let r = &runs.runs[i];
+                let _ = writeln!(
+                    terminal,
+                    "  {:>10} s  e = {}  {} (h = {}, dt = {})",
+                    table::sci(r.wall_time_s),
+                    table::sci(r.errors[e]),
+                    runs.groups[r.group].title,
+                    table::sci(r.h),
+                    table::sci(r.dt)
+                );
+            }
+            if front.len() > 8 {
+                let _ = writeln!(terminal, "  … {} more in work_precision.md", front.len() - 8);
+            }
+        }
+    }
+    if runs.errors.is_empty() {
+        md.push_str("No error column has a value (no reference solution): nothing to plot against cost.\n");
+        terminal.push_str("work-precision: no error column has a value\n");
+    }
+    Section {
+        table: t,
+        cost,
+        markdown: md,
+        terminal,
+    }
+}
