@@ -122,3 +122,25 @@ fn backward_euler_augmented_energy_non_increasing() {
         );
     }
 }
+
+#[test]
+fn penalty_hybrid_energy_with_its_potential_never_increases() {
+    // For the penalty the contact argument and the force direction coincide (p = q), so the
+    // proof of 003 Prop 3.7 applies with E^h + κ/2 [s]₊² in place of E_Θ.
+    for d in draws(4, 16) {
+        let o = ok(bar1d(
+            BarParams::default(),
+            d.elements,
+            d.dt,
+            6.0,
+            ContactMethod::Penalty {
+                gamma0: 1.0 / d.gamma0,
+            },
+            MassVariant::Consistent,
+            Scheme::Hybrid,
+            0,
+        ));
+        let inc = o.metrics.energy_max_increase.unwrap();
+        assert!(inc <= TOL, "m={} dt={} κh/E={}: {inc:e}", d.elements, d.dt, 1.0 / d.gamma0);
+    }
+}

@@ -278,6 +278,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
     let mut term_rows: Vec<Vec<String>> = Vec::new();
     let mut hidden = 0usize;
     let mut last_group: Option<usize> = None;
+    let mut last_path: Option<usize> = None;
 
     md.push_str("# Convergence\n\n");
     let _ = writeln!(
@@ -557,10 +558,12 @@ pub(crate) fn section(runs: &Runs) -> Section {
             // The group's number and title once, on its first line.
             let first_of_group = last_group != Some(g);
             last_group = Some(g);
+            let first_of_path = last_path != Some(pi);
+            last_path = Some(pi);
             term_rows.push(vec![
                 if first_of_group { (g + 1).to_string() } else { String::new() },
                 if first_of_group { runs.groups[g].title.clone() } else { String::new() },
-                p.fixed.short(),
+                if first_of_path { p.fixed.short() } else { String::new() },
                 format!("{}/{}", f.used, p.levels.len()),
                 runs.errors[*e].to_string(),
                 table::rate(f.slope_all),

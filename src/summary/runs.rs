@@ -196,6 +196,9 @@ pub(crate) struct Group {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum Fixed {
     Courant(f64),
+    /// dt/h held (equivalent to a fixed Courant number, c0 being constant in a group), for
+    /// runs without a courant column.
+    Ratio(f64),
     Dt(f64),
     H(f64),
 }
@@ -204,6 +207,7 @@ impl Fixed {
     pub(crate) fn name(&self) -> &'static str {
         match self {
             Fixed::Courant(_) => "courant",
+            Fixed::Ratio(_) => "dt/h",
             Fixed::Dt(_) => "dt",
             Fixed::H(_) => "h",
         }
@@ -211,14 +215,14 @@ impl Fixed {
 
     pub(crate) fn value(&self) -> f64 {
         match *self {
-            Fixed::Courant(x) | Fixed::Dt(x) | Fixed::H(x) => x,
+            Fixed::Courant(x) | Fixed::Ratio(x) | Fixed::Dt(x) | Fixed::H(x) => x,
         }
     }
 
     /// The refined axis: h when Courant or dt is held, dt when h is held.
     pub(crate) fn refined(&self) -> &'static str {
         match self {
-            Fixed::Courant(_) | Fixed::Dt(_) => "h",
+            Fixed::Courant(_) | Fixed::Ratio(_) | Fixed::Dt(_) => "h",
             Fixed::H(_) => "dt",
         }
     }
@@ -226,6 +230,7 @@ impl Fixed {
     pub(crate) fn describe(&self) -> String {
         match self {
             Fixed::Courant(x) => format!("courant = {x} fixed, h refined"),
+            Fixed::Ratio(x) => format!("dt/h = {x} fixed, h refined"),
             Fixed::Dt(x) => format!("dt = {x} fixed, h refined"),
             Fixed::H(x) => format!("h = {x} fixed, dt refined"),
         }
@@ -234,6 +239,7 @@ impl Fixed {
     pub(crate) fn short(&self) -> String {
         match self {
             Fixed::Courant(x) => format!("ν={x}, h↓"),
+            Fixed::Ratio(x) => format!("dt/h={x}, h↓"),
             Fixed::Dt(x) => format!("dt={x}, h↓"),
             Fixed::H(x) => format!("h={x}, dt↓"),
         }
@@ -565,12 +571,15 @@ fn opt_key(x: Option<f64>) -> String {
 }
 
 /// The refinement paths of one group: Courant held (h refined), dt held (h refined), h held
-/// (dt refined); each with ≥ 2 distinct levels.
+/// (dt refined); each with ≥ 2 distinct levels. A fixed Courant number is detected as a fixed
+/// dt/h (the wave speed c0 is a function of the group's parameters), so rows of a version
+/// without the courant column still join their path; the path is labelled by the Courant
+/// number when every level reports the same one.
 fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
     let mut out = Vec::new();
     type Axis = fn(&Run) -> Option<f64>;
     let axes: [(Axis, Axis, fn(f64) -> Fixed); 3] = [
-        (|r| r.courant, |r| r.h, Fixed::Courant),
+        (|r| Some(r.dt? / r.h?), |r| r.h, Fixed::Ratio),
         (|r| r.dt, |r| r.h, Fixed::Dt),
         (|r| r.h, |r| r.dt, Fixed::H),
     ];
@@ -599,9 +608,17 @@ fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
             let mut lv: Vec<(f64, usize)> = levels.into_values().collect();
             // Coarse → fine.
             lv.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut fixed = make(f);
+            if let Fixed::Ratio(_) = fixed {
+                let c: HashSet<Option<String>> =
+                    lv.iter().map(|&(_, i)| runs[i].courant.map(float_key)).collect();
+                if let (1, Some(c)) = (c.len(), lv.first().and_then(|&(_, i)| runs[i].courant)) {
+                    fixed = Fixed::Courant(c);
+                }
+            }
             found.push(RefPath {
                 group,
-                fixed: make(f),
+                fixed,
                 levels: lv,
             });
         }

@@ -377,7 +377,7 @@ fn resolve(entries: &[&Entry]) -> Outcome {
                     return Outcome::Invalid(vec![Issue::at(
                         &dt_origin,
                         format!(
-                            "dt = {dt} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
+                            "dt = {dt:.6e} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
                             scheme.label(),
                             c0 * dt_max / h
                         ),
