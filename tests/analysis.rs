@@ -15,10 +15,23 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("qs");
-    let o = cli(repo, &["run", "sweeps/quickstart.toml", "--out", out.to_str().unwrap(), "--no-summary"]);
+    let o = cli(
+        repo,
+        &[
+            "run",
+            "sweeps/quickstart.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--no-summary",
+        ],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let figs = out.join("figures");
-    for script in ["plot_series.py", "plot_convergence.py", "plot_work_precision.py"] {
+    for script in [
+        "plot_series.py",
+        "plot_convergence.py",
+        "plot_work_precision.py",
+    ] {
         let o = Command::new("python3")
             .arg(repo.join("analysis").join(script))
             .arg(&out)
@@ -38,12 +51,25 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(o.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     // series (12 parts for 60 runs), convergence, work-precision
     let last = stdout.lines().last().unwrap_or("");
-    let passed: usize = last.split_whitespace().next().unwrap_or("0").parse().unwrap_or(0);
+    let passed: usize = last
+        .split_whitespace()
+        .next()
+        .unwrap_or("0")
+        .parse()
+        .unwrap_or(0);
     assert!(passed >= 3 && last.ends_with("0 failed"), "{last}");
-    for f in ["convergence_quickstart.png", "convergence_quickstart.pdf", "work_precision_quickstart_err_u_l2h1.png"] {
+    for f in [
+        "convergence_quickstart.png",
+        "convergence_quickstart.pdf",
+        "work_precision_quickstart_err_u_l2h1.png",
+    ] {
         assert!(figs.join(f).exists(), "{f} missing");
     }
 }

@@ -27,7 +27,16 @@ fn massless_contact_variants_start_quasi_static_and_conserve_energy_with_cn() {
         MassVariant::NodeNeighbour,
         MassVariant::Weights(vec![1.5, 1.0]),
     ] {
-        let o = ok(bar1d(BarParams::default(), 100, 0.015, 12.0, ContactMethod::Mixed, mass.clone(), CN, 1));
+        let o = ok(bar1d(
+            BarParams::default(),
+            100,
+            0.015,
+            12.0,
+            ContactMethod::Mixed,
+            mass.clone(),
+            CN,
+            1,
+        ));
         let e0 = o.metrics.energy_initial.unwrap();
         // closed form of the discrete initial energy: round-off only.
         assert!((e0 - (1.0 - h) / 8.0).abs() < 1e-14, "{mass:?}: E0 = {e0}");
@@ -46,13 +55,25 @@ fn penalty_penetration_scales_with_the_inverse_stiffness() {
     // an overshoot (measured ≤ 3.5× at τ = h), so: at least the static value, at most 5× it,
     // and two decades of κ buy more than one decade of penetration.
     let penetration = |g: f64| {
-        let o = ok(bar1d(BarParams::default(), 100, 0.01, 3.0, ContactMethod::Penalty { gamma0: g }, MassVariant::Consistent, Scheme::Hybrid, 1));
+        let o = ok(bar1d(
+            BarParams::default(),
+            100,
+            0.01,
+            3.0,
+            ContactMethod::Penalty { gamma0: g },
+            MassVariant::Consistent,
+            Scheme::Hybrid,
+            1,
+        ));
         o.series.iter().map(|r| -r.u_contact).fold(0.0, f64::max)
     };
     let (a, b, c) = (penetration(10.0), penetration(100.0), penetration(1000.0));
     for (p, g) in [(a, 10.0), (b, 100.0), (c, 1000.0)] {
         let est = 0.5 * 0.01 / g;
-        assert!(p > 0.9 * est && p < 5.0 * est, "γ0 = {g}: penetration {p:e}, static {est:e}");
+        assert!(
+            p > 0.9 * est && p < 5.0 * est,
+            "γ0 = {g}: penetration {p:e}, static {est:e}"
+        );
     }
     assert!(a > b && b > c && a / c > 10.0, "{a:e} {b:e} {c:e}");
 }
@@ -67,7 +88,10 @@ fn paoli_schatzman_restitution_controls_the_impact_energy() {
             12.0,
             ContactMethod::Mixed,
             mass,
-            Scheme::PaoliSchatzman(PaoliSchatzmanParams { beta: 0.25, restitution: e }),
+            Scheme::PaoliSchatzman(PaoliSchatzmanParams {
+                beta: 0.25,
+                restitution: e,
+            }),
             0,
         ))
     };

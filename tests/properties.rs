@@ -141,6 +141,12 @@ fn penalty_hybrid_energy_with_its_potential_never_increases() {
             0,
         ));
         let inc = o.metrics.energy_max_increase.unwrap();
-        assert!(inc <= TOL, "m={} dt={} κh/E={}: {inc:e}", d.elements, d.dt, 1.0 / d.gamma0);
+        assert!(
+            inc <= TOL,
+            "m={} dt={} κh/E={}: {inc:e}",
+            d.elements,
+            d.dt,
+            1.0 / d.gamma0
+        );
     }
 }

@@ -15,13 +15,18 @@
 use std::fs::File;
 use std::path::Path;
 
-use contact_sweep::summary::{self, NO_REFINEMENT, loglog_cost, lsq_slope, observed_rate, pareto_front};
+use contact_sweep::summary::{
+    self, NO_REFINEMENT, loglog_cost, lsq_slope, observed_rate, pareto_front,
+};
 use polars::prelude::*;
 
 const TOL: f64 = 1e-10;
 
 fn close(a: f64, b: f64, what: &str) {
-    assert!((a - b).abs() <= TOL * b.abs().max(1.0), "{what}: got {a}, expected {b}");
+    assert!(
+        (a - b).abs() <= TOL * b.abs().max(1.0),
+        "{what}: got {a}, expected {b}"
+    );
 }
 
 /// One synthetic run.
@@ -41,7 +46,13 @@ struct R {
     max_dev: Option<f64>,
 }
 
-fn run(label: &'static str, scheme_label: &'static str, h: f64, dt: f64, err: [Option<f64>; 4]) -> R {
+fn run(
+    label: &'static str,
+    scheme_label: &'static str,
+    h: f64,
+    dt: f64,
+    err: [Option<f64>; 4],
+) -> R {
     R {
         label,
         space: "mixed",
@@ -66,7 +77,10 @@ fn runs_frame(rows: &[R]) -> DataFrame {
     let f = |f: &dyn Fn(&R) -> Option<f64>| rows.iter().map(f).collect::<Vec<_>>();
     let i = |f: &dyn Fn(&R) -> Option<i64>| rows.iter().map(f).collect::<Vec<_>>();
     let cols = vec![
-        Column::new("run_id".into(), s(&|r| Some(format!("{}-{}-{}", r.scheme_label, r.h, r.dt)))),
+        Column::new(
+            "run_id".into(),
+            s(&|r| Some(format!("{}-{}-{}-{}", r.space, r.scheme_label, r.h, r.dt))),
+        ),
         Column::new("sweep".into(), vec![Some("synthetic"); n]),
         Column::new("scene".into(), vec![Some("bar1d"); n]),
         Column::new("label".into(), s(&|r| Some(r.label.to_string()))),
@@ -83,7 +97,10 @@ fn runs_frame(rows: &[R]) -> DataFrame {
         Column::new("space".into(), s(&|r| Some(r.space.to_string()))),
         Column::new("mass".into(), vec![Some("mod3"); n]),
         Column::new("scheme".into(), vec![Some("newmark"); n]),
-        Column::new("scheme_label".into(), s(&|r| Some(r.scheme_label.to_string()))),
+        Column::new(
+            "scheme_label".into(),
+            s(&|r| Some(r.scheme_label.to_string())),
+        ),
         Column::new("nitsche_theta".into(), vec![None::<f64>; n]),
         Column::new("length".into(), vec![Some(1.0); n]),
         Column::new("young".into(), vec![Some(1.0); n]),
@@ -116,7 +133,9 @@ fn write_runs(dir: &Path, part: &str, df: &mut DataFrame) {
 }
 
 fn read(path: &Path) -> DataFrame {
-    ParquetReader::new(File::open(path).unwrap()).finish().unwrap()
+    ParquetReader::new(File::open(path).unwrap())
+        .finish()
+        .unwrap()
 }
 
 /// Rows of convergence.parquet for one label and error column, ordered by level.
@@ -150,7 +169,10 @@ fn strs(df: &DataFrame, c: &str) -> Vec<Option<String>> {
 /// The single value of a per-path column (repeated on every level row).
 fn one_f64(df: &DataFrame, c: &str) -> f64 {
     let v = f64s(df, c);
-    assert!(v.windows(2).all(|w| w[0] == w[1]), "{c} differs between levels");
+    assert!(
+        v.windows(2).all(|w| w[0] == w[1]),
+        "{c} differs between levels"
+    );
     v[0].unwrap_or_else(|| panic!("{c} is null"))
 }
 fn one_bool(df: &DataFrame, c: &str) -> bool {
@@ -165,18 +187,66 @@ const HY: &str = "mixed · mod3 · hybrid";
 /// 0.05, 0.02 — ratios 2, 2.5.
 fn synthetic() -> Vec<R> {
     let mut a = vec![
-        run(CN, "crank-nicolson", 0.25, 0.25, [Some(0.1), Some(0.5), Some(1e2), Some(0.5)]),
-        run(CN, "crank-nicolson", 1.0 / 12.0, 1.0 / 12.0, [Some(0.02), Some(0.52), Some(1e-3), Some(1.0 / 6.0)]),
-        run(CN, "crank-nicolson", 1.0 / 24.0, 1.0 / 24.0, [Some(0.006), Some(0.49), Some(1e-8), Some(1.0 / 12.0)]),
+        run(
+            CN,
+            "crank-nicolson",
+            0.25,
+            0.25,
+            [Some(0.1), Some(0.5), Some(1e2), Some(0.5)],
+        ),
+        run(
+            CN,
+            "crank-nicolson",
+            1.0 / 12.0,
+            1.0 / 12.0,
+            [Some(0.02), Some(0.52), Some(1e-3), Some(1.0 / 6.0)],
+        ),
+        run(
+            CN,
+            "crank-nicolson",
+            1.0 / 24.0,
+            1.0 / 24.0,
+            [Some(0.006), Some(0.49), Some(1e-8), Some(1.0 / 12.0)],
+        ),
         // The failed level carries a bogus error value that must not enter any fit.
-        run(CN, "crank-nicolson", 1.0 / 48.0, 1.0 / 48.0, [Some(1e3), None, None, None]),
-        run(CN, "crank-nicolson", 1.0 / 96.0, 1.0 / 96.0, [Some(3.75e-4), Some(0.5), Some(5e-11), Some(1.0 / 48.0)]),
+        run(
+            CN,
+            "crank-nicolson",
+            1.0 / 48.0,
+            1.0 / 48.0,
+            [Some(1e3), None, None, None],
+        ),
+        run(
+            CN,
+            "crank-nicolson",
+            1.0 / 96.0,
+            1.0 / 96.0,
+            [Some(3.75e-4), Some(0.5), Some(5e-11), Some(1.0 / 48.0)],
+        ),
     ];
     a[3].status = "diverged";
     let b = vec![
-        run(HY, "hybrid", 0.1, 0.1, [Some(0.3 * 0.01), Some(3e-14), Some(1e-3), Some(1.0)]),
-        run(HY, "hybrid", 0.1, 0.05, [Some(0.3 * 0.0025), Some(2e-14), Some(0.0), None]),
-        run(HY, "hybrid", 0.1, 0.02, [Some(0.3 * 0.0004), Some(5e-14), Some(2.5e-4), Some(0.2)]),
+        run(
+            HY,
+            "hybrid",
+            0.1,
+            0.1,
+            [Some(0.3 * 0.01), Some(3e-14), Some(1e-3), Some(1.0)],
+        ),
+        run(
+            HY,
+            "hybrid",
+            0.1,
+            0.05,
+            [Some(0.3 * 0.0025), Some(2e-14), Some(0.0), None],
+        ),
+        run(
+            HY,
+            "hybrid",
+            0.1,
+            0.02,
+            [Some(0.3 * 0.0004), Some(5e-14), Some(2.5e-4), Some(0.2)],
+        ),
     ];
     a.into_iter().chain(b).collect()
 }
@@ -206,7 +276,10 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
     assert_eq!(rate[3], None, "no rate at the failed level");
     // Across the failed level: ln(0.006/3.75e-4)/ln((1/24)/(1/96)) = ln 16 / ln 4 = 2.
     close(rate[4].unwrap(), 2.0, "rate 1/24→1/96");
-    assert_eq!(i64s(&d, "rate_from_level"), vec![None, Some(0), Some(1), None, Some(2)]);
+    assert_eq!(
+        i64s(&d, "rate_from_level"),
+        vec![None, Some(0), Some(1), None, Some(2)]
+    );
     assert_eq!(
         bools(&d, "used_in_fit"),
         vec![Some(true), Some(true), Some(true), Some(false), Some(true)]
@@ -218,20 +291,43 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
     // LSQ of ln e on ln h over h = 1/4, 1/12, 1/24, 1/96 (the diverged 1/48 excluded).
     close(one_f64(&d, "slope_all"), 1.7656461960639913, "LSQ all");
     assert_eq!(i64s(&d, "fit_levels")[0], Some(4));
-    close(one_f64(&d, "slope_finest3"), 1.9248473126189163, "LSQ finest 3");
+    close(
+        one_f64(&d, "slope_finest3"),
+        1.9248473126189163,
+        "LSQ finest 3",
+    );
     // Spread 2 − ln5/ln3 = 0.535 > 0.3.
-    close(one_f64(&d, "rate_spread"), 2.0 - 5f64.ln() / 3f64.ln(), "spread");
+    close(
+        one_f64(&d, "rate_spread"),
+        2.0 - 5f64.ln() / 3f64.ln(),
+        "spread",
+    );
     assert!(one_bool(&d, "pre_asymptotic"));
     assert!(!one_bool(&d, "stagnating"));
     assert!(!one_bool(&d, "roundoff_floor"));
     assert_eq!(i64s(&d, "failed_levels")[0], Some(1));
-    assert_eq!(strs(&d, "flags")[0].as_deref(), Some("pre-asymptotic, 1 failed level"));
+    assert_eq!(
+        strs(&d, "flags")[0].as_deref(),
+        Some("pre-asymptotic, 1 failed level")
+    );
 
     // --- A, err_u_l2h1: stagnating (finest-three slope 0.014 < 0.1), spread 0.12 ≤ 0.3.
     let d = conv_rows(tmp.path(), CN, "err_u_l2h1");
-    close(one_f64(&d, "slope_all"), 0.0041353159872802026, "l2h1 LSQ all");
-    close(one_f64(&d, "slope_finest3"), 0.01408484055756812, "l2h1 LSQ finest 3");
-    close(one_f64(&d, "rate_spread"), 0.12143010563427992, "l2h1 spread");
+    close(
+        one_f64(&d, "slope_all"),
+        0.0041353159872802026,
+        "l2h1 LSQ all",
+    );
+    close(
+        one_f64(&d, "slope_finest3"),
+        0.01408484055756812,
+        "l2h1 LSQ finest 3",
+    );
+    close(
+        one_f64(&d, "rate_spread"),
+        0.12143010563427992,
+        "l2h1 spread",
+    );
     assert!(one_bool(&d, "stagnating"));
     assert!(!one_bool(&d, "pre_asymptotic"));
     assert!(!one_bool(&d, "roundoff_floor"));
@@ -241,7 +337,11 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
     let d = conv_rows(tmp.path(), CN, "err_u_linfl2");
     assert!(one_bool(&d, "roundoff_floor"));
     close(one_f64(&d, "slope_all"), 9.141710670626383, "linf LSQ all");
-    close(one_f64(&d, "slope_finest3"), 7.475560203330062, "linf LSQ finest 3");
+    close(
+        one_f64(&d, "slope_finest3"),
+        7.475560203330062,
+        "linf LSQ finest 3",
+    );
 
     // --- A, err_sigma_l2 = 2h exactly: every rate 1, no flag but the failed level.
     let d = conv_rows(tmp.path(), CN, "err_sigma_l2");
@@ -254,7 +354,8 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
 
     // All-null and absent error columns produce no rows.
     let all = read(&tmp.path().join("summary/convergence.parquet"));
-    let errors: std::collections::BTreeSet<String> = strs(&all, "error").into_iter().flatten().collect();
+    let errors: std::collections::BTreeSet<String> =
+        strs(&all, "error").into_iter().flatten().collect();
     assert_eq!(
         errors.into_iter().collect::<Vec<_>>(),
         ["err_sigma_l2", "err_u_l2h1", "err_u_l2l2", "err_u_linfl2"]
@@ -277,26 +378,41 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
     // it: ln(1e-3/2.5e-4)/ln(0.1/0.02) = ln 4 / ln 5.
     let d = conv_rows(tmp.path(), HY, "err_u_linfl2");
     assert_eq!(strs(&d, "excluded")[1].as_deref(), Some("zero error"));
-    close(f64s(&d, "rate")[2].unwrap(), 4f64.ln() / 5f64.ln(), "rate across zero");
+    close(
+        f64s(&d, "rate")[2].unwrap(),
+        4f64.ln() / 5f64.ln(),
+        "rate across zero",
+    );
     assert_eq!(i64s(&d, "rate_from_level")[2], Some(0));
     assert!(one_bool(&d, "roundoff_floor"));
     assert_eq!(i64s(&d, "failed_levels")[0], Some(0));
     // An ok level without a value: excluded as "no value", not counted as failed.
     let d = conv_rows(tmp.path(), HY, "err_sigma_l2");
     assert_eq!(strs(&d, "excluded")[1].as_deref(), Some("no value"));
-    close(f64s(&d, "rate")[2].unwrap(), 1.0, "rate across missing value");
+    close(
+        f64s(&d, "rate")[2].unwrap(),
+        1.0,
+        "rate across missing value",
+    );
     assert_eq!(strs(&d, "flags")[0].as_deref(), Some("-"));
 
     // The Markdown and LaTeX tables exist, one per path, and show the marks.
     let md = std::fs::read_to_string(tmp.path().join("summary/convergence.md")).unwrap();
     assert_eq!(md.matches("\n## group").count(), 2);
-    assert!(md.contains("diverged ✗") && md.contains("(1.0000e3) ✗") && md.contains("2.00 †"), "{md}");
+    assert!(
+        md.contains("diverged ✗") && md.contains("(1.0000e3) ✗") && md.contains("2.00 †"),
+        "{md}"
+    );
     assert!(md.contains("| LSQ slope, all usable levels |"));
     let tex = std::fs::read_to_string(tmp.path().join("summary/convergence.tex")).unwrap();
     assert_eq!(tex.matches("\\begin{table}").count(), 2);
     assert!(tex.contains("\\toprule") && tex.contains("\\bottomrule"));
     // The terminal shows the slopes and flags.
-    assert!(s.terminal.contains("1.77") && s.terminal.contains("pre-asym"), "{}", s.terminal);
+    assert!(
+        s.terminal.contains("1.77") && s.terminal.contains("pre-asym"),
+        "{}",
+        s.terminal
+    );
     // CSV mirrors the Parquet.
     let csv = std::fs::read_to_string(tmp.path().join("summary/convergence.csv")).unwrap();
     assert_eq!(csv.lines().count(), all.height() + 1);
@@ -321,12 +437,17 @@ fn extra_unknown_columns_and_missing_columns_from_another_version() {
     // Part 1: this version plus columns it does not know (a float, a string, a list).
     let mut a = runs_frame(&rows[..3]);
     let n = a.height();
-    a.with_column(Column::new("future_metric".into(), vec![1.5f64; n])).unwrap();
-    a.with_column(Column::new("solver_notes".into(), vec!["fine"; n])).unwrap();
-    let lists: Vec<Series> = (0..n).map(|i| Series::new("".into(), [i as i64, 2])).collect();
+    a.with_column(Column::new("future_metric".into(), vec![1.5f64; n]))
+        .unwrap();
+    a.with_column(Column::new("solver_notes".into(), vec!["fine"; n]))
+        .unwrap();
+    let lists: Vec<Series> = (0..n)
+        .map(|i| Series::new("".into(), [i as i64, 2]))
+        .collect();
     a.with_column(Column::new("history".into(), lists)).unwrap();
     // A known column stored with another type (i32 instead of i64).
-    a.with_column(Column::new("repeats".into(), vec![3i32; n])).unwrap();
+    a.with_column(Column::new("repeats".into(), vec![3i32; n]))
+        .unwrap();
     write_runs(tmp.path(), "part-a.parquet", &mut a);
     // Part 2: an older version without courant, label, message, timing spread, energy
     // columns; elements stored as float; one extra boolean.
@@ -346,16 +467,25 @@ fn extra_unknown_columns_and_missing_columns_from_another_version() {
         .collect()
         .unwrap();
     let m = b.height();
-    b.with_column(Column::new("legacy_flag".into(), vec![true; m])).unwrap();
+    b.with_column(Column::new("legacy_flag".into(), vec![true; m]))
+        .unwrap();
     write_runs(tmp.path(), "part-b.parquet", &mut b);
 
     let s = summary::summarize(tmp.path()).unwrap();
     assert_eq!(s.runs, 5);
     for c in ["future_metric", "solver_notes", "history", "legacy_flag"] {
-        assert!(s.ignored_columns.iter().any(|x| x == c), "{c} not reported: {:?}", s.ignored_columns);
+        assert!(
+            s.ignored_columns.iter().any(|x| x == c),
+            "{c} not reported: {:?}",
+            s.ignored_columns
+        );
         assert!(s.terminal.contains(c));
     }
-    assert!(!s.ignored_columns.iter().any(|x| x == "repeats" || x == "elements"));
+    assert!(
+        !s.ignored_columns
+            .iter()
+            .any(|x| x == "repeats" || x == "elements")
+    );
     // The old rows (no courant) still join the Courant-1 path: dt/h = 1 is held.
     assert_eq!(s.refinement_paths, 1, "{}", s.terminal);
     let all = read(&tmp.path().join("summary/convergence.parquet"));
@@ -367,9 +497,19 @@ fn extra_unknown_columns_and_missing_columns_from_another_version() {
         .unwrap();
     assert_eq!(d.height(), 5);
     assert_eq!(strs(&d, "fixed")[0].as_deref(), Some("dt/h"));
-    close(one_f64(&d, "slope_all"), 1.7656461960639913, "LSQ all across versions");
+    close(
+        one_f64(&d, "slope_all"),
+        1.7656461960639913,
+        "LSQ all across versions",
+    );
     // Unknown columns never reach the outputs.
-    for f in ["convergence", "energy", "work_precision", "impacts", "cost_to_error"] {
+    for f in [
+        "convergence",
+        "energy",
+        "work_precision",
+        "impacts",
+        "cost_to_error",
+    ] {
         let df = read(&tmp.path().join(format!("summary/{f}.parquet")));
         for c in ["future_metric", "solver_notes", "history", "legacy_flag"] {
             assert!(df.column(c).is_err(), "{c} leaked into {f}");
@@ -377,7 +517,11 @@ fn extra_unknown_columns_and_missing_columns_from_another_version() {
     }
     // A label is composed for rows without one.
     let e = read(&tmp.path().join("summary/energy.parquet"));
-    assert!(strs(&e, "label").iter().all(|l| l.as_deref().is_some_and(|l| !l.is_empty())));
+    assert!(
+        strs(&e, "label")
+            .iter()
+            .all(|l| l.as_deref().is_some_and(|l| !l.is_empty()))
+    );
 }
 
 #[test]
@@ -385,9 +529,27 @@ fn no_refinement_axis_says_so_and_still_writes_the_other_sections() {
     let tmp = tempfile::tempdir().unwrap();
     // Three methods, each at a single (h, dt).
     let mut rows = vec![
-        run(CN, "crank-nicolson", 0.1, 0.1, [Some(0.01), Some(0.1), Some(0.01), Some(0.2)]),
-        run(HY, "hybrid", 0.1, 0.1, [Some(0.02), Some(0.2), Some(0.02), Some(0.3)]),
-        run("nitsche · mod3 · hybrid", "hybrid", 0.1, 0.1, [Some(0.03), Some(0.3), Some(0.03), Some(0.4)]),
+        run(
+            CN,
+            "crank-nicolson",
+            0.1,
+            0.1,
+            [Some(0.01), Some(0.1), Some(0.01), Some(0.2)],
+        ),
+        run(
+            HY,
+            "hybrid",
+            0.1,
+            0.1,
+            [Some(0.02), Some(0.2), Some(0.02), Some(0.3)],
+        ),
+        run(
+            "nitsche · mod3 · hybrid",
+            "hybrid",
+            0.1,
+            0.1,
+            [Some(0.03), Some(0.3), Some(0.03), Some(0.4)],
+        ),
     ];
     rows[2].space = "nitsche";
     write_runs(tmp.path(), "part-0.parquet", &mut runs_frame(&rows));
@@ -395,7 +557,10 @@ fn no_refinement_axis_says_so_and_still_writes_the_other_sections() {
     assert_eq!(s.groups, 3);
     assert_eq!(s.refinement_paths, 0);
     assert!(s.terminal.contains(NO_REFINEMENT), "{}", s.terminal);
-    assert_eq!(NO_REFINEMENT, "no refinement axis: every group has a single (h, dt) level");
+    assert_eq!(
+        NO_REFINEMENT,
+        "no refinement axis: every group has a single (h, dt) level"
+    );
     let md = std::fs::read_to_string(tmp.path().join("summary/convergence.md")).unwrap();
     assert!(md.contains(NO_REFINEMENT), "{md}");
     assert!(!md.contains("| level |"), "no empty table");
@@ -404,8 +569,16 @@ fn no_refinement_axis_says_so_and_still_writes_the_other_sections() {
     assert_eq!(conv.height(), 0);
     assert!(conv.column("slope_all").is_ok());
     assert_eq!(read(&tmp.path().join("summary/energy.parquet")).height(), 3);
-    assert_eq!(read(&tmp.path().join("summary/work_precision.parquet")).height(), 3 * 4);
-    for f in ["energy.md", "work_precision.md", "energy_groups.parquet", "impacts.parquet"] {
+    assert_eq!(
+        read(&tmp.path().join("summary/work_precision.parquet")).height(),
+        3 * 4
+    );
+    for f in [
+        "energy.md",
+        "work_precision.md",
+        "energy_groups.parquet",
+        "impacts.parquet",
+    ] {
         assert!(tmp.path().join("summary").join(f).exists(), "{f}");
     }
 }
@@ -414,7 +587,10 @@ fn no_refinement_axis_says_so_and_still_writes_the_other_sections() {
 fn a_folder_without_runs_is_an_error_naming_it() {
     let tmp = tempfile::tempdir().unwrap();
     let err = summary::summarize(tmp.path()).unwrap_err().to_string();
-    assert!(err.contains(&tmp.path().display().to_string()) && err.contains("no runs"), "{err}");
+    assert!(
+        err.contains(&tmp.path().display().to_string()) && err.contains("no runs"),
+        "{err}"
+    );
     // runs/ exists but holds only a temporary of an interrupted write.
     std::fs::create_dir_all(tmp.path().join("runs")).unwrap();
     std::fs::write(tmp.path().join("runs/.tmp-part-0.parquet"), b"partial").unwrap();
@@ -422,8 +598,14 @@ fn a_folder_without_runs_is_an_error_naming_it() {
     assert!(err.contains("no runs"), "{err}");
     let missing = tmp.path().join("nowhere");
     let err = summary::summarize(&missing).unwrap_err().to_string();
-    assert!(err.contains("nowhere") && err.contains("no such folder"), "{err}");
-    assert!(!tmp.path().join("summary").exists(), "nothing written on error");
+    assert!(
+        err.contains("nowhere") && err.contains("no such folder"),
+        "{err}"
+    );
+    assert!(
+        !tmp.path().join("summary").exists(),
+        "nothing written on error"
+    );
 }
 
 #[test]
@@ -443,7 +625,7 @@ fn energy_flags_and_impact_losses() {
 
     // Series of the hybrid run, decimated by 2 (steps 0, 2, …, 18): two contact phases.
     // σ_C < 0 at steps 4–6 and 12; energies before/after: 1.0 → 0.7 and 0.7 → 0.6.
-    let id = "hybrid-0.25-0.25";
+    let id = "mixed-hybrid-0.25-0.25";
     let steps: Vec<i64> = (0..10).map(|k| 2 * k).collect();
     let sigma = [0.0, 0.0, -1.0, -2.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0];
     let energy = [1.0, 1.0, 0.9, 0.8, 0.7, 0.7, 0.65, 0.6, 0.6, 0.6];
@@ -453,7 +635,10 @@ fn energy_flags_and_impact_losses() {
         vec![
             Column::new("run_id".into(), vec![id; n]),
             Column::new("step".into(), &steps),
-            Column::new("t".into(), steps.iter().map(|&s| s as f64 * 0.25).collect::<Vec<_>>()),
+            Column::new(
+                "t".into(),
+                steps.iter().map(|&s| s as f64 * 0.25).collect::<Vec<_>>(),
+            ),
             Column::new("u_contact".into(), vec![0.0; n]),
             Column::new("sigma_contact".into(), &sigma),
             Column::new("energy".into(), &energy),
@@ -468,18 +653,35 @@ fn energy_flags_and_impact_losses() {
     summary::summarize(tmp.path()).unwrap();
     let e = read(&tmp.path().join("summary/energy.parquet"))
         .lazy()
-        .sort(["label", "h"], SortMultipleOptions::default().with_order_descending_multi([false, true]))
+        .sort(
+            ["label", "h"],
+            SortMultipleOptions::default().with_order_descending_multi([false, true]),
+        )
         .collect()
         .unwrap();
     assert_eq!(
         strs(&e, "behaviour"),
-        vec![Some("growth".into()), Some("monotone decay".into()), Some("conserved".into())]
+        vec![
+            Some("growth".into()),
+            Some("monotone decay".into()),
+            Some("conserved".into())
+        ]
     );
-    assert_eq!(bools(&e, "energy_growth"), vec![Some(true), Some(false), Some(false)]);
-    assert_eq!(bools(&e, "monotone_decay"), vec![Some(false), Some(true), Some(false)]);
+    assert_eq!(
+        bools(&e, "energy_growth"),
+        vec![Some(true), Some(false), Some(false)]
+    );
+    assert_eq!(
+        bools(&e, "monotone_decay"),
+        vec![Some(false), Some(true), Some(false)]
+    );
     assert_eq!(i64s(&e, "impacts"), vec![None, None, Some(2)]);
     assert_eq!(bools(&e, "series_decimated")[2], Some(true));
-    close(f64s(&e, "impact_loss_total")[2].unwrap(), 0.4, "total impact loss");
+    close(
+        f64s(&e, "impact_loss_total")[2].unwrap(),
+        0.4,
+        "total impact loss",
+    );
 
     let g = read(&tmp.path().join("summary/energy_groups.parquet"));
     let cn = g.lazy().filter(col("label").eq(lit(CN))).collect().unwrap();
@@ -499,20 +701,41 @@ fn energy_flags_and_impact_losses() {
     let loss = f64s(&imp, "energy_loss_rel");
     close(loss[0].unwrap(), 0.3, "first impact");
     close(loss[1].unwrap(), 0.1, "second impact");
-    assert_eq!(bools(&imp, "series_decimated"), vec![Some(true), Some(true)]);
+    assert_eq!(
+        bools(&imp, "series_decimated"),
+        vec![Some(true), Some(true)]
+    );
     assert_eq!(i64s(&imp, "series_stride"), vec![Some(2), Some(2)]);
-    assert!(std::fs::read_to_string(tmp.path().join("summary/energy.md")).unwrap().contains("decimated"));
+    assert!(
+        std::fs::read_to_string(tmp.path().join("summary/energy.md"))
+            .unwrap()
+            .contains("decimated")
+    );
 }
 
 #[test]
 fn pareto_front_and_cost_to_reach_an_error() {
     // (cost, error): (1, 5) (2, 3) (2, 4) (3, 3) (4, 1) (4, 1): (2, 4) is beaten by (2, 3) at
     // equal cost, (3, 3) by (2, 3); the two identical (4, 1) dominate neither each other.
-    let pts = [(1.0, 5.0), (2.0, 3.0), (2.0, 4.0), (3.0, 3.0), (4.0, 1.0), (4.0, 1.0)];
-    assert_eq!(pareto_front(&pts), vec![true, true, false, false, true, true]);
+    let pts = [
+        (1.0, 5.0),
+        (2.0, 3.0),
+        (2.0, 4.0),
+        (3.0, 3.0),
+        (4.0, 1.0),
+        (4.0, 1.0),
+    ];
+    assert_eq!(
+        pareto_front(&pts),
+        vec![true, true, false, false, true, true]
+    );
     // c = 2 e^-2 exactly: the log-log interpolant reproduces it between any two points.
     let c = |e: f64| 2.0 / (e * e);
-    close(loglog_cost(0.03, (0.1, c(0.1)), (0.01, c(0.01))).unwrap(), c(0.03), "loglog");
+    close(
+        loglog_cost(0.03, (0.1, c(0.1)), (0.01, c(0.01))).unwrap(),
+        c(0.03),
+        "loglog",
+    );
 
     let tmp = tempfile::tempdir().unwrap();
     write_runs(tmp.path(), "part-0.parquet", &mut runs_frame(&synthetic()));
@@ -531,20 +754,50 @@ fn pareto_front_and_cost_to_reach_an_error() {
     // ε = 1e-2 lies between e = 0.02 (h = 1/12, wall 1e-3·144) and 0.006 (h = 1/24, wall
     // 1e-3·576): wall = 0.144 · 4^s, s = ln(0.01/0.02)/ln(0.006/0.02).
     let s = (0.5f64).ln() / (0.3f64).ln();
-    close(f64s(&cost, "wall_time_s")[0].unwrap(), 0.144 * 4f64.powf(s), "cost to 1e-2");
+    close(
+        f64s(&cost, "wall_time_s")[0].unwrap(),
+        0.144 * 4f64.powf(s),
+        "cost to 1e-2",
+    );
     // work = steps × dofs = 144 and 576 on the same levels.
-    close(f64s(&cost, "work")[0].unwrap(), 144.0 * 4f64.powf(s), "work to 1e-2");
-    // ε = 1e-1 is already met by the coarsest CN level (e = 0.1 ≤ ε): a crossing at the first
-    // level, so its own cost.
+    close(
+        f64s(&cost, "work")[0].unwrap(),
+        144.0 * 4f64.powf(s),
+        "work to 1e-2",
+    );
+    // ε = 1e-1 equals the coarsest CN error: the crossing is at that level, so its own cost
+    // (1e-3 / (1/4)² = 0.016 s).
+    let first = read(&tmp.path().join("summary/cost_to_error.parquet"))
+        .lazy()
+        .filter(
+            col("label")
+                .eq(lit(CN))
+                .and(col("error").eq(lit("err_u_l2l2")))
+                .and(col("epsilon").eq(lit(1e-1))),
+        )
+        .collect()
+        .unwrap();
+    close(
+        f64s(&first, "wall_time_s")[0].unwrap(),
+        0.016,
+        "cost to 1e-1",
+    );
     let wp = read(&tmp.path().join("summary/work_precision.parquet"));
     let ok_l2 = wp
         .lazy()
-        .filter(col("error").eq(lit("err_u_l2l2")).and(col("status").eq(lit("ok"))))
+        .filter(
+            col("error")
+                .eq(lit("err_u_l2l2"))
+                .and(col("status").eq(lit("ok"))),
+        )
         .collect()
         .unwrap();
     assert_eq!(ok_l2.height(), 7);
     // Every ok run has a Pareto verdict, the failed one none.
     assert!(bools(&ok_l2, "pareto_wall").iter().all(Option::is_some));
     let md = std::fs::read_to_string(tmp.path().join("summary/work_precision.md")).unwrap();
-    assert!(md.contains("Pareto front") && md.contains("ε = 1e-2"), "{md}");
+    assert!(
+        md.contains("Pareto front") && md.contains("ε = 1e-2"),
+        "{md}"
+    );
 }

@@ -58,9 +58,19 @@ struct RefValue {
 
 /// Reference solution U(ξ, s) for L = E = ρ = 1, a = ½ (table of SPEC §1.1).
 fn reference(xi: f64, s: f64) -> RefValue {
+    let (phase, f) = phase_of(s);
+    reference_at(xi, phase, f)
+}
+
+/// Phase k = floor(s mod 3) and f = (s mod 3) mod 1 of a scaled time.
+fn phase_of(s: f64) -> (f64, f64) {
     let sp = s.rem_euclid(3.0);
     let phase = sp.floor();
-    let f = sp - phase;
+    (phase, sp - phase)
+}
+
+/// U(ξ) at a time given by its phase and f (hoisted out of loops over ξ).
+fn reference_at(xi: f64, phase: f64, f: f64) -> RefValue {
     // Zone of (ξ, f): I f<ξ, f≤1−ξ; III f<ξ, f>1−ξ; II f≥ξ, f≤1−ξ; IV f≥ξ, f>1−ξ.
     let left = f < xi; // I or III
     let low = f <= 1.0 - xi; // I or II
@@ -139,8 +149,9 @@ impl BarExact {
     /// clamped end, value 0). Exact: elements are split at the kinks of u(·, t).
     pub fn error_sq(&self, nodal: &[f64], h: f64, t: f64) -> (f64, f64) {
         let l = self.p.length;
-        let s = self.scaled_time(t);
-        let f = s.rem_euclid(3.0).fract();
+        let (phase, f) = phase_of(self.scaled_time(t));
+        let amp = 2.0 * self.p.amplitude;
+        let exact = |x: f64| amp * reference_at(x / l, phase, f).u;
         let (k1, k2) = if f <= 0.5 {
             (f * l, (1.0 - f) * l)
         } else {
@@ -148,36 +159,35 @@ impl BarExact {
         };
         let m = nodal.len();
         let (mut l2, mut h1) = (0.0, 0.0);
+        // Exact value at the left node of the element, carried from the previous element.
+        let mut u_left = exact(0.0);
         for i in 0..m {
             let (xa, xb) = (i as f64 * h, (i + 1) as f64 * h);
             let ua = nodal[i];
             let ub = if i + 1 < m { nodal[i + 1] } else { 0.0 };
             let slope = (ub - ua) / h;
-            let mut pts = [xa, xb, xb, xb];
-            let mut np = 1;
-            for k in [k1, k2] {
-                if k > pts[np - 1] && k < xb {
-                    pts[np] = k;
-                    np += 1;
-                }
-            }
-            pts[np] = xb;
             // The exact field is continuous, so its values at the piece ends determine the affine
             // error on each piece; ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3.
-            let mut xl = pts[0];
-            let mut el = ua - self.u(xl, t);
-            for &xr in &pts[1..=np] {
-                let d = xr - xl;
-                if d <= 0.0 {
-                    continue;
+            let mut xl = xa;
+            let mut el = ua - u_left;
+            let mut piece = |xr: f64, ur: f64, xl: &mut f64, el: &mut f64| {
+                let d = xr - *xl;
+                if d > 0.0 {
+                    let er = ua + slope * (xr - xa) - ur;
+                    l2 += d * (*el * *el + *el * er + er * er) / 3.0;
+                    let de = (er - *el) / d;
+                    h1 += d * de * de;
+                    *xl = xr;
+                    *el = er;
                 }
-                let er = ua + slope * (xr - xa) - self.u(xr, t);
-                l2 += d * (el * el + el * er + er * er) / 3.0;
-                let de = (er - el) / d;
-                h1 += d * de * de;
-                xl = xr;
-                el = er;
+            };
+            for k in [k1, k2] {
+                if k > xl && k < xb {
+                    piece(k, exact(k), &mut xl, &mut el);
+                }
             }
+            u_left = exact(xb);
+            piece(xb, u_left, &mut xl, &mut el);
         }
         (l2, h1)
     }

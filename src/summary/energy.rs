@@ -56,7 +56,12 @@ struct Series {
 impl Series {
     /// Largest gap between recorded steps: 1 for a complete series, k for `series_every = k`.
     fn stride(&self) -> i64 {
-        self.step.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(1).max(1)
+        self.step
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .max()
+            .unwrap_or(1)
+            .max(1)
     }
 
     /// Contact phases: maximal runs of consecutive rows with σ_C < 0.
@@ -85,7 +90,10 @@ impl Series {
 }
 
 /// The series of the bar1d runs, keyed by run_id; `Err(reason)` when there are none.
-fn read_series(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
+fn read_series(
+    dir: &std::path::Path,
+    runs: &Runs,
+) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
     let wanted: HashMap<&str, ()> = runs
         .runs
         .iter()
@@ -95,30 +103,29 @@ fn read_series(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Result<Hash
     if wanted.is_empty() {
         return Ok(Err("no bar1d runs".into()));
     }
-    let raw = crate::sink::read_series(dir)?;
+    // Typed per part (another version may store a column with another type).
+    let (raw, _) = super::runs::read_typed(
+        &dir.join("series"),
+        &[
+            ("run_id", Kind::Str),
+            ("step", Kind::I64),
+            ("t", Kind::F64),
+            ("sigma_contact", Kind::F64),
+            ("energy", Kind::F64),
+            ("energy_theta", Kind::F64),
+        ],
+    )?;
     if raw.height() == 0 {
         return Ok(Err("no time series in series/ (series_every = 0?)".into()));
     }
-    let schema = raw.schema().clone();
     let need = ["run_id", "step", "t", "sigma_contact", "energy"];
-    if let Some(m) = need.iter().find(|c| schema.get(c).is_none()) {
+    if let Some(m) = need.iter().find(|c| raw.column(c).is_err()) {
         return Ok(Err(format!("the series have no `{m}` column")));
     }
-    let mut exprs = vec![
-        col("run_id").cast(DataType::String),
-        col("step").cast(DataType::Int64),
-        col("t").cast(DataType::Float64),
-        col("sigma_contact").cast(DataType::Float64),
-        col("energy").cast(DataType::Float64),
-    ];
-    let has_theta = schema.get("energy_theta").is_some();
-    if has_theta {
-        exprs.push(col("energy_theta").cast(DataType::Float64));
-    }
-    // Lazy: keep the needed columns only, drop rows without a key, order by run and step.
+    let has_theta = raw.column("energy_theta").is_ok();
+    // Lazy: drop rows without a key, order by run and step.
     let df = raw
         .lazy()
-        .select(exprs)
         .filter(col("run_id").is_not_null().and(col("step").is_not_null()))
         .sort(["run_id", "step"], SortMultipleOptions::default())
         .collect()
@@ -260,7 +267,9 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
 
     for (ri, r) in runs.runs.iter().enumerate() {
         let Ok(map) = &series else { break };
-        let Some(s) = map.get(&r.run_id) else { continue };
+        let Some(s) = map.get(&r.run_id) else {
+            continue;
+        };
         if s.step.is_empty() {
             continue;
         }
@@ -345,7 +354,10 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         per_run.f64("energy_max_dev", r.energy_max_dev);
         per_run.f64("energy_max_increase", r.energy_max_increase);
         per_run.f64("energy_theta_max_increase", r.energy_theta_max_increase);
-        per_run.bool("energy_growth", r.energy_max_increase.map(|x| x > ENERGY_TOL));
+        per_run.bool(
+            "energy_growth",
+            r.energy_max_increase.map(|x| x > ENERGY_TOL),
+        );
         per_run.bool(
             "energy_theta_growth",
             r.energy_theta_max_increase.map(|x| x > ENERGY_TOL),
@@ -375,8 +387,14 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             b.unwrap_or("").to_string(),
             imp.map(|i| i.0.to_string()).unwrap_or_default(),
             imp.map(|i| table::sci(Some(i.1))).unwrap_or_default(),
-            imp.map(|i| if i.2 { format!("every {}", i.3) } else { "no".into() })
-                .unwrap_or_default(),
+            imp.map(|i| {
+                if i.2 {
+                    format!("every {}", i.3)
+                } else {
+                    "no".into()
+                }
+            })
+            .unwrap_or_default(),
         ]);
     }
 
@@ -406,7 +424,12 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     ));
     let mut group_rows_md: Vec<Vec<String>> = Vec::new();
     for (gi, g) in runs.groups.iter().enumerate() {
-        let ok: Vec<&Run> = g.runs.iter().map(|&i| &runs.runs[i]).filter(|r| r.ok()).collect();
+        let ok: Vec<&Run> = g
+            .runs
+            .iter()
+            .map(|&i| &runs.runs[i])
+            .filter(|r| r.ok())
+            .collect();
         let drift = minmax(ok.iter().map(|r| r.energy_drift));
         let dev = minmax(ok.iter().map(|r| r.energy_max_dev));
         let inc = minmax(ok.iter().map(|r| r.energy_max_increase));
@@ -521,7 +544,13 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     .iter()
     .map(|s| s.to_string())
     .collect();
-    let mut ra = vec![Align::Right, Align::Left, Align::Right, Align::Right, Align::Left];
+    let mut ra = vec![
+        Align::Right,
+        Align::Left,
+        Align::Right,
+        Align::Right,
+        Align::Left,
+    ];
     ra.extend([Align::Right; 4]);
     ra.extend([Align::Left, Align::Right, Align::Right, Align::Left]);
     md.push_str(&table::markdown(&rh, &ra, &run_rows_md));

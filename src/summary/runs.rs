@@ -276,7 +276,10 @@ pub(crate) struct Runs {
 impl Runs {
     /// Parameter columns as declared output columns.
     pub(crate) fn param_columns(&self) -> Vec<(String, Kind)> {
-        self.params.iter().map(|(n, k)| (n.to_string(), *k)).collect()
+        self.params
+            .iter()
+            .map(|(n, k)| (n.to_string(), *k))
+            .collect()
     }
 
     /// Parameters that vary across the folder, excluding those in the label.
@@ -308,6 +311,68 @@ fn castable(found: &DataType) -> bool {
     found.is_primitive_numeric() || found.is_bool() || found.is_string() || found.is_null()
 }
 
+/// Read every committed Parquet part of `folder`, keeping only the `known` columns, each cast
+/// to the type this version expects, and concatenate them diagonally (a column missing from a
+/// part is null there). Returns the frame and the columns that were not read.
+///
+/// Why not `sink::read_runs`: it concatenates the parts as stored, which fails when two
+/// versions stored a column with different types (`repeats` as i32 and i64, `elements` as
+/// integer and float) or a foreign column differs between parts; casting each part first
+/// makes the union always well-typed.
+pub(crate) fn read_typed(
+    folder: &Path,
+    known: &[(&'static str, Kind)],
+) -> anyhow::Result<(DataFrame, Vec<String>)> {
+    let mut ignored: Vec<String> = Vec::new();
+    let mut frames = Vec::new();
+    for part in crate::sink::parquet_parts(folder)? {
+        let file = std::fs::File::open(&part).with_context(|| format!("{}", part.display()))?;
+        let parquet_err =
+            |e: PolarsError| anyhow::Error::new(e).context(format!("{}: parquet", part.display()));
+        let mut reader = ParquetReader::new(file);
+        let stored: Vec<String> = reader
+            .schema()
+            .map_err(parquet_err)?
+            .iter_names()
+            .map(|n| n.to_string())
+            .collect();
+        // Read only the known columns (a series part can be large; the rest is never loaded).
+        let wanted: Vec<String> = stored
+            .iter()
+            .filter(|n| known.iter().any(|(k, _)| k == n))
+            .cloned()
+            .collect();
+        let raw = reader
+            .with_columns(Some(wanted))
+            .finish()
+            .map_err(parquet_err)?;
+        let schema = raw.schema().clone();
+        for name in &stored {
+            let usable = schema.get(name).is_some_and(castable);
+            if !usable && !ignored.iter().any(|i| i == name) {
+                ignored.push(name.clone());
+            }
+        }
+        let exprs: Vec<Expr> = known
+            .iter()
+            .filter(|(n, _)| schema.get(n).is_some_and(castable))
+            .map(|(n, k)| col(*n).cast(dtype(*k)))
+            .collect();
+        if exprs.is_empty() {
+            continue;
+        }
+        frames.push(raw.lazy().select(exprs));
+    }
+    if frames.is_empty() {
+        return Ok((DataFrame::empty(), ignored));
+    }
+    let df = concat_lf_diagonal(frames, UnionArgs::default())
+        .and_then(|lf| lf.collect())
+        .map_err(anyhow::Error::new)
+        .with_context(|| format!("{}: reading the parts", folder.display()))?;
+    Ok((df, ignored))
+}
+
 fn f64s(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<f64>>>> {
     match df.column(name) {
         Ok(c) => Ok(Some(c.f64()?.iter().collect())),
@@ -334,17 +399,11 @@ fn strs(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<String>>
 /// Read and group the runs of `dir`.
 pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     if !dir.is_dir() {
-        bail!("{}: no such folder (expected a results folder with runs/)", dir.display());
-    }
-    let raw = crate::sink::read_runs(dir)?;
-    if raw.height() == 0 {
         bail!(
-            "{}: no runs to summarize: {} holds no committed *.parquet part (is this a contact-sweep output folder?)",
-            dir.display(),
-            dir.join("runs").display()
+            "{}: no such folder (expected a results folder with runs/)",
+            dir.display()
         );
     }
-    let schema = raw.schema().clone();
     let known: Vec<(&'static str, Kind)> = MEASURED
         .iter()
         .chain(PARAMS)
@@ -352,29 +411,14 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         .copied()
         .chain(ERRORS.iter().map(|e| (*e, Kind::F64)))
         .collect();
-    let mut ignored: Vec<String> = Vec::new();
-    for (name, found) in schema.iter() {
-        let usable = known
-            .iter()
-            .find(|(n, _)| *n == name.as_str())
-            .is_some_and(|_| castable(found));
-        if !usable {
-            ignored.push(name.to_string());
-        }
+    let (df, ignored) = read_typed(&dir.join("runs"), &known)?;
+    if df.height() == 0 {
+        bail!(
+            "{}: no runs to summarize: {} holds no committed *.parquet part (is this a contact-sweep output folder?)",
+            dir.display(),
+            dir.join("runs").display()
+        );
     }
-    // Select the known columns with the types this version expects; the rest is dropped
-    // before anything else looks at it.
-    let exprs: Vec<Expr> = known
-        .iter()
-        .filter(|(n, _)| schema.get(n).is_some_and(castable))
-        .map(|(n, k)| col(*n).cast(dtype(*k)))
-        .collect();
-    let df = raw
-        .lazy()
-        .select(exprs)
-        .collect()
-        .map_err(anyhow::Error::new)
-        .with_context(|| format!("{}: reading the runs table", dir.join("runs").display()))?;
     let n = df.height();
 
     let run_id = strs(&df, "run_id")?;
@@ -410,14 +454,19 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let mut errors: Vec<&'static str> = Vec::new();
     let mut error_values: Vec<Vec<Option<f64>>> = Vec::new();
     for e in ERRORS {
-        if let Some(v) = f64s(&df, e)? {
-            if v.iter().any(|x| x.is_some_and(|x| !x.is_nan())) {
-                errors.push(e);
-                error_values.push(v);
-            }
+        if let Some(v) = f64s(&df, e)?
+            && v.iter().any(|x| x.is_some_and(|x| !x.is_nan()))
+        {
+            errors.push(e);
+            error_values.push(v);
         }
     }
-    let (h, elements, dt, courant) = (get_f("h")?, get_i("elements")?, get_f("dt")?, get_f("courant")?);
+    let (h, elements, dt, courant) = (
+        get_f("h")?,
+        get_i("elements")?,
+        get_f("dt")?,
+        get_f("courant")?,
+    );
     let (wt, wt_min, wt_max) = (
         get_f("wall_time_s")?,
         get_f("wall_time_min_s")?,
@@ -449,19 +498,36 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             continue;
         }
         let params_i: Vec<Cell> = param_values.iter().map(|v| v[i].clone()).collect();
-        let lbl = label.as_ref().and_then(|v| v[i].clone()).unwrap_or_else(|| {
-            // No label column: compose one from the method parameters that exist.
-            let pick = |name: &str| {
-                params
-                    .iter()
-                    .position(|(n, _)| *n == name)
-                    .and_then(|j| params_i[j].show())
-            };
-            [pick("space"), pick("mass"), pick("scheme_label").or(pick("scheme"))]
+        let lbl = label
+            .as_ref()
+            .and_then(|v| v[i].clone())
+            .unwrap_or_else(|| {
+                // No label column: compose one from the method parameters that exist.
+                let pick = |name: &str| {
+                    params
+                        .iter()
+                        .position(|(n, _)| *n == name)
+                        .and_then(|j| params_i[j].show())
+                };
+                [
+                    pick("space"),
+                    pick("mass"),
+                    pick("scheme_label").or(pick("scheme")),
+                ]
                 .into_iter()
                 .flatten()
                 .collect::<Vec<_>>()
                 .join(" · ")
+            });
+        // h is always filled by this version (SPEC §8); an older row with only `elements`
+        // gets h = length / elements.
+        let h_i = finite(h[i]).filter(|x| *x > 0.0).or_else(|| {
+            let m = elements[i].filter(|m| *m > 0)? as f64;
+            let j = params.iter().position(|(n, _)| *n == "length")?;
+            match params_i[j] {
+                Cell::F64(Some(l)) if l > 0.0 => Some(l / m),
+                _ => None,
+            }
         });
         runs.push(Run {
             run_id: id,
@@ -472,7 +538,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             },
             message: message.as_ref().and_then(|v| v[i].clone()),
             params: params_i,
-            h: finite(h[i]).filter(|x| *x > 0.0),
+            h: h_i,
             elements: elements[i].filter(|m| *m > 0),
             dt: finite(dt[i]).filter(|x| *x > 0.0),
             courant: finite(courant[i]).filter(|x| *x > 0.0),
@@ -511,7 +577,12 @@ fn group(r: &mut Runs) {
     let varying = r.varying();
     let mut by_key: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     for (i, run) in r.runs.iter().enumerate() {
-        let key = run.params.iter().map(Cell::key).collect::<Vec<_>>().join("|");
+        let key = run
+            .params
+            .iter()
+            .map(Cell::key)
+            .collect::<Vec<_>>()
+            .join("|");
         by_key.entry(key).or_default().push(i);
     }
     let mut groups: Vec<(String, String, Vec<usize>)> = by_key
@@ -520,7 +591,11 @@ fn group(r: &mut Runs) {
             let first = &r.runs[idx[0]];
             let extra: Vec<String> = varying
                 .iter()
-                .filter_map(|&j| first.params[j].show().map(|v| format!("{}={v}", r.params[j].0)))
+                .filter_map(|&j| {
+                    first.params[j]
+                        .show()
+                        .map(|v| format!("{}={v}", r.params[j].0))
+                })
                 .collect();
             let title = if extra.is_empty() {
                 first.label.clone()
@@ -578,7 +653,8 @@ fn opt_key(x: Option<f64>) -> String {
 fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
     let mut out = Vec::new();
     type Axis = fn(&Run) -> Option<f64>;
-    let axes: [(Axis, Axis, fn(f64) -> Fixed); 3] = [
+    type Make = fn(f64) -> Fixed;
+    let axes: [(Axis, Axis, Make); 3] = [
         (|r| Some(r.dt? / r.h?), |r| r.h, Fixed::Ratio),
         (|r| r.dt, |r| r.h, Fixed::Dt),
         (|r| r.h, |r| r.dt, Fixed::H),
@@ -610,8 +686,10 @@ fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
             lv.sort_by(|a, b| b.0.total_cmp(&a.0));
             let mut fixed = make(f);
             if let Fixed::Ratio(_) = fixed {
-                let c: HashSet<Option<String>> =
-                    lv.iter().map(|&(_, i)| runs[i].courant.map(float_key)).collect();
+                let c: HashSet<Option<String>> = lv
+                    .iter()
+                    .map(|&(_, i)| runs[i].courant.map(float_key))
+                    .collect();
                 if let (1, Some(c)) = (c.len(), lv.first().and_then(|&(_, i)| runs[i].courant)) {
                     fixed = Fixed::Courant(c);
                 }

@@ -97,7 +97,11 @@ impl Table {
             .unwrap_or_else(|| panic!("summary table: column `{name}` was not declared"));
         let rows = self.rows;
         let v = &mut self.values[i];
-        assert_eq!(v.len(), rows, "summary table: column `{name}` set twice in one row");
+        assert_eq!(
+            v.len(),
+            rows,
+            "summary table: column `{name}` set twice in one row"
+        );
         v
     }
 
@@ -205,7 +209,13 @@ pub(crate) fn markdown(header: &[String], align: &[Align], rows: &[Vec<String>])
     let esc = |s: &str| s.replace('|', "\\|");
     let mut out = String::new();
     out.push_str("| ");
-    out.push_str(&header.iter().map(|h| esc(h)).collect::<Vec<_>>().join(" | "));
+    out.push_str(
+        &header
+            .iter()
+            .map(|h| esc(h))
+            .collect::<Vec<_>>()
+            .join(" | "),
+    );
     out.push_str(" |\n|");
     for i in 0..header.len() {
         out.push_str(match align.get(i).copied().unwrap_or(Align::Right) {
@@ -316,7 +326,7 @@ pub(crate) fn tex_sci(x: Option<f64>) -> String {
                 format!("${m}\\cdot10^{{{e}}}$")
             }
         }
-        Some(x) if x == 0.0 => "$0$".into(),
+        Some(0.0) => "$0$".into(),
         Some(x) => tex(&format!("{x}")),
         None => String::new(),
     }

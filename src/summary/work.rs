@@ -46,7 +46,11 @@ pub fn loglog_cost(eps: f64, (e_a, c_a): (f64, f64), (e_b, c_b): (f64, f64)) -> 
         return None;
     }
     let de = e_b.ln() - e_a.ln();
-    let s = if de == 0.0 { 0.0 } else { (eps.ln() - e_a.ln()) / de };
+    let s = if de == 0.0 {
+        0.0
+    } else {
+        (eps.ln() - e_a.ln()) / de
+    };
     Some((c_a.ln() + s * (c_b.ln() - c_a.ln())).exp())
 }
 
@@ -168,7 +172,10 @@ pub(crate) fn section(runs: &Runs) -> Section {
             .iter()
             .map(|&i| {
                 let r = &runs.runs[i];
-                (r.wall_time_s.unwrap_or(f64::NAN), r.errors[e].unwrap_or(f64::NAN))
+                (
+                    r.wall_time_s.unwrap_or(f64::NAN),
+                    r.errors[e].unwrap_or(f64::NAN),
+                )
             })
             .collect();
         for (k, f) in pareto_front(&pts).into_iter().enumerate() {
@@ -195,7 +202,12 @@ pub(crate) fn section(runs: &Runs) -> Section {
                     .h
                     .unwrap_or(0.0)
                     .total_cmp(&runs.runs[a].h.unwrap_or(0.0))
-                    .then(runs.runs[b].dt.unwrap_or(0.0).total_cmp(&runs.runs[a].dt.unwrap_or(0.0))),
+                    .then(
+                        runs.runs[b]
+                            .dt
+                            .unwrap_or(0.0)
+                            .total_cmp(&runs.runs[a].dt.unwrap_or(0.0)),
+                    ),
             )
         });
         for &i in &order {
@@ -226,7 +238,10 @@ pub(crate) fn section(runs: &Runs) -> Section {
         }
 
         // Markdown: the Pareto front (wall time).
-        let _ = writeln!(md, "## {ename}\n\n### Pareto front (error against wall time)\n");
+        let _ = writeln!(
+            md,
+            "## {ename}\n\n### Pareto front (error against wall time)\n"
+        );
         let mut front: Vec<usize> = wall_pts
             .iter()
             .copied()
@@ -238,10 +253,19 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 .unwrap_or(0.0)
                 .total_cmp(&runs.runs[b].wall_time_s.unwrap_or(0.0))
         });
-        let header: Vec<String> = ["#", "family", "h", "dt", ename, "wall time [min, max] s", "work", "repeats"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let header: Vec<String> = [
+            "#",
+            "family",
+            "h",
+            "dt",
+            ename,
+            "wall time [min, max] s",
+            "work",
+            "repeats",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         let align = [
             Align::Right,
             Align::Left,
@@ -272,7 +296,9 @@ pub(crate) fn section(runs: &Runs) -> Section {
                     table::sci(r.dt),
                     table::sci(r.errors[e]),
                     wall_cell(i),
-                    work_of(r.steps, r.dofs).map(|w| w.to_string()).unwrap_or_default(),
+                    work_of(r.steps, r.dofs)
+                        .map(|w| w.to_string())
+                        .unwrap_or_default(),
                     r.repeats.map(|x| x.to_string()).unwrap_or_default(),
                 ]
             })
@@ -285,18 +311,31 @@ pub(crate) fn section(runs: &Runs) -> Section {
         }
 
         // Cost to reach ε.
-        let values: Vec<f64> = cand.iter().filter_map(|&i| usable(runs.runs[i].errors[e])).collect();
+        let values: Vec<f64> = cand
+            .iter()
+            .filter_map(|&i| usable(runs.runs[i].errors[e]))
+            .collect();
         let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let decades: Vec<f64> = if values.is_empty() {
             Vec::new()
         } else {
             let (a, b) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
-            (a..=b).rev().take(40).map(|k| 10f64.powi(k)).collect()
+            (a..=b)
+                .rev()
+                .take(40)
+                // Parsed from its decimal form: exactly the double a reader writes as 1e-2.
+                .map(|k| format!("1e{k}").parse::<f64>().unwrap_or(f64::NAN))
+                .collect()
         };
-        let _ = writeln!(md, "### Cost to reach ε (wall time in s; work in steps × dofs)\n");
+        let _ = writeln!(
+            md,
+            "### Cost to reach ε (wall time in s; work in steps × dofs)\n"
+        );
         if decades.is_empty() {
-            md.push_str("The errors span less than a decade: no power of ten inside their range.\n\n");
+            md.push_str(
+                "The errors span less than a decade: no power of ten inside their range.\n\n",
+            );
         }
         let mut cost_rows: Vec<Vec<String>> = Vec::new();
         for (gi, g) in runs.groups.iter().enumerate() {
@@ -330,7 +369,9 @@ pub(crate) fn section(runs: &Runs) -> Section {
                             _ => None,
                         };
                         let work = match (work_of(a.steps, a.dofs), work_of(b.steps, b.dofs)) {
-                            (Some(ca), Some(cb)) => loglog_cost(eps, (ea, ca as f64), (eb, cb as f64)),
+                            (Some(ca), Some(cb)) => {
+                                loglog_cost(eps, (ea, ca as f64), (eb, cb as f64))
+                            }
                             _ => None,
                         };
                         let c = Crossing {
@@ -424,10 +465,20 @@ pub(crate) fn section(runs: &Runs) -> Section {
 
         // Markdown: every run (error against cost), by family.
         let _ = writeln!(md, "### All runs\n");
-        let header: Vec<String> = ["#", "label", "h", "dt", "status", ename, "wall time [min, max] s", "work", "front"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let header: Vec<String> = [
+            "#",
+            "label",
+            "h",
+            "dt",
+            "status",
+            ename,
+            "wall time [min, max] s",
+            "work",
+            "front",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         let align = [
             Align::Right,
             Align::Left,
@@ -457,7 +508,9 @@ pub(crate) fn section(runs: &Runs) -> Section {
                     r.status.clone(),
                     table::sci(r.errors[e]),
                     wall_cell(i),
-                    work_of(r.steps, r.dofs).map(|w| w.to_string()).unwrap_or_default(),
+                    work_of(r.steps, r.dofs)
+                        .map(|w| w.to_string())
+                        .unwrap_or_default(),
                     front.to_string(),
                 ]
             })
@@ -486,12 +539,18 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 );
             }
             if front.len() > 8 {
-                let _ = writeln!(terminal, "  … {} more in work_precision.md", front.len() - 8);
+                let _ = writeln!(
+                    terminal,
+                    "  … {} more in work_precision.md",
+                    front.len() - 8
+                );
             }
         }
     }
     if runs.errors.is_empty() {
-        md.push_str("No error column has a value (no reference solution): nothing to plot against cost.\n");
+        md.push_str(
+            "No error column has a value (no reference solution): nothing to plot against cost.\n",
+        );
         terminal.push_str("work-precision: no error column has a value\n");
     }
     Section {
