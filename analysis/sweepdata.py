@@ -74,6 +74,7 @@ ERROR_COLUMNS = [
     "err_u_l2h1",
     "err_u_linfl2",
     "err_sigma_l2",
+    "err_sigma_mid_l2",
     "err_energy_l2",
     "err_u_contact_max",
 ]

@@ -402,13 +402,28 @@ fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), Contac
 /// Observation helper shared by both loops.
 struct Recorder<'a> {
     sp: &'a Bar1dSpace,
+    /// Whether σ_C is a function of the state (else a multiplier).
+    state_pressure: bool,
+    /// (u₀, u₁) of the previous observation.
+    prev01: Option<[f64; 2]>,
     exact: Option<BarExact>,
     tau: f64,
     obs: Observer,
 }
 
 impl Recorder<'_> {
+    /// Observe step `step`. The midpoint pressure σ_C(u^{n−½}) is evaluated on the midpoint
+    /// state where the pressure is a function of the state (Nitsche, penalty, a quasi-static
+    /// contact node); a multiplier of a node with mass is averaged by the observer instead.
     fn record(&mut self, step: usize, u: &[f64], v: &[f64], sigma: f64) -> Result<(), Divergence> {
+        let now = [u[0], u[1]];
+        let sigma_mid = match self.prev01.replace(now) {
+            Some(p) if self.state_pressure => Some(
+                self.sp
+                    .contact_pressure(&[0.5 * (p[0] + now[0]), 0.5 * (p[1] + now[1])]),
+            ),
+            _ => None,
+        };
         let t = step as f64 * self.tau;
         let (energy, energy_theta) = self.sp.energies(u, v);
         let exact = self.exact.map(|ex| {
@@ -416,6 +431,7 @@ impl Recorder<'_> {
             ExactValues {
                 u_contact: ex.u(0.0, t),
                 sigma_contact: ex.contact_stress(t),
+                sigma_contact_mid: (step > 0).then(|| ex.contact_stress(t - 0.5 * self.tau)),
                 energy: ex.energy(),
                 l2_sq,
                 h1_semi_sq,
@@ -428,6 +444,7 @@ impl Recorder<'_> {
                 u_contact: u[0],
                 v_contact: v[0],
                 sigma_contact: sigma,
+                sigma_mid,
                 energy,
                 energy_theta,
             },
@@ -486,6 +503,8 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
     };
     let mut rec = Recorder {
         sp: &eng.sp,
+        state_pressure: eng.sp.method != ContactMethod::Mixed || eng.sp.massless_contact,
+        prev01: None,
         exact: cfg.bar.exact(),
         tau,
         obs: Observer::new(tau, opts.series_every, cfg.steps),

@@ -299,10 +299,17 @@ fn read_parts(dir: &Path) -> Result<DataFrame, SinkError> {
     if frames.is_empty() {
         return Ok(DataFrame::empty());
     }
-    concat_lf_diagonal(frames, UnionArgs::default())
-        .and_then(|lf| lf.collect())
-        .map_err(|source| SinkError::Parquet {
-            path: dir.to_path_buf(),
-            source,
-        })
+    // Parts written by other versions may store a column with another type: supertypes.
+    concat_lf_diagonal(
+        frames,
+        UnionArgs {
+            to_supertypes: true,
+            ..UnionArgs::default()
+        },
+    )
+    .and_then(|lf| lf.collect())
+    .map_err(|source| SinkError::Parquet {
+        path: dir.to_path_buf(),
+        source,
+    })
 }

@@ -16,9 +16,9 @@ use super::table::Kind;
 
 /// Parameter columns (SPEC §7, §8) that identify a method group, in output order. The
 /// refinement axes ([`REFINEMENT`]) and the derived `label` are not among them: `label` is a
-/// function of these parameters and is carried, not grouped by.
+/// function of these parameters and is carried, not grouped by. `sweep` is not a parameter:
+/// the same method run by two sweeps into one folder (`--resume`) is one group.
 pub(crate) const PARAMS: &[(&str, Kind)] = &[
-    ("sweep", Kind::Str),
     ("scene", Kind::Str),
     ("space", Kind::Str),
     ("mass", Kind::Str),
@@ -76,6 +76,7 @@ pub(crate) const ERRORS: &[&str] = &[
     "err_u_l2h1",
     "err_u_linfl2",
     "err_sigma_l2",
+    "err_sigma_mid_l2",
     "err_energy_l2",
     "err_u_contact_max",
 ];
@@ -411,7 +412,9 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         .copied()
         .chain(ERRORS.iter().map(|e| (*e, Kind::F64)))
         .collect();
-    let (df, ignored) = read_typed(&dir.join("runs"), &known)?;
+    let (df, mut ignored) = read_typed(&dir.join("runs"), &known)?;
+    // Columns of this version's own schema that the summary does not need are not foreign.
+    ignored.retain(|n| !crate::run::RunRecord::COLUMNS.iter().any(|c| c.0 == n));
     if df.height() == 0 {
         bail!(
             "{}: no runs to summarize: {} holds no committed *.parquet part (is this a contact-sweep output folder?)",
