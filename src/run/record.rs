@@ -136,7 +136,7 @@ schema! {
         err_u_l2h1: Option<f64> => "", "same with the full H1 norm";
         err_u_linfl2: Option<f64> => "m^{3/2}", "max_n ‖u^n − u(t^n)‖_L2";
         err_sigma_l2: Option<f64> => "Pa·s^½", "l2(τ) error of the contact pressure σ_C^n at t^n";
-        err_sigma_mid_l2: Option<f64> => "Pa·s^½", "l2(τ) error of the midpoint pressure (σ_C^{n−1} + σ_C^n)/2 at t^{n−½} (003 §4.1.2e)";
+        err_sigma_mid_l2: Option<f64> => "Pa·s^½", "l2(τ) error of the pressure at midpoint, σ_C(u^{n−½}) against σ(t^{n−½}) (003 §4.1.2e; a multiplier of a node with mass: mean of two)";
         err_energy_l2: Option<f64> => "", "l2(τ) error of the energy";
         err_u_contact_max: Option<f64> => "m", "max_n |u^n(contact) − u(contact, t^n)|";
         tool_version: String => "", "contact-sweep version that computed the row";
