@@ -192,7 +192,7 @@ def main() -> int:
                 print(f"  {col:<14} {p:6.2f}  ({n} levels)  {name}")
             pngs.append(sd.save_figure(fig, out, f"convergence_{sd.safe_name(sweep)}"))
 
-    sd.write_manifest(out, "plot_convergence.py", pngs)
+    sd.write_manifest(out, "plot_convergence.py", pngs, args.dir)
     if not pngs:
         print("nothing to plot: no method group has errors on at least 2 refinement levels "
               "(status ok, finite positive error, h set). Convergence plots need a scene with a "

@@ -238,7 +238,7 @@ def main() -> int:
             fig = plot_chunk(sweep, chunk, series, legend_cols, k, len(chunks), args)
             pngs.append(sd.save_figure(fig, out, stem if len(chunks) == 1 else f"{stem}_part{k}"))
 
-    sd.write_manifest(out, "plot_series.py", pngs)
+    sd.write_manifest(out, "plot_series.py", pngs, args.dir)
     if not pngs:
         print("nothing to plot: no run has series rows")
     return 0

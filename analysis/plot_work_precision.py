@@ -139,7 +139,7 @@ def main() -> int:
                     print(f"  {cost_col}={cost:<10.4g} {col}={err:<10.4g} {row['run_id']}  {row['label']}")
             pngs.append(sd.save_figure(fig, out, f"work_precision_{sd.safe_name(sweep)}_{col}"))
 
-    sd.write_manifest(out, f"plot_work_precision.py:{col}", pngs)
+    sd.write_manifest(out, f"plot_work_precision.py:{col}", pngs, args.dir)
     if not pngs:
         print(f"nothing to plot: no ok run has both a value of {col} and a cost "
               f"(wall_time_s or steps*dofs)")

@@ -360,13 +360,16 @@ def save_figure(fig, out_dir: str, stem: str) -> str:
     return png
 
 
-def write_manifest(out_dir: str, script: str, pngs: Sequence[str]) -> None:
-    """Record which PNGs ``script`` produced, for check_figures.py.
+def write_manifest(out_dir: str, script: str, pngs: Sequence[str], source: str) -> None:
+    """Record which PNGs ``script`` produced from the results folder ``source``.
 
-    Each script owns its own entry and rewrites it on every run; figures it
-    recorded last time but did not produce now (e.g. a sweep that was
-    renamed) are deleted so that a stale picture cannot pass for a fresh one.
+    Each (script, source folder) pair owns its own entry and rewrites it on
+    every run; figures it recorded last time but did not produce now (e.g. a
+    sweep that was renamed) are deleted so that a stale picture cannot pass
+    for a fresh one. Figures drawn from other folders into the same FIGDIR are
+    never touched.
     """
+    script = f"{script} {os.path.abspath(source)}"
     os.makedirs(out_dir, exist_ok=True)
     path = os.path.join(out_dir, MANIFEST)
     manifest: dict = {}
