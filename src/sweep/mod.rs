@@ -633,7 +633,7 @@ impl SweepFile {
         // A parameter may come from one place only: [fixed], one grid axis, or [zip].
         let mut sources: Vec<(Key, Origin, String)> = Vec::new();
         let mut note = |key: Key, origin: &Origin, source: String, ck: &mut Checker| {
-            if let Some((_, o, s)) = sources.iter().find(|(k, _, s)| *k == key && *s != source) {
+            if let Some((_, o, _)) = sources.iter().find(|(k, _, s)| *k == key && *s != source) {
                 ck.issues.push(Issue::at(
                     origin,
                     format!(
@@ -643,7 +643,6 @@ impl SweepFile {
                         o.line.unwrap_or(0)
                     ),
                 ));
-                let _ = s;
             } else if !sources.iter().any(|(k, _, s)| *k == key && *s == source) {
                 sources.push((key, origin.clone(), source));
             }
