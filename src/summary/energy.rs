@@ -64,7 +64,10 @@ impl Series {
             .max(1)
     }
 
-    /// Contact phases: maximal runs of consecutive rows with σ_C < 0.
+    /// Contact phases: maximal runs of rows with σ_C < 0, where a gap of at most
+    /// [`MERGE_GAP`] row without pressure does not end a phase — it is the step-to-step
+    /// alternation of the pressure (Nitsche-Hybrid's σ_C^n alternates between 0 and about
+    /// three times the exact value while the node stays on the obstacle), not a lift-off.
     fn impacts(&self) -> Vec<Impact> {
         let n = self.step.len();
         let contact = |i: usize| self.sigma[i].is_some_and(|s| s < 0.0);
@@ -73,21 +76,31 @@ impl Series {
         while i < n {
             if contact(i) {
                 let first = i;
-                while i + 1 < n && contact(i + 1) {
-                    i += 1;
+                let mut last = i;
+                let mut j = i + 1;
+                while j < n && j - last <= MERGE_GAP + 1 {
+                    if contact(j) {
+                        last = j;
+                    }
+                    j += 1;
                 }
                 out.push(Impact {
                     first,
-                    last: i,
+                    last,
                     before: first.checked_sub(1),
-                    after: (i + 1 < n).then_some(i + 1),
+                    after: (last + 1 < n).then_some(last + 1),
                 });
+                i = last;
             }
             i += 1;
         }
         out
     }
 }
+
+/// Rows without pressure that do not end a contact phase (one: a pressure alternating
+/// step by step; two rows without pressure already count as a lift-off).
+const MERGE_GAP: usize = 1;
 
 /// The series of the bar1d runs, keyed by run_id; `Err(reason)` when there are none.
 fn read_series(
