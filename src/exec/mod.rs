@@ -31,6 +31,24 @@ pub struct ExecOptions {
     pub run: RunOptions,
 }
 
+/// Run `f`; a panic becomes a `solver-failed` outcome carrying the panic message, so one bad
+/// run never takes the sweep down.
+fn guarded(f: impl FnOnce() -> Outcome) -> Outcome {
+    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let what = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Outcome {
+            status: Status::SolverFailed,
+            message: Some(format!("internal error (panic): {what}")),
+            metrics: Metrics::default(),
+            series: Vec::new(),
+        }
+    })
+}
+
 /// Run one spec (with its timing repeats), never panicking.
 pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
     let mut times = Vec::with_capacity(spec.repeats.max(1));
@@ -42,21 +60,8 @@ pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
             ..*opts
         };
         let start = Instant::now();
-        let res = catch_unwind(AssertUnwindSafe(|| run::simulate(&spec.config, &o)));
+        let out = guarded(|| run::simulate(&spec.config, &o));
         times.push(start.elapsed().as_secs_f64());
-        let out = res.unwrap_or_else(|payload| {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            Outcome {
-                status: Status::SolverFailed,
-                message: Some(format!("internal error (panic): {what}")),
-                metrics: Metrics::default(),
-                series: Vec::new(),
-            }
-        });
         let stop = out.status != Status::Ok;
         if outcome.is_none() {
             outcome = Some(out);
@@ -131,4 +136,22 @@ pub fn execute<E: Send>(
         drop(rx);
         result
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_a_failed_outcome_with_its_message() {
+        let out = guarded(|| panic!("index out of bounds: the len is 3"));
+        assert_eq!(out.status, Status::SolverFailed);
+        let msg = out.message.unwrap();
+        assert!(
+            msg.contains("internal error (panic)") && msg.contains("the len is 3"),
+            "{msg}"
+        );
+        let out = guarded(|| panic!("{} of {}", 1, 2));
+        assert!(out.message.unwrap().contains("1 of 2"));
+    }
 }

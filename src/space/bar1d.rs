@@ -55,6 +55,8 @@ pub struct Bar1dSpace {
 pub enum SpaceError {
     #[error("the mesh needs at least 2 elements (got {0})")]
     TooFewElements(usize),
+    #[error("mass_weights must list at least one weight")]
+    NoWeights,
     #[error("mass matrix of the free nodes is singular (pivot {pivot} at node {node})")]
     SingularMass { node: usize, pivot: f64 },
 }
@@ -68,6 +70,9 @@ impl Bar1dSpace {
     ) -> Result<Self, SpaceError> {
         if m < 2 {
             return Err(SpaceError::TooFewElements(m));
+        }
+        if matches!(mass, MassVariant::Weights(w) if w.is_empty()) {
+            return Err(SpaceError::NoWeights);
         }
         let h = bar.length / m as f64;
         let rho = bar.density;
