@@ -75,6 +75,10 @@ pub struct RunArgs {
     /// Do not write the summary tables at the end.
     #[arg(long)]
     pub no_summary: bool,
+    /// Run only shard K of N (runs whose plan index is K mod N), e.g. `--shard
+    /// $SLURM_ARRAY_TASK_ID/8` in a job array; all shards may write into one --out folder.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
 }
 
 /// Bad input detected by the CLI itself.
@@ -100,6 +104,7 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
 /// Validated `run` arguments.
 struct RunConfig {
     plan: Plan,
+    shard: Option<(usize, usize)>,
     out: PathBuf,
     exec: ExecOptions,
     resume: bool,
@@ -122,11 +127,32 @@ impl RunArgs {
         if self.batch == 0 {
             return Err(UsageError("--batch must be at least 1".into()).into());
         }
+        let shard = match &self.shard {
+            None => None,
+            Some(s) => {
+                let parsed = s.split_once('/').and_then(|(k, n)| {
+                    Some((
+                        k.trim().parse::<usize>().ok()?,
+                        n.trim().parse::<usize>().ok()?,
+                    ))
+                });
+                match parsed {
+                    Some((k, n)) if n > 0 && k < n => Some((k, n)),
+                    _ => {
+                        return Err(UsageError(format!(
+                            "--shard must be K/N with 0 ≤ K < N (e.g. 0/4), got `{s}`"
+                        ))
+                        .into());
+                    }
+                }
+            }
+        };
         let out = self
             .out
             .unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
         let series_every = self.series_every.unwrap_or(plan.sweep.series_every);
         Ok(RunConfig {
+            shard,
             exec: ExecOptions {
                 threads: self.threads,
                 run: RunOptions {
@@ -189,12 +215,27 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         .into());
     }
     let (mut sink, done) = Sink::open(dir, cfg.batch)?;
-    let todo: Vec<&sweep::RunSpec> = plan
+    // Round-robin shards: neighbouring plan entries (levels of one ladder) have similar costs,
+    // so every shard gets a share of the expensive ones.
+    let mine: Vec<&sweep::RunSpec> = plan
         .runs
         .iter()
+        .enumerate()
+        .filter(|(i, _)| cfg.shard.is_none_or(|(k, n)| i % n == k))
+        .map(|(_, r)| r)
+        .collect();
+    let todo: Vec<&sweep::RunSpec> = mine
+        .iter()
+        .copied()
         .filter(|r| !done.contains(&r.run_id))
         .collect();
-    let skipped = plan.runs.len() - todo.len();
+    let skipped = mine.len() - todo.len();
+    if sink.shared_with_others() && cfg.shard.is_none() {
+        eprintln!(
+            "warning: another session is writing into {}; unless it runs other runs (a shard), rows may be duplicated",
+            dir.display()
+        );
+    }
     let threads = if cfg.exec.threads == 0 {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -202,13 +243,20 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     } else {
         cfg.exec.threads
     };
-    let mut manifest = Manifest::begin(dir, plan, plan.runs.len(), skipped, threads)?;
+    let mut manifest = Manifest::begin(dir, plan, mine.len(), skipped, threads, cfg.shard)?;
     eprint!("{}", plan.summary());
+    if let Some((k, n)) = cfg.shard {
+        eprintln!(
+            "shard {k}/{n}: {} of the {} runs",
+            mine.len(),
+            plan.runs.len()
+        );
+    }
     if skipped > 0 {
         eprintln!(
             "resuming in {}: {skipped} of {} runs already done",
             dir.display(),
-            plan.runs.len()
+            mine.len()
         );
     }
     let bar = ProgressBar::new(todo.len() as u64);
@@ -241,7 +289,7 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     );
     let flushed = sink.flush();
     bar.finish_and_clear();
-    manifest.finish(sink.written, result.is_err() || flushed.is_err())?;
+    manifest.finish(dir, sink.written, result.is_err() || flushed.is_err())?;
     result?;
     flushed?;
     eprintln!(
@@ -251,9 +299,14 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         failed,
         diverged
     );
-    let ids: HashSet<&str> = plan.runs.iter().map(|r| r.run_id.as_str()).collect();
+    let ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
     print!("{}", result_table(dir, plan, &ids)?);
-    if cfg.summary {
+    if cfg.shard.is_some() {
+        eprintln!(
+            "(a shard: run `contact-sweep summarize {}` once every shard is done)",
+            dir.display()
+        );
+    } else if cfg.summary {
         match summary::summarize(dir) {
             Ok(s) => print!("{}", s.terminal),
             Err(e) => eprintln!("summary not written: {e:#}"),
@@ -323,6 +376,9 @@ fn render(header: &[String], rows: &[Vec<String>]) -> String {
 
 /// Per-run results of this sweep, in plan order, read back from the Parquet parts.
 fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> {
+    if ids.is_empty() {
+        return Ok(String::new()); // a shard with no runs
+    }
     let df = crate::sink::read_runs(dir)?;
     let get_str = |name: &str| -> Result<Vec<Option<String>>> {
         Ok(df

@@ -29,8 +29,9 @@ fn machine() -> Json {
 
 /// The manifest of a results folder.
 pub struct Manifest {
-    doc: Json,
     path: std::path::PathBuf,
+    /// This session's id in the `sessions` list.
+    id: String,
 }
 
 impl Manifest {
@@ -51,70 +52,106 @@ impl Manifest {
         Ok(doc["sweep"].as_str().map(String::from))
     }
 
-    /// Start a session: create or extend the manifest.
+    /// Start a session: create or extend the manifest. `shard` is (k, n) for one shard of a
+    /// job array.
     pub fn begin(
         dir: &Path,
         plan: &Plan,
         planned: usize,
         skipped: usize,
         threads: usize,
+        shard: Option<(usize, usize)>,
     ) -> Result<Manifest, SinkError> {
         let path = dir.join("manifest.json");
-        let mut doc = if path.exists() {
-            let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
-                path: path.clone(),
-                source,
-            })?;
-            serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
-                path: path.clone(),
-                message: e.to_string(),
-            })?
-        } else {
-            json!({
-                "tool": "contact-sweep",
-                "sweep": plan.sweep.name,
-                "scene": plan.sweep.scene.name(),
-                "sessions": [],
-            })
-        };
+        let id = format!(
+            "{}-{}",
+            SystemTime::now()
+                .duration_since(SystemTime::UNIX_EPOCH)
+                .unwrap_or_default()
+                .as_nanos(),
+            std::process::id()
+        );
         let commit = env!("CONTACT_SWEEP_GIT_COMMIT");
         let session = json!({
+            "id": id,
             "started": now(),
             "finished": Json::Null,
             "version": env!("CARGO_PKG_VERSION"),
             "git_commit": if commit.is_empty() { Json::Null } else { Json::from(commit) },
             "machine": machine(),
             "threads": threads,
+            "shard": shard.map(|(k, n)| format!("{k}/{n}")),
             "sweep_file": plan.sweep.path.display().to_string(),
             "sweep_text": plan.sweep.text,
             "runs_planned": planned,
             "runs_skipped_as_done": skipped,
             "runs_written": 0,
         });
-        if !doc["sessions"].is_array() {
-            doc["sessions"] = json!([]);
-        }
-        doc["sessions"].as_array_mut().expect("array").push(session);
-        let m = Manifest { doc, path };
-        m.save()?;
+        let m = Manifest { path, id };
+        m.update(dir, |doc| {
+            if doc.is_null() {
+                *doc = json!({
+                    "tool": "contact-sweep",
+                    "sweep": plan.sweep.name,
+                    "scene": plan.sweep.scene.name(),
+                    "sessions": [],
+                });
+            }
+            if !doc["sessions"].is_array() {
+                doc["sessions"] = json!([]);
+            }
+            doc["sessions"].as_array_mut().expect("array").push(session);
+        })?;
         Ok(m)
     }
 
-    fn save(&self) -> Result<(), SinkError> {
-        let text = serde_json::to_string_pretty(&self.doc).expect("JSON values serialize");
+    /// Read-modify-write under an exclusive lock on DIR/.manifest.lock: the shards of a job
+    /// array start and finish concurrently, and none may lose another's session entry.
+    fn update(&self, dir: &Path, f: impl FnOnce(&mut Json)) -> Result<(), SinkError> {
+        let lock_path = dir.join(".manifest.lock");
+        let io = |path: &Path| {
+            let path = path.to_path_buf();
+            move |source| SinkError::Io { path, source }
+        };
+        let lock = std::fs::File::options()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&lock_path)
+            .map_err(io(&lock_path))?;
+        lock.lock().map_err(io(&lock_path))?;
+        let mut doc = if self.path.exists() {
+            let text = std::fs::read_to_string(&self.path).map_err(io(&self.path))?;
+            serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
+                path: self.path.clone(),
+                message: e.to_string(),
+            })?
+        } else {
+            Json::Null
+        };
+        f(&mut doc);
+        let text = serde_json::to_string_pretty(&doc).expect("JSON values serialize");
         write_atomic(&self.path, text.as_bytes())
+        // the lock is released when `lock` drops
     }
 
     /// Close the session with its end time and the number of rows written.
-    pub fn finish(&mut self, written: usize, interrupted: bool) -> Result<(), SinkError> {
-        if let Some(last) = self.doc["sessions"]
-            .as_array_mut()
-            .and_then(|a| a.last_mut())
-        {
-            last["finished"] = Json::from(now());
-            last["runs_written"] = Json::from(written);
-            last["interrupted"] = Json::from(interrupted);
-        }
-        self.save()
+    pub fn finish(
+        &mut self,
+        dir: &Path,
+        written: usize,
+        interrupted: bool,
+    ) -> Result<(), SinkError> {
+        let id = self.id.clone();
+        self.update(dir, |doc| {
+            if let Some(me) = doc["sessions"]
+                .as_array_mut()
+                .and_then(|a| a.iter_mut().find(|s| s["id"] == Json::from(id.as_str())))
+            {
+                me["finished"] = Json::from(now());
+                me["runs_written"] = Json::from(written);
+                me["interrupted"] = Json::from(interrupted);
+            }
+        })
     }
 }

@@ -13,6 +13,11 @@
 //! landed; [`Sink::open`] removes both, so `--resume` loses only the runs in flight and never
 //! duplicates a row. Batches are flushed every `batch_runs` runs or `batch_seconds`, whichever
 //! comes first, so a long sweep never holds much unsaved work.
+//!
+//! Several sessions may write into one DIR at once (the shards of a job array): each holds a
+//! shared lock on `DIR/.lock` while it writes, and the clean-up above takes the exclusive lock
+//! — so it runs only when no other session is writing, and never removes a temporary or a
+//! series part that another session is about to commit.
 
 use std::collections::HashSet;
 use std::fs::{self, File};
@@ -181,6 +186,9 @@ pub struct Sink {
     tag: String,
     seq: usize,
     pub written: usize,
+    shared_with_others: bool,
+    /// Shared lock on DIR/.lock, held while this session may write.
+    _lock: File,
 }
 
 impl Sink {
@@ -191,24 +199,24 @@ impl Sink {
         let series_dir = dir.join("series");
         fs::create_dir_all(&runs_dir).map_err(io(&runs_dir))?;
         fs::create_dir_all(&series_dir).map_err(io(&series_dir))?;
-        for d in [&runs_dir, &series_dir] {
-            for entry in fs::read_dir(d).map_err(io(d))? {
-                let p = entry.map_err(io(d))?.path();
-                if p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with(".tmp-"))
-                {
-                    fs::remove_file(&p).map_err(io(&p))?;
-                }
-            }
+        let lock_path = dir.join(".lock");
+        let lock = File::options()
+            .create(true)
+            .truncate(false)
+            .read(true)
+            .write(true)
+            .open(&lock_path)
+            .map_err(io(&lock_path))?;
+        let alone = match lock.try_lock() {
+            Ok(()) => true,
+            Err(fs::TryLockError::WouldBlock) => false,
+            Err(fs::TryLockError::Error(e)) => return Err(io(&lock_path)(e)),
+        };
+        if alone {
+            Self::clean(&runs_dir, &series_dir)?;
+            lock.unlock().map_err(io(&lock_path))?;
         }
-        // A series part without its runs part belongs to a batch that never committed.
-        for part in parquet_parts(&series_dir)? {
-            let name = part.file_name().expect("a file");
-            if !runs_dir.join(name).exists() {
-                fs::remove_file(&part).map_err(io(&part))?;
-            }
-        }
+        lock.lock_shared().map_err(io(&lock_path))?;
         let done = committed_run_ids(&runs_dir)?;
         let stamp = SystemTime::now()
             .duration_since(SystemTime::UNIX_EPOCH)
@@ -225,9 +233,40 @@ impl Sink {
                 tag: format!("{stamp}-{}", std::process::id()),
                 seq: 0,
                 written: 0,
+                shared_with_others: !alone,
+                _lock: lock,
             },
             done,
         ))
+    }
+
+    /// Remove what a killed session left: temporaries and series parts whose runs part never
+    /// landed. Only called under the exclusive lock.
+    fn clean(runs_dir: &Path, series_dir: &Path) -> Result<(), SinkError> {
+        for d in [runs_dir, series_dir] {
+            for entry in fs::read_dir(d).map_err(io(d))? {
+                let p = entry.map_err(io(d))?.path();
+                if p.file_name()
+                    .and_then(|n| n.to_str())
+                    .is_some_and(|n| n.starts_with(".tmp-"))
+                {
+                    fs::remove_file(&p).map_err(io(&p))?;
+                }
+            }
+        }
+        // A series part without its runs part belongs to a batch that never committed.
+        for part in parquet_parts(series_dir)? {
+            let name = part.file_name().expect("a file");
+            if !runs_dir.join(name).exists() {
+                fs::remove_file(&part).map_err(io(&part))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether another session was writing into the folder when this one opened it.
+    pub fn shared_with_others(&self) -> bool {
+        self.shared_with_others
     }
 
     /// Add a finished run; flush if the batch is full or old.
