@@ -146,7 +146,7 @@ impl Manifest {
         self.update(dir, |doc| {
             if let Some(me) = doc["sessions"]
                 .as_array_mut()
-                .and_then(|a| a.iter_mut().find(|s| s["id"] == Json::from(id.as_str())))
+                .and_then(|a| a.iter_mut().find(|s| s["id"] == id.as_str()))
             {
                 me["finished"] = Json::from(now());
                 me["runs_written"] = Json::from(written);
