@@ -47,6 +47,32 @@ pub enum Command {
     },
     /// Print the output schema (runs and series columns) as Markdown.
     Schema,
+    /// Write (and with --submit, submit) a Slurm job array running the sweep in shards.
+    Slurm(SlurmArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SlurmArgs {
+    /// The sweep file.
+    pub sweep: PathBuf,
+    /// Number of array tasks (shards).
+    #[arg(long)]
+    pub tasks: usize,
+    /// Output folder shared by all tasks (default: out/<sweep name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// CPUs per task (each task runs that many threads).
+    #[arg(long, default_value_t = 1)]
+    pub cpus_per_task: usize,
+    /// Time limit per task (Slurm syntax, e.g. 01:00:00).
+    #[arg(long)]
+    pub time: Option<String>,
+    /// Partition.
+    #[arg(long)]
+    pub partition: Option<String>,
+    /// Submit with sbatch (the summary job depends on the array).
+    #[arg(long)]
+    pub submit: bool,
 }
 
 #[derive(Debug, Args)]
@@ -196,6 +222,7 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
             print!("{}", schema_markdown());
             Ok(ExitCode::SUCCESS)
         }
+        Command::Slurm(args) => slurm(args),
     }
 }
 
@@ -311,6 +338,55 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
             Ok(s) => print!("{}", s.terminal),
             Err(e) => eprintln!("summary not written: {e:#}"),
         }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn slurm(args: SlurmArgs) -> Result<ExitCode> {
+    use crate::exec::slurm::{SlurmOptions, submit, write_scripts};
+    if args.tasks == 0 || args.cpus_per_task == 0 {
+        return Err(UsageError("--tasks and --cpus-per-task must be at least 1".into()).into());
+    }
+    let sf = SweepFile::load(&args.sweep)?;
+    let plan = sweep::expand(&sf)?;
+    let out = args
+        .out
+        .unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let out = out
+        .canonicalize()
+        .with_context(|| format!("{}", out.display()))?;
+    let exe = std::env::current_exe().context("locating the contact-sweep binary")?;
+    let scripts = write_scripts(
+        &exe,
+        &plan.sweep.name,
+        &plan.sweep.text,
+        &out,
+        &SlurmOptions {
+            tasks: args.tasks,
+            cpus_per_task: args.cpus_per_task,
+            time: args.time,
+            partition: args.partition,
+        },
+    )?;
+    eprint!("{}", plan.summary());
+    eprintln!(
+        "{} runs in {} array tasks ({} to {} runs each)",
+        plan.runs.len(),
+        args.tasks,
+        plan.runs.len() / args.tasks,
+        plan.runs.len().div_ceil(args.tasks)
+    );
+    if args.submit {
+        let (array, summary) = submit(&scripts)?;
+        println!("submitted array job {array} and summary job {summary} (afterok:{array})");
+        println!("results: {}", out.display());
+    } else {
+        println!("sbatch {}", scripts.array.display());
+        println!(
+            "sbatch --dependency=afterok:<array job id> {}",
+            scripts.summarize.display()
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

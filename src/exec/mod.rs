@@ -5,6 +5,8 @@
 //! Rows do not depend on the thread count: every run is a pure function of its spec, so the
 //! 1-thread and N-thread outputs are identical except the timing columns (tested).
 
+pub mod slurm;
+
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
