@@ -3,12 +3,11 @@
 
 mod common;
 
-use std::collections::HashSet;
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use common::{bin, cli, write};
+use common::{assert_complete, bin, cli, write};
 use contact_sweep::sink::{parquet_parts, read_runs, read_series};
 use polars::prelude::*;
 
@@ -186,36 +185,8 @@ fn sigkill_mid_sweep_then_resume_loses_nothing_and_duplicates_nothing() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("resuming"), "{err}");
-    let runs = read_runs(&out).unwrap();
-    assert_eq!(runs.height(), 240);
-    let ids: HashSet<String> = runs
-        .column("run_id")
-        .unwrap()
-        .str()
-        .unwrap()
-        .iter()
-        .flatten()
-        .map(String::from)
-        .collect();
-    assert_eq!(ids.len(), 240, "duplicate rows after resume");
-    // The series has exactly one copy of every (run, step).
-    let series = read_series(&out).unwrap();
-    let uniq = series
-        .select(["run_id", "step"])
-        .unwrap()
-        .unique_stable(None, UniqueKeepStrategy::First, None)
-        .unwrap();
-    assert_eq!(uniq.height(), series.height(), "duplicate series rows");
-    let sids: HashSet<String> = series
-        .column("run_id")
-        .unwrap()
-        .str()
-        .unwrap()
-        .iter()
-        .flatten()
-        .map(String::from)
-        .collect();
-    assert_eq!(sids, ids, "every run has its series, and no orphan series");
+    // Every run once, every (run, step) of the series once, no orphan series.
+    assert_complete(&out, 240);
     // A third invocation has nothing left to do.
     let o = cli(
         tmp.path(),
@@ -341,25 +312,7 @@ fn concurrent_shards_share_one_folder_without_losing_or_duplicating_rows() {
         let o = c.wait_with_output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     }
-    let runs = read_runs(&out).unwrap();
-    assert_eq!(runs.height(), 240);
-    let ids: HashSet<String> = runs
-        .column("run_id")
-        .unwrap()
-        .str()
-        .unwrap()
-        .iter()
-        .flatten()
-        .map(String::from)
-        .collect();
-    assert_eq!(ids.len(), 240, "duplicate rows across shards");
-    let series = read_series(&out).unwrap();
-    let uniq = series
-        .select(["run_id", "step"])
-        .unwrap()
-        .unique_stable(None, UniqueKeepStrategy::First, None)
-        .unwrap();
-    assert_eq!(uniq.height(), series.height());
+    assert_complete(&out, 240);
     // One manifest entry per shard, each closed.
     let manifest: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();

@@ -170,6 +170,21 @@ impl Key {
         }
     }
 
+    /// Scene physics (material, geometry, load), as opposed to discretisation and method keys.
+    pub fn is_physics(self) -> bool {
+        matches!(
+            self,
+            Key::Length
+                | Key::Young
+                | Key::Density
+                | Key::Amplitude
+                | Key::Gap
+                | Key::LameLambda
+                | Key::LameMu
+                | Key::Gravity
+        )
+    }
+
     pub fn from_name(name: &str) -> Option<Key> {
         Key::ALL.into_iter().find(|k| k.name() == name)
     }

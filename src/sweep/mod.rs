@@ -296,19 +296,9 @@ impl Checker {
     }
 }
 
-/// Whether `scene` accepts `key`.
+/// Whether `scene` accepts `key`: every discretisation and method key, and its own physics.
 pub fn accepted(scene: SceneKind, key: Key) -> bool {
-    let physics = [
-        Key::Length,
-        Key::Young,
-        Key::Density,
-        Key::Amplitude,
-        Key::Gap,
-        Key::LameLambda,
-        Key::LameMu,
-        Key::Gravity,
-    ];
-    !physics.contains(&key) || scene.physics_keys().contains(&key.name())
+    !key.is_physics() || scene.physics_keys().contains(&key.name())
 }
 
 fn suggest(name: &str) -> String {

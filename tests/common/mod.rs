@@ -82,3 +82,38 @@ pub fn assert_printed_within(what: &str, x: f64, printed: &str, units: f64) {
         "{what}: computed {x:.6e}, SPEC §6 prints {printed} (tolerance ±{half_ulp:e})"
     );
 }
+
+/// Assert that DIR holds exactly `n` runs, each once, and that the time series has one row per
+/// (run, step) and belongs to exactly those runs. Returns the run ids.
+pub fn assert_complete(dir: &Path, n: usize) -> std::collections::HashSet<String> {
+    use polars::prelude::UniqueKeepStrategy;
+    let ids_of = |df: &polars::prelude::DataFrame| -> std::collections::HashSet<String> {
+        df.column("run_id")
+            .unwrap()
+            .str()
+            .unwrap()
+            .iter()
+            .flatten()
+            .map(String::from)
+            .collect()
+    };
+    let runs = contact_sweep::sink::read_runs(dir).unwrap();
+    assert_eq!(runs.height(), n, "rows in {}", dir.display());
+    let ids = ids_of(&runs);
+    assert_eq!(ids.len(), n, "duplicate run rows in {}", dir.display());
+    let series = contact_sweep::sink::read_series(dir).unwrap();
+    let uniq = series
+        .select(["run_id", "step"])
+        .unwrap()
+        .unique_stable(None, UniqueKeepStrategy::First, None)
+        .unwrap();
+    assert_eq!(uniq.height(), series.height(), "duplicate series rows");
+    if series.height() > 0 {
+        assert_eq!(
+            ids_of(&series),
+            ids,
+            "series of other runs than the rows, or missing"
+        );
+    }
+    ids
+}
