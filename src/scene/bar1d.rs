@@ -149,45 +149,53 @@ impl BarExact {
     /// clamped end, value 0). Exact: elements are split at the kinks of u(·, t).
     pub fn error_sq(&self, nodal: &[f64], h: f64, t: f64) -> (f64, f64) {
         let l = self.p.length;
+        let inv_l = 1.0 / l;
         let (phase, f) = phase_of(self.scaled_time(t));
         let amp = 2.0 * self.p.amplitude;
-        let exact = |x: f64| amp * reference_at(x / l, phase, f).u;
+        let exact = |x: f64| amp * reference_at(x * inv_l, phase, f).u;
         let (k1, k2) = if f <= 0.5 {
             (f * l, (1.0 - f) * l)
         } else {
             ((1.0 - f) * l, f * l)
         };
+        let (h3, inv_h) = (h / 3.0, 1.0 / h);
         let m = nodal.len();
         let (mut l2, mut h1) = (0.0, 0.0);
+        // The exact field is continuous, so its values at the piece ends determine the affine
+        // error on each piece; ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3.
         // Exact value at the left node of the element, carried from the previous element.
-        let mut u_left = exact(0.0);
+        let mut el = nodal[0] - exact(0.0);
         for i in 0..m {
-            let (xa, xb) = (i as f64 * h, (i + 1) as f64 * h);
+            let xa = i as f64 * h;
+            let xb = (i + 1) as f64 * h;
             let ua = nodal[i];
             let ub = if i + 1 < m { nodal[i + 1] } else { 0.0 };
-            let slope = (ub - ua) / h;
-            // The exact field is continuous, so its values at the piece ends determine the affine
-            // error on each piece; ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3.
-            let mut xl = xa;
-            let mut el = ua - u_left;
-            let mut piece = |xr: f64, ur: f64, xl: &mut f64, el: &mut f64| {
-                let d = xr - *xl;
-                if d > 0.0 {
-                    let er = ua + slope * (xr - xa) - ur;
-                    l2 += d * (*el * *el + *el * er + er * er) / 3.0;
-                    let de = (er - *el) / d;
-                    h1 += d * de * de;
-                    *xl = xr;
-                    *el = er;
-                }
-            };
-            for k in [k1, k2] {
-                if k > xl && k < xb {
-                    piece(k, exact(k), &mut xl, &mut el);
+            let er_node = ub - exact(xb);
+            if !((k1 > xa && k1 < xb) || (k2 > xa && k2 < xb)) {
+                // No kink inside (all elements but at most two): one affine piece.
+                l2 += h3 * (el * el + el * er_node + er_node * er_node);
+                let de = er_node - el;
+                h1 += de * de * inv_h;
+            } else {
+                let slope = (ub - ua) * inv_h;
+                let (mut xl, mut e_l) = (xa, el);
+                for (xr, er) in [k1, k2]
+                    .into_iter()
+                    .filter(|k| *k > xa && *k < xb)
+                    .map(|k| (k, ua + slope * (k - xa) - exact(k)))
+                    .chain(std::iter::once((xb, er_node)))
+                {
+                    let d = xr - xl;
+                    if d > 0.0 {
+                        l2 += d * (e_l * e_l + e_l * er + er * er) / 3.0;
+                        let de = er - e_l;
+                        h1 += de * de / d;
+                        xl = xr;
+                        e_l = er;
+                    }
                 }
             }
-            u_left = exact(xb);
-            piece(xb, u_left, &mut xl, &mut el);
+            el = er_node;
         }
         (l2, h1)
     }

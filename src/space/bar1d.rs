@@ -198,13 +198,13 @@ impl Bar1dSpace {
     /// Σ K_ii u_i² + 2 Σ K_i,i+1 u_i u_{i+1} cancels terms of size E/h·u² down to O(1) and loses
     /// ~1e-12 relative accuracy, which energy-monotonicity checks at 1e-12 would see.
     pub fn strain_energy(&self, u: &[f64]) -> f64 {
-        let m = u.len();
-        let mut s = 0.0;
-        for k in 0..m {
-            let next = if k + 1 < m { u[k + 1] } else { 0.0 };
-            let d = next - u[k];
-            s += d * d;
-        }
+        // u_m = 0 (clamped): the last element's strain is −u_{m−1}/h.
+        let last = u[u.len() - 1];
+        let s: f64 = u
+            .windows(2)
+            .map(|w| (w[1] - w[0]) * (w[1] - w[0]))
+            .sum::<f64>()
+            + last * last;
         0.5 * self.bar.young / self.h * s
     }
 

@@ -86,30 +86,31 @@ impl Tridiag {
         }
     }
 
-    /// `out = A x`.
+    /// `out = A x`. The first and last rows are peeled so that the interior loop has no
+    /// branch (this product runs twice per step over every node).
     pub fn mul_into(&self, x: &[f64], out: &mut [f64]) {
         let n = self.len();
-        for i in 0..n {
-            let mut s = self.diag[i] * x[i];
-            if i > 0 {
-                s += self.lower[i - 1] * x[i - 1];
-            }
-            if i + 1 < n {
-                s += self.upper[i] * x[i + 1];
-            }
-            out[i] = s;
+        if n == 1 {
+            out[0] = self.diag[0] * x[0];
+            return;
         }
+        let (l, d, u) = (&self.lower[..n - 1], &self.diag[..n], &self.upper[..n - 1]);
+        let (x, out) = (&x[..n], &mut out[..n]);
+        out[0] = d[0] * x[0] + u[0] * x[1];
+        for i in 1..n - 1 {
+            out[i] = l[i - 1] * x[i - 1] + d[i] * x[i] + u[i] * x[i + 1];
+        }
+        out[n - 1] = l[n - 2] * x[n - 2] + d[n - 1] * x[n - 1];
     }
 
     /// xᵀ A x without a temporary.
     pub fn quad(&self, x: &[f64]) -> f64 {
         let n = self.len();
-        let mut s = 0.0;
-        for i in 0..n {
-            s += self.diag[i] * x[i] * x[i];
-            if i + 1 < n {
-                s += (self.upper[i] + self.lower[i]) * x[i] * x[i + 1];
-            }
+        let (l, d, u) = (&self.lower[..n - 1], &self.diag[..n], &self.upper[..n - 1]);
+        let x = &x[..n];
+        let mut s = d[n - 1] * x[n - 1] * x[n - 1];
+        for i in 0..n - 1 {
+            s += d[i] * x[i] * x[i] + (u[i] + l[i]) * x[i] * x[i + 1];
         }
         s
     }
@@ -135,7 +136,7 @@ impl Tridiag {
             if d == 0.0 || !d.is_finite() {
                 return None;
             }
-            piv[i] = d;
+            piv[i] = 1.0 / d;
             prev = d;
         }
         Some(TridiagLu {
@@ -196,6 +197,7 @@ impl Tridiag {
 #[derive(Debug, Clone)]
 pub struct TridiagLu {
     mult: Vec<f64>,
+    /// Inverse pivots (a multiplication per row instead of a division).
     piv: Vec<f64>,
     upper: Vec<f64>,
 }
@@ -204,15 +206,14 @@ impl TridiagLu {
     /// Overwrite `x` (the right-hand side) with the solution.
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let n = self.piv.len();
+        let x = &mut x[..n];
+        let (mult, piv, upper) = (&self.mult[..n - 1], &self.piv[..n], &self.upper[..n - 1]);
         for i in 1..n {
-            x[i] -= self.mult[i - 1] * x[i - 1];
+            x[i] -= mult[i - 1] * x[i - 1];
         }
-        for i in (0..n).rev() {
-            let mut s = x[i];
-            if i + 1 < n {
-                s -= self.upper[i] * x[i + 1];
-            }
-            x[i] = s / self.piv[i];
+        x[n - 1] *= piv[n - 1];
+        for i in (0..n - 1).rev() {
+            x[i] = (x[i] - upper[i] * x[i + 1]) * piv[i];
         }
     }
 }
