@@ -181,6 +181,33 @@ fn non_default_bar_scales_exactly_onto_the_default() {
             rates.push((l / m as f64, s.metrics.err_u_l2l2.unwrap()));
         }
     }
+    // The contact displacement itself against the closed form of the scaled bar over four
+    // impacts: max error 14.2 % of the amplitude at m = 20 and 5.4 % at m = 80 (the phase error
+    // of mod3 + CN accumulates over the periods), i.e. a rate of 0.70 like the L2 error. Bounds:
+    // below 6 % at m = 80, and a rate above 0.5.
+    let contact_err = |m: usize| {
+        let o = ok(bar1d(
+            p,
+            m,
+            (1.0 / m as f64) * p.length / c0,
+            12.0 * p.length / c0,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+            1,
+        ));
+        o.series
+            .iter()
+            .map(|r| (r.u_contact - r.u_contact_exact.unwrap()).abs())
+            .fold(0.0, f64::max)
+            / p.amplitude
+    };
+    let (coarse, fine) = (contact_err(20), contact_err(80));
+    let rate = (coarse / fine).ln() / 4f64.ln();
+    assert!(
+        fine < 0.06 && rate > 0.5,
+        "relative contact errors {coarse} → {fine} (rate {rate})"
+    );
     // …and so the scaled errors shrink at the default's rate: ≈ 0.7–0.9 in L2 (SPEC §6).
     let r = (rates[0].1 / rates[2].1).ln() / (rates[0].0 / rates[2].0).ln();
     assert!((0.6..1.1).contains(&r), "L2 rate {r}");
