@@ -4,7 +4,7 @@
     python3 analysis/plot_convergence.py DIR [--out FIGDIR] [--errors COL ...]
 
 For every sweep in DIR one figure (convergence_SWEEP.png/.pdf) with one panel
-per error column (default err_u_l2l2, err_u_l2h1, err_sigma_l2,
+per error column (default err_u_l2l2, err_u_l2h1, err_sigma_mid_l2,
 err_energy_l2) that has values. Each curve is a method group: the runs that
 share every parameter except h, elements, dt and courant (the refinement
 path). Only runs with status ok count. Every curve gets a slope triangle
@@ -35,7 +35,7 @@ from matplotlib.ticker import NullFormatter
 
 import sweepdata as sd
 
-DEFAULT_ERRORS = ["err_u_l2l2", "err_u_l2h1", "err_sigma_l2", "err_energy_l2"]
+DEFAULT_ERRORS = ["err_u_l2l2", "err_u_l2h1", "err_sigma_mid_l2", "err_energy_l2"]
 
 
 @dataclass
