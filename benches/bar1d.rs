@@ -78,6 +78,7 @@ fn steps(c: &mut Criterion) {
     let no_series = RunOptions {
         series_every: 0,
         timeout: None,
+        cancel: None,
     };
     for (name, cfg) in &cases {
         g.bench_function(*name, |b| b.iter(|| simulate(cfg, &no_series)));
@@ -91,6 +92,7 @@ fn steps(c: &mut Criterion) {
         let o = RunOptions {
             series_every: every,
             timeout: None,
+            cancel: None,
         };
         g.bench_function(name, |b| b.iter(|| simulate(cfg, &o)));
     }
@@ -122,6 +124,7 @@ mass = ["mod3"]
             run: RunOptions {
                 series_every: 0,
                 timeout: None,
+                cancel: None,
             },
         };
         g.bench_function(format!("threads-{threads}"), |b| {

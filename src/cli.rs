@@ -8,6 +8,7 @@ use std::collections::HashSet;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
@@ -127,6 +128,10 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
     1
 }
 
+/// Raised by SIGINT/SIGTERM (Ctrl-C, or Slurm at a time limit): the sweep stops starting runs,
+/// drops the ones in flight, commits every finished one and exits with status 130.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
 /// Validated `run` arguments.
 struct RunConfig {
     plan: Plan,
@@ -184,6 +189,7 @@ impl RunArgs {
                 run: RunOptions {
                     series_every,
                     timeout: self.run_timeout.map(Duration::from_secs_f64),
+                    cancel: Some(&INTERRUPTED),
                 },
             },
             plan,
@@ -295,6 +301,14 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     } else {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
+    // A second signal is left to the default action: the user can still kill a stuck process.
+    if let Err(e) = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    }) {
+        eprintln!("warning: no signal handler ({e}); an interrupt loses the batch in flight");
+    }
     let (mut failed, mut diverged) = (0usize, 0usize);
     let result = exec::execute(
         &plan.sweep.name,
@@ -316,9 +330,22 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     );
     let flushed = sink.flush();
     bar.finish_and_clear();
-    manifest.finish(dir, sink.written, result.is_err() || flushed.is_err())?;
+    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+    manifest.finish(
+        dir,
+        sink.written,
+        interrupted || result.is_err() || flushed.is_err(),
+    )?;
     result?;
     flushed?;
+    if interrupted {
+        eprintln!(
+            "interrupted: {} finished runs committed to {}; the runs in flight were dropped — run the same command to resume",
+            sink.written,
+            dir.display()
+        );
+        return Ok(ExitCode::from(130));
+    }
     eprintln!(
         "{} runs written to {} ({} failed, {} diverged)",
         sink.written,

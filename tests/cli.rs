@@ -349,3 +349,58 @@ fn bad_shard_specs_are_usage_errors() {
         assert!(String::from_utf8_lossy(&o.stderr).contains("--shard must be K/N"));
     }
 }
+
+#[test]
+fn sigterm_commits_every_finished_run_and_exits_130() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(tmp.path(), "long.toml", LONG);
+    let out = tmp.path().join("out");
+    // Large batches: without the handler, a signal would lose every uncommitted finished run.
+    let child = Command::new(bin())
+        .args([
+            "run",
+            sweep.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            "2",
+            "--batch",
+            "1000",
+            "--no-summary",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Let some runs finish (the first batch commits only after 2 s), then SIGTERM, as Slurm
+    // does at a time limit.
+    std::thread::sleep(Duration::from_millis(700));
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let t0 = Instant::now();
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        t0.elapsed() < Duration::from_secs(10),
+        "the interrupt took {:?}",
+        t0.elapsed()
+    );
+    assert!(err.contains("interrupted"), "{err}");
+    let saved = read_runs(&out).map(|df| df.height()).unwrap_or(0);
+    assert!(saved > 0 && saved < 240, "{saved} rows saved");
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["sessions"][0]["interrupted"], true);
+    assert_eq!(manifest["sessions"][0]["runs_written"], saved);
+    // Resume completes the sweep, with every row once.
+    let o = cli(
+        tmp.path(),
+        &["run", "long.toml", "--out", "out", "--no-summary"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_complete(&out, 240);
+}

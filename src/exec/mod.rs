@@ -96,15 +96,24 @@ pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
 
 /// Execute `runs`, calling `on_result` in this thread as each finishes (in plan order for the
 /// serial path, in completion order otherwise). Stops early if `on_result` returns an error.
+/// When `opts.run.cancel` is raised no run starts any more, and the runs it interrupted are
+/// dropped (they are redone on resume); every run finished before is still handed over.
 pub fn execute<E: Send>(
     sweep: &str,
     runs: &[&RunSpec],
     opts: &ExecOptions,
     mut on_result: impl FnMut(RunResult) -> Result<(), E>,
 ) -> Result<(), E> {
+    let keep = |r: &RunResult| r.record.status != Status::Cancelled.as_str();
     if opts.threads == 1 {
         for spec in runs {
-            on_result(run_one(sweep, spec, &opts.run))?;
+            if opts.run.cancelled() {
+                break;
+            }
+            let r = run_one(sweep, spec, &opts.run);
+            if keep(&r) {
+                on_result(r)?;
+            }
         }
         return Ok(());
     }
@@ -120,9 +129,13 @@ pub fn execute<E: Send>(
         scope.spawn(move || {
             pool.install(|| {
                 runs.par_iter().for_each_with(tx, |tx, spec| {
-                    // The consumer failed (e.g. the disk is full): start nothing new.
-                    if !cancel.load(Ordering::Relaxed) {
-                        let _ = tx.send(run_one(sweep, spec, &run_opts));
+                    // The consumer failed (e.g. the disk is full) or the sweep was interrupted:
+                    // start nothing new.
+                    if !cancel.load(Ordering::Relaxed) && !run_opts.cancelled() {
+                        let r = run_one(sweep, spec, &run_opts);
+                        if keep(&r) {
+                            let _ = tx.send(r);
+                        }
                     }
                 });
             });

@@ -70,6 +70,7 @@ enum Stop {
     Solver(usize, ContactSolveError),
     Diverged(Divergence),
     Timeout(usize),
+    Cancelled,
 }
 
 /// The per-run constant part: operators, factorisations, condensed contact.
@@ -520,8 +521,18 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
             );
         }
     };
-    let timed_out = |n: usize| {
-        n.is_multiple_of(CLOCK_EVERY) && opts.timeout.is_some_and(|limit| start.elapsed() > limit)
+    // Checked every CLOCK_EVERY steps: the time budget and an interruption of the sweep.
+    let interrupted = |n: usize| -> Result<(), Stop> {
+        if !n.is_multiple_of(CLOCK_EVERY) {
+            return Ok(());
+        }
+        if opts.cancelled() {
+            return Err(Stop::Cancelled);
+        }
+        if opts.timeout.is_some_and(|limit| start.elapsed() > limit) {
+            return Err(Stop::Timeout(n));
+        }
+        Ok(())
     };
     let mut done = 0usize;
     let stop = (|| -> Result<(), Stop> {
@@ -535,9 +546,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     let sigma = eng.sigma(&st.u, phi);
                     rec.record(n, &st.u, &st.v, sigma).map_err(Stop::Diverged)?;
                     done = n;
-                    if timed_out(n) {
-                        return Err(Stop::Timeout(n));
-                    }
+                    interrupted(n)?;
                 }
             }
             Some(first) => {
@@ -579,9 +588,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     done = n;
                     std::mem::swap(&mut prev, &mut st.u);
                     std::mem::swap(&mut st.u, &mut wk.y);
-                    if timed_out(n) {
-                        return Err(Stop::Timeout(n));
-                    }
+                    interrupted(n)?;
                 }
             }
         }
@@ -598,6 +605,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
             )
         }
         Err(Stop::Diverged(d)) => (Status::Diverged, Some(d.0)),
+        Err(Stop::Cancelled) => (Status::Cancelled, Some("interrupted".into())),
         Err(Stop::Timeout(n)) => (
             Status::Timeout,
             Some(format!(

@@ -10,6 +10,7 @@ pub mod bar1d;
 pub mod observe;
 pub mod record;
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 pub use observe::{Metrics, SeriesRow};
@@ -23,6 +24,9 @@ pub enum Status {
     SolverFailed,
     Invalid,
     Timeout,
+    /// Interrupted (Ctrl-C, or the scheduler's SIGTERM): never written — the run is redone when
+    /// the sweep resumes.
+    Cancelled,
 }
 
 impl Status {
@@ -33,6 +37,7 @@ impl Status {
             Status::SolverFailed => "solver-failed",
             Status::Invalid => "invalid",
             Status::Timeout => "timeout",
+            Status::Cancelled => "cancelled",
         }
     }
 }
@@ -44,6 +49,8 @@ pub struct RunOptions {
     /// kept when k > 0.
     pub series_every: usize,
     pub timeout: Option<Duration>,
+    /// Set by a signal handler: runs in flight stop at their next clock check.
+    pub cancel: Option<&'static AtomicBool>,
 }
 
 impl Default for RunOptions {
@@ -51,7 +58,15 @@ impl Default for RunOptions {
         Self {
             series_every: 1,
             timeout: None,
+            cancel: None,
         }
+    }
+}
+
+impl RunOptions {
+    /// Whether the sweep was interrupted.
+    pub fn cancelled(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
     }
 }
 

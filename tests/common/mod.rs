@@ -47,6 +47,7 @@ pub fn bar1d(
         &RunOptions {
             series_every,
             timeout: None,
+            cancel: None,
         },
     )
 }
