@@ -491,15 +491,20 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
             .map(|s| s.map(String::from))
             .collect())
     };
-    let get_f64 =
-        |name: &str| -> Result<Vec<Option<f64>>> { Ok(df.column(name)?.f64()?.iter().collect()) };
+    // A column absent from every part (written by an older version) prints as "—".
+    let get_f64 = |name: &str| -> Result<Vec<Option<f64>>> {
+        match df.column(name) {
+            Ok(c) => Ok(c.f64()?.iter().collect()),
+            Err(_) => Ok(vec![None; df.height()]),
+        }
+    };
     let run_ids = get_str("run_id")?;
     let status = get_str("status")?;
     let (e0, ef) = (get_f64("energy_initial")?, get_f64("energy_final")?);
     let (l2, h1, sig) = (
         get_f64("err_u_l2l2")?,
         get_f64("err_u_l2h1")?,
-        get_f64("err_sigma_l2")?,
+        get_f64("err_sigma_mid_l2")?,
     );
     let header: Vec<String> = [
         "#",
@@ -510,7 +515,7 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
         "E(T)/E0",
         "l2(τ;L2)",
         "l2(τ;H1)",
-        "σ l2(τ)",
+        "σ½ l2(τ)",
     ]
     .iter()
     .map(|s| s.to_string())
