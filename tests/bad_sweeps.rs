@@ -134,9 +134,9 @@ const CASES: &[(&str, &str, &str)] = &[
         "needs nitsche_gamma0",
     ),
     (
-        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nh = [0.1, 0.2]\n",
-        "grid.h[0]",
-        "from one place only",
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\ndt = 0.1\n[zip]\nh = [0.1, 0.2]\n[grid]\nh = [0.1, 0.2]\n",
+        "zip.h[0]",
+        "two axes may not set one parameter",
     ),
     (
         "name = \"x\"\nscene = \"bar1d\"\nreference = { h = 0.01 }\n[fixed]\nh = 0.1\ndt = 0.1\n",

@@ -194,3 +194,28 @@ fn ensembles_expand_into_distinct_members() {
     assert_eq!(v.len(), 4);
     assert_eq!(p.runs[3].sample, Some((3, 1e-14)));
 }
+
+#[test]
+fn an_axis_overrides_a_fixed_value() {
+    // SPEC §7's own example sets h and dt in [fixed] and again in [zip]: [fixed] is a baseline.
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\nmass = \"mod3\"\n[grid]\nmass = [\"mod1\", \"mod2\"]\n[zip]\nh = [0.25, 0.125]\ndt = [0.25, 0.125]\n"
+    ));
+    assert_eq!(p.runs.len(), 4);
+    assert!(p.runs.iter().all(|r| num_of(r, Key::H) >= 0.125));
+    assert!(
+        p.runs
+            .iter()
+            .all(|r| r.params[&Key::Mass] != Value::Str("mod3".into()))
+    );
+    let s = p.summary();
+    assert!(
+        s.contains("fixed.h is overridden by [zip]")
+            && s.contains("fixed.mass is overridden by [grid] mass"),
+        "{s}"
+    );
+}
+
+fn num_of(r: &contact_sweep::sweep::RunSpec, k: Key) -> f64 {
+    r.params[&k].as_f64().unwrap()
+}

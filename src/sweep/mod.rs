@@ -115,6 +115,8 @@ pub struct SweepFile {
     pub ensemble: Option<Ensemble>,
     /// Keep every k-th step in DIR/series (0: no time series).
     pub series_every: usize,
+    /// `[fixed]` values that an axis overrides (reported by the plan).
+    pub overridden: Vec<String>,
 }
 
 const TOP_KEYS: [&str; 11] = [
@@ -620,30 +622,36 @@ impl SweepFile {
                 "scene bar1d has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
             );
         }
-        // A parameter may come from one place only: [fixed], one grid axis, or [zip].
+        // [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
+        // in both [fixed] and [zip]); two axes setting one parameter would be ambiguous.
         let mut sources: Vec<(Key, Origin, String)> = Vec::new();
-        let mut note = |key: Key, origin: &Origin, source: String, ck: &mut Checker| {
-            if let Some((_, o, _)) = sources.iter().find(|(k, _, s)| *k == key && *s != source) {
-                ck.issues.push(Issue::at(
-                    origin,
-                    format!(
-                        "`{}` is also set by {} (line {}): a parameter may come from one place only",
-                        key.name(),
-                        o.path,
-                        o.line.unwrap_or(0)
-                    ),
-                ));
-            } else if !sources.iter().any(|(k, _, s)| *k == key && *s == source) {
-                sources.push((key, origin.clone(), source));
-            }
-        };
-        for e in &fixed {
-            note(e.key, &e.origin, "fixed".into(), &mut ck);
-        }
-        for ax in grid.iter().chain(zip.iter()) {
-            for item in &ax.items {
-                for e in item {
-                    note(e.key, &e.origin, format!("axis {}", ax.name), &mut ck);
+        let mut overridden: Vec<String> = Vec::new();
+        let axes = grid
+            .iter()
+            .map(|a| (a, format!("[grid] {}", a.name)))
+            .chain(zip.iter().map(|a| (a, "[zip]".to_string())));
+        for (ax, source) in axes {
+            for e in ax.items.iter().flatten() {
+                if let Some((_, o, _)) =
+                    sources.iter().find(|(k, _, s)| *k == e.key && *s != source)
+                {
+                    ck.issues.push(Issue::at(
+                        &e.origin,
+                        format!(
+                            "`{}` is also set by {} (line {}): two axes may not set one parameter",
+                            e.key.name(),
+                            o.path,
+                            o.line.unwrap_or(0)
+                        ),
+                    ));
+                } else if !sources.iter().any(|(k, _, s)| *k == e.key && *s == source) {
+                    sources.push((e.key, e.origin.clone(), source.clone()));
+                }
+                if let Some(f) = fixed.iter().find(|f| f.key == e.key) {
+                    let note = format!("{} is overridden by {}", f.origin.path, source);
+                    if !overridden.contains(&note) {
+                        overridden.push(note);
+                    }
                 }
             }
         }
@@ -661,6 +669,7 @@ impl SweepFile {
                 repeats,
                 ensemble,
                 series_every,
+                overridden,
             })
         } else {
             let mut issues = ck.issues;

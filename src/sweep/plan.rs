@@ -667,6 +667,9 @@ impl Plan {
             s.push_str(" (ensemble members included)");
         }
         s.push('\n');
+        for note in &self.sweep.overridden {
+            let _ = writeln!(s, "  {note}");
+        }
         if self.excluded_by_filter > 0 {
             let _ = writeln!(
                 s,
