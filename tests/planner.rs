@@ -219,3 +219,15 @@ fn an_axis_overrides_a_fixed_value() {
 fn num_of(r: &contact_sweep::sweep::RunSpec, k: Key) -> f64 {
     r.params[&k].as_f64().unwrap()
 }
+
+#[test]
+fn the_example_of_spec_section_7_is_accepted_verbatim() {
+    let spec = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/SPEC.md"))
+        .expect("../shared/SPEC.md beside the checkout");
+    let start = spec.find("```toml\n").expect("a toml block") + "```toml\n".len();
+    let end = start + spec[start..].find("```").unwrap();
+    let p = plan(&spec[start..end]);
+    // 5 schemes (two explicit Newmark bundles, backward Euler, CN, hybrid) × 3 zipped levels.
+    assert_eq!(p.runs.len(), 15);
+    assert_eq!(p.sweep.name, "nitsche-energy");
+}
