@@ -429,23 +429,35 @@ fn fmt_num(x: Option<f64>) -> String {
 /// The plan as a table of the parameters that vary between runs.
 fn plan_table(plan: &Plan) -> String {
     let keys = plan.varying_keys();
-    let mut header: Vec<String> = vec!["#".into(), "run_id".into()];
+    let mut header: Vec<String> = vec!["#".into(), "run_id".into(), "label".into()];
     header.extend(keys.iter().map(|k| k.name().to_string()));
-    let rows: Vec<Vec<String>> = plan
+    // steps × unknowns: what a run costs, to see where the time of a sweep goes before running it
+    header.push("work".into());
+    let mut total = 0u64;
+    let mut rows: Vec<Vec<String>> = plan
         .runs
         .iter()
         .enumerate()
         .map(|(i, r)| {
-            let mut row = vec![i.to_string(), r.run_id.clone()];
+            let mut row = vec![i.to_string(), r.run_id.clone(), r.label.clone()];
             row.extend(keys.iter().map(|k| {
                 r.params
                     .get(k)
                     .map(|v| v.to_string())
                     .unwrap_or_else(|| "—".into())
             }));
+            let work = match &r.config {
+                crate::run::RunConfig::Bar1d(c) => (c.steps * c.elements) as u64,
+            } * r.repeats as u64;
+            total += work;
+            row.push(format!("{work:.2e}", work = work as f64));
             row
         })
         .collect();
+    let mut last = vec![String::new(); header.len()];
+    last[2] = "total".into();
+    *last.last_mut().expect("a column") = format!("{:.2e}", total as f64);
+    rows.push(last);
     render(&header, &rows)
 }
 
