@@ -404,3 +404,33 @@ fn sigterm_commits_every_finished_run_and_exits_130() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_complete(&out, 240);
 }
+
+#[test]
+fn plan_prints_counts_reasons_and_the_varying_parameters() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"p\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nT = 1.0\n[grid]\nspace = [\"mixed\", \"nitsche\"]\nnitsche_gamma0 = [1e-6, 0.1]\n",
+    );
+    let o = cli(tmp.path(), &["plan", "s.toml"]);
+    assert!(o.status.success());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("4 combinations → 3 runs"), "{out}");
+    assert!(
+        out.contains(
+            "1 collapsed into identical runs: nitsche_gamma0 applies to space = nitsche only"
+        ),
+        "{out}"
+    );
+    // the varying parameters are columns; the work column totals 3 runs × 10 steps × 10 nodes
+    assert!(
+        out.contains("nitsche_gamma0") && out.contains("space"),
+        "{out}"
+    );
+    assert!(
+        out.lines().last().unwrap().trim_end().ends_with("3.00e2"),
+        "{out}"
+    );
+    assert!(!tmp.path().join("out").exists(), "plan writes nothing");
+}
