@@ -11,8 +11,9 @@
 //! - [`run`] — one run: setup (factorisations once), the allocation-free time loop,
 //!   observables (energies, exact error norms), and the output schema ([`run::RunRecord`]).
 //! - [`sweep`] — sweep files: parsing with line numbers, validation, expansion, run ids.
-//! - [`exec`] — serial (reference) and rayon execution; failures become rows.
-//! - [`sink`] — atomic Parquet parts, resume, manifest.
+//! - [`exec`] — serial (reference) and rayon execution; failures become rows; Slurm job arrays
+//!   of shards ([`exec::slurm`]).
+//! - [`sink`] — atomic Parquet parts, resume, manifest, several shards writing one folder.
 //! - [`summary`] — convergence rates, energy drift and speed-against-error tables.
 //! - [`cli`] — command-line flags and their validation into the types above.
 
