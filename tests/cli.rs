@@ -131,27 +131,29 @@ method = [
 amplitude = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4, 1.5, 1.6, 1.7, 1.8, 1.9, 2.0]
 "#;
 
-#[test]
-fn sigkill_mid_sweep_then_resume_loses_nothing_and_duplicates_nothing() {
-    let tmp = tempfile::tempdir().unwrap();
-    let sweep = write(tmp.path(), "long.toml", LONG);
-    let out = tmp.path().join("out");
-    let mut child = Command::new(bin())
+/// Start `contact-sweep run` on the LONG sweep in the background (stderr piped).
+fn spawn_long(sweep: &Path, out: &Path, extra: &[&str]) -> std::process::Child {
+    Command::new(bin())
         .args([
             "run",
             sweep.to_str().unwrap(),
             "--out",
             out.to_str().unwrap(),
-            "--threads",
-            "2",
-            "--batch",
-            "1",
             "--no-summary",
         ])
+        .args(extra)
         .stdout(Stdio::null())
-        .stderr(Stdio::null())
+        .stderr(Stdio::piped())
         .spawn()
-        .unwrap();
+        .unwrap()
+}
+
+#[test]
+fn sigkill_mid_sweep_then_resume_loses_nothing_and_duplicates_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(tmp.path(), "long.toml", LONG);
+    let out = tmp.path().join("out");
+    let mut child = spawn_long(&sweep, &out, &["--threads", "2", "--batch", "1"]);
     // Wait until a few batches are committed, then kill without warning.
     let start = Instant::now();
     loop {
@@ -289,23 +291,18 @@ fn concurrent_shards_share_one_folder_without_losing_or_duplicating_rows() {
     // shards' commits interleave.
     let children: Vec<_> = (0..3)
         .map(|k| {
-            Command::new(bin())
-                .args([
-                    "run",
-                    sweep.to_str().unwrap(),
-                    "--out",
-                    out.to_str().unwrap(),
+            spawn_long(
+                &sweep,
+                &out,
+                &[
                     "--threads",
                     "1",
                     "--batch",
                     "1",
                     "--shard",
                     &format!("{k}/3"),
-                ])
-                .stdout(Stdio::null())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap()
+                ],
+            )
         })
         .collect();
     for c in children {
@@ -356,22 +353,7 @@ fn sigterm_commits_every_finished_run_and_exits_130() {
     let sweep = write(tmp.path(), "long.toml", LONG);
     let out = tmp.path().join("out");
     // Large batches: without the handler, a signal would lose every uncommitted finished run.
-    let child = Command::new(bin())
-        .args([
-            "run",
-            sweep.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--threads",
-            "2",
-            "--batch",
-            "1000",
-            "--no-summary",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_long(&sweep, &out, &["--threads", "2", "--batch", "1000"]);
     // Let some runs finish (the first batch commits only after 2 s), then SIGTERM, as Slurm
     // does at a time limit.
     std::thread::sleep(Duration::from_millis(700));
