@@ -130,7 +130,7 @@ mass = ["mod3"]
         g.bench_function(format!("threads-{threads}"), |b| {
             b.iter(|| {
                 let mut n = 0;
-                exec::execute::<()>("bench", &runs, &opts, |_| {
+                exec::execute::<()>("bench", &runs, &Default::default(), &opts, |_| {
                     n += 1;
                     Ok(())
                 })

@@ -106,6 +106,10 @@ pub struct RunArgs {
     /// $SLURM_ARRAY_TASK_ID/8` in a job array; all shards may write into one --out folder.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
+    /// Compute the sweep's reference runs into DIR/references and stop (the first job of a
+    /// Slurm submission; the array depends on it).
+    #[arg(long)]
+    pub references_only: bool,
 }
 
 /// Bad input detected by the CLI itself.
@@ -141,6 +145,7 @@ struct RunConfig {
     resume: bool,
     batch: BatchPolicy,
     summary: bool,
+    references_only: bool,
 }
 
 impl RunArgs {
@@ -200,6 +205,7 @@ impl RunArgs {
                 seconds: 2.0,
             },
             summary: !self.no_summary,
+            references_only: self.references_only,
         })
     }
 }
@@ -246,6 +252,16 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
             expected: plan.sweep.name.clone(),
         }
         .into());
+    }
+    if cfg.references_only {
+        let all: Vec<&sweep::RunSpec> = plan.runs.iter().collect();
+        let refs = exec::references::ensure(dir, plan, &all, &cfg.exec.run)?;
+        eprintln!(
+            "{} reference run(s) ready in {}",
+            refs.len(),
+            dir.join("references").display()
+        );
+        return Ok(ExitCode::SUCCESS);
     }
     let (mut sink, done) = Sink::open(dir, cfg.batch)?;
     // Round-robin shards: neighbouring plan entries (levels of one ladder) have similar costs,
@@ -310,9 +326,11 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         eprintln!("warning: no signal handler ({e}); an interrupt loses the batch in flight");
     }
     let (mut failed, mut diverged) = (0usize, 0usize);
+    let refs = exec::references::ensure(dir, plan, &todo, &cfg.exec.run)?;
     let result = exec::execute(
         &plan.sweep.name,
         &todo,
+        &refs,
         &ExecOptions {
             threads,
             ..cfg.exec
@@ -388,6 +406,7 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
         &exe,
         &plan.sweep.name,
         &plan.sweep.text,
+        !plan.references.is_empty(),
         &out,
         &SlurmOptions {
             tasks: args.tasks,
@@ -405,10 +424,17 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
         plan.runs.len().div_ceil(args.tasks)
     );
     if args.submit {
-        let (array, summary) = submit(&scripts)?;
+        let (references, array, summary) = submit(&scripts)?;
+        if let Some(r) = references {
+            println!("submitted reference job {r}; the array depends on it (afterok:{r})");
+        }
         println!("submitted array job {array} and summary job {summary} (afterok:{array})");
         println!("results: {}", out.display());
     } else {
+        if let Some(r) = &scripts.references {
+            println!("sbatch {}", r.display());
+            println!("(then the array with --dependency=afterok:<reference job id>)");
+        }
         println!("sbatch {}", scripts.array.display());
         println!(
             "sbatch --dependency=afterok:<array job id> {}",
@@ -446,9 +472,7 @@ fn plan_table(plan: &Plan) -> String {
                     .map(|v| v.to_string())
                     .unwrap_or_else(|| "—".into())
             }));
-            let work = match &r.config {
-                crate::run::RunConfig::Bar1d(c) => (c.steps * c.elements) as u64,
-            } * r.repeats as u64;
+            let work = r.config.work() * r.repeats as u64;
             total += work;
             row.push(format!("{work:.2e}", work = work as f64));
             row

@@ -2,17 +2,24 @@
 //!
 //! The modules form a pipeline and depend on each other in this order only:
 //!
-//! - [`scene`] — the physical problems (the 1D bar with its closed form, …).
+//! - [`scene`] — the physical problems behind one trait ([`scene::Scene`]): the 1D bar with its
+//!   closed form, the 2D/3D bars dropped on an obstacle; each declares its keys, defaults,
+//!   applicability and error source, and hands the engines a setup.
 //! - [`space`] — meshes, mass variants, stiffness, and how each contact method enters the
-//!   semi-discrete system (its operators and contact direction vectors).
+//!   semi-discrete system; `space::fe` (Q1 elements, sparse assembly with the pattern built
+//!   once) and `space::linalg` (faer's sparse Cholesky: symbolic once, numeric per matrix).
 //! - [`time`] — the time schemes as data with named presets.
 //! - [`contact`] — the condensed contact solve: one scalar piecewise-linear equation per step,
-//!   solved exactly by branch enumeration.
-//! - [`run`] — one run: setup (factorisations once), the allocation-free time loop,
-//!   observables (energies, exact error norms), and the output schema ([`run::RunRecord`]).
+//!   solved exactly by branch enumeration (1D); a small dense LCP on the contact dofs solved
+//!   exactly by an active-set method (2D/3D).
+//! - [`run`] — one run: setup (factorisations once, shared between runs with the same matrix),
+//!   the allocation-free time loop of the tridiagonal and the sparse engine, observables
+//!   (energies, error norms against the closed form or a reference run), and the output schema
+//!   ([`run::RunRecord`]).
 //! - [`sweep`] — sweep files: parsing with line numbers, validation, expansion, run ids.
-//! - [`exec`] — serial (reference) and rayon execution; failures become rows; Slurm job arrays
-//!   of shards ([`exec::slurm`]).
+//! - [`exec`] — serial (reference) and rayon execution; failures become rows; reference runs
+//!   computed once per output folder ([`exec::references`]); Slurm job arrays of shards
+//!   ([`exec::slurm`]).
 //! - [`sink`] — atomic Parquet parts, resume, manifest, several shards writing one folder.
 //! - [`summary`] — convergence rates, energy drift and speed-against-error tables.
 //! - [`cli`] — command-line flags and their validation into the types above.

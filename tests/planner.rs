@@ -231,3 +231,98 @@ fn the_example_of_spec_section_7_is_accepted_verbatim() {
     assert_eq!(p.runs.len(), 15);
     assert_eq!(p.sweep.name, "nitsche-energy");
 }
+
+fn plan_err(text: &str) -> String {
+    let sf = match SweepFile::parse(Path::new("test.toml"), text) {
+        Ok(sf) => sf,
+        Err(e) => return e.to_string(),
+    };
+    match sweep::expand(&sf) {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e.to_string(),
+    }
+}
+
+const BAR2D: &str = "name = \"b\"\nscene = \"bar2d\"\n";
+
+#[test]
+fn bar2d_runs_share_one_reference_stored_on_the_coarsest_common_lattice() {
+    let p = plan(&format!(
+        "{BAR2D}reference = {{ h = 0.0015625, dt = 0.00078125, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n\
+         [zip]\nh = [0.05, 0.025, 0.0125]\ndt = [0.025, 0.0125, 0.00625]\n[grid]\nmass = [\"consistent\", \"mod1\"]\nscheme = [\"crank-nicolson\", \"backward-euler\"]\n"
+    ));
+    assert_eq!(p.runs.len(), 12);
+    // One reference whatever the run's mass and scheme: the reference's keys override them.
+    assert_eq!(p.references.len(), 1);
+    let r = &p.references[0];
+    // Ratios 32, 16, 8 in space and time: everything the runs need is every 8th node and step.
+    assert_eq!((r.space_stride, r.time_stride), (8, 8));
+    assert!(
+        p.runs
+            .iter()
+            .all(|x| x.reference.as_deref() == Some(r.spec.run_id.as_str()))
+    );
+    // Defaults of bar2d (SPEC §1.2) fill the columns; elements counts the height (1/h).
+    assert_eq!(num(&p, 0, Key::T), 2.0);
+    assert_eq!(num(&p, 0, Key::Gap), 0.2);
+    assert_eq!(num(&p, 0, Key::LameMu), 0.5);
+    assert_eq!(p.runs[0].params[&Key::Elements], Value::Int(20));
+    // courant = c_p τ / h with c_p = √((λ+2μ)/ρ) = √1.25.
+    assert!((num(&p, 0, Key::Courant) - 0.5 * 1.25f64.sqrt()).abs() < 1e-12);
+    // The reference is part of a run's identity: another reference, another id.
+    let q = plan(&format!(
+        "{BAR2D}reference = {{ h = 0.003125, dt = 0.0015625, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n\
+         [zip]\nh = [0.05, 0.025, 0.0125]\ndt = [0.025, 0.0125, 0.00625]\n[grid]\nmass = [\"consistent\", \"mod1\"]\nscheme = [\"crank-nicolson\", \"backward-euler\"]\n"
+    ));
+    assert_ne!(ids(&p), ids(&q));
+}
+
+#[test]
+fn bar2d_refuses_what_it_cannot_model_with_the_key_and_reason() {
+    let base = "[fixed]\nh = 0.05\ndt = 0.025\n";
+    let e = plan_err(&format!(
+        "{BAR2D}reference = {{ h = 0.02, dt = 0.0125 }}\n{base}"
+    ));
+    assert!(
+        e.contains("test.toml") && e.contains("key `reference.h`"),
+        "{e}"
+    );
+    let e = plan_err(&format!(
+        "{BAR2D}reference = {{ h = 0.00625, dt = 0.01 }}\n{base}"
+    ));
+    assert!(
+        e.contains("key `reference.dt`") && e.contains("whole number"),
+        "{e}"
+    );
+    let e = plan_err(&format!(
+        "{BAR2D}{base}space = \"nitsche\"\nnitsche_gamma0 = 1e-3\n"
+    ));
+    assert!(
+        e.contains("key `fixed.space`") && e.contains("bar2d"),
+        "{e}"
+    );
+    let e = plan_err(&format!("{BAR2D}{base}mass = \"singular-dynamic\"\n"));
+    assert!(
+        e.contains("key `fixed.mass`") && e.contains("1D bar only"),
+        "{e}"
+    );
+    let e = plan_err(&format!("{BAR2D}[fixed]\nh = 0.03\ndt = 0.01\n"));
+    assert!(e.contains("key `fixed.h`") && e.contains("width"), "{e}");
+    let e = plan_err(&format!("{BAR2D}{base}amplitude = 0.5\n"));
+    assert!(e.contains("not a parameter of scene bar2d"), "{e}");
+    let e = plan_err(&format!(
+        "{BAR2D}{base}scheme = \"central-difference\"\nmass = \"mod1\"\n"
+    ));
+    assert!(
+        e.contains("key `fixed.scheme`") && e.contains("explicit"),
+        "{e}"
+    );
+    // bar1d has a closed form: a reference is refused there.
+    let e = plan_err(&format!(
+        "{HEAD}reference = {{ h = 0.01 }}\n[fixed]\nh = 0.1\ndt = 0.1\n"
+    ));
+    assert!(
+        e.contains("key `reference`") && e.contains("closed-form"),
+        "{e}"
+    );
+}

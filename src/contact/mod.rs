@@ -11,6 +11,13 @@
 //! linear branches — no Newton iteration, no tolerance. The count of solutions is itself the
 //! well-posedness condition of 003 §2.2.3: none or several (a branch on which 1 − w·slope ≤ 0)
 //! is reported, never silently resolved.
+//!
+//! The finite-element scenes condense onto several contact dofs: [`lcp`] solves the resulting
+//! small dense complementarity problem exactly by an active-set method.
+
+pub mod lcp;
+
+pub use lcp::{Lcp, LcpError};
 
 /// A contact law φ(s) on the scalar contact argument.
 #[derive(Debug, Clone, Copy, PartialEq)]

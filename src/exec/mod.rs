@@ -5,6 +5,7 @@
 //! Rows do not depend on the thread count: every run is a pure function of its spec, so the
 //! 1-thread and N-thread outputs are identical except the timing columns (tested).
 
+pub mod references;
 pub mod slurm;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -15,7 +16,11 @@ use std::time::Instant;
 use rayon::prelude::*;
 
 use crate::run::record::Timing;
-use crate::run::{self, Metrics, Outcome, RunOptions, RunRecord, SeriesRow, Status};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::run::reference::ReferenceData;
+use crate::run::{self, Metrics, Outcome, RunContext, RunOptions, RunRecord, SeriesRow, Status};
 use crate::sweep::RunSpec;
 
 /// A finished run: its row and its (possibly decimated) time series.
@@ -47,12 +52,20 @@ fn guarded(f: impl FnOnce() -> Outcome) -> Outcome {
             message: Some(format!("internal error (panic): {what}")),
             metrics: Metrics::default(),
             series: Vec::new(),
+            reference: None,
         }
     })
 }
 
+/// The reference solutions of a sweep's runs, by reference run_id.
+pub type References = HashMap<String, Arc<ReferenceData>>;
+
 /// Run one spec (with its timing repeats), never panicking.
-pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
+pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions, refs: &References) -> RunResult {
+    let ctx = RunContext {
+        reference: spec.reference.as_ref().and_then(|id| refs.get(id).cloned()),
+        record_reference: None,
+    };
     let mut times = Vec::with_capacity(spec.repeats.max(1));
     let mut outcome: Option<Outcome> = None;
     for rep in 0..spec.repeats.max(1) {
@@ -62,7 +75,7 @@ pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
             ..*opts
         };
         let start = Instant::now();
-        let out = guarded(|| run::simulate(&spec.config, &o));
+        let out = guarded(|| run::simulate_with(&spec.config, &o, &ctx));
         times.push(start.elapsed().as_secs_f64());
         let stop = out.status != Status::Ok;
         if outcome.is_none() {
@@ -101,6 +114,7 @@ pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions) -> RunResult {
 pub fn execute<E: Send>(
     sweep: &str,
     runs: &[&RunSpec],
+    refs: &References,
     opts: &ExecOptions,
     mut on_result: impl FnMut(RunResult) -> Result<(), E>,
 ) -> Result<(), E> {
@@ -110,7 +124,7 @@ pub fn execute<E: Send>(
             if opts.run.cancelled() {
                 break;
             }
-            let r = run_one(sweep, spec, &opts.run);
+            let r = run_one(sweep, spec, &opts.run, refs);
             if keep(&r) {
                 on_result(r)?;
             }
@@ -132,7 +146,7 @@ pub fn execute<E: Send>(
                     // The consumer failed (e.g. the disk is full) or the sweep was interrupted:
                     // start nothing new.
                     if !cancel.load(Ordering::Relaxed) && !run_opts.cancelled() {
-                        let r = run_one(sweep, spec, &run_opts);
+                        let r = run_one(sweep, spec, &run_opts, refs);
                         if keep(&r) {
                             let _ = tx.send(r);
                         }

@@ -6,9 +6,12 @@
 //! - `array.sh`: a job array of N tasks, task K running `run --shard K/N --no-summary` into DIR
 //!   (shards share the folder safely: see [`crate::sink`]); a task that is requeued or rerun
 //!   resumes, skipping the run_ids already committed;
-//! - `summarize.sh`: `summarize DIR`, to run after the array (`--dependency=afterok`).
+//! - `summarize.sh`: `summarize DIR`, to run after the array (`--dependency=afterok`);
+//! - `references.sh`, when the sweep has reference runs (SPEC §1.2): `run --references-only`,
+//!   one job computing each reference once; the array depends on it (`afterok`), so no task
+//!   computes a reference and every task reads the stored ones.
 //!
-//! With `--submit` both are passed to `sbatch` and the job ids are printed.
+//! With `--submit` they are passed to `sbatch` in that order and the job ids are printed.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -28,6 +31,7 @@ pub struct SlurmOptions {
 pub struct SlurmScripts {
     pub array: PathBuf,
     pub summarize: PathBuf,
+    pub references: Option<PathBuf>,
 }
 
 /// Failures of writing or submitting the scripts.
@@ -52,6 +56,7 @@ pub fn write_scripts(
     exe: &Path,
     name: &str,
     sweep_text: &str,
+    with_references: bool,
     dir: &Path,
     opts: &SlurmOptions,
 ) -> Result<SlurmScripts, SlurmError> {
@@ -100,11 +105,37 @@ pub fn write_scripts(
         quote(exe),
         quote(dir)
     );
+    let mut refs = format!(
+        "#!/bin/bash\n#SBATCH --job-name=cs-{name}-references\n#SBATCH --cpus-per-task={}\n#SBATCH --output={}/references-%j.log\n",
+        opts.cpus_per_task,
+        slurm.display()
+    );
+    if let Some(t) = &opts.time {
+        let _ = writeln!(refs, "#SBATCH --time={t}");
+    }
+    if let Some(p) = &opts.partition {
+        let _ = writeln!(refs, "#SBATCH --partition={p}");
+    }
+    let _ = write!(
+        refs,
+        "set -euo pipefail\nexec {} run {} --out {} --references-only --threads \"${{SLURM_CPUS_PER_TASK:-1}}\"\n",
+        quote(exe),
+        quote(&sweep),
+        quote(dir)
+    );
     let scripts = SlurmScripts {
         array: slurm.join("array.sh"),
         summarize: slurm.join("summarize.sh"),
+        references: with_references.then(|| slurm.join("references.sh")),
     };
-    for (path, text) in [(&scripts.array, array), (&scripts.summarize, summ)] {
+    let mut files = vec![
+        (scripts.array.clone(), array),
+        (scripts.summarize.clone(), summ),
+    ];
+    if let Some(r) = &scripts.references {
+        files.push((r.clone(), refs));
+    }
+    for (path, text) in &files {
         crate::sink::write_atomic(path, text.as_bytes()).map_err(|e| SlurmError::Io {
             path: path.clone(),
             source: std::io::Error::other(e.to_string()),
@@ -113,8 +144,9 @@ pub fn write_scripts(
     Ok(scripts)
 }
 
-/// Submit the array, then the summary with `--dependency=afterok` on it. Returns the job ids.
-pub fn submit(scripts: &SlurmScripts) -> Result<(String, String), SlurmError> {
+/// Submit the reference job (if any), the array depending on it, then the summary with
+/// `--dependency=afterok` on the array. Returns the job ids.
+pub fn submit(scripts: &SlurmScripts) -> Result<(Option<String>, String, String), SlurmError> {
     let sbatch = |args: &[&str], script: &Path| -> Result<String, SlurmError> {
         let out = Command::new("sbatch")
             .arg("--parsable")
@@ -135,8 +167,15 @@ pub fn submit(scripts: &SlurmScripts) -> Result<(String, String), SlurmError> {
         let text = String::from_utf8_lossy(&out.stdout);
         Ok(text.trim().split(';').next().unwrap_or("").to_string())
     };
-    let array = sbatch(&[], &scripts.array)?;
+    let references = match &scripts.references {
+        Some(r) => Some(sbatch(&[], r)?),
+        None => None,
+    };
+    let array = match &references {
+        Some(r) => sbatch(&[&format!("--dependency=afterok:{r}")], &scripts.array)?,
+        None => sbatch(&[], &scripts.array)?,
+    };
     let dep = format!("--dependency=afterok:{array}");
     let summary = sbatch(&[&dep], &scripts.summarize)?;
-    Ok((array, summary))
+    Ok((references, array, summary))
 }

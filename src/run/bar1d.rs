@@ -65,6 +65,46 @@ impl Bar1dConfig {
     }
 }
 
+impl Bar1dConfig {
+    /// The largest stable dt of an explicit scheme (None for implicit ones): τ ω_max ≤ the
+    /// scheme's bound, ω_max from the assembled operators with the contact stiffness inactive
+    /// and active.
+    pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
+        let Some(bound) = self.scheme.explicit_stability_limit() else {
+            return Ok(None);
+        };
+        let sp = Bar1dSpace::new(self.bar, self.elements, &self.mass, self.method)
+            .map_err(|e| ("mass", e.to_string()))?;
+        Ok(Some(bound / max_frequency_sq(&sp).sqrt()))
+    }
+}
+
+/// ω²_max of the linear part, with and without the contact stiffness active.
+fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
+    let free = sp.stiffness_lin.max_generalized_eigenvalue(&sp.mass);
+    let mut active: Tridiag = sp.stiffness_lin.clone();
+    match sp.method {
+        ContactMethod::Mixed => {
+            // u₀ = −g held: node 0 clamped.
+            active.set_row(0, (0.0, 1.0, 0.0));
+            active.lower[0] = 0.0;
+        }
+        ContactMethod::Nitsche { gamma0, .. } => {
+            let k = 1.0 / (gamma0 * sp.h);
+            let p = sp.p.0;
+            active.add_element(
+                0,
+                [
+                    [k * p[0] * p[0], k * p[0] * p[1]],
+                    [k * p[0] * p[1], k * p[1] * p[1]],
+                ],
+            );
+        }
+        ContactMethod::Penalty { gamma0 } => active.diag[0] += sp.penalty_stiffness(gamma0),
+    }
+    free.max(active.max_generalized_eigenvalue(&sp.mass))
+}
+
 /// Why a run stopped before its last step.
 enum Stop {
     Solver(usize, ContactSolveError),
@@ -469,6 +509,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         message: Some(msg),
         metrics,
         series: Vec::new(),
+        reference: None,
     };
     let sp = match Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method) {
         Ok(sp) => sp,
@@ -621,5 +662,6 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         message,
         metrics,
         series: std::mem::take(&mut rec.obs.series),
+        reference: None,
     }
 }

@@ -7,11 +7,17 @@
 //! point is kept.
 
 pub mod bar1d;
+pub mod fe;
 pub mod observe;
 pub mod record;
+pub mod reference;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
+
+use crate::scene::SceneSetup;
+use crate::space::{ContactMethod, MassVariant};
+use crate::time::Scheme;
 
 pub use observe::{Metrics, SeriesRow};
 pub use record::{RunRecord, SERIES_COLUMNS};
@@ -70,10 +76,81 @@ impl RunOptions {
     }
 }
 
-/// The validated configuration of one run, per scene.
+/// The validated configuration of one run, per discretisation family: the tridiagonal 1D
+/// engine or the sparse finite-element engine (which runs every FE scene).
 #[derive(Debug, Clone, PartialEq)]
 pub enum RunConfig {
     Bar1d(bar1d::Bar1dConfig),
+    Fe(fe::FeConfig),
+}
+
+impl RunConfig {
+    /// The run of a scene's setup with a contact method, mass, scheme and step.
+    pub fn new(
+        setup: SceneSetup,
+        method: ContactMethod,
+        mass: MassVariant,
+        scheme: Scheme,
+        dt: f64,
+        steps: usize,
+    ) -> RunConfig {
+        match setup {
+            SceneSetup::Bar1d { bar, elements } => RunConfig::Bar1d(bar1d::Bar1dConfig {
+                bar,
+                elements,
+                dt,
+                steps,
+                method,
+                mass,
+                scheme,
+                perturbation: None,
+            }),
+            SceneSetup::Fe(setup) => RunConfig::Fe(fe::FeConfig {
+                setup,
+                method,
+                mass,
+                scheme,
+                dt,
+                steps,
+                perturbation: None,
+            }),
+        }
+    }
+
+    /// Ensemble member: relative amplitude of a perturbation of u⁰ and its seed.
+    pub fn set_perturbation(&mut self, p: Option<(f64, u64)>) {
+        match self {
+            RunConfig::Bar1d(c) => c.perturbation = p,
+            RunConfig::Fe(c) => c.perturbation = p,
+        }
+    }
+
+    /// The largest stable dt of an explicit scheme, from the assembled operators (None for
+    /// implicit schemes); `Err` names the key at fault and why the operators cannot be built
+    /// or the scheme cannot run.
+    pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
+        match self {
+            RunConfig::Bar1d(c) => c.explicit_dt_limit(),
+            RunConfig::Fe(c) => c.explicit_dt_limit(),
+        }
+    }
+
+    /// Work estimate: steps × unknowns.
+    pub fn work(&self) -> u64 {
+        match self {
+            RunConfig::Bar1d(c) => (c.steps * c.elements) as u64,
+            RunConfig::Fe(c) => (c.steps * c.unknowns()) as u64,
+        }
+    }
+}
+
+/// What a run receives besides its configuration: the reference solution its errors are
+/// measured against, and whether it must record itself as a reference for others.
+#[derive(Debug, Clone, Default)]
+pub struct RunContext {
+    pub reference: Option<std::sync::Arc<reference::ReferenceData>>,
+    /// Record the solution on this lattice (space stride, time stride).
+    pub record_reference: Option<(usize, usize)>,
 }
 
 /// What a run produced.
@@ -83,11 +160,19 @@ pub struct Outcome {
     pub message: Option<String>,
     pub metrics: Metrics,
     pub series: Vec<SeriesRow>,
+    /// The recorded solution, when the context asked for it.
+    pub reference: Option<reference::ReferenceData>,
 }
 
 /// Run one simulation.
 pub fn simulate(config: &RunConfig, options: &RunOptions) -> Outcome {
+    simulate_with(config, options, &RunContext::default())
+}
+
+/// Run one simulation with its reference solution (or recording itself as one).
+pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext) -> Outcome {
     match config {
         RunConfig::Bar1d(c) => bar1d::simulate(c, options),
+        RunConfig::Fe(c) => fe::simulate(c, options, ctx),
     }
 }

@@ -35,6 +35,20 @@ pub struct Metrics {
     pub err_sigma_mid_l2: Option<f64>,
     pub err_energy_l2: Option<f64>,
     pub err_u_contact_max: Option<f64>,
+    /// The scene's energy scale (E⁰ for the bars).
+    pub energy_scale: Option<f64>,
+    /// l2(τ) error of the total contact force against a reference run (FE scenes).
+    pub err_force_l2: Option<f64>,
+    /// Contact unknowns (the dofs the contact problem is condensed onto).
+    pub contact_dofs: Option<i64>,
+    /// Times the total contact force switched between zero and non-zero (FE scenes).
+    pub contact_toggles: Option<i64>,
+    /// Factorisations taken from the sweep's cache instead of being computed.
+    pub factor_cache_hits: Option<i64>,
+    /// Setup time: operators, factorisation, condensation.
+    pub setup_time_s: Option<f64>,
+    /// Time spent in the time loop (observables included).
+    pub stepping_time_s: Option<f64>,
 }
 
 /// One row of the time series (SPEC §5).

@@ -90,7 +90,7 @@ schema! {
         message: Option<String> => "", "why the run did not end ok (null if ok)";
         T: f64 => "s", "final time requested";
         h: f64 => "m", "mesh size (derived from elements when the sweep gave elements)";
-        elements: i64 => "", "number of elements m (h = length/m)";
+        elements: i64 => "", "number of elements m (h = length/m; 2D/3D: elements across the height)";
         dt: f64 => "s", "time step τ (derived from courant when the sweep gave courant)";
         courant: f64 => "", "Courant number ν = c0 τ / h";
         space: String => "", "contact treatment: mixed | nitsche | penalty";
@@ -138,7 +138,14 @@ schema! {
         err_sigma_l2: Option<f64> => "Pa·s^½", "l2(τ) error of the contact pressure σ_C^n at t^n";
         err_sigma_mid_l2: Option<f64> => "Pa·s^½", "l2(τ) error of the pressure at midpoint, σ_C(u^{n−½}) against σ(t^{n−½}) (003 §4.1.2e; a multiplier of a node with mass: mean of two)";
         err_energy_l2: Option<f64> => "", "l2(τ) error of the energy";
-        err_u_contact_max: Option<f64> => "m", "max_n |u^n(contact) − u(contact, t^n)|";
+        err_u_contact_max: Option<f64> => "m", "max_n |u^n(contact) − u(contact, t^n)| (2D/3D: mean u_d over Γ_C against the reference)";
+        energy_scale: Option<f64> => "J", "the scene's energy scale relative energies are measured in (E⁰ for the bars)";
+        err_force_l2: Option<f64> => "N·s^½", "l2(τ) error of the total contact force against the reference run (2D/3D)";
+        contact_dofs: Option<i64> => "", "unknowns the contact problem is condensed onto (2D/3D: vertical dofs of Γ_C)";
+        contact_toggles: Option<i64> => "", "times the total contact force switched between zero and non-zero (2D/3D; 002's chatter)";
+        factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D)";
+        setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set (2D/3D)";
+        stepping_time_s: Option<f64> => "s", "time loop, observables included (2D/3D)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -148,13 +155,23 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
     ("run_id", "String", "", "run the row belongs to"),
     ("step", "i64", "", "time step n"),
     ("t", "f64", "s", "time t^n"),
-    ("u_contact", "f64", "m", "displacement of the contact node"),
-    ("v_contact", "f64", "m/s", "velocity of the contact node"),
+    (
+        "u_contact",
+        "f64",
+        "m",
+        "displacement of the contact node (2D/3D: mean u_d over Γ_C)",
+    ),
+    (
+        "v_contact",
+        "f64",
+        "m/s",
+        "velocity of the contact node (2D/3D: mean v_d over Γ_C)",
+    ),
     (
         "sigma_contact",
         "f64",
         "Pa",
-        "contact pressure σ_C (≤ 0 in contact)",
+        "contact pressure σ_C (≤ 0 in contact; 2D/3D: minus the total contact force)",
     ),
     (
         "energy",
@@ -172,13 +189,13 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "u_contact_exact",
         "Option<f64>",
         "m",
-        "closed-form contact displacement",
+        "closed-form (or reference-run) contact displacement",
     ),
     (
         "sigma_contact_exact",
         "Option<f64>",
         "Pa",
-        "closed-form contact stress",
+        "closed-form (or reference-run) contact stress",
     ),
 ];
 
@@ -223,9 +240,7 @@ impl RunRecord {
         let f = |k: Key| p.get(&k).and_then(Value::as_f64);
         let s = |k: Key| p.get(&k).map(|v| v.to_string()).unwrap_or_default();
         let m = &out.metrics;
-        let scene = match &spec.config {
-            crate::run::RunConfig::Bar1d(_) => "bar1d",
-        };
+        let scene = spec.scene.name();
         RunRecord {
             run_id: spec.run_id.clone(),
             sweep: sweep.to_string(),
@@ -297,6 +312,13 @@ impl RunRecord {
             err_sigma_mid_l2: m.err_sigma_mid_l2,
             err_energy_l2: m.err_energy_l2,
             err_u_contact_max: m.err_u_contact_max,
+            energy_scale: m.energy_scale,
+            err_force_l2: m.err_force_l2,
+            contact_dofs: m.contact_dofs,
+            contact_toggles: m.contact_toggles,
+            factor_cache_hits: m.factor_cache_hits,
+            setup_time_s: m.setup_time_s,
+            stepping_time_s: m.stepping_time_s,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

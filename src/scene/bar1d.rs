@@ -9,6 +9,99 @@
 //! norms are therefore integrated *exactly*: every element is split at those kinks and the
 //! difference between the P1 field and the exact field is affine on each piece.
 
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+
+/// The scene `bar1d` (SPEC §1.1): physics keys, mesh from h, closed form for a zero gap.
+#[derive(Debug, Clone, Copy)]
+pub struct Bar1dScene;
+
+const BAR1D_PHYSICS: [PhysicsKey; 5] = [
+    PhysicsKey {
+        name: "length",
+        default: 1.0,
+    },
+    PhysicsKey {
+        name: "young",
+        default: 1.0,
+    },
+    PhysicsKey {
+        name: "density",
+        default: 1.0,
+    },
+    PhysicsKey {
+        name: "amplitude",
+        default: 0.5,
+    },
+    PhysicsKey {
+        name: "gap",
+        default: 0.0,
+    },
+];
+
+impl Bar1dScene {
+    fn bar(physics: &Physics) -> BarParams {
+        BarParams {
+            length: physics.get("length"),
+            young: physics.get("young"),
+            density: physics.get("density"),
+            amplitude: physics.get("amplitude"),
+            gap: physics.get("gap"),
+        }
+    }
+}
+
+impl Scene for Bar1dScene {
+    fn name(&self) -> &'static str {
+        "bar1d"
+    }
+    fn physics(&self) -> &'static [PhysicsKey] {
+        &BAR1D_PHYSICS
+    }
+    fn default_t(&self) -> f64 {
+        12.0
+    }
+    fn wave_speed(&self, physics: &Physics) -> f64 {
+        Self::bar(physics).wave_speed()
+    }
+    fn mesh_from_h(&self, physics: &Physics, h: f64) -> Result<MeshChoice, String> {
+        let length = physics.get("length");
+        let ratio = length / h;
+        let m = ratio.round();
+        if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
+            return Err(format!(
+                "h = {h} does not divide length = {length} into at least 2 elements (L/h = {ratio}); use `elements` or an h with L/h a whole number"
+            ));
+        }
+        Ok(MeshChoice {
+            elements: m as usize,
+            h: length / m,
+        })
+    }
+    fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String> {
+        Ok(MeshChoice {
+            elements,
+            h: physics.get("length") / elements as f64,
+        })
+    }
+    fn supports(
+        &self,
+        _space: &str,
+        _mass: &str,
+        _scheme: &str,
+    ) -> Result<(), (&'static str, String)> {
+        Ok(())
+    }
+    fn error_source(&self, physics: &Physics) -> Option<ErrorSource> {
+        Self::bar(physics).exact().map(|_| ErrorSource::Exact)
+    }
+    fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup {
+        SceneSetup::Bar1d {
+            bar: Self::bar(physics),
+            elements: mesh.elements,
+        }
+    }
+}
+
 /// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BarParams {

@@ -1,39 +1,147 @@
-//! Scenes: a physical problem with its geometry, material, loads and initial state.
+//! Scenes: a physical problem with its geometry, material, loads and initial state (SPEC §1).
 //!
-//! A scene declares which parameters it accepts (SPEC §1); the planner refuses every other key,
-//! so nothing is expanded, modelled or stored that the scene does not use.
+//! A scene is *data* behind the [`Scene`] trait: it declares its physics keys with their
+//! defaults, its default final time, which contact methods / masses / schemes it supports, how a
+//! mesh size becomes a mesh, its wave speed (for `courant`), and whether its errors are measured
+//! against a closed form or a reference run. The planner, the run ids, the executor, the sink and
+//! the summaries only talk to this trait: adding a scene is a new file here (and, if its geometry
+//! is new, a mesh in `space/fe`), never a change to `sweep/`, `exec/`, `sink/` or `summary/`.
+//!
+//! What a scene hands to the engines is a [`SceneSetup`]: the 1D bar's parameters and element
+//! count, or a finite-element description ([`FeSetup`]: geometry, material, load, initial velocity,
+//! gap) which `space::fe` meshes and `run::fe` integrates, whatever the scene.
 
+pub mod bar;
 pub mod bar1d;
 
-pub use bar1d::{BarExact, BarParams};
+pub use bar::{BarScene, FeGeometry, FeSetup};
+pub use bar1d::{Bar1dScene, BarExact, BarParams};
 
-/// The scenes the engine can run.
+/// A physics parameter of a scene: its key name (SPEC §7) and default value.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysicsKey {
+    pub name: &'static str,
+    pub default: f64,
+}
+
+/// The physics values of one run, in the scene's declaration order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Physics(pub Vec<(&'static str, f64)>);
+
+impl Physics {
+    /// The value of a declared key (panics on an undeclared name: a programming error).
+    pub fn get(&self, name: &str) -> f64 {
+        self.0
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, v)| *v)
+            .unwrap_or_else(|| panic!("physics key `{name}` is not declared by this scene"))
+    }
+}
+
+/// How a run's errors are measured.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorSource {
+    /// A closed-form solution (bar1d with zero gap).
+    Exact,
+    /// A reference run of the same scene on a finer nested mesh and step (SPEC §1.2).
+    ReferenceRun,
+}
+
+/// The mesh of a run as the scene resolved it from `h` or `elements`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshChoice {
+    /// The integer that identifies the mesh (`elements` column): elements along the scene's
+    /// main axis (the bar's length, the height of the 2D/3D bars).
+    pub elements: usize,
+    /// Nominal mesh size h.
+    pub h: f64,
+}
+
+/// What a scene hands to the engines.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneSetup {
+    /// The 1D bar (tridiagonal engine).
+    Bar1d { bar: BarParams, elements: usize },
+    /// A finite-element scene (sparse engine).
+    Fe(FeSetup),
+}
+
+/// A physical problem, as the planner sees it.
+pub trait Scene: Send + Sync {
+    /// The `scene` value of sweep files.
+    fn name(&self) -> &'static str;
+    /// Physics keys this scene accepts, with their defaults (besides discretisation and method
+    /// keys, which every scene accepts).
+    fn physics(&self) -> &'static [PhysicsKey];
+    /// Default final time T.
+    fn default_t(&self) -> f64;
+    /// Wave speed c0 (courant → dt = ν h / c0): √(E/ρ) in 1D, the P-wave speed √((λ+2μ)/ρ)
+    /// in 2D/3D.
+    fn wave_speed(&self, physics: &Physics) -> f64;
+    /// The mesh for a requested size h, or why h does not give one.
+    fn mesh_from_h(&self, physics: &Physics, h: f64) -> Result<MeshChoice, String>;
+    /// The mesh for a requested `elements` count, or why not.
+    fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String>;
+    /// Whether the scene implements this combination of contact method (`space`), mass variant
+    /// and scheme family (`newmark`, `theta`, `paoli-schatzman`, `hybrid`); `Err` names the key
+    /// at fault and the reason (a sweep error, not a silently dropped run).
+    fn supports(&self, space: &str, mass: &str, scheme: &str)
+    -> Result<(), (&'static str, String)>;
+    /// Where the errors come from.
+    fn error_source(&self, physics: &Physics) -> Option<ErrorSource>;
+    /// The description the engines run.
+    fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
+}
+
+/// The scenes the engine can run (the registry; SPEC §1 names five).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SceneKind {
     /// The 1D impacting bar with its closed form (SPEC §1.1).
     Bar1d,
+    /// The 2D plane-strain bar dropped on an obstacle (SPEC §1.2).
+    Bar2d,
+    /// The 3D bar dropped on an obstacle (SPEC §1.2).
+    Bar3d,
 }
+
+static BAR1D: Bar1dScene = Bar1dScene;
+static BAR2D: BarScene = BarScene { dim: 2 };
+static BAR3D: BarScene = BarScene { dim: 3 };
 
 impl SceneKind {
     /// Every scene name of SPEC §1, with whether this build implements it.
     pub const NAMES: [(&'static str, Option<SceneKind>); 5] = [
         ("bar1d", Some(SceneKind::Bar1d)),
-        ("bar2d", None),
-        ("bar3d", None),
+        ("bar2d", Some(SceneKind::Bar2d)),
+        ("bar3d", Some(SceneKind::Bar3d)),
         ("disc2d", None),
         ("sphere3d", None),
     ];
 
-    pub fn name(self) -> &'static str {
+    /// The scene behind this name.
+    pub fn get(self) -> &'static dyn Scene {
         match self {
-            SceneKind::Bar1d => "bar1d",
+            SceneKind::Bar1d => &BAR1D,
+            SceneKind::Bar2d => &BAR2D,
+            SceneKind::Bar3d => &BAR3D,
         }
     }
 
-    /// Physics keys this scene accepts (besides the discretisation and method keys).
-    pub fn physics_keys(self) -> &'static [&'static str] {
-        match self {
-            SceneKind::Bar1d => &["length", "young", "density", "amplitude", "gap"],
-        }
+    pub fn name(self) -> &'static str {
+        self.get().name()
+    }
+
+    /// Whether this scene accepts the physics key `name`.
+    pub fn accepts_physics(self, name: &str) -> bool {
+        self.get().physics().iter().any(|k| k.name == name)
+    }
+
+    /// The scene of a `scene` column value.
+    pub fn from_name(name: &str) -> Option<SceneKind> {
+        Self::NAMES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .and_then(|(_, k)| *k)
     }
 }

@@ -102,19 +102,16 @@ impl Series {
 /// step by step; two rows without pressure already count as a lift-off).
 const MERGE_GAP: usize = 1;
 
-/// The series of the bar1d runs, keyed by run_id; `Err(reason)` when there are none.
+/// The series of the runs, keyed by run_id; `Err(reason)` when there are none. Every scene
+/// stores σ_C < 0 while in contact (2D/3D: minus the total contact force), so the impacts are
+/// read the same way whatever the scene.
 fn read_series(
     dir: &std::path::Path,
     runs: &Runs,
 ) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
-    let wanted: HashMap<&str, ()> = runs
-        .runs
-        .iter()
-        .filter(|r| r.param(runs, "scene").as_deref() == Some("bar1d"))
-        .map(|r| (r.run_id.as_str(), ()))
-        .collect();
+    let wanted: HashMap<&str, ()> = runs.runs.iter().map(|r| (r.run_id.as_str(), ())).collect();
     if wanted.is_empty() {
-        return Ok(Err("no bar1d runs".into()));
+        return Ok(Err("no runs".into()));
     }
     // Typed per part (another version may store a column with another type).
     let (raw, _) = super::runs::read_typed(
@@ -520,7 +517,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         Ok(_) => {
             let _ = writeln!(
                 md,
-                "Impacts (bar1d): contact phases = maximal runs of recorded steps with σ_C < 0; \
+                "Impacts: contact phases = maximal runs of recorded steps with σ_C < 0; \
                  loss = (E just before − E just after)/E⁰ summed over complete phases; full list \
                  in impacts.parquet. {impact_count} contact phases in {runs_with_series} runs with \
                  series{}.\n",
@@ -598,7 +595,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         Ok(_) => {
             let _ = writeln!(
                 terminal,
-                "  impacts: {impact_count} contact phases in {runs_with_series} bar1d runs with series{}",
+                "  impacts: {impact_count} contact phases in {runs_with_series} runs with series{}",
                 if decimated_runs > 0 {
                     format!(" ({decimated_runs} decimated)")
                 } else {

@@ -173,13 +173,6 @@ impl Run {
     pub(crate) fn ok(&self) -> bool {
         self.status == "ok"
     }
-
-    pub(crate) fn param(&self, runs: &Runs, name: &str) -> Option<String> {
-        runs.params
-            .iter()
-            .position(|(n, _)| *n == name)
-            .and_then(|i| self.params[i].show())
-    }
 }
 
 /// A method group: runs equal in every parameter except the refinement axes.

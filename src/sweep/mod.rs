@@ -117,6 +117,9 @@ pub struct SweepFile {
     pub series_every: usize,
     /// `[fixed]` values that an axis overrides (reported by the plan).
     pub overridden: Vec<String>,
+    /// `reference = {…}`: the parameters that turn each run into its reference run (SPEC §7;
+    /// scenes without a closed form).
+    pub reference: Option<Vec<Entry>>,
 }
 
 const TOP_KEYS: [&str; 11] = [
@@ -300,7 +303,7 @@ impl Checker {
 
 /// Whether `scene` accepts `key`: every discretisation and method key, and its own physics.
 pub fn accepted(scene: SceneKind, key: Key) -> bool {
-    !key.is_physics() || scene.physics_keys().contains(&key.name())
+    !key.is_physics() || scene.accepts_physics(key.name())
 }
 
 fn suggest(name: &str) -> String {
@@ -438,8 +441,10 @@ impl SweepFile {
                     ck.issues.push(Issue {
                         line: None,
                         key: "scene".into(),
-                        reason: "required key missing (bar1d, bar2d, bar3d, disc2d or sphere3d)"
-                            .into(),
+                        reason: format!(
+                            "required key missing (one of {})",
+                            SceneKind::NAMES.map(|(n, _)| n).join(", ")
+                        ),
                     });
                 }
             }
@@ -613,14 +618,40 @@ impl SweepFile {
                 );
             }
         }
-        if let Some((_, line, _)) = get("reference")
-            && ck.scene == Some(SceneKind::Bar1d)
-        {
-            ck.issue(
-                "reference",
-                *line,
-                "scene bar1d has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
-            );
+        let mut reference = None;
+        if let Some((_, line, node)) = get("reference") {
+            let uses_reference = ck.scene.map(|s| {
+                let scene = s.get();
+                let defaults = crate::scene::Physics(
+                    scene
+                        .physics()
+                        .iter()
+                        .map(|k| (k.name, k.default))
+                        .collect(),
+                );
+                scene.error_source(&defaults) == Some(crate::scene::ErrorSource::ReferenceRun)
+            });
+            match (&node.kind, uses_reference) {
+                (_, Some(false)) => ck.issue(
+                    "reference",
+                    *line,
+                    format!(
+                        "scene {} has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+                        ck.scene.map(|s| s.name()).unwrap_or_default()
+                    ),
+                ),
+                (Kind::Table(t), _) if !t.is_empty() => {
+                    reference = Some(ck.bundle(t, "reference"));
+                }
+                (k, _) => ck.issue(
+                    "reference",
+                    *line,
+                    format!(
+                        "expected a non-empty inline table of parameters, e.g. {{ h = 0.0015625, dt = 0.00078125, mass = \"mod3\", scheme = \"crank-nicolson\" }}, found a {}",
+                        k.type_name()
+                    ),
+                ),
+            }
         }
         // [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
         // in both [fixed] and [zip]); two axes setting one parameter would be ambiguous.
@@ -670,6 +701,7 @@ impl SweepFile {
                 ensemble,
                 series_every,
                 overridden,
+                reference,
             })
         } else {
             let mut issues = ck.issues;

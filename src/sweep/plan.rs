@@ -20,9 +20,8 @@ use sha2::{Digest, Sha256};
 use super::keys::canonical_number;
 use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::run::RunConfig;
-use crate::run::bar1d::Bar1dConfig;
-use crate::scene::{BarParams, SceneKind};
-use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag};
+use crate::scene::{Physics, Scene, SceneKind};
+use crate::space::{ContactMethod, MassVariant};
 use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
 
 /// One run of the plan.
@@ -39,6 +38,20 @@ pub struct RunSpec {
     pub repeats: usize,
     /// Ensemble member (sample index, relative perturbation).
     pub sample: Option<(usize, f64)>,
+    pub scene: SceneKind,
+    /// The run_id of the reference run its errors are measured against (SPEC §1.2, §7).
+    pub reference: Option<String>,
+}
+
+/// A reference run of the plan and the lattice its solution is stored on: every
+/// `space_stride`-th reference node along each axis and every `time_stride`-th reference step
+/// (the greatest common divisor of its consumers' ratios, so every consumer's nodes and times
+/// are stored and nothing else).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferencePlan {
+    pub spec: RunSpec,
+    pub space_stride: usize,
+    pub time_stride: usize,
 }
 
 /// The expanded sweep.
@@ -53,17 +66,23 @@ pub struct Plan {
     pub inapplicable: BTreeMap<String, usize>,
     /// Combinations merged into an earlier identical run, by reason.
     pub collapsed: BTreeMap<String, usize>,
+    /// The distinct reference runs, in order of first use.
+    pub references: Vec<ReferencePlan>,
 }
 
 /// Resolved parameters of one combination.
 struct Resolved {
     params: BTreeMap<Key, Value>,
     canonical: BTreeMap<Key, String>,
-    config: Bar1dConfig,
+    config: RunConfig,
     label: String,
     scheme_label: String,
     scheme_names: [String; 2],
     dropped: Vec<String>,
+    /// (h, dt, T) for the nesting check of a reference run.
+    h: f64,
+    dt: f64,
+    t_final: f64,
 }
 
 enum Outcome {
@@ -72,10 +91,11 @@ enum Outcome {
     Invalid(Vec<Issue>),
 }
 
-/// Defaults of bar1d (SPEC §1.1, 003 §4.1).
-fn default_of(key: Key) -> Option<Value> {
+/// Defaults: the method and scheme keys are the same for every scene (003 §4.1: mixed,
+/// consistent mass, Crank–Nicolson, Θ = 1, Newmark ¼/½, e = 1); T and physics are the scene's.
+fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
     Some(match key {
-        Key::T => Value::Num(12.0),
+        Key::T => Value::Num(scene.default_t()),
         Key::Space => Value::Str("mixed".into()),
         Key::Mass => Value::Str("consistent".into()),
         Key::Scheme => Value::Str("crank-nicolson".into()),
@@ -83,9 +103,9 @@ fn default_of(key: Key) -> Option<Value> {
         Key::NewmarkBeta => Value::Num(0.25),
         Key::NewmarkGamma => Value::Num(0.5),
         Key::Restitution => Value::Num(1.0),
-        Key::Length | Key::Young | Key::Density => Value::Num(1.0),
-        Key::Amplitude => Value::Num(0.5),
-        Key::Gap => Value::Num(0.0),
+        k if k.is_physics() => {
+            Value::Num(scene.physics().iter().find(|p| p.name == k.name())?.default)
+        }
         _ => return None,
     })
 }
@@ -94,8 +114,9 @@ fn same(a: &Value, b: &Value) -> bool {
     a.canonical() == b.canonical()
 }
 
-/// Resolve one combination of entries.
-fn resolve(entries: &[&Entry]) -> Outcome {
+/// Resolve one combination of entries for `scene`.
+fn resolve(scene_kind: SceneKind, entries: &[&Entry]) -> Outcome {
+    let scene = scene_kind.get();
     let mut issues = Vec::new();
     let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
     for e in entries {
@@ -104,7 +125,7 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     let get = |k: Key| {
         user.get(&k)
             .map(|(v, _)| v.clone())
-            .or_else(|| default_of(k))
+            .or_else(|| default_of(scene, k))
     };
     let num = |k: Key| get(k).and_then(|v| v.as_f64());
     let origin = |k: Key| {
@@ -224,6 +245,10 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     } else {
         MassVariant::from_name(&mass_name).expect("checked")
     };
+    if let Err((key, why)) = scene.supports(&space_name, &mass_name, scheme.family()) {
+        let k = Key::from_name(key).expect("scenes name sweep keys");
+        return Outcome::Invalid(vec![Issue::at(&origin(k), why)]);
+    }
 
     // Applicability (SPEC §3): which keys this run uses.
     let applies = |k: Key| -> Result<(), &'static str> {
@@ -272,39 +297,38 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         );
     }
 
-    // Geometry and time step.
-    let bar = BarParams {
-        length: num(Key::Length).unwrap(),
-        young: num(Key::Young).unwrap(),
-        density: num(Key::Density).unwrap(),
-        amplitude: num(Key::Amplitude).unwrap(),
-        gap: num(Key::Gap).unwrap(),
-    };
-    let c0 = bar.wave_speed();
-    let elements = match (user.get(&Key::H), user.get(&Key::Elements)) {
+    // Physics, mesh and time step: the scene's.
+    let physics = Physics(
+        scene
+            .physics()
+            .iter()
+            .map(|k| {
+                let key = Key::from_name(k.name).expect("scenes declare sweep keys");
+                (k.name, num(key).unwrap_or(k.default))
+            })
+            .collect(),
+    );
+    let c0 = scene.wave_speed(&physics);
+    let mesh = match (user.get(&Key::H), user.get(&Key::Elements)) {
         (Some(_), Some((_, o))) => {
             issues.push(Issue::at(o, "give either h or elements, not both"));
             None
         }
-        (Some((v, o)), None) => {
-            let h = v.as_f64().unwrap();
-            let ratio = bar.length / h;
-            let m = ratio.round();
-            if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
-                issues.push(Issue::at(
-                    o,
-                    format!(
-                        "h = {h} does not divide length = {} into at least 2 elements (L/h = {ratio}); use `elements` or an h with L/h a whole number",
-                        bar.length
-                    ),
-                ));
+        (Some((v, o)), None) => match scene.mesh_from_h(&physics, v.as_f64().unwrap()) {
+            Ok(m) => Some(m),
+            Err(why) => {
+                issues.push(Issue::at(o, why));
                 None
-            } else {
-                Some(m as usize)
             }
-        }
-        (None, Some((v, _))) => match v {
-            Value::Int(i) => Some(*i as usize),
+        },
+        (None, Some((v, o))) => match v {
+            Value::Int(i) => match scene.mesh_from_elements(&physics, *i as usize) {
+                Ok(m) => Some(m),
+                Err(why) => {
+                    issues.push(Issue::at(o, why));
+                    None
+                }
+            },
             _ => None,
         },
         (None, None) => {
@@ -318,7 +342,7 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             None
         }
     };
-    let h = elements.map(|m| bar.length / m as f64);
+    let h = mesh.map(|m| m.h);
     let dt = match (user.get(&Key::Dt), user.get(&Key::Courant), h) {
         (Some(_), Some((_, o)), _) => {
             issues.push(Issue::at(o, "give either dt or courant, not both"));
@@ -342,7 +366,13 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     if !issues.is_empty() {
         return Outcome::Invalid(issues);
     }
-    let (m, h, dt) = (elements.unwrap(), h.unwrap(), dt.unwrap());
+    let (mesh, dt) = (mesh.unwrap(), dt.unwrap());
+    let h = mesh.h;
+    let dt_origin = origin(if user.contains_key(&Key::Dt) {
+        Key::Dt
+    } else {
+        Key::Courant
+    });
     let ratio = t_final / dt;
     let steps = if (ratio - ratio.round()).abs() <= 1e-9 * ratio {
         ratio.round() as usize
@@ -351,54 +381,51 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     };
     if steps == 0 || steps > 100_000_000 {
         return Outcome::Invalid(vec![Issue::at(
-            &origin(if user.contains_key(&Key::Dt) {
-                Key::Dt
-            } else {
-                Key::Courant
-            }),
+            &dt_origin,
             format!("T/dt = {ratio:.3e} steps is out of range (1 … 1e8)"),
         )]);
     }
     let courant = c0 * dt / h;
+    let config = RunConfig::new(
+        scene.setup(&physics, mesh),
+        method,
+        mass.clone(),
+        scheme,
+        dt,
+        steps,
+    );
 
     // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
-    if let Some(bound) = scheme.explicit_stability_limit() {
-        let dt_origin = origin(if user.contains_key(&Key::Dt) {
-            Key::Dt
-        } else {
-            Key::Courant
-        });
-        match Bar1dSpace::new(bar, m, &mass, method) {
-            Ok(sp) => {
-                let omega2 = max_frequency_sq(&sp);
-                let dt_max = bound / omega2.sqrt();
-                if dt > dt_max * (1.0 + 1e-12) {
-                    return Outcome::Invalid(vec![Issue::at(
-                        &dt_origin,
-                        format!(
-                            "dt = {dt:.6e} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
-                            scheme.label(),
-                            c0 * dt_max / h
-                        ),
-                    )]);
-                }
-            }
-            Err(e) => return Outcome::Invalid(vec![Issue::at(&origin(Key::Mass), e.to_string())]),
+    match config.explicit_dt_limit() {
+        Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) => {
+            return Outcome::Invalid(vec![Issue::at(
+                &dt_origin,
+                format!(
+                    "dt = {dt:.6e} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
+                    scheme.label(),
+                    c0 * dt_max / h
+                ),
+            )]);
+        }
+        Ok(_) => {}
+        Err((key, e)) => {
+            let k = Key::from_name(key).expect("engines name sweep keys");
+            return Outcome::Invalid(vec![Issue::at(&origin(k), e)]);
         }
     }
 
     // Columns and canonical text.
     let mut canonical = BTreeMap::new();
     let mut put = |k: Key, v: Value, always: bool| {
-        let is_default = default_of(k).is_some_and(|d| same(&d, &v));
+        let is_default = default_of(scene, k).is_some_and(|d| same(&d, &v));
         if always || !is_default {
             canonical.insert(k, v.canonical());
         }
         params.insert(k, v);
     };
     put(Key::T, Value::Num(t_final), false);
-    put(Key::Elements, Value::Int(m as i64), true);
+    put(Key::Elements, Value::Int(mesh.elements as i64), true);
     put(Key::Dt, Value::Num(dt), true);
     put(Key::Space, Value::Str(space_name.clone()), false);
     put(Key::Mass, Value::Str(mass_name.clone()), false);
@@ -426,11 +453,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         }
         Scheme::Hybrid => {}
     }
-    put(Key::Length, Value::Num(bar.length), false);
-    put(Key::Young, Value::Num(bar.young), false);
-    put(Key::Density, Value::Num(bar.density), false);
-    put(Key::Amplitude, Value::Num(bar.amplitude), false);
-    put(Key::Gap, Value::Num(bar.gap), false);
+    for (name, value) in &physics.0 {
+        put(Key::from_name(name).unwrap(), Value::Num(*value), false);
+    }
     // Derived columns, not part of the identity.
     params.insert(Key::H, Value::Num(h));
     params.insert(Key::Courant, Value::Num(courant));
@@ -457,44 +482,12 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         label: format!("{space_label} · {mass_label} · {scheme_label}"),
         scheme_names: [scheme.family().to_string(), scheme_label.clone()],
         scheme_label,
-        config: Bar1dConfig {
-            bar,
-            elements: m,
-            dt,
-            steps,
-            method,
-            mass,
-            scheme,
-            perturbation: None,
-        },
+        config,
         dropped,
+        h,
+        dt,
+        t_final,
     }))
-}
-
-/// ω²_max of the linear part, with and without the contact stiffness active.
-fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
-    let free = sp.stiffness_lin.max_generalized_eigenvalue(&sp.mass);
-    let mut active: Tridiag = sp.stiffness_lin.clone();
-    match sp.method {
-        ContactMethod::Mixed => {
-            // u₀ = −g held: node 0 clamped.
-            active.set_row(0, (0.0, 1.0, 0.0));
-            active.lower[0] = 0.0;
-        }
-        ContactMethod::Nitsche { gamma0, .. } => {
-            let k = 1.0 / (gamma0 * sp.h);
-            let p = sp.p.0;
-            active.add_element(
-                0,
-                [
-                    [k * p[0] * p[0], k * p[0] * p[1]],
-                    [k * p[0] * p[1], k * p[1] * p[1]],
-                ],
-            );
-        }
-        ContactMethod::Penalty { gamma0 } => active.diag[0] += sp.penalty_stiffness(gamma0),
-    }
-    free.max(active.max_generalized_eigenvalue(&sp.mass))
 }
 
 /// Whether an exclude filter matches a resolved run.
@@ -518,6 +511,111 @@ fn resolve_scheme_alias(name: &str) -> Option<&'static str> {
         "backward-euler" => Some("backward-euler"),
         _ => None,
     }
+}
+
+fn gcd(a: usize, b: usize) -> usize {
+    if b == 0 { a } else { gcd(b, a % b) }
+}
+
+/// The reference run of one combination: its entries overridden by `reference = {…}` (keys not
+/// given are the run's; a reference giving h or elements replaces both, likewise dt or
+/// courant). Returns the reference's spec and the run's (space, time) refinement ratios; the
+/// reference must be nested: h_run/h_ref and dt_run/dt_ref whole numbers, and last as long.
+fn reference_of(
+    sweep: &SweepFile,
+    entries: &[&Entry],
+    over: &[Entry],
+    run: &Resolved,
+) -> Result<(RunSpec, usize, usize), Vec<Issue>> {
+    let sets = |keys: [Key; 2]| over.iter().any(|e| keys.contains(&e.key));
+    let (mesh_keys, step_keys) = ([Key::H, Key::Elements], [Key::Dt, Key::Courant]);
+    let (new_mesh, new_step) = (sets(mesh_keys), sets(step_keys));
+    let mut combined: Vec<&Entry> = entries
+        .iter()
+        .copied()
+        .filter(|e| {
+            !(new_mesh && mesh_keys.contains(&e.key)
+                || new_step && step_keys.contains(&e.key)
+                || over.iter().any(|o| o.key == e.key))
+        })
+        .collect();
+    combined.extend(over.iter());
+    let at = |keys: [Key; 2]| {
+        over.iter()
+            .find(|e| keys.contains(&e.key))
+            .map(|e| e.origin.clone())
+            .unwrap_or(Origin {
+                path: "reference".into(),
+                line: None,
+            })
+    };
+    let r = match resolve(sweep.scene, &combined) {
+        Outcome::Run(r) => r,
+        Outcome::Inapplicable(why) => {
+            return Err(vec![Issue::at(
+                &at(mesh_keys),
+                format!("the reference run is meaningless: {why}"),
+            )]);
+        }
+        Outcome::Invalid(is) => {
+            return Err(is
+                .into_iter()
+                .map(|i| Issue {
+                    reason: format!("in the reference run: {}", i.reason),
+                    ..i
+                })
+                .collect());
+        }
+    };
+    let ratio = |coarse: f64, fine: f64| {
+        let q = coarse / fine;
+        let n = q.round();
+        (n >= 1.0 && (q - n).abs() <= 1e-9 * n).then_some(n as usize)
+    };
+    let sx = ratio(run.h, r.h).ok_or_else(|| {
+        vec![Issue::at(
+            &at(mesh_keys),
+            format!(
+                "the reference mesh (h = {}) is not nested in the run's (h = {}): h_run/h_ref = {} must be a whole number ≥ 1",
+                r.h,
+                run.h,
+                run.h / r.h
+            ),
+        )]
+    })?;
+    let st = ratio(run.dt, r.dt).ok_or_else(|| {
+        vec![Issue::at(
+            &at(step_keys),
+            format!(
+                "the reference step (dt = {}) does not divide the run's (dt = {}): dt_run/dt_ref = {} must be a whole number ≥ 1",
+                r.dt,
+                run.dt,
+                run.dt / r.dt
+            ),
+        )]
+    })?;
+    if r.t_final < run.t_final * (1.0 - 1e-12) {
+        return Err(vec![Issue::at(
+            &at([Key::T, Key::T]),
+            format!(
+                "the reference run ends at T = {} before the run (T = {})",
+                r.t_final, run.t_final
+            ),
+        )]);
+    }
+    let id = run_id(sweep.scene, &r.canonical, "");
+    let spec = RunSpec {
+        run_id: id,
+        label: format!("reference: {}", r.label),
+        params: r.params.clone(),
+        scheme_label: r.scheme_label.clone(),
+        config: r.config.clone(),
+        repeats: 1,
+        sample: None,
+        scene: sweep.scene,
+        reference: None,
+    };
+    Ok((spec, sx, st))
 }
 
 /// Hash of the canonical text.
@@ -548,29 +646,59 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
     let mut excluded_by_filter = 0;
     let mut inapplicable: BTreeMap<String, usize> = BTreeMap::new();
     let mut collapsed: BTreeMap<String, usize> = BTreeMap::new();
+    let mut references: Vec<ReferencePlan> = Vec::new();
     for _ in 0..combinations {
         let mut entries: Vec<&Entry> = sweep.fixed.iter().collect();
         for (a, &i) in axes.iter().zip(&idx) {
             entries.extend(a.items[i].iter());
         }
-        match resolve(&entries) {
+        match resolve(sweep.scene, &entries) {
             Outcome::Invalid(mut is) => issues.append(&mut is),
             Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
                 if sweep.exclude.iter().any(|f| matches_filter(f, &r)) {
                     excluded_by_filter += 1;
                 } else {
+                    let reference = match &sweep.reference {
+                        None => None,
+                        Some(over) => match reference_of(sweep, &entries, over, &r) {
+                            Ok((spec, sx, st)) => {
+                                let id = spec.run_id.clone();
+                                match references.iter_mut().find(|p| p.spec.run_id == id) {
+                                    Some(p) => {
+                                        p.space_stride = gcd(p.space_stride, sx);
+                                        p.time_stride = gcd(p.time_stride, st);
+                                    }
+                                    None => references.push(ReferencePlan {
+                                        spec,
+                                        space_stride: sx,
+                                        time_stride: st,
+                                    }),
+                                }
+                                Some(id)
+                            }
+                            Err(mut is) => {
+                                issues.append(&mut is);
+                                None
+                            }
+                        },
+                    };
                     let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
                         None => vec![None],
                         Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
                     };
                     for sample in samples {
-                        let extra = match (sample, sweep.ensemble) {
+                        let mut extra = match (sample, sweep.ensemble) {
                             (Some((k, p)), Some(e)) => {
                                 format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
                             }
                             _ => String::new(),
                         };
+                        // The errors depend on the reference: a run measured against another
+                        // reference is another run.
+                        if let Some(rid) = &reference {
+                            let _ = writeln!(extra, "reference={rid}");
+                        }
                         let id = run_id(sweep.scene, &r.canonical, &extra);
                         if seen.contains_key(&id) {
                             let why = if r.dropped.is_empty() {
@@ -585,16 +713,18 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
                         let mut config = r.config.clone();
                         if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
                             let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
-                            config.perturbation = Some((p, seed));
+                            config.set_perturbation(Some((p, seed)));
                         }
                         runs.push(RunSpec {
                             run_id: id,
                             label: r.label.clone(),
                             params: r.params.clone(),
                             scheme_label: r.scheme_label.clone(),
-                            config: RunConfig::Bar1d(config),
+                            config,
                             repeats: sweep.repeats,
                             sample,
+                            scene: sweep.scene,
+                            reference: reference.clone(),
                         });
                     }
                 }
@@ -637,6 +767,7 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
         excluded_by_filter,
         inapplicable,
         collapsed,
+        references,
     })
 }
 

@@ -118,3 +118,38 @@ pub fn assert_complete(dir: &Path, n: usize) -> std::collections::HashSet<String
     }
     ids
 }
+
+/// Plan and run a sweep given as text through the library (references computed into a
+/// temporary folder), on two threads; the records in plan order.
+pub fn run_sweep_text(text: &str) -> Vec<contact_sweep::run::RunRecord> {
+    use contact_sweep::exec::{self, ExecOptions};
+    use contact_sweep::sweep::{SweepFile, expand};
+    let sweep = SweepFile::parse(Path::new("test.toml"), text).expect("valid sweep");
+    let plan = expand(&sweep).expect("plan");
+    let dir = tempfile::tempdir().unwrap();
+    let runs: Vec<_> = plan.runs.iter().collect();
+    let opts = RunOptions {
+        series_every: 0,
+        timeout: None,
+        cancel: None,
+    };
+    let refs = exec::references::ensure(dir.path(), &plan, &runs, &opts).expect("references");
+    let mut out = Vec::new();
+    exec::execute::<()>(
+        &plan.sweep.name,
+        &runs,
+        &refs,
+        &ExecOptions {
+            threads: 2,
+            run: opts,
+        },
+        |r| {
+            out.push(r.record);
+            Ok(())
+        },
+    )
+    .unwrap();
+    let order: Vec<&str> = plan.runs.iter().map(|r| r.run_id.as_str()).collect();
+    out.sort_by_key(|r| order.iter().position(|id| *id == r.run_id));
+    out
+}

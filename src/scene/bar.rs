@@ -1,0 +1,190 @@
+//! The elastic bar dropped on an obstacle, 2D (plane strain) and 3D (SPEC §1.2; papers 000
+//! Table 1 and 002).
+//!
+//! Ω = [0, 0.1] × [0, 1] or [0, 0.1]² × [0, 1], the last axis vertical; ρ = 1, λ = 0.25,
+//! μ = 0.5; Q1 squares/cubes of side h. The top face x_d = 1 is clamped, the sides are
+//! traction-free, the bottom face x_d = 0 is Γ_C, facing a rigid plane at distance g = 0.2:
+//! u_d ≥ −g. Undeformed at t = 0 with v⁰ = −½ e_d on every node not on the clamped face; T = 2.
+//! There is no closed form: errors are measured against a reference run of the same scene on a
+//! nested finer mesh and step (SPEC §1.2, the sweep file's `reference = {…}`).
+//!
+//! `elements` counts the elements across the height (n_d = 1/h); the width 0.1 must hold a whole
+//! number of elements too, so h ∈ {0.1, 0.05, 0.025, …, 0.1/k}.
+
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+
+/// The finite-element geometry a scene asks for.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FeGeometry {
+    /// A box [0, extent_0] × … meshed by Q1 elements, `cells` per axis; the last axis is
+    /// vertical, its top face clamped, its bottom face the contact boundary.
+    Box { extent: Vec<f64>, cells: Vec<usize> },
+}
+
+/// A finite-element scene as the sparse engine runs it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FeSetup {
+    /// Scene name (for messages).
+    pub scene: &'static str,
+    pub dim: usize,
+    pub geometry: FeGeometry,
+    /// Nominal mesh size.
+    pub h: f64,
+    pub density: f64,
+    pub lame_lambda: f64,
+    pub lame_mu: f64,
+    /// Distance from Γ_C to the rigid plane.
+    pub gap: f64,
+    /// Volume load per unit mass towards the obstacle (−gravity e_d).
+    pub gravity: f64,
+    /// Initial vertical velocity of every node not on a clamped face.
+    pub v0: f64,
+}
+
+/// The scenes `bar2d` (dim 2) and `bar3d` (dim 3).
+#[derive(Debug, Clone, Copy)]
+pub struct BarScene {
+    pub dim: usize,
+}
+
+const BAR_PHYSICS: [PhysicsKey; 4] = [
+    PhysicsKey {
+        name: "density",
+        default: 1.0,
+    },
+    PhysicsKey {
+        name: "lame_lambda",
+        default: 0.25,
+    },
+    PhysicsKey {
+        name: "lame_mu",
+        default: 0.5,
+    },
+    PhysicsKey {
+        name: "gap",
+        default: 0.2,
+    },
+];
+
+/// Width and height of the bars.
+const WIDTH: f64 = 0.1;
+const HEIGHT: f64 = 1.0;
+
+impl BarScene {
+    fn check_width(h: f64) -> Result<usize, String> {
+        let r = WIDTH / h;
+        let n = r.round();
+        if n < 1.0 || (r - n).abs() > 1e-9 * n.max(1.0) {
+            return Err(format!(
+                "h = {h} does not divide the bar's width {WIDTH} into a whole number of square elements (0.1/h = {r}); use h = 0.1/k"
+            ));
+        }
+        Ok(n as usize)
+    }
+}
+
+impl Scene for BarScene {
+    fn name(&self) -> &'static str {
+        if self.dim == 2 { "bar2d" } else { "bar3d" }
+    }
+    fn physics(&self) -> &'static [PhysicsKey] {
+        &BAR_PHYSICS
+    }
+    fn default_t(&self) -> f64 {
+        2.0
+    }
+    fn wave_speed(&self, p: &Physics) -> f64 {
+        ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()
+    }
+    fn mesh_from_h(&self, _p: &Physics, h: f64) -> Result<MeshChoice, String> {
+        let n = Self::check_width(h)?;
+        let h = WIDTH / n as f64;
+        Ok(MeshChoice {
+            elements: (HEIGHT / h).round() as usize,
+            h,
+        })
+    }
+    fn mesh_from_elements(&self, p: &Physics, elements: usize) -> Result<MeshChoice, String> {
+        self.mesh_from_h(p, HEIGHT / elements as f64)
+            .map_err(|e| format!("elements = {elements} (h = 1/{elements}): {e}"))
+    }
+    fn supports(
+        &self,
+        space: &str,
+        mass: &str,
+        scheme: &str,
+    ) -> Result<(), (&'static str, String)> {
+        if space != "mixed" {
+            return Err((
+                "space",
+                format!(
+                    "space = {space} is not available for scene {} (SPEC §1.2 uses the nodal multiplier, `mixed`)",
+                    self.name()
+                ),
+            ));
+        }
+        if matches!(mass, "singular-dynamic" | "node-neighbour") {
+            return Err((
+                "mass",
+                format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
+            ));
+        }
+        if matches!(scheme, "paoli-schatzman" | "hybrid") {
+            return Err((
+                "scheme",
+                format!(
+                    "scheme = {scheme} is implemented for the 1D bar only (000 §4–5); scene {} takes newmark and theta schemes",
+                    self.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+    fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
+        Some(ErrorSource::ReferenceRun)
+    }
+    fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
+        let across = (WIDTH / mesh.h).round() as usize;
+        let (extent, cells) = if self.dim == 2 {
+            (vec![WIDTH, HEIGHT], vec![across, mesh.elements])
+        } else {
+            (
+                vec![WIDTH, WIDTH, HEIGHT],
+                vec![across, across, mesh.elements],
+            )
+        };
+        SceneSetup::Fe(FeSetup {
+            scene: self.name(),
+            dim: self.dim,
+            geometry: FeGeometry::Box { extent, cells },
+            h: mesh.h,
+            density: p.get("density"),
+            lame_lambda: p.get("lame_lambda"),
+            lame_mu: p.get("lame_mu"),
+            gap: p.get("gap"),
+            gravity: 0.0,
+            v0: -0.5,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn physics() -> Physics {
+        Physics(BAR_PHYSICS.iter().map(|k| (k.name, k.default)).collect())
+    }
+
+    #[test]
+    fn mesh_sizes_divide_the_width() {
+        let s = BarScene { dim: 2 };
+        let m = s.mesh_from_h(&physics(), 0.05).unwrap();
+        assert_eq!(m.elements, 20);
+        assert!(s.mesh_from_h(&physics(), 0.03).is_err());
+        assert!(s.mesh_from_elements(&physics(), 25).is_err());
+        assert_eq!(s.mesh_from_elements(&physics(), 40).unwrap().h, 0.025);
+        // P-wave speed √((λ+2μ)/ρ) = √1.25 with the defaults.
+        assert!((s.wave_speed(&physics()) - 1.25f64.sqrt()).abs() < 1e-15);
+    }
+}
