@@ -8,6 +8,8 @@
 //! method produced them.
 
 pub mod bar1d;
+pub mod fe;
+pub mod linalg;
 pub mod tridiag;
 
 pub use bar1d::Bar1dSpace;

@@ -1,0 +1,314 @@
+//! Element matrices of the vector Q1 element (bilinear squares, trilinear cubes), isoparametric.
+//!
+//! Reference element [−1, 1]^d with the 2^d nodes in tensor order (local node a sits at
+//! ξ_k = −1 if bit k of a is 0, +1 otherwise) and shape functions N_a(ξ) = Π_k (1 + s_ak ξ_k)/2.
+//! At each quadrature point the Jacobian J = Σ_a x_a ⊗ ∇_ξ N_a maps the reference gradients to
+//! physical ones, ∇N_a = J⁻ᵀ ∇_ξ N_a, and dx = det J dξ — nothing assumes the box's constant
+//! Jacobian, so distorted (mapped) elements use the same code.
+//!
+//! Element dofs are node-major like the global ones: local dof a·d + i is component i of node a.
+//! With isotropic elasticity (2D = plane strain) the forms are
+//! - mass        M_{ai,bj} = δ_ij ∫ ρ N_a N_b,
+//! - stiffness   K_{ai,bj} = ∫ λ ∂_i N_a ∂_j N_b + μ (δ_ij ∇N_a·∇N_b + ∂_j N_a ∂_i N_b)
+//!   (the bilinear form ∫ λ div u div v + 2μ ε(u):ε(v)),
+//! - grad-grad   G_{ai,bj} = δ_ij ∫ ∇N_a·∇N_b (full vector gradient, for H1 error norms),
+//! - load        F_{ai} = ∫ ρ f_i N_a.
+//!
+//! Quadrature: Gauss–Legendre with 2 points per direction. It is exact for the Q1 mass and
+//! stiffness on squares, rectangles and boxes (integrands of degree ≤ 2 per variable, the rule is
+//! exact to degree 3) — the matrices of SPEC §1.2, never a reduced integration. On distorted
+//! elements the stiffness integrand is rational and the rule is the usual approximation; it still
+//! integrates ∫ ∇N_a exactly (cofactor of J is polynomial of degree ≤ 2 per variable), which is
+//! what the patch test needs.
+//!
+//! The kernels are generic over the dimension `D`, the node count `NN` and the dof count
+//! `ND = D·NN` (checked at compile time), so the 2D and 3D paths share one code; the concrete
+//! sizes are [`Q1Mat2`] (8×8) and [`Q1Mat3`] (24×24).
+
+use nalgebra::{SMatrix, SVector};
+
+/// The 2D Q1 element matrix (4 nodes × 2 components).
+pub type Q1Mat2 = SMatrix<f64, 8, 8>;
+/// The 3D Q1 element matrix (8 nodes × 3 components).
+pub type Q1Mat3 = SMatrix<f64, 24, 24>;
+
+/// Which element bilinear form to compute (see the module header).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ElementOp {
+    /// Vector mass ρ ∫ N_a N_b δ_ij.
+    Mass { rho: f64 },
+    /// Isotropic linear elasticity (plane strain in 2D).
+    Stiffness { lambda: f64, mu: f64 },
+    /// ∫ ∇u : ∇v (full vector gradient).
+    GradGrad,
+}
+
+/// Gauss–Legendre points and weights on [−1, 1] (2 points: exact to degree 3).
+const GAUSS2: [(f64, f64); 2] = [
+    (-0.577_350_269_189_625_8, 1.0),
+    (0.577_350_269_189_625_8, 1.0),
+];
+
+/// Q1 shape functions and their reference gradients at ξ.
+fn q1_shape<const D: usize, const NN: usize>(xi: [f64; D]) -> ([f64; NN], [[f64; D]; NN]) {
+    const { assert!(NN == 1 << D) };
+    let mut n = [0.0; NN];
+    let mut dn = [[0.0; D]; NN];
+    for a in 0..NN {
+        // One-dimensional factors (1 ± ξ_k)/2 and their derivatives ±1/2.
+        let mut f = [0.0; D];
+        let mut df = [0.0; D];
+        for k in 0..D {
+            let s = if (a >> k) & 1 == 1 { 1.0 } else { -1.0 };
+            f[k] = 0.5 * (1.0 + s * xi[k]);
+            df[k] = 0.5 * s;
+        }
+        n[a] = f.iter().product();
+        for j in 0..D {
+            dn[a][j] = (0..D).map(|k| if k == j { df[k] } else { f[k] }).product();
+        }
+    }
+    (n, dn)
+}
+
+/// Determinant and inverse of a 2×2 or 3×3 matrix (cofactor formulas).
+fn det_inv<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
+    let mut inv = [[0.0; D]; D];
+    let det = match D {
+        2 => {
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            inv[0][0] = j[1][1] / det;
+            inv[0][1] = -j[0][1] / det;
+            inv[1][0] = -j[1][0] / det;
+            inv[1][1] = j[0][0] / det;
+            det
+        }
+        3 => {
+            // inv = adj(J)/det, adj_ik = cofactor_ki.
+            let c = |r: usize, s: usize| {
+                let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+                let (s1, s2) = ((s + 1) % 3, (s + 2) % 3);
+                j[r1][s1] * j[r2][s2] - j[r1][s2] * j[r2][s1]
+            };
+            let det = j[0][0] * c(0, 0) + j[0][1] * c(0, 1) + j[0][2] * c(0, 2);
+            for i in 0..3 {
+                for k in 0..3 {
+                    inv[i][k] = c(k, i) / det;
+                }
+            }
+            det
+        }
+        _ => unreachable!("Q1 elements exist in 2D and 3D only"),
+    };
+    (det, inv)
+}
+
+/// Shape functions, physical gradients and det J at reference point ξ of the element with node
+/// coordinates `x`.
+///
+/// # Panics
+/// If det J ≤ 0 (inverted or degenerate element: a mesh construction bug; the structured meshes
+/// never produce one).
+fn map_at<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+    xi: [f64; D],
+) -> ([f64; NN], [[f64; D]; NN], f64) {
+    let (n, dn) = q1_shape::<D, NN>(xi);
+    let mut jac = [[0.0; D]; D];
+    for a in 0..NN {
+        for i in 0..D {
+            for j in 0..D {
+                jac[i][j] += x[a][i] * dn[a][j];
+            }
+        }
+    }
+    let (det, jinv) = det_inv(&jac);
+    assert!(
+        det > 0.0,
+        "Q1 element with det J = {det} ≤ 0 (inverted or degenerate element)"
+    );
+    // ∇N_a = J⁻ᵀ ∇_ξ N_a, i.e. g_i = Σ_j (J⁻¹)_ji ∂_ξj N_a.
+    let mut g = [[0.0; D]; NN];
+    for a in 0..NN {
+        for i in 0..D {
+            g[a][i] = (0..D).map(|j| jinv[j][i] * dn[a][j]).sum();
+        }
+    }
+    (n, g, det)
+}
+
+/// Calls `f(N, ∇N, w·det J)` at each of the 2^D Gauss points of the element with node
+/// coordinates `x`.
+fn for_each_point<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+    mut f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),
+) {
+    for q in 0..NN {
+        let mut xi = [0.0; D];
+        let mut w = 1.0;
+        for k in 0..D {
+            let (p, wk) = GAUSS2[(q >> k) & 1];
+            xi[k] = p;
+            w *= wk;
+        }
+        let (n, g, det) = map_at(x, xi);
+        f(&n, &g, w * det);
+    }
+}
+
+/// The displacement gradient ∇u (`[i][j]` = ∂u_i/∂x_j) at reference point ξ ∈ [−1, 1]^D of the
+/// element with node coordinates `x` and nodal displacements `u` (strains and stresses).
+pub fn q1_gradient_at<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+    u: &[[f64; D]; NN],
+    xi: [f64; D],
+) -> [[f64; D]; D] {
+    let (_, g, _) = map_at(x, xi);
+    let mut grad = [[0.0; D]; D];
+    for a in 0..NN {
+        for i in 0..D {
+            for j in 0..D {
+                grad[i][j] += u[a][i] * g[a][j];
+            }
+        }
+    }
+    grad
+}
+
+/// The element matrix of `op` for the element with node coordinates `x`.
+pub fn element_matrix<const D: usize, const NN: usize, const ND: usize>(
+    op: ElementOp,
+    x: &[[f64; D]; NN],
+) -> SMatrix<f64, ND, ND> {
+    match op {
+        ElementOp::Mass { rho } => q1_mass(x, rho),
+        ElementOp::Stiffness { lambda, mu } => q1_stiffness(x, lambda, mu),
+        ElementOp::GradGrad => q1_grad_grad(x),
+    }
+}
+
+/// Vector mass matrix ρ ∫ N_a N_b δ_ij.
+pub fn q1_mass<const D: usize, const NN: usize, const ND: usize>(
+    x: &[[f64; D]; NN],
+    rho: f64,
+) -> SMatrix<f64, ND, ND> {
+    const { assert!(ND == D * NN) };
+    let mut m = SMatrix::<f64, ND, ND>::zeros();
+    for_each_point(x, |n, _, dv| {
+        for a in 0..NN {
+            for b in 0..NN {
+                let v = rho * n[a] * n[b] * dv;
+                for i in 0..D {
+                    m[(a * D + i, b * D + i)] += v;
+                }
+            }
+        }
+    });
+    m
+}
+
+/// Isotropic elasticity stiffness ∫ λ div u div v + 2μ ε(u):ε(v) (plane strain in 2D).
+pub fn q1_stiffness<const D: usize, const NN: usize, const ND: usize>(
+    x: &[[f64; D]; NN],
+    lambda: f64,
+    mu: f64,
+) -> SMatrix<f64, ND, ND> {
+    const { assert!(ND == D * NN) };
+    let mut k = SMatrix::<f64, ND, ND>::zeros();
+    for_each_point(x, |_, g, dv| {
+        for a in 0..NN {
+            for b in 0..NN {
+                let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
+                for i in 0..D {
+                    for j in 0..D {
+                        let mut v = lambda * g[a][i] * g[b][j] + mu * g[a][j] * g[b][i];
+                        if i == j {
+                            v += mu * gab;
+                        }
+                        k[(a * D + i, b * D + j)] += v * dv;
+                    }
+                }
+            }
+        }
+    });
+    k
+}
+
+/// ∫ ∇u : ∇v, the full vector gradient (δ_ij ∫ ∇N_a·∇N_b).
+pub fn q1_grad_grad<const D: usize, const NN: usize, const ND: usize>(
+    x: &[[f64; D]; NN],
+) -> SMatrix<f64, ND, ND> {
+    const { assert!(ND == D * NN) };
+    let mut k = SMatrix::<f64, ND, ND>::zeros();
+    for_each_point(x, |_, g, dv| {
+        for a in 0..NN {
+            for b in 0..NN {
+                let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
+                for i in 0..D {
+                    k[(a * D + i, b * D + i)] += gab * dv;
+                }
+            }
+        }
+    });
+    k
+}
+
+/// Volume load ∫ ρ f·v for a constant body force density f (only the first D components used).
+pub fn q1_load<const D: usize, const NN: usize, const ND: usize>(
+    x: &[[f64; D]; NN],
+    rho: f64,
+    f: [f64; 3],
+) -> SVector<f64, ND> {
+    const { assert!(ND == D * NN) };
+    let mut r = SVector::<f64, ND>::zeros();
+    for_each_point(x, |n, _, dv| {
+        for a in 0..NN {
+            for i in 0..D {
+                r[a * D + i] += rho * f[i] * n[a] * dv;
+            }
+        }
+    });
+    r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(h: f64) -> [[f64; 2]; 4] {
+        [[0.0, 0.0], [h, 0.0], [0.0, h], [h, h]]
+    }
+
+    #[test]
+    fn shape_functions_partition_unity() {
+        // Σ N_a = 1 and Σ ∇_ξ N_a = 0 at an arbitrary point: exact polynomial identities, so only
+        // rounding (a few ulps) remains.
+        let (n, dn) = q1_shape::<3, 8>([0.3, -0.7, 0.1]);
+        assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        for j in 0..3 {
+            assert!(dn.iter().map(|d| d[j]).sum::<f64>().abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn element_matrices_are_symmetric() {
+        // A distorted quadrilateral: symmetry is structural (same sums in both orders up to
+        // rounding of a few terms of size ≤ λ+2μ), so 1e-14 absolute.
+        let x = [[0.0, 0.0], [1.1, 0.1], [-0.1, 0.9], [1.2, 1.3]];
+        let k: Q1Mat2 = q1_stiffness(&x, 0.25, 0.5);
+        let m: Q1Mat2 = q1_mass(&x, 1.0);
+        assert!((k - k.transpose()).amax() < 1e-14);
+        assert!((m - m.transpose()).amax() < 1e-14);
+    }
+
+    #[test]
+    fn load_sums_to_force_times_volume() {
+        // Σ_a F_ai = ρ f_i |e| since Σ N_a = 1; exact quadrature of a linear det J → 1e-15.
+        let x = square(0.5);
+        let f: SVector<f64, 8> = q1_load(&x, 2.0, [1.0, -3.0, 0.0]);
+        let fx: f64 = (0..4).map(|a| f[2 * a]).sum();
+        let fy: f64 = (0..4).map(|a| f[2 * a + 1]).sum();
+        assert!((fx - 2.0 * 0.25).abs() < 1e-15);
+        assert!((fy + 2.0 * 3.0 * 0.25).abs() < 1e-15);
+    }
+}

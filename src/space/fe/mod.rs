@@ -1,0 +1,146 @@
+//! The finite-element layer of the 2D/3D scenes (SPEC §1.2, §2): meshes, vector Q1 element
+//! matrices, and global sparse assembly with the pattern built once and refilled many times.
+//!
+//! - [`mesh`]: the structured box of Q1 squares/cubes (`bar2d`, `bar3d`) behind the [`Mesh`]
+//!   trait (elements = node ids + node coordinates), so mapped meshes plug in later;
+//! - [`element`]: isoparametric Q1 mass, elasticity stiffness, grad-grad and load with nalgebra
+//!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
+//! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
+//!   element weights (the layer-weighted masses of SPEC §2.2) and the matrix operations of a
+//!   time loop (`matvec_into` allocates nothing).
+//!
+//! Degrees of freedom are node-major interleaved: dof = node·d + component. Constrained dofs
+//! (Dirichlet: clamped face, rollers) are dropped from the assembled matrices by [`DofMap`];
+//! the factorisation of the assembled matrices is [`crate::space::linalg`].
+
+pub mod element;
+pub mod mesh;
+pub mod sparse;
+
+pub use element::{ElementOp, Q1Mat2, Q1Mat3};
+pub use mesh::{BoxMesh, Mesh};
+pub use sparse::{Pattern, SymMatrix, assemble, assemble_into, assemble_load, fe_pattern};
+
+/// Errors of the finite-element layer (bad shapes, bad user-given matrices).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FeError {
+    #[error("invalid mesh: {0}")]
+    BadMesh(String),
+    #[error("invalid matrix: {0}")]
+    BadMatrix(String),
+}
+
+/// Which global dofs are unknowns: `free[r]` is the global dof of reduced index r (increasing),
+/// `free_of[g]` the reduced index of global dof g or `u32::MAX` if g is constrained.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DofMap {
+    pub n_total: usize,
+    pub free_of: Vec<u32>,
+    pub free: Vec<usize>,
+}
+
+impl DofMap {
+    /// Marker of a constrained dof in `free_of`.
+    pub const CONSTRAINED: u32 = u32::MAX;
+
+    /// Keep the dofs for which `constrained(g)` is false, in increasing order.
+    ///
+    /// # Panics
+    /// If `n_total` ≥ 2³² − 1 (reduced indices are stored as u32: 4·10⁹ dofs is far beyond what
+    /// a direct solver handles).
+    pub fn new(n_total: usize, constrained: impl Fn(usize) -> bool) -> DofMap {
+        assert!(
+            n_total < u32::MAX as usize,
+            "DofMap: {n_total} dofs exceed the u32 index range"
+        );
+        let mut free_of = vec![Self::CONSTRAINED; n_total];
+        let mut free = Vec::with_capacity(n_total);
+        for (g, slot) in free_of.iter_mut().enumerate() {
+            if !constrained(g) {
+                *slot = free.len() as u32;
+                free.push(g);
+            }
+        }
+        DofMap {
+            n_total,
+            free_of,
+            free,
+        }
+    }
+
+    /// Dofs of a mesh with `dim` components per node, constrained per (node, component).
+    pub fn for_nodes(
+        num_nodes: usize,
+        dim: usize,
+        constrained: impl Fn(usize, usize) -> bool,
+    ) -> DofMap {
+        DofMap::new(num_nodes * dim, |g| constrained(g / dim, g % dim))
+    }
+
+    /// Nothing constrained (the full dof set: total mass, rigid motions, error norms).
+    pub fn all(n_total: usize) -> DofMap {
+        DofMap::new(n_total, |_| false)
+    }
+
+    pub fn n_free(&self) -> usize {
+        self.free.len()
+    }
+
+    /// Reduced index of global dof `g`, `None` if constrained.
+    pub fn free_index(&self, g: usize) -> Option<usize> {
+        match self.free_of[g] {
+            Self::CONSTRAINED => None,
+            r => Some(r as usize),
+        }
+    }
+
+    /// The free dofs (reduced indices) in the order of `node_order`, components of a node
+    /// together: turns a node ordering (e.g. [`BoxMesh::nested_dissection`]) into an elimination
+    /// order for [`crate::space::linalg::SymbolicCholesky::with_ordering`].
+    pub fn order_by_nodes(&self, node_order: &[usize], dim: usize) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.n_free());
+        for &n in node_order {
+            for c in 0..dim {
+                if let Some(r) = self.free_index(n * dim + c) {
+                    out.push(r);
+                }
+            }
+        }
+        out
+    }
+
+    /// `reduced[r] = full[free[r]]`.
+    pub fn gather(&self, full: &[f64], reduced: &mut [f64]) {
+        for (r, &g) in reduced.iter_mut().zip(&self.free) {
+            *r = full[g];
+        }
+    }
+
+    /// `full[free[r]] = reduced[r]`; constrained entries of `full` are left as they are.
+    pub fn scatter(&self, reduced: &[f64], full: &mut [f64]) {
+        for (&r, &g) in reduced.iter().zip(&self.free) {
+            full[g] = r;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dofmap_round_trip() {
+        // 3 nodes × 2 components, node 1 clamped, x of node 2 on a roller.
+        let d = DofMap::for_nodes(3, 2, |n, c| n == 1 || (n == 2 && c == 0));
+        assert_eq!(d.free, vec![0, 1, 5]);
+        assert_eq!(d.free_index(5), Some(2));
+        assert_eq!(d.free_index(2), None);
+        let full = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+        let mut red = [0.0; 3];
+        d.gather(&full, &mut red);
+        assert_eq!(red, [1.0, 2.0, 6.0]);
+        let mut back = [0.0; 6];
+        d.scatter(&red, &mut back);
+        assert_eq!(back, [1.0, 2.0, 0.0, 0.0, 0.0, 6.0]);
+    }
+}
