@@ -274,3 +274,31 @@ mass = ["mod1", "mod3"]
         "recomputed bit for bit"
     );
 }
+
+/// Runs with the same matrix (mesh, material, mass, dt, scheme coefficient) share one
+/// factorisation: the second finds it in the cache. T and Newmark's γ do not enter
+/// A = M + βτ²K, so these three runs need one factorisation in all. (A material value no other
+/// test uses keeps the process-wide cache key to this test.)
+#[test]
+fn runs_with_the_same_matrix_share_one_factorisation() {
+    let rows = run_sweep_text(
+        r#"
+name = "c"
+scene = "bar2d"
+[fixed]
+h = 0.05
+dt = 0.025
+lame_mu = 0.4375
+mass = "mod3"
+[grid]
+method = [
+  { T = 0.5, scheme = "crank-nicolson" },
+  { T = 1.0, scheme = "crank-nicolson" },
+  { T = 1.0, scheme = "newmark", newmark_beta = 0.25, newmark_gamma = 0.6 },
+]
+"#,
+    );
+    let computed: i64 = rows.iter().map(|r| r.factorizations).sum();
+    let hits: i64 = rows.iter().map(|r| r.factor_cache_hits.unwrap()).sum();
+    assert_eq!((computed, hits), (1, 2), "{rows:?}");
+}
