@@ -19,7 +19,7 @@
 use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
-use super::{Metrics, Outcome, RunOptions, Status};
+use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::{BarExact, BarParams};
 use crate::space::bar1d::Pair;
@@ -103,14 +103,6 @@ fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
         ContactMethod::Penalty { gamma0 } => active.diag[0] += sp.penalty_stiffness(gamma0),
     }
     free.max(active.max_generalized_eigenvalue(&sp.mass))
-}
-
-/// Why a run stopped before its last step.
-enum Stop {
-    Solver(usize, ContactSolveError),
-    Diverged(Divergence),
-    Timeout(usize),
-    Cancelled,
 }
 
 /// The per-run constant part: operators, factorisations, condensed contact.
@@ -563,7 +555,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         }
     };
     // Checked every CLOCK_EVERY steps: the time budget and an interruption of the sweep.
-    let interrupted = |n: usize| -> Result<(), Stop> {
+    let interrupted = |n: usize| -> Result<(), Stop<ContactSolveError>> {
         if !n.is_multiple_of(CLOCK_EVERY) {
             return Ok(());
         }
@@ -576,7 +568,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     };
     let mut done = 0usize;
-    let stop = (|| -> Result<(), Stop> {
+    let stop = (|| -> Result<(), Stop<ContactSolveError>> {
         rec.record(0, &st.u, &st.v, sigma0)
             .map_err(Stop::Diverged)?;
         match &starter {
@@ -636,26 +628,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     })();
     metrics.steps = done as i64;
-    let (status, message) = match stop {
-        Ok(()) => (Status::Ok, None),
-        Err(Stop::Solver(n, e)) => {
-            metrics.solver_failures = 1;
-            (
-                Status::SolverFailed,
-                Some(format!("step {n} (t = {:.6}): {e}", n as f64 * tau)),
-            )
-        }
-        Err(Stop::Diverged(d)) => (Status::Diverged, Some(d.0)),
-        Err(Stop::Cancelled) => (Status::Cancelled, Some("interrupted".into())),
-        Err(Stop::Timeout(n)) => (
-            Status::Timeout,
-            Some(format!(
-                "run timeout after {:.3} s at step {n} of {}",
-                start.elapsed().as_secs_f64(),
-                cfg.steps
-            )),
-        ),
-    };
+    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     rec.obs.finish(&mut metrics, status == Status::Ok);
     Outcome {
         status,

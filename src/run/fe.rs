@@ -30,7 +30,7 @@ use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::reference::ReferenceData;
-use super::{Metrics, Outcome, RunContext, RunOptions, Status};
+use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
 use crate::contact::{Lcp, LcpError};
 use crate::scene::{FeGeometry, FeSetup};
 use crate::space::fe::{BoxMesh, DofMap, ElementOp, Pattern, SymMatrix, assemble, fe_pattern};
@@ -437,14 +437,6 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
     })
 }
 
-/// Why the time loop stopped early.
-enum Stop {
-    Solver(usize, LcpError),
-    Diverged(Divergence),
-    Timeout(usize),
-    Cancelled,
-}
-
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
     let start = Instant::now();
@@ -654,7 +646,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let mut done = 0usize;
     let mut iterations = 0i64;
-    let stop = (|| -> Result<(), Stop> {
+    let stop = (|| -> Result<(), Stop<LcpError>> {
         observe(0, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
         for step in 1..=cfg.steps {
@@ -710,26 +702,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.steps = done as i64;
     metrics.iterations = iterations;
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
-    let (status, message) = match stop {
-        Ok(()) => (Status::Ok, None),
-        Err(Stop::Solver(step, e)) => {
-            metrics.solver_failures = 1;
-            (
-                Status::SolverFailed,
-                Some(format!("step {step} (t = {:.6}): {e}", step as f64 * tau)),
-            )
-        }
-        Err(Stop::Diverged(dv)) => (Status::Diverged, Some(dv.0)),
-        Err(Stop::Cancelled) => (Status::Cancelled, Some("interrupted".into())),
-        Err(Stop::Timeout(step)) => (
-            Status::Timeout,
-            Some(format!(
-                "run timeout after {:.3} s at step {step} of {}",
-                start.elapsed().as_secs_f64(),
-                cfg.steps
-            )),
-        ),
-    };
+    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
     // The observer's pressure columns are the total force here; there is no midpoint pressure.
     metrics.err_force_l2 = metrics.err_sigma_l2.take();

@@ -153,6 +153,47 @@ pub struct RunContext {
     pub record_reference: Option<(usize, usize)>,
 }
 
+/// Why an engine's time loop stopped before its last step.
+pub(crate) enum Stop<E> {
+    /// The contact problem of this step had no (or several) solutions.
+    Solver(usize, E),
+    Diverged(observe::Divergence),
+    Timeout(usize),
+    Cancelled,
+}
+
+impl<E: std::fmt::Display> Stop<E> {
+    /// The run's status and message for how its loop ended (`tau` and `steps` for the
+    /// message); a solver failure is counted in `metrics`.
+    pub(crate) fn status(
+        end: Result<(), Stop<E>>,
+        tau: f64,
+        steps: usize,
+        start: std::time::Instant,
+        metrics: &mut Metrics,
+    ) -> (Status, Option<String>) {
+        match end {
+            Ok(()) => (Status::Ok, None),
+            Err(Stop::Solver(n, e)) => {
+                metrics.solver_failures = 1;
+                (
+                    Status::SolverFailed,
+                    Some(format!("step {n} (t = {:.6}): {e}", n as f64 * tau)),
+                )
+            }
+            Err(Stop::Diverged(d)) => (Status::Diverged, Some(d.0)),
+            Err(Stop::Cancelled) => (Status::Cancelled, Some("interrupted".into())),
+            Err(Stop::Timeout(n)) => (
+                Status::Timeout,
+                Some(format!(
+                    "run timeout after {:.3} s at step {n} of {steps}",
+                    start.elapsed().as_secs_f64()
+                )),
+            ),
+        }
+    }
+}
+
 /// What a run produced.
 #[derive(Debug, Clone)]
 pub struct Outcome {

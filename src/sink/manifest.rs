@@ -113,13 +113,7 @@ impl Manifest {
             let path = path.to_path_buf();
             move |source| SinkError::Io { path, source }
         };
-        let lock = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&lock_path)
-            .map_err(io(&lock_path))?;
-        lock.lock().map_err(io(&lock_path))?;
+        let _lock = super::lock_exclusive(&lock_path).map_err(io(&lock_path))?;
         let mut doc = if self.path.exists() {
             let text = std::fs::read_to_string(&self.path).map_err(io(&self.path))?;
             serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
