@@ -2,7 +2,9 @@
 //!
 //! A sweep file names a scene and a parameter space: `[fixed]` values, a cartesian `[grid]`
 //! (items may be bundles — inline tables setting several parameters at once), equal-length
-//! `[zip]` lists advanced together, and `exclude` filters. Everything is checked before
+//! `[zip]` lists advanced together, and `exclude` filters; a `[summary]` table chooses the
+//! columns of the convergence tables ([`crate::summary::SummaryOptions`]; [`summary_options`]
+//! reads it back from the text stored in a results folder). Everything is checked before
 //! anything runs: each problem is reported with the file, the key path, the line and the
 //! reason ([`SweepError`]). [`plan::expand`] turns the file into [`plan::Plan`]: deterministic
 //! order, meaningless combinations dropped, parameters that do not apply to a run's method
