@@ -22,7 +22,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::run::RunConfig;
 use crate::run::bar1d::Bar1dConfig;
 use crate::scene::{BarParams, SceneKind};
-use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag};
+use crate::space::{Bar1dSpace, ContactInit, ContactMethod, MassVariant, Tridiag};
 use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
 
 /// One run of the plan.
@@ -86,6 +86,7 @@ fn default_of(key: Key) -> Option<Value> {
         Key::Length | Key::Young | Key::Density => Value::Num(1.0),
         Key::Amplitude => Value::Num(0.5),
         Key::Gap => Value::Num(0.0),
+        Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
         _ => return None,
     })
 }
@@ -235,6 +236,7 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             Key::ThetaScheme => matches!(scheme, Scheme::Theta(_)),
             Key::Restitution => matches!(scheme, Scheme::PaoliSchatzman(_)),
             Key::MassWeights => mass_name == "weights",
+            Key::ContactInit => mass.massless_contact(),
             _ => true,
         };
         if ok {
@@ -247,6 +249,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             Key::NewmarkGamma => "applies to newmark only",
             Key::ThetaScheme => "applies to the theta scheme only",
             Key::Restitution => "applies to paoli-schatzman only",
+            Key::ContactInit => {
+                "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+            }
             _ => "applies to mass = weights only",
         })
     };
@@ -258,6 +263,9 @@ fn resolve(entries: &[&Entry]) -> Outcome {
 
     // Meaningless combinations (SPEC §3).
     let massless = mass.massless_contact();
+    let contact_init = get(Key::ContactInit)
+        .and_then(|v| v.as_str().and_then(ContactInit::from_name))
+        .expect("checked");
     if matches!(scheme, Scheme::PaoliSchatzman(_)) && method != ContactMethod::Mixed {
         return Outcome::Inapplicable("paoli-schatzman is defined for space = mixed only".into());
     }
@@ -406,6 +414,13 @@ fn resolve(entries: &[&Entry]) -> Outcome {
     if let MassVariant::Weights(w) = &mass {
         put(Key::MassWeights, Value::List(w.clone()), true);
     }
+    if massless {
+        put(
+            Key::ContactInit,
+            Value::Str(contact_init.name().into()),
+            false,
+        );
+    }
     match method {
         ContactMethod::Nitsche { theta, gamma0 } => {
             put(Key::NitscheTheta, Value::Num(theta), false);
@@ -450,6 +465,10 @@ fn resolve(entries: &[&Entry]) -> Outcome {
         ),
         other => other.name().to_string(),
     };
+    let mass_label = match (massless, contact_init) {
+        (true, ContactInit::Interpolant) => format!("{mass_label} (interpolant start)"),
+        _ => mass_label,
+    };
     let scheme_label = scheme.label();
     Outcome::Run(Box::new(Resolved {
         params,
@@ -465,6 +484,11 @@ fn resolve(entries: &[&Entry]) -> Outcome {
             method,
             mass,
             scheme,
+            contact_init: if massless {
+                contact_init
+            } else {
+                ContactInit::Consistent
+            },
             perturbation: None,
         },
         dropped,
