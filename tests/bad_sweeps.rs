@@ -9,6 +9,11 @@ use common::{cli, write};
 /// (file body, key the message must name, a phrase of the reason)
 const CASES: &[(&str, &str, &str)] = &[
     (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"mod3\"\n[grid]\ncontact_init = [\"consistent\", \"exact\"]\n",
+        "grid.contact_init[1]",
+        "unknown contact_init `exact` (expected consistent or interpolant",
+    ),
+    (
         "name = \"x\"\nscene = \"bar1d\"\nnmae = 1\n[fixed]\nh = 0.1\ndt = 0.1\n",
         "nmae",
         "unknown top-level key",

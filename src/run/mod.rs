@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use crate::scene::SceneSetup;
-use crate::space::{ContactMethod, MassVariant};
+use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
 pub use observe::{Metrics, SeriesRow};
@@ -103,6 +103,7 @@ impl RunConfig {
                 method,
                 mass,
                 scheme,
+                contact_init: ContactInit::Consistent,
                 perturbation: None,
             }),
             SceneSetup::Fe(setup) => RunConfig::Fe(fe::FeConfig {
@@ -115,6 +116,16 @@ impl RunConfig {
                 perturbation: None,
             }),
         }
+    }
+
+    /// The initial value of a massless contact node (SPEC §2.2). The FE scenes start from
+    /// rest and unloaded, where the interpolant of u⁰ = 0 is already the quasi-static value:
+    /// both starts are the same state there.
+    pub fn with_contact_init(mut self, init: ContactInit) -> RunConfig {
+        if let RunConfig::Bar1d(c) = &mut self {
+            c.contact_init = init;
+        }
+        self
     }
 
     /// Ensemble member: relative amplitude of a perturbation of u⁰ and its seed.
