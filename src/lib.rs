@@ -32,11 +32,11 @@
 pub mod cli;
 pub mod contact;
 pub mod exec;
+pub mod report;
 pub mod run;
 pub mod scene;
 pub mod sink;
 pub mod space;
 pub mod summary;
-pub mod report;
 pub mod sweep;
 pub mod time;

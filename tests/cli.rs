@@ -73,7 +73,10 @@ fn quickstart_runs_and_prints_errors_against_the_exact_solution() {
         "{stdout}"
     );
     // One engineering format: no `e0` exponents, no five-digit mantissas.
-    assert!(!stdout.contains("e0 ") && !stdout.contains("1.0025"), "{stdout}");
+    assert!(
+        !stdout.contains("e0 ") && !stdout.contains("1.0025"),
+        "{stdout}"
+    );
     let df = read_runs(&out).unwrap();
     assert!(df.height() >= 50, "quickstart has {} runs", df.height());
     // Every run has its errors against the closed form, and its derived columns filled.
@@ -505,11 +508,21 @@ fn table_flag_chooses_runs_or_groups() {
     assert_eq!(run_lines, 6, "{out}");
     assert!(out.contains("σ½ l2(τ): contact pressure error"), "{out}");
     // --table groups: no per-run line, one line per group.
-    let o = cli(tmp.path(), &["run", "s.toml", "--out", "b", "--table", "groups"]);
+    let o = cli(
+        tmp.path(),
+        &["run", "s.toml", "--out", "b", "--table", "groups"],
+    );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
-    assert_eq!(out.lines().filter(|l| l.contains("  ok  ")).count(), 0, "{out}");
-    assert!(out.contains("1  mixed · consistent · crank-nicolson"), "{out}");
+    assert_eq!(
+        out.lines().filter(|l| l.contains("  ok  ")).count(),
+        0,
+        "{out}"
+    );
+    assert!(
+        out.contains("1  mixed · consistent · crank-nicolson"),
+        "{out}"
+    );
     assert!(out.contains("2  mixed · mod3 · crank-nicolson"), "{out}");
     // A bad mode is a usage error (clap: exit 2) naming the accepted values.
     let o = cli(tmp.path(), &["run", "s.toml", "--table", "all"]);
@@ -519,15 +532,20 @@ fn table_flag_chooses_runs_or_groups() {
 
 #[test]
 fn every_subcommand_help_ends_with_examples() {
-    for sub in ["plan", "run", "summarize", "schema", "slurm"] {
+    for sub in ["plan", "run", "summarize", "schema", "slurm", "report"] {
         let o = cli(repo(), &[sub, "--help"]);
         assert!(o.status.success(), "{sub}");
         let help = String::from_utf8_lossy(&o.stdout);
         let tail = help.trim_end();
-        let at = tail.rfind("Examples:").unwrap_or_else(|| panic!("{sub}: {help}"));
+        let at = tail
+            .rfind("Examples:")
+            .unwrap_or_else(|| panic!("{sub}: {help}"));
         // the examples are the last block, each line a command
         assert!(
-            tail[at..].lines().skip(1).all(|l| l.trim_start().starts_with("contact-sweep ")),
+            tail[at..]
+                .lines()
+                .skip(1)
+                .all(|l| l.trim_start().starts_with("contact-sweep ")),
             "{sub}: {help}"
         );
     }

@@ -50,11 +50,20 @@ fn flags_give_the_ids_of_the_equivalent_file() {
     // fixed.h with the grid's h left in place: the axis overrides [fixed] (as in a file).
     let fixed = SweepFile::parse_with(Path::new("f.toml"), FILE, &sets(&["fixed.h=0.5"])).unwrap();
     assert_eq!(ids(&fixed), want);
-    assert!(fixed.overridden.iter().any(|n| n.contains("fixed.h")), "{:?}", fixed.overridden);
+    assert!(
+        fixed.overridden.iter().any(|n| n.contains("fixed.h")),
+        "{:?}",
+        fixed.overridden
+    );
     // Bare words are strings; a list of them is an axis.
     let schemes = SweepFile::from_flags(
         "bar1d",
-        &sets(&["h=0.25", "courant=1", "T=2", "scheme=[hybrid,crank-nicolson]"]),
+        &sets(&[
+            "h=0.25",
+            "courant=1",
+            "T=2",
+            "scheme=[hybrid,crank-nicolson]",
+        ]),
     )
     .unwrap();
     assert_eq!(ids(&schemes).len(), 2);
@@ -145,7 +154,14 @@ fn run_with_flags_only_matches_the_file_and_records_the_overrides() {
     // `summarize` finds a [summary] choice given by --set again (through the manifest).
     let o = cli(
         tmp.path(),
-        &["run", "f.toml", "--out", "chosen", "--set", "summary.errors=[err_u_l2h1]"],
+        &[
+            "run",
+            "f.toml",
+            "--out",
+            "chosen",
+            "--set",
+            "summary.errors=[err_u_l2h1]",
+        ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let o = cli(tmp.path(), &["summarize", "chosen"]);
@@ -171,12 +187,18 @@ fn bad_flags_exit_2_naming_the_flag_and_the_key() {
             vec!["plan", "f.toml", "--set", "h=[0.25,-1]"],
             "--set h=[0.25,-1]: key `grid.h[1]`",
         ),
-        (vec!["run", "f.toml", "--set", "h"], "--set `h`: expected key=value"),
+        (
+            vec!["run", "f.toml", "--set", "h"],
+            "--set `h`: expected key=value",
+        ),
         (
             vec!["run", "--scene", "bar4d", "--set", "h=0.1"],
             "--scene bar4d: key `scene`: unknown scene `bar4d`",
         ),
-        (vec!["run", "--set", "h=0.1"], "give a sweep file, or --scene"),
+        (
+            vec!["run", "--set", "h=0.1"],
+            "give a sweep file, or --scene",
+        ),
     ] {
         let o = cli(tmp.path(), &args);
         let err = String::from_utf8_lossy(&o.stderr);

@@ -24,11 +24,13 @@ pub struct FigureError {
     pub message: String,
 }
 
-/// One curve: its name and points.
+/// One curve: its name, points and colour (an index into [`color`]: the method group's, so
+/// that a group has one colour in every figure and one HTML legend serves them all).
 #[derive(Debug, Clone)]
 pub struct Curve {
     pub name: String,
     pub points: Vec<(f64, f64)>,
+    pub color: usize,
 }
 
 /// The colour of curve `i`: a qualitative palette (Okabe–Ito, readable by colour-blind
@@ -61,7 +63,9 @@ fn err(figure: &str) -> impl Fn(String) -> FigureError + '_ {
 fn log_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if !(lo.is_finite() && hi > 0.0) {
         return None;
     }
@@ -87,10 +91,27 @@ fn lin_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     Some((lo - pad, hi + pad))
 }
 
-/// Tick labels in the terminal's engineering format.
+/// Tick labels: the terminal's engineering format without trailing zeros (`0.1`, `1e-3`).
 fn tick(x: &f64) -> String {
-    crate::summary::eng(*x)
+    let s = crate::summary::eng(*x);
+    let (mantissa, exp) = match s.split_once('e') {
+        Some((m, e)) => (m.to_string(), format!("e{e}")),
+        None => (s.clone(), String::new()),
+    };
+    let mantissa = if mantissa.contains('.') {
+        mantissa
+            .trim_end_matches('0')
+            .trim_end_matches('.')
+            .to_string()
+    } else {
+        mantissa
+    };
+    format!("{mantissa}{exp}")
 }
+
+/// Grid lines: the bold ones at the labelled ticks only (a log axis's minor lines would shade
+/// the plot grey).
+const MINOR: RGBAColor = RGBAColor(0, 0, 0, 0.0);
 
 /// A convergence figure: `curves[i]` = (x, error) of group i's main path, `slopes[i]` its
 /// least-squares (p, c) of log e = c + p log x.
@@ -127,24 +148,18 @@ pub fn convergence(
             .y_desc(y_name)
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .light_line_style(RGBColor(235, 235, 235))
+            .x_labels(8)
+            .y_labels(8)
+            .light_line_style(MINOR)
             .draw()
             .map_err(|x| e(x.to_string()))?;
         for (i, c) in curves.iter().enumerate() {
-            let col = color(i);
+            let col = color(c.color);
             chart
                 .draw_series(LineSeries::new(c.points.clone(), col.stroke_width(2)))
-                .map_err(|x| e(x.to_string()))?
-                .label(c.name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
-                });
+                .map_err(|x| e(x.to_string()))?;
             chart
-                .draw_series(
-                    c.points
-                        .iter()
-                        .map(|&p| Circle::new(p, 3, col.filled())),
-                )
+                .draw_series(c.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
                 .map_err(|x| e(x.to_string()))?;
             // The slope triangle over interval (i mod (levels − 1)), 60 % of its width (in log x).
             if let Some(Some((p, cst))) = slopes.get(i) {
@@ -172,21 +187,13 @@ pub fn convergence(
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
         root.present().map_err(|x| e(x.to_string()))?;
     }
     Ok(svg)
 }
 
 /// A work-precision figure: every ok run as a point (wall time, error) coloured by its group
-/// (`groups[i]` = name, points), and the Pareto front as a staircase.
+/// (`groups[i]`), and the Pareto front as a staircase with its points circled.
 pub fn work_precision(
     title: &str,
     y_name: &str,
@@ -216,7 +223,9 @@ pub fn work_precision(
             .y_desc(y_name)
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .light_line_style(RGBColor(235, 235, 235))
+            .x_labels(8)
+            .y_labels(8)
+            .light_line_style(MINOR)
             .draw()
             .map_err(|x| e(x.to_string()))?;
         // The front: from the cheapest point, right then down to each more accurate one.
@@ -234,17 +243,11 @@ pub fn work_precision(
             .map_err(|x| e(x.to_string()))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
-        for (i, c) in groups.iter().enumerate() {
-            let col = color(i);
+        for c in groups {
+            let col = color(c.color);
             chart
-                .draw_series(
-                    c.points
-                        .iter()
-                        .map(|&p| Circle::new(p, 3, col.filled())),
-                )
-                .map_err(|x| e(x.to_string()))?
-                .label(c.name.clone())
-                .legend(move |(x, y)| Circle::new((x + 9, y), 3, col.filled()));
+                .draw_series(c.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
+                .map_err(|x| e(x.to_string()))?;
         }
         chart
             .draw_series(f.iter().map(|&p| Circle::new(p, 5, BLACK.stroke_width(1))))
@@ -328,18 +331,14 @@ pub fn series(
             .y_desc(y_name)
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
-            .light_line_style(RGBColor(240, 240, 240))
+            .light_line_style(MINOR)
             .draw()
             .map_err(|x| e(x.to_string()))?;
-        for (i, c) in curves.iter().enumerate() {
-            let col = color(i);
+        for c in curves {
+            let col = color(c.color);
             chart
                 .draw_series(LineSeries::new(c.points.clone(), col.stroke_width(1)))
-                .map_err(|x| e(x.to_string()))?
-                .label(c.name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
-                });
+                .map_err(|x| e(x.to_string()))?;
         }
         if let Some(ex) = exact {
             // Dashes of about 1 % of the time range: drawn as separate segments.
@@ -372,15 +371,15 @@ pub fn series(
                     first = false;
                 }
             }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(180, 180, 180))
+                .label_font(("sans-serif", 11))
+                .draw()
+                .map_err(|x| e(x.to_string()))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
         root.present().map_err(|x| e(x.to_string()))?;
     }
     Ok(svg)
@@ -407,6 +406,7 @@ mod tests {
         let c = Curve {
             name: "g".into(),
             points: vec![(0.1, 0.01), (0.05, 0.0025), (0.025, 0.000625)],
+            color: 0,
         };
         let svg = convergence("t", "h", "e", &[c], &[Some((2.0, 0.0))]).unwrap();
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));

@@ -88,8 +88,8 @@ fn session(dir: &Path) -> anyhow::Result<Session> {
     if !path.exists() {
         return Ok(Session::default());
     }
-    let text =
-        std::fs::read_to_string(&path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("{}: cannot read", path.display()))?;
     let doc: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("{}: not a manifest (invalid JSON)", path.display()))?;
     let s = |v: &serde_json::Value| v.as_str().map(String::from);
@@ -185,7 +185,12 @@ fn markdown(md: &str, shift: usize) -> String {
             let header = cells(l);
             let right: Vec<bool> = lines
                 .get(i + 1)
-                .map(|a| cells(a).iter().map(|c| c.ends_with(':') && !c.starts_with(':')).collect())
+                .map(|a| {
+                    cells(a)
+                        .iter()
+                        .map(|c| c.ends_with(':') && !c.starts_with(':'))
+                        .collect()
+                })
                 .unwrap_or_default();
             out.push_str("<table><thead><tr>");
             for h in &header {
@@ -251,6 +256,28 @@ fn html_table(header: &[String], right: &[bool], rows: &[Vec<String>]) -> String
         out.push_str("</tr>\n");
     }
     out.push_str("</tbody></table>\n");
+    out
+}
+
+/// The colour legend of the method groups, shared by every figure (a group has one colour).
+fn legend(runs: &Runs, groups: &[usize], note: &str) -> String {
+    let mut out = String::from("<div class=\"legend\">");
+    for &g in groups {
+        let c = figures::color(g);
+        let _ = write!(
+            out,
+            "<span><i style=\"background:rgb({},{},{})\"></i>{} {}</span>",
+            c.0,
+            c.1,
+            c.2,
+            g + 1,
+            esc(&runs.groups[g].title)
+        );
+    }
+    if !note.is_empty() {
+        let _ = write!(out, "<span>{}</span>", note);
+    }
+    out.push_str("</div>\n");
     out
 }
 
@@ -375,7 +402,8 @@ th{background:#f3f3f3}td.r{text-align:right;font-variant-numeric:tabular-nums}
 pre{background:#f7f7f7;padding:8px;overflow-x:auto;font-size:.85em}
 .hints{background:#fff8e1;border-left:4px solid #e6a700;padding:6px 12px}
 .note{color:#666;font-size:.9em}details{margin:.6em 0}summary{cursor:pointer;font-weight:600}
-nav a{margin-right:1em}";
+nav a{margin-right:1em}
+.legend{display:flex;flex-wrap:wrap;gap:4px 18px;font-size:.85em;margin:.4em 0}.legend i{display:inline-block;width:22px;height:4px;margin:0 6px 3px 0;vertical-align:middle}";
 
 fn render(dir: &Path) -> anyhow::Result<Html> {
     let opts = crate::summary::stored_options(dir)?;
@@ -399,10 +427,11 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
     let _ = writeln!(body, "<h1>Sweep <code>{}</code></h1>", esc(&name));
     let description = ses.text.as_deref().and_then(|t| {
         crate::sweep::tree::parse(t).ok().and_then(|top| {
-            top.into_iter().find_map(|(k, _, n)| match (k.as_str(), n.kind) {
-                ("description", crate::sweep::tree::Kind::Str(s)) => Some(s),
-                _ => None,
-            })
+            top.into_iter()
+                .find_map(|(k, _, n)| match (k.as_str(), n.kind) {
+                    ("description", crate::sweep::tree::Kind::Str(s)) => Some(s),
+                    _ => None,
+                })
         })
     });
     if let Some(d) = description {
@@ -455,6 +484,8 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
             "<p class=\"note\">Each curve is a method group's longest refinement path ({}); the triangles have the least-squares slope of the curve (the number next to each). Only ok runs with a positive error are drawn — the levels the fits use.</p>",
             esc(&conv.groups.caption)
         );
+        let gs: Vec<usize> = mains.iter().map(|&(g, _)| g).collect();
+        body.push_str(&legend(&runs, &gs, ""));
         body.push_str("<div class=\"figs\">\n");
         for &e in &conv.display {
             let (abbr, what) = stable::error_abbrev(runs.errors[e]);
@@ -466,6 +497,7 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
                 curves.push(Curve {
                     name: format!("{} · {}", runs.groups[g].title, runs.paths[p].fixed.short()),
                     points: pts,
+                    color: g,
                 });
             }
             let t = format!("{abbr}: {what}");
@@ -488,9 +520,11 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
             let mut groups: Vec<Curve> = runs
                 .groups
                 .iter()
-                .map(|g| Curve {
+                .enumerate()
+                .map(|(k, g)| Curve {
                     name: g.title.clone(),
                     points: Vec::new(),
+                    color: k,
                 })
                 .collect();
             let mut all = Vec::new();
@@ -520,6 +554,10 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
                 "{}: error against wall time",
                 stable::error_abbrev(runs.errors[e]).0
             );
+            let gs: Vec<usize> = (0..runs.groups.len())
+                .filter(|&g| !groups[g].points.is_empty())
+                .collect();
+            body.push_str(&legend(&runs, &gs, "○ black: Pareto front"));
             match figures::work_precision(&t, runs.errors[e], &groups, &front) {
                 Ok(svg) => {
                     let _ = writeln!(body, "<div class=\"fig\">{svg}</div>");
@@ -531,7 +569,9 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
     }
 
     // 2c. Time series: one run per group, the finest ok level of its main path.
-    body.push_str("<h2 id=\"series\">Contact displacement, pressure and energy against time</h2>\n");
+    body.push_str(
+        "<h2 id=\"series\">Contact displacement, pressure and energy against time</h2>\n",
+    );
     let chosen: Vec<(usize, usize)> = runs
         .groups
         .iter()
@@ -563,7 +603,10 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
             body,
             "<p class=\"note\">One run per method group: the finest ok level of its main refinement path{}. Black dashes: the exact solution (closed form; for 2D/3D scenes the reference run). Energy relative to the run's E⁰.</p>",
             if runs.groups.len() > SERIES_GROUPS {
-                format!(" (the first {SERIES_GROUPS} groups of {})", runs.groups.len())
+                format!(
+                    " (the first {SERIES_GROUPS} groups of {})",
+                    runs.groups.len()
+                )
             } else {
                 String::new()
             }
@@ -587,10 +630,12 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
             u.push(Curve {
                 name: name.clone(),
                 points: figures::decimate(&rs.u, 1500),
+                color: g,
             });
             s.push(Curve {
                 name: name.clone(),
                 points: figures::decimate(&rs.sigma, 1500),
+                color: g,
             });
             let e0 = rs.energy.first().map(|p| p.1).filter(|e| *e != 0.0);
             if let Some(e0) = e0 {
@@ -598,6 +643,7 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
                 en.push(Curve {
                     name,
                     points: figures::decimate(&rel, 1500),
+                    color: g,
                 });
             }
             // The exact solution of the longest run (the finest time resolution).
@@ -605,15 +651,19 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
                 exact_u = Some(Curve {
                     name: "exact".into(),
                     points: figures::decimate(&rs.u_exact, 1500),
+                    color: 0,
                 });
             }
             if rs.sigma_exact.len() > exact_s.as_ref().map_or(0, |c| c.points.len()) {
                 exact_s = Some(Curve {
                     name: "exact".into(),
                     points: figures::decimate(&rs.sigma_exact, 1500),
+                    color: 0,
                 });
             }
         }
+        let gs: Vec<usize> = chosen.iter().map(|&(g, _)| g).collect();
+        body.push_str(&legend(&runs, &gs, "black dashes: exact"));
         body.push_str("<div class=\"figs\">\n");
         for (t, y, curves, exact) in [
             ("contact displacement u_C(t)", "u_C", &u, exact_u.as_ref()),
@@ -674,9 +724,14 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
 
     // 4. Energy and the full tables.
     body.push_str("<h2 id=\"energy\">Energy behaviour</h2>\n");
-    let (groups_md, runs_md) = match en.markdown.find("\n## Per run") {
-        Some(k) => en.markdown.split_at(k),
-        None => (en.markdown.as_str(), ""),
+    // The section has its own heading: drop the file's "# Energy".
+    let energy_md = en
+        .markdown
+        .strip_prefix("# Energy\n")
+        .unwrap_or(&en.markdown);
+    let (groups_md, runs_md) = match energy_md.find("\n## Per run") {
+        Some(k) => energy_md.split_at(k),
+        None => (energy_md, ""),
     };
     body.push_str(&markdown(groups_md, 1));
     if !runs_md.is_empty() {
@@ -711,7 +766,12 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
         ),
         Some(text) => {
             let file = ses.file.clone().unwrap_or_else(|| "sweep.toml".into());
-            let _ = writeln!(body, "<p><code>{}</code>:</p><pre>{}</pre>", esc(&file), esc(text));
+            let _ = writeln!(
+                body,
+                "<p><code>{}</code>:</p><pre>{}</pre>",
+                esc(&file),
+                esc(text)
+            );
             if !ses.sets.is_empty() {
                 let _ = writeln!(
                     body,
@@ -773,15 +833,23 @@ mod tests {
         let md = "# Title\n\nSome `code` and **bold** < text.\n\n| a | b \\| c |\n|:---|---:|\n| 1 | 2 |\n\n- item\n";
         let h = markdown(md, 1);
         assert!(h.contains("<h2>Title</h2>"), "{h}");
-        assert!(h.contains("<code>code</code>") && h.contains("<b>bold</b>") && h.contains("&lt; text"));
-        assert!(h.contains("<th>b | c</th>") && h.contains("<td class=\"r\">2</td>"), "{h}");
+        assert!(
+            h.contains("<code>code</code>") && h.contains("<b>bold</b>") && h.contains("&lt; text")
+        );
+        assert!(
+            h.contains("<th>b | c</th>") && h.contains("<td class=\"r\">2</td>"),
+            "{h}"
+        );
         assert!(h.contains("<li>item</li>"));
     }
 
     #[test]
     fn the_fitted_line_recovers_a_power_law() {
         // e = 3 x^2: slope 2, intercept ln 3 (exact up to rounding of the logarithms).
-        let pts: Vec<(f64, f64)> = [0.1, 0.05, 0.025].iter().map(|&x| (x, 3.0 * x * x)).collect();
+        let pts: Vec<(f64, f64)> = [0.1, 0.05, 0.025]
+            .iter()
+            .map(|&x| (x, 3.0 * x * x))
+            .collect();
         let (p, c) = fit_line(&pts).unwrap();
         assert!((p - 2.0).abs() < 1e-12 && (c - 3f64.ln()).abs() < 1e-12);
     }

@@ -366,7 +366,10 @@ pub(crate) fn error_abbrev(column: &str) -> (&'static str, &'static str) {
         "err_u_l2l2" => ("l2(τ;L2)", "displacement error in l2(0,T;L2)"),
         "err_u_l2h1" => ("l2(τ;H1)", "displacement error in l2(0,T;H1)"),
         "err_u_linfl2" => ("l∞(τ;L2)", "displacement error in l∞(0,T;L2)"),
-        "err_sigma_l2" => ("σ l2(τ)", "contact pressure error at the time levels, l2(0,T)"),
+        "err_sigma_l2" => (
+            "σ l2(τ)",
+            "contact pressure error at the time levels, l2(0,T)",
+        ),
         "err_sigma_mid_l2" => (
             "σ½ l2(τ)",
             "contact pressure error at the midpoints t^(n+½), l2(0,T)",

@@ -177,10 +177,14 @@ pub fn apply(top: &mut Entries, sets: &[Set]) {
             [key] => match Key::from_name(key) {
                 Some(k) => {
                     for section in ["fixed", "grid", "zip"] {
-                        if let Some((_, _, Node {
-                            kind: Kind::Table(t),
-                            ..
-                        })) = top.iter_mut().find(|(n, _, _)| n == section)
+                        if let Some((
+                            _,
+                            _,
+                            Node {
+                                kind: Kind::Table(t),
+                                ..
+                            },
+                        )) = top.iter_mut().find(|(n, _, _)| n == section)
                         {
                             t.retain(|(n, _, _)| n != key);
                         }
@@ -227,16 +231,30 @@ mod tests {
         };
         assert_eq!(items[1].kind, Kind::Float(0.005));
         // every node names its flag through the line
-        assert_eq!(parse(&["a=1".into(), "b=2".into()]).unwrap()[1].value.line, SET_LINE + 1);
-        assert!(parse(&["h".into()]).unwrap_err().contains("--set `h`: expected key=value"));
-        assert!(parse(&["a.b.c=1".into()]).unwrap_err().contains("more than one dot"));
+        assert_eq!(
+            parse(&["a=1".into(), "b=2".into()]).unwrap()[1].value.line,
+            SET_LINE + 1
+        );
+        assert!(
+            parse(&["h".into()])
+                .unwrap_err()
+                .contains("--set `h`: expected key=value")
+        );
+        assert!(
+            parse(&["a.b.c=1".into()])
+                .unwrap_err()
+                .contains("more than one dot")
+        );
     }
 
     #[test]
     fn a_bare_parameter_replaces_the_files_axis() {
-        let mut top = tree::parse("name = \"x\"\n[fixed]\nT = 1.0\n[grid]\nh = [0.1, 0.05]\n")
-            .unwrap();
-        apply(&mut top, &parse(&["h=0.2".into(), "dt=[0.1,0.05]".into()]).unwrap());
+        let mut top =
+            tree::parse("name = \"x\"\n[fixed]\nT = 1.0\n[grid]\nh = [0.1, 0.05]\n").unwrap();
+        apply(
+            &mut top,
+            &parse(&["h=0.2".into(), "dt=[0.1,0.05]".into()]).unwrap(),
+        );
         let table = |n: &str| match &top.iter().find(|(k, _, _)| k == n).unwrap().2.kind {
             Kind::Table(t) => t.iter().map(|(k, _, _)| k.clone()).collect::<Vec<_>>(),
             _ => panic!(),
