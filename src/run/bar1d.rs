@@ -18,7 +18,7 @@
 
 use std::time::Instant;
 
-use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Status};
 use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::{BarExact, BarParams};
@@ -576,6 +576,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     };
     let mut done = 0usize;
+    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
+    let loop_start = Instant::now();
+    let mut observe_timer = SampledTimer::default();
     let stop = (|| -> Result<(), Stop> {
         rec.record(0, &st.u, &st.v, sigma0)
             .map_err(Stop::Diverged)?;
@@ -585,7 +588,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(n, e))?;
                     metrics.iterations += 1;
                     let sigma = eng.sigma(&st.u, phi);
-                    rec.record(n, &st.u, &st.v, sigma).map_err(Stop::Diverged)?;
+                    observe_timer
+                        .time(n, || rec.record(n, &st.u, &st.v, sigma))
+                        .map_err(Stop::Diverged)?;
                     done = n;
                     interrupted(n)?;
                 }
@@ -625,7 +630,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     for i in 0..m {
                         vn[i] = (wk.y[i] - prev[i]) / (2.0 * tau);
                     }
-                    rec.record(n, &st.u, &vn, lambda).map_err(Stop::Diverged)?;
+                    observe_timer
+                        .time(n, || rec.record(n, &st.u, &vn, lambda))
+                        .map_err(Stop::Diverged)?;
                     done = n;
                     std::mem::swap(&mut prev, &mut st.u);
                     std::mem::swap(&mut st.u, &mut wk.y);
@@ -636,6 +643,8 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     })();
     metrics.steps = done as i64;
+    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = match stop {
         Ok(()) => (Status::Ok, None),
         Err(Stop::Solver(n, e)) => {
