@@ -84,6 +84,14 @@ fn assert_loop_allocates_nothing(text: &str, t_final: f64) {
             drop(out);
         }
         assert_eq!(steps[1], 2 * steps[0], "{}: steps {steps:?}", a.label);
+        // The contact solve must have run in both states: the short run already switches
+        // between contact and release, so its loop took every branch the long one takes.
+        assert!(
+            out.metrics.contact_switches >= 2,
+            "{}: {} contact switches — the loop never left or entered contact",
+            a.label,
+            out.metrics.contact_switches
+        );
         assert!(steps[0] >= 100, "{}: too few steps to show", a.label);
         // Control: the counter sees this thread's allocations (a run's setup allocates).
         assert!(counts[0] > 0, "{}: no allocation counted at all", a.label);
@@ -130,10 +138,10 @@ method = [
     );
 }
 
-/// The FE engine (bar2d): the modified mass with Crank–Nicolson, the consistent mass with
+/// The FE engine on bar2d: the modified mass with Crank–Nicolson, the consistent mass with
 /// backward Euler.
 #[test]
-fn fe_time_loop_allocates_nothing() {
+fn bar2d_time_loop_allocates_nothing() {
     assert_loop_allocates_nothing(
         r#"
 name = "alloc-fe"
@@ -146,6 +154,29 @@ dt = 0.01
 method = [
   { mass = "mod3", scheme = "crank-nicolson" },
   { mass = "consistent", scheme = "backward-euler" },
+]
+"#,
+        1.0,
+    );
+}
+
+/// The FE engine on bar3d (a 3 × 3 × 21-node box at h = 0.1: the contact face has 9 nodes, so
+/// the LCP has several unknowns and switches), both masses and both schemes.
+#[test]
+fn bar3d_time_loop_allocates_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-3d"
+scene = "bar3d"
+[fixed]
+T = T_FINAL
+h = 0.1
+dt = 0.01
+[grid]
+method = [
+  { mass = "mod3", scheme = "crank-nicolson" },
+  { mass = "consistent", scheme = "crank-nicolson" },
+  { mass = "mod1", scheme = "backward-euler" },
 ]
 "#,
         1.0,
