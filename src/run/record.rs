@@ -132,6 +132,7 @@ schema! {
         energy_max_dev: Option<f64> => "", "max_n |E^n − E⁰|/E⁰";
         energy_max_increase: Option<f64> => "", "max_n (E^{n+1} − E^n)/E⁰";
         energy_theta_max_increase: Option<f64> => "", "same for the augmented energy E_Θ (Nitsche)";
+        energy_theta_drift: Option<f64> => "", "(E_Θ^N − E_Θ⁰)/E_Θ⁰, the drift of the augmented energy (Nitsche)";
         err_u_l2l2: Option<f64> => "m·s^½", "(τ Σ_n ‖u^n − u(t^n)‖²_L2)^½, n = 0…N";
         err_u_l2h1: Option<f64> => "", "same with the full H1 norm";
         err_u_linfl2: Option<f64> => "m^{3/2}", "max_n ‖u^n − u(t^n)‖_L2";
@@ -305,6 +306,7 @@ impl RunRecord {
             energy_max_dev: m.energy_max_dev,
             energy_max_increase: m.energy_max_increase,
             energy_theta_max_increase: m.energy_theta_max_increase,
+            energy_theta_drift: m.energy_theta_drift,
             err_u_l2l2: m.err_u_l2l2,
             err_u_l2h1: m.err_u_l2h1,
             err_u_linfl2: m.err_u_linfl2,
