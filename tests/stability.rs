@@ -176,6 +176,28 @@ fn energy_class_of_every_quickstart_method() {
             "{label}: {classes} not printed:\n{stdout}"
         );
     }
+    // The stability map of each method over the two swept axes (h × ν): 10 cells, every one
+    // `growing` for the two ill-posed methods and `stable` for the others.
+    let m = read(dir.join("summary/stability_map.parquet"));
+    let mut cells: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    for ((method, state), (xa, ya)) in strs(&m, "method")
+        .into_iter()
+        .zip(strs(&m, "state"))
+        .zip(strs(&m, "x_axis").into_iter().zip(strs(&m, "y_axis")))
+    {
+        assert_eq!((xa.as_str(), ya.as_str()), ("courant", "h"), "{method}");
+        cells.entry(method).or_default().push(state);
+    }
+    assert_eq!(cells.len(), 6, "{cells:?}");
+    for (method, states) in &cells {
+        assert_eq!(states.len(), 10, "{method}");
+        let want = if method.ends_with("consistent · crank-nicolson") {
+            "growing"
+        } else {
+            "stable"
+        };
+        assert!(states.iter().all(|s| s == want), "{method}: {states:?}");
+    }
     // The functional each is judged by: E_Θ for Nitsche, E^h for the mixed methods.
     let en = read(dir.join("summary/energy.parquet"));
     for (label, f) in strs(&en, "label")

@@ -50,7 +50,9 @@
 //!
 //! # Files (all written atomically: temporary dot-file, fsync, rename)
 //! `convergence.{parquet,csv,md,tex}`, `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
-//! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `work_precision.{parquet,csv,md}`,
+//! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `stability_map.{parquet,csv,md}`
+//! ([`stability`]: per method and pair of swept axes, the state of every cell),
+//! `work_precision.{parquet,csv,md}`,
 //! `cost_to_error.{parquet,csv}`.
 
 use std::path::{Path, PathBuf};
@@ -61,6 +63,7 @@ pub mod convergence;
 pub mod energy;
 pub mod ensemble;
 mod runs;
+pub mod stability;
 mod table;
 pub mod work;
 
@@ -111,6 +114,10 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     files.extend(table::write_table(&out, "ensemble", &ens.table)?);
     files.push(table::write_text(&out, "ensemble.md", &ens.markdown)?);
 
+    let st = stability::section(&runs);
+    files.extend(table::write_table(&out, "stability_map", &st.table)?);
+    files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
+
     let wp = work::section(&runs);
     files.extend(table::write_table(&out, "work_precision", &wp.table)?);
     files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
@@ -141,9 +148,10 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     terminal.push_str(&conv.terminal);
     terminal.push_str(&en.terminal);
     terminal.push_str(&ens.terminal);
+    terminal.push_str(&st.terminal);
     terminal.push_str(&wp.terminal);
     terminal.push_str(&format!(
-        "tables: {} (convergence, energy, impacts, ensemble, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
+        "tables: {} (convergence, energy, impacts, ensemble, stability_map, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
         out.display()
     ));
     Ok(Summary {
