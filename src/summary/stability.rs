@@ -150,7 +150,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
         let distinct = |axis: &str| -> BTreeSet<String> {
             idx.iter()
                 .filter_map(|&i| axis_value(runs, &runs.runs[i], axis))
-                .map(|x| super::runs::float_key(x))
+                .map(super::runs::float_key)
                 .collect()
         };
         let mut axes: Vec<(&str, usize)> = AXES
