@@ -115,6 +115,7 @@ schema! {
         gravity: Option<f64> => "m/s²", "volume load (2D/3D scenes)";
         ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
         ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
+        search: Option<String> => "", "the [search] this run is a probe of (name, key, criterion, bracket, method index; null for grid runs)";
         wall_time_s: f64 => "s", "wall time of the run (median over repeats)";
         wall_time_min_s: f64 => "s", "fastest of the repeats";
         wall_time_max_s: f64 => "s", "slowest of the repeats";
@@ -289,6 +290,7 @@ impl RunRecord {
             gravity: f(Key::Gravity),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
+            search: spec.search.clone(),
             wall_time_s: timing.median_s,
             wall_time_min_s: timing.min_s,
             wall_time_max_s: timing.max_s,

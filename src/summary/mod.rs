@@ -52,6 +52,7 @@
 //! `convergence.{parquet,csv,md,tex}`, `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
 //! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `stability_map.{parquet,csv,md}`
 //! ([`stability`]: per method and pair of swept axes, the state of every cell),
+//! `search.{parquet,csv,md}` (the boundaries of a `[search]`),
 //! `work_precision.{parquet,csv,md}`,
 //! `cost_to_error.{parquet,csv}`.
 
@@ -63,6 +64,7 @@ pub mod convergence;
 pub mod energy;
 pub mod ensemble;
 mod runs;
+mod search;
 pub mod stability;
 mod table;
 pub mod work;
@@ -118,6 +120,10 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     files.extend(table::write_table(&out, "stability_map", &st.table)?);
     files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
 
+    let se = search::section(&runs);
+    files.extend(table::write_table(&out, "search", &se.table)?);
+    files.push(table::write_text(&out, "search.md", &se.markdown)?);
+
     let wp = work::section(&runs);
     files.extend(table::write_table(&out, "work_precision", &wp.table)?);
     files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
@@ -149,9 +155,10 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     terminal.push_str(&en.terminal);
     terminal.push_str(&ens.terminal);
     terminal.push_str(&st.terminal);
+    terminal.push_str(&se.terminal);
     terminal.push_str(&wp.terminal);
     terminal.push_str(&format!(
-        "tables: {} (convergence, energy, impacts, ensemble, stability_map, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
+        "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
         out.display()
     ));
     Ok(Summary {

@@ -7,7 +7,7 @@
 //! numeric parameter that takes ≥ 2 values among a method's runs is an *axis*. Of h, dt and
 //! the Courant number only two are independent: when all three vary, the one with the most
 //! distinct values (the derived one — a grid over h and ν gives n_h·n_ν values of dt) is not
-//! an axis. A cell is one pair of axis values; it holds every run of the method with those
+//! an axis; when two vary and the third is fixed they are one axis (courant kept, else h). A cell is one pair of axis values; it holds every run of the method with those
 //! values (other axes, ensemble members), and its state is the worst of their states in the
 //! order diverged, solver-failed, timeout, growing, invalid, stable: a cell is stable only if
 //! every run in it is. `uniform` says whether its runs agreed.
@@ -171,6 +171,13 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 .map(|(a, _)| *a)
                 .expect("three");
             axes.retain(|(a, _)| *a != drop);
+        } else if mesh.len() == 2 {
+            // The third is fixed, so the two are one axis (ν = c0·dt/h): keep courant, else h.
+            let keep = ["courant", "h", "dt"]
+                .into_iter()
+                .find(|k| mesh.iter().any(|(a, _)| a == k))
+                .expect("two");
+            axes.retain(|(a, _)| !["h", "dt", "courant"].contains(a) || *a == keep);
         }
         for (ai, &(xa, _)) in axes.iter().enumerate() {
             for &(ya, _) in &axes[ai + 1..] {
