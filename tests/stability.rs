@@ -343,3 +343,88 @@ fn gamma0_search_for_theta_one_brackets_the_spec_threshold() {
     );
     assert_eq!(boundaries(&dir), found);
 }
+
+#[test]
+fn spec_6_nitsche_behaviours_hold_through_the_theta_gamma0_stability_map() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("f48");
+    run_sweep("sweeps/003_figs4-8_nitsche_parameters.toml", &dir);
+    let m = read(dir.join("summary/stability_map.parquet"));
+    let (method, xa, ya, state) = (
+        strs(&m, "method"),
+        strs(&m, "x_axis"),
+        strs(&m, "y_axis"),
+        strs(&m, "state"),
+    );
+    let (x, y) = (f64s(&m, "x"), f64s(&m, "y"));
+    let steps: Vec<i64> = m
+        .column("steps")
+        .unwrap()
+        .i64()
+        .unwrap()
+        .iter()
+        .map(|s| s.unwrap())
+        .collect();
+    // (scheme, Θ, γ0) → (state, time the worst run of the cell reached).
+    let mut cell = BTreeMap::new();
+    for i in 0..m.height() {
+        assert_eq!((xa[i].as_str(), ya[i].as_str()), ("nitsche_theta", "nitsche_gamma0"));
+        let scheme = method[i].rsplit(" · ").next().unwrap().to_string();
+        let key = (scheme, x[i].unwrap().to_string(), y[i].unwrap().to_string());
+        cell.insert(key, (state[i].clone(), steps[i] as f64 * 0.015));
+    }
+    assert_eq!(cell.len(), 2 * 3 * 7);
+    let get = |s: &str, th: f64, g: f64| {
+        cell.iter()
+            .find(|((sc, t, y), _)| sc == s && *t == th.to_string() && *y == g.to_string())
+            .map(|(_, v)| v.clone())
+            .unwrap_or_else(|| panic!("no cell {s} Θ={th} γ0={g}"))
+    };
+    // The first impact is at t = 1 (SPEC §1.1).
+    for s in ["crank-nicolson", "hybrid"] {
+        for g in [3.0, 10.0, 100.0, 1e4] {
+            // Θ = 1, γ0 ≥ 3: A_Θγ indefinite, blows up before any contact.
+            let (st, t) = get(s, 1.0, g);
+            assert!(st == "diverged" && t < 1.0, "{s} Θ=1 γ0={g}: {st} at t = {t}");
+        }
+        // Θ = 1, γ0 = 1: finite (unphysical: see the energy check below).
+        assert!(!["diverged", "solver-failed"].contains(&get(s, 1.0, 1.0).0.as_str()));
+        // Θ = 0 stays finite up to γ0 = 1e4.
+        for g in [1e-6, 0.1, 1.0, 3.0, 10.0, 100.0, 1e4] {
+            let (st, _) = get(s, 0.0, g);
+            assert!(st == "stable" || st == "growing", "{s} Θ=0 γ0={g}: {st}");
+        }
+    }
+    // Nitsche-Hybrid, Θ = −1: every γ0 ≥ 3 diverges; for γ0 = 3 and 10 after the first impact
+    // as SPEC §6 says. (Measured, not in SPEC: for γ0 = 100 and 1e4 the hybrid blows up before
+    // the first impact, at t = 0.42 and 0.03.)
+    for g in [3.0, 10.0, 100.0, 1e4] {
+        let (st, t) = get("hybrid", -1.0, g);
+        assert_eq!(st, "diverged", "hybrid Θ=−1 γ0={g}");
+        if g <= 10.0 {
+            assert!(t > 1.0, "hybrid Θ=−1 γ0={g}: diverged at t = {t}, before the impact");
+        }
+    }
+    // Θ = −1 with CN stays finite (SPEC: E(T)/E⁰ 4.97 at γ0 = 10, 6.02 at 100).
+    assert_ne!(get("crank-nicolson", -1.0, 100.0).0, "diverged");
+    // Θ = 1, γ0 = 1 is unphysical: E^h strays by more than 100 E⁰ (SPEC: peaks ≈ 231 E⁰)
+    // while the run ends ok.
+    let runs = contact_sweep::sink::read_runs(&dir).unwrap();
+    let unphys = runs
+        .lazy()
+        .filter(
+            col("nitsche_theta")
+                .eq(lit(1.0))
+                .and(col("nitsche_gamma0").eq(lit(1.0))),
+        )
+        .collect()
+        .unwrap();
+    assert_eq!(unphys.height(), 2);
+    for (st, dev) in strs(&unphys, "status")
+        .iter()
+        .zip(f64s(&unphys, "energy_max_dev"))
+    {
+        assert_eq!(st, "ok");
+        assert!(dev.unwrap() > 100.0, "max |E^h − E⁰|/E⁰ = {dev:?}");
+    }
+}
