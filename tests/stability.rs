@@ -428,3 +428,74 @@ fn spec_6_nitsche_behaviours_hold_through_the_theta_gamma0_stability_map() {
         assert!(dev.unwrap() > 100.0, "max |E^h − E⁰|/E⁰ = {dev:?}");
     }
 }
+
+#[test]
+fn hard_cases_every_run_ends_with_a_status_and_a_message() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("hard");
+    // A generous per-run budget: the slowest run takes about 1 s; a hang would end `timeout`.
+    let o = cli(
+        repo(),
+        &[
+            "run",
+            "sweeps/hard_cases.toml",
+            "--out",
+            dir.to_str().unwrap(),
+            "--threads",
+            "2",
+            "--run-timeout",
+            "120",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let runs = contact_sweep::sink::read_runs(&dir).unwrap();
+    assert_eq!(runs.height(), 1036, "every run of the plan has its row");
+    let status = strs(&runs, "status");
+    let message: Vec<Option<String>> = runs
+        .column("message")
+        .unwrap()
+        .str()
+        .unwrap()
+        .iter()
+        .map(|m| m.map(String::from))
+        .collect();
+    for (st, msg) in status.iter().zip(&message) {
+        assert!(
+            ["ok", "diverged", "solver-failed"].contains(&st.as_str()),
+            "status {st}: {msg:?}"
+        );
+        if st != "ok" {
+            let m = msg.as_deref().unwrap_or("");
+            assert!(!m.is_empty(), "a {st} run without a message");
+            assert!(!m.contains("panic"), "{m}");
+        }
+    }
+    // Through the map (h × ν, worst over Θ and γ0): central differences diverge beyond the
+    // CFL limit (ν ≥ 1 with the massless contact node of mod3, whose limit is 0.578), the
+    // 000 §5 hybrid and the dissipative schemes are stable in every cell.
+    let m = read(dir.join("summary/stability_map.parquet"));
+    let hc = m
+        .lazy()
+        .filter(col("x_axis").eq(lit("courant")).and(col("y_axis").eq(lit("h"))))
+        .collect()
+        .unwrap();
+    let (meth, x, st) = (strs(&hc, "method"), f64s(&hc, "x"), strs(&hc, "state"));
+    let mut seen = 0;
+    for i in 0..hc.height() {
+        let nu = x[i].unwrap();
+        match meth[i].as_str() {
+            "mixed · mod3 · central-difference" if nu >= 1.0 => {
+                assert_eq!(st[i], "diverged", "CD at ν = {nu}")
+            }
+            "mixed · mod3 · hybrid"
+            | "mixed · zero-contact · backward-euler"
+            | "mixed · consistent · newmark-dissipative"
+            | "penalty · consistent · hybrid" => {
+                assert_eq!(st[i], "stable", "{} at ν = {nu}", meth[i])
+            }
+            _ => continue,
+        }
+        seen += 1;
+    }
+    assert_eq!(seen, 4 * 14 + 4 * 3, "cells checked");
+}

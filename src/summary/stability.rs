@@ -7,7 +7,9 @@
 //! numeric parameter that takes ≥ 2 values among a method's runs is an *axis*. Of h, dt and
 //! the Courant number only two are independent: when all three vary, the one with the most
 //! distinct values (the derived one — a grid over h and ν gives n_h·n_ν values of dt) is not
-//! an axis; when two vary and the third is fixed they are one axis (courant kept, else h). A cell is one pair of axis values; it holds every run of the method with those
+//! an axis; when two vary and the third is fixed they are one axis (courant kept, else h).
+//! Likewise any axis in one-to-one correspondence with an earlier one (h and T bundled in one
+//! grid item) is not an axis of its own. A cell is one pair of axis values; it holds every run of the method with those
 //! values (other axes, ensemble members), and its state is the worst of their states in the
 //! order diverged, solver-failed, timeout, growing, invalid, stable: a cell is stable only if
 //! every run in it is. `uniform` says whether its runs agreed.
@@ -179,6 +181,29 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 .expect("two");
             axes.retain(|(a, _)| !["h", "dt", "courant"].contains(a) || *a == keep);
         }
+        // Axes that move together (bundled in one grid item, e.g. { h, T }) are one axis: an
+        // axis in one-to-one correspondence with an earlier one is dropped.
+        let key_of = |i: usize, a: &str| {
+            axis_value(runs, &runs.runs[i], a).map(super::runs::float_key)
+        };
+        let mut kept: Vec<(&str, usize)> = Vec::new();
+        for &(b, n) in &axes {
+            let tied = kept.iter().any(|&(a, _)| {
+                let mut fwd: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
+                let mut back: BTreeMap<Option<String>, BTreeSet<Option<String>>> =
+                    BTreeMap::new();
+                for &i in idx {
+                    let (ka, kb) = (key_of(i, a), key_of(i, b));
+                    fwd.entry(ka.clone()).or_default().insert(kb.clone());
+                    back.entry(kb).or_default().insert(ka);
+                }
+                fwd.values().all(|v| v.len() == 1) && back.values().all(|v| v.len() == 1)
+            });
+            if !tied {
+                kept.push((b, n));
+            }
+        }
+        let axes = kept;
         for (ai, &(xa, _)) in axes.iter().enumerate() {
             for &(ya, _) in &axes[ai + 1..] {
                 maps += 1;
