@@ -14,11 +14,11 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use contact_sweep::run::fe::FeConfig;
+use contact_sweep::run::fe::{FeConfig, cholesky_options};
 use contact_sweep::run::{RunOptions, simulate};
 use contact_sweep::scene::{BarScene, MeshChoice, Physics, Scene, SceneSetup};
 use contact_sweep::space::fe::{BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern};
-use contact_sweep::space::linalg::{Cholesky, SymbolicCholesky};
+use contact_sweep::space::linalg::{Cholesky, CholeskyOptions, SymbolicCholesky};
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
 
@@ -46,8 +46,9 @@ fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
     }
 }
 
-/// The step matrix A = M + τ²/4 K of `config` (mod3 mass), assembled outside the engine.
-fn step_matrix(cfg: &FeConfig) -> (SymMatrix, usize) {
+/// The step matrix A = M + τ²/4 K of `config` (mod3 mass), assembled outside the engine, and
+/// the engine's choice of ordering and factor kind for it.
+fn step_matrix(cfg: &FeConfig) -> (SymMatrix, usize, CholeskyOptions) {
     let contact_sweep::scene::FeGeometry::Box { extent, cells } = &cfg.setup.geometry;
     let mesh = BoxMesh::new(extent, cells);
     let d = mesh.dim;
@@ -77,9 +78,11 @@ fn step_matrix(cfg: &FeConfig) -> (SymMatrix, usize) {
         },
     );
     let tau = cfg.dt;
+    let opts = cholesky_options(&mesh, &dofs);
     (
         SymMatrix::lin_comb(1.0, &m, tau * tau / 4.0, &k),
         dofs.n_free(),
+        opts,
     )
 }
 
@@ -87,8 +90,8 @@ fn bench_bar(c: &mut Criterion, name: &str, dim: usize, h: f64) {
     let mut g = c.benchmark_group(name);
     g.sample_size(10).warm_up_time(Duration::from_millis(500));
     let cfg = config(dim, h, 64);
-    let (a, n) = step_matrix(&cfg);
-    let sym = SymbolicCholesky::new(&a.pattern).unwrap();
+    let (a, n, opts) = step_matrix(&cfg);
+    let sym = SymbolicCholesky::with_options(&a.pattern, &opts).unwrap();
     g.bench_function("factorization", |b| {
         b.iter(|| Cholesky::new(&sym, &a).unwrap())
     });

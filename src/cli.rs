@@ -45,6 +45,11 @@ pub enum Command {
     Summarize {
         /// A folder written by `run`.
         dir: PathBuf,
+        /// Error columns of the Markdown and LaTeX convergence tables, comma-separated (or
+        /// `all`); overrides the sweep file's `[summary] errors`. Default: err_u_l2l2,
+        /// err_u_l2h1, err_sigma_mid_l2, err_energy_l2.
+        #[arg(long, value_name = "A,B,…", value_delimiter = ',')]
+        errors: Option<Vec<String>>,
     },
     /// Print the output schema (runs and series columns) as Markdown.
     Schema,
@@ -225,8 +230,9 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
             let cfg = args.validate()?;
             run(cfg)
         }
-        Command::Summarize { dir } => {
-            let s = summary::summarize(&dir)?;
+        Command::Summarize { dir, errors } => {
+            let opts = summarize_options(&dir, errors.as_deref())?;
+            let s = summary::summarize_with(&dir, &opts)?;
             print!("{}", s.terminal);
             Ok(ExitCode::SUCCESS)
         }
@@ -236,6 +242,24 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
         }
         Command::Slurm(args) => slurm(args),
     }
+}
+
+/// The column choice of `summarize DIR`: the `[summary]` table stored with DIR, its error
+/// columns replaced by `--errors` when given (checked first: a bad flag is reported even when
+/// the stored table is fine).
+fn summarize_options(dir: &Path, errors: Option<&[String]>) -> Result<summary::SummaryOptions> {
+    let flag = match errors {
+        Some(names) => Some(
+            summary::parse_errors(names)
+                .map_err(|reason| UsageError(format!("--errors: {reason}")))?,
+        ),
+        None => None,
+    };
+    let mut opts = summary::stored_options(dir)?;
+    if flag.is_some() {
+        opts.errors = flag;
+    }
+    Ok(opts)
 }
 
 fn run(cfg: RunConfig) -> Result<ExitCode> {
@@ -395,7 +419,7 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
             dir.display()
         );
     } else if cfg.summary {
-        match summary::summarize(dir) {
+        match summary::summarize_with(dir, &plan.sweep.summary) {
             Ok(s) => print!("{}", s.terminal),
             Err(e) => eprintln!("summary not written: {e:#}"),
         }

@@ -9,6 +9,11 @@ use common::{cli, write};
 /// (file body, key the message must name, a phrase of the reason)
 const CASES: &[(&str, &str, &str)] = &[
     (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"mod3\"\n[grid]\ncontact_init = [\"consistent\", \"exact\"]\n",
+        "grid.contact_init[1]",
+        "unknown contact_init `exact` (expected consistent or interpolant",
+    ),
+    (
         "name = \"x\"\nscene = \"bar1d\"\nnmae = 1\n[fixed]\nh = 0.1\ndt = 0.1\n",
         "nmae",
         "unknown top-level key",
@@ -158,6 +163,37 @@ const CASES: &[(&str, &str, &str)] = &[
         "name",
         "folder-safe",
     ),
+    // [summary]: the column choice of the convergence tables.
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nerrors = [\"err_u_l2h1\", \"err_u_h1\"]\n",
+        "summary.errors",
+        "unknown error column `err_u_h1`; valid: err_u_l2l2, err_u_l2h1, err_u_linfl2, err_sigma_l2, err_sigma_mid_l2, err_energy_l2, err_u_contact_max, or all",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nerrors = []\n",
+        "summary.errors",
+        "empty list",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nerrors = [\"err_u_l2h1\", 3]\n",
+        "summary.errors[1]",
+        "expected an error column name (a string), found a integer",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nrates = \"no\"\n",
+        "summary.rates",
+        "expected true or false, found a string",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\ncolumns = [\"err_u_l2h1\"]\n",
+        "summary.columns",
+        "unknown key (expected errors, rates, slopes, flags)",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\nsummary = 1\n[fixed]\nh = 0.1\ndt = 0.1\n",
+        "summary",
+        "expected a table",
+    ),
 ];
 
 #[test]
@@ -197,6 +233,23 @@ fn every_bad_sweep_is_refused_with_the_key_and_exit_2() {
             );
         }
     }
+}
+
+#[test]
+fn a_bad_summary_table_names_its_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nflags = true\nerrors = [\"l2h1\"]\n",
+    );
+    let o = cli(tmp.path(), &["plan", "s.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("s.toml:8: key `summary.errors`: unknown error column `l2h1`"),
+        "{err}"
+    );
 }
 
 #[test]

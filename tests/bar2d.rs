@@ -158,3 +158,147 @@ mass = ["consistent", "mod1", "mod2", "mod3"]
     // 3 × 3 nodes on Γ_C, 3 × 3 × 20 free nodes × 3 components.
     assert_eq!((r.contact_dofs, r.dofs), (Some(9), 540));
 }
+
+/// The layer weights are one mechanism (SPEC §2.2): `weights = [2, 1]` is mod3 and
+/// `weights = [n_d/(n_d−1)]` is mod2, to the last bit of the error norms (same matrices,
+/// same operations). Lumped and zero-contact run too, with the total mass they represent:
+/// lumping keeps ρ·|Ω| = 0.1; zero-contact drops the bottom nodes' rows and columns, i.e. the
+/// entries of the layer-0 elements that touch a bottom node. The Q1 mass is the tensor product
+/// of the 1D (h/6)[2 1; 1 2], so an element's two top nodes keep (4 + 4 + 2 + 2)/36 = ⅓ of its
+/// mass: removed = ⅔ · ρ·0.1·h = 0.00333… at h = 0.05.
+#[test]
+fn weights_reproduce_mod2_and_mod3_and_every_mass_variant_runs() {
+    let rows = run_sweep_text(
+        r#"
+name = "w"
+scene = "bar2d"
+reference = { h = 0.0125, dt = 0.00625, mass = "mod3", scheme = "crank-nicolson" }
+[fixed]
+T = 1.0
+h = 0.05
+dt = 0.025
+[grid]
+method = [
+  { mass = "mod3" },
+  { mass = "weights", mass_weights = [2.0, 1.0] },
+  { mass = "mod2" },
+  { mass = "weights", mass_weights = [1.0526315789473684] },
+  { mass = "lumped" },
+  { mass = "zero-contact" },
+]
+"#,
+    );
+    assert!(rows.iter().all(|r| r.status == "ok"), "{rows:?}");
+    let by = |m: &str, w: Option<&str>| {
+        rows.iter()
+            .find(|r| r.mass == m && r.mass_weights.as_deref() == w)
+            .unwrap()
+    };
+    let mod3 = by("mod3", None);
+    let w3 = by("weights", Some("2,1"));
+    assert_eq!(mod3.err_u_linfl2, w3.err_u_linfl2);
+    assert_eq!(mod3.energy_final, w3.energy_final);
+    let mod2 = by("mod2", None);
+    let w2 = rows
+        .iter()
+        .find(|r| r.mass == "weights" && r.mass_weights.as_deref() != Some("2,1"))
+        .unwrap();
+    // 20/19 is not exact in binary: the weights agree to one rounding, the results to 1e-12.
+    let rel = |a: f64, b: f64| ((a - b) / b).abs();
+    assert!(rel(w2.err_u_linfl2.unwrap(), mod2.err_u_linfl2.unwrap()) < 1e-12);
+    assert!((by("lumped", None).mass_total.unwrap() - 0.1).abs() < 1e-14);
+    let zc = by("zero-contact", None).mass_total.unwrap();
+    assert!(
+        (zc - (0.1 - 2.0 / 3.0 * 0.1 * 0.05)).abs() < 1e-14,
+        "zero-contact mass {zc}"
+    );
+}
+
+/// Reference runs through the command line: computed once into DIR/references, reused by the
+/// next shard writing into the same folder, and a damaged stored file is recomputed with a
+/// warning rather than trusted.
+#[test]
+fn the_reference_is_computed_once_per_folder_and_reused() {
+    use common::{cli, write};
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        r#"
+name = "r"
+scene = "bar2d"
+reference = { h = 0.0125, dt = 0.00625, mass = "mod3", scheme = "crank-nicolson" }
+[fixed]
+T = 1.0
+h = 0.05
+dt = 0.025
+[grid]
+mass = ["mod1", "mod3"]
+"#,
+    );
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", "s.toml", "--out", "o", "--no-summary"];
+        args.extend_from_slice(extra);
+        let o = cli(tmp.path(), &args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).to_string()
+    };
+    let first = run(&["--shard", "0/2"]);
+    assert!(
+        first.contains("computing") && first.contains("stored in"),
+        "{first}"
+    );
+    let second = run(&["--shard", "1/2"]);
+    assert!(
+        second.contains("stored, reused") && !second.contains("computing"),
+        "{second}"
+    );
+    let refs = tmp.path().join("o/references");
+    let file = std::fs::read_dir(&refs)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "ref"))
+        .unwrap();
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::write(&file, &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::remove_dir_all(tmp.path().join("o/runs")).unwrap();
+    std::fs::remove_dir_all(tmp.path().join("o/series")).unwrap();
+    let third = run(&[]);
+    assert!(
+        third.contains("damaged reference") && third.contains("computing"),
+        "{third}"
+    );
+    assert_eq!(
+        std::fs::read(&file).unwrap(),
+        bytes,
+        "recomputed bit for bit"
+    );
+}
+
+/// Runs with the same matrix (mesh, material, mass, dt, scheme coefficient) share one
+/// factorisation: the second finds it in the cache. T and Newmark's γ do not enter
+/// A = M + βτ²K, so these three runs need one factorisation in all. (A material value no other
+/// test uses keeps the process-wide cache key to this test.)
+#[test]
+fn runs_with_the_same_matrix_share_one_factorisation() {
+    let rows = run_sweep_text(
+        r#"
+name = "c"
+scene = "bar2d"
+[fixed]
+h = 0.05
+dt = 0.025
+lame_mu = 0.4375
+mass = "mod3"
+[grid]
+method = [
+  { T = 0.5, scheme = "crank-nicolson" },
+  { T = 1.0, scheme = "crank-nicolson" },
+  { T = 1.0, scheme = "newmark", newmark_beta = 0.25, newmark_gamma = 0.6 },
+]
+"#,
+    );
+    let computed: i64 = rows.iter().map(|r| r.factorizations).sum();
+    let hits: i64 = rows.iter().map(|r| r.factor_cache_hits.unwrap()).sum();
+    assert_eq!((computed, hits), (1, 2), "{rows:?}");
+}

@@ -416,3 +416,35 @@ fn plan_prints_counts_reasons_and_the_varying_parameters() {
     );
     assert!(!tmp.path().join("out").exists(), "plan writes nothing");
 }
+
+#[test]
+fn run_prints_the_columns_of_the_sweeps_summary_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"x\"\nscene = \"bar1d\"\nseries_every = 0\n[fixed]\nT = 1.0\ncourant = 1.0\n\
+         [grid]\nelements = [4, 8, 16]\n[summary]\nerrors = [\"err_energy_l2\", \"err_u_l2h1\"]\nflags = false\n",
+    );
+    let o = cli(tmp.path(), &["run", "s.toml", "--out", "out"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(tmp.path().join("out/summary/convergence.md")).unwrap();
+    assert!(
+        md.contains("| level | h | dt | status | err_energy_l2 | rate | err_u_l2h1 | rate |\n"),
+        "{md}"
+    );
+    assert!(md.contains("| LSQ slope, finest 3 |") && !md.contains("| flags |"));
+    // `summarize` alone finds the same choice in the manifest; --errors overrides the columns.
+    let o = cli(tmp.path(), &["summarize", "out"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let again = std::fs::read_to_string(tmp.path().join("out/summary/convergence.md")).unwrap();
+    assert_eq!(again, md);
+    let o = cli(tmp.path(), &["summarize", "out", "--errors", "err_u_l2l2"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(tmp.path().join("out/summary/convergence.md")).unwrap();
+    assert!(
+        md.contains("| level | h | dt | status | err_u_l2l2 | rate |\n")
+            && !md.contains("| flags |"),
+        "{md}"
+    );
+}

@@ -175,6 +175,51 @@ fn run_ids_are_canonical_and_stable() {
 }
 
 #[test]
+fn contact_init_applies_to_a_massless_contact_node_only() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n[grid]\nmass = [\"consistent\", \"mod3\"]\ncontact_init = [\"consistent\", \"interpolant\"]\n"
+    ));
+    // consistent mass × 2 starts collapse into one run, with the reason; mod3 keeps both.
+    assert_eq!(p.combinations, 4);
+    assert_eq!(p.runs.len(), 3);
+    let reasons: Vec<(&String, &usize)> = p.collapsed.iter().collect();
+    assert_eq!(reasons.len(), 1, "{reasons:?}");
+    assert!(
+        reasons[0]
+            .0
+            .contains("contact_init applies to a massless contact node only"),
+        "{reasons:?}"
+    );
+    assert_eq!(*reasons[0].1, 1);
+    // The column is absent where it does not apply, present (default included) where it does.
+    assert!(!p.runs[0].params.contains_key(&Key::ContactInit));
+    assert_eq!(
+        p.runs[1].params[&Key::ContactInit],
+        Value::Str("consistent".into())
+    );
+    assert_eq!(
+        p.runs[2].params[&Key::ContactInit],
+        Value::Str("interpolant".into())
+    );
+    assert!(
+        p.runs[2].label.contains("interpolant"),
+        "{}",
+        p.runs[2].label
+    );
+    // Frozen ids (SPEC §7): explicit `consistent` is the default and enters no id, so runs
+    // written before the key existed keep theirs — the 003 CN run with the consistent mass
+    // and with mod3 (see run_ids_are_canonical_and_stable).
+    assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
+    assert_eq!(p.runs[1].run_id, "0475aa43696174b7");
+    let omitted = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n[grid]\nmass = [\"consistent\", \"mod3\"]\n"
+    ));
+    assert_eq!(ids(&omitted), ids(&p)[..2].to_vec());
+    // The interpolant start is another run.
+    assert!(!ids(&omitted).contains(&p.runs[2].run_id));
+}
+
+#[test]
 fn aliases_and_explicit_parameters_are_the_same_run() {
     let p = plan(&format!(
         "{HEAD}[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nscheme = [\"crank-nicolson\", {{ scheme = \"newmark\", newmark_beta = 0.25, newmark_gamma = 0.5 }}, \"backward-euler\", {{ scheme = \"theta\", theta_scheme = 1.0 }}]\n"

@@ -404,9 +404,33 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
         "{md}"
     );
     assert!(md.contains("| LSQ slope, all usable levels |"));
+    // The text tables show the default columns that have values, in the default order; the
+    // others are named (the Parquet holds all four, checked above).
+    assert!(
+        md.contains("| level | h | dt | status | err_u_l2l2 | rate | err_u_l2h1 | rate |"),
+        "{md}"
+    );
+    assert!(!md.contains("| err_u_linfl2 |") && !md.contains("| err_sigma_l2 |"));
+    assert!(
+        md.contains("No value in this folder for err_sigma_mid_l2, err_energy_l2.")
+            && md.contains(
+                "Not shown here (in convergence.parquet and .csv): err_u_linfl2, err_sigma_l2."
+            ),
+        "{md}"
+    );
+    // LaTeX: one float per method group (two groups of one short path each).
     let tex = std::fs::read_to_string(tmp.path().join("summary/convergence.tex")).unwrap();
     assert_eq!(tex.matches("\\begin{table}").count(), 2);
     assert!(tex.contains("\\toprule") && tex.contains("\\bottomrule"));
+    // The failed level: its status column, its value in parentheses, the rate across it.
+    assert!(
+        tex.contains("$1/48$ & $1/48$ & diverged & ($1.000\\cdot10^{3}$)")
+            && tex.contains("$2.00$$^\\dagger$"),
+        "{tex}"
+    );
+    let doc = std::fs::read_to_string(tmp.path().join("summary/convergence_doc.tex")).unwrap();
+    assert!(doc.starts_with("% Stand-alone") && doc.contains("\\documentclass"));
+    assert!(doc.contains("\\end{document}") && !doc.contains("longtable"));
     // The terminal shows the slopes and flags.
     assert!(
         s.terminal.contains("1.77") && s.terminal.contains("pre-asym"),
@@ -416,6 +440,96 @@ fn rates_slopes_and_flags_match_hand_computed_values() {
     // CSV mirrors the Parquet.
     let csv = std::fs::read_to_string(tmp.path().join("summary/convergence.csv")).unwrap();
     assert_eq!(csv.lines().count(), all.height() + 1);
+}
+
+/// A manifest as `run` writes it: the sweep file's text in each session.
+fn write_manifest(dir: &Path, sweep_texts: &[&str]) {
+    let sessions: Vec<serde_json::Value> = sweep_texts
+        .iter()
+        .map(|t| serde_json::json!({ "sweep_file": "s.toml", "sweep_text": t }))
+        .collect();
+    let doc = serde_json::json!({ "tool": "contact-sweep", "sweep": "x", "sessions": sessions });
+    std::fs::write(dir.join("manifest.json"), doc.to_string()).unwrap();
+}
+
+#[test]
+fn the_summary_table_of_the_stored_sweep_file_chooses_the_columns() {
+    let tmp = tempfile::tempdir().unwrap();
+    write_runs(tmp.path(), "part-0.parquet", &mut runs_frame(&synthetic()));
+    // Two sessions: the latest sweep file's [summary] counts.
+    let base = "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n";
+    write_manifest(
+        tmp.path(),
+        &[
+            &format!("{base}[summary]\nerrors = [\"err_u_l2l2\"]\n"),
+            &format!(
+                "{base}[summary]\nerrors = [\"err_sigma_l2\", \"err_u_linfl2\"]\nrates = false\nslopes = false\n"
+            ),
+        ],
+    );
+    let stored = summary::stored_options(tmp.path()).unwrap();
+    assert_eq!(
+        stored,
+        summary::SummaryOptions {
+            errors: Some(vec!["err_sigma_l2", "err_u_linfl2"]),
+            rates: false,
+            slopes: false,
+            flags: true,
+        }
+    );
+    summary::summarize(tmp.path()).unwrap();
+    let md = std::fs::read_to_string(tmp.path().join("summary/convergence.md")).unwrap();
+    assert!(
+        md.contains("| level | h | dt | status | err_sigma_l2 | err_u_linfl2 |\n"),
+        "{md}"
+    );
+    assert!(!md.contains("| rate") && !md.contains("LSQ slope") && md.contains("| flags |"));
+    let tex = std::fs::read_to_string(tmp.path().join("summary/convergence.tex")).unwrap();
+    let (sigma, linf) = (
+        tex.find("$\\sigma_C^n$: $l^2(\\tau)$")
+            .expect("sigma column"),
+        tex.find("$u$: $l^\\infty(L^2)$").expect("linf column"),
+    );
+    assert!(sigma < linf, "chosen order");
+    assert!(!tex.contains("& rate") && !tex.contains("LSQ slope") && tex.contains("{flags}"));
+    // The Parquet keeps every column whatever the choice.
+    assert_eq!(
+        read(&tmp.path().join("summary/convergence.parquet")).height(),
+        4 * 5 + 4 * 3
+    );
+
+    // `summarize --errors` replaces the columns and keeps the rest of the stored choice.
+    let flag = summary::SummaryOptions {
+        errors: Some(summary::parse_errors(&["err_u_l2h1"]).unwrap()),
+        ..stored
+    };
+    summary::summarize_with(tmp.path(), &flag).unwrap();
+    let md = std::fs::read_to_string(tmp.path().join("summary/convergence.md")).unwrap();
+    assert!(
+        md.contains("| level | h | dt | status | err_u_l2h1 |\n"),
+        "{md}"
+    );
+
+    // A [summary] table this version refuses: a sweep-file error naming the manifest, the key
+    // and the line in the stored text (exit 2 from the CLI).
+    write_manifest(
+        tmp.path(),
+        &[&format!(
+            "{base}[summary]\nerrors = [\"err_u_l2h1\", \"nope\"]\n"
+        )],
+    );
+    let err = summary::summarize(tmp.path()).unwrap_err();
+    assert!(
+        err.chain().any(|c| c
+            .downcast_ref::<contact_sweep::sweep::SweepError>()
+            .is_some()),
+        "{err:#}"
+    );
+    let msg = format!("{err:#}");
+    assert!(
+        msg.contains("manifest.json (the sweep file stored in it):7: key `summary.errors`: unknown error column `nope`"),
+        "{msg}"
+    );
 }
 
 #[test]

@@ -57,13 +57,8 @@ pub fn ensure(
         let id = &rp.spec.run_id;
         let path = folder.join(format!("{id}.ref"));
         let lock_path = folder.join(format!("{id}.lock"));
-        let lock = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&lock_path)
-            .map_err(io(&lock_path))?;
-        lock.lock().map_err(io(&lock_path))?;
+        // Held until the reference is stored: a concurrent shard waits, then reads it.
+        let _lock = crate::sink::lock_exclusive(&lock_path).map_err(io(&lock_path))?;
         if path.exists() {
             match ReferenceData::load(&path) {
                 Ok(d) if d.space_stride == rp.space_stride && d.time_stride == rp.time_stride => {

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use crate::scene::SceneSetup;
-use crate::space::{ContactMethod, MassVariant};
+use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
 pub use observe::{Metrics, SeriesRow};
@@ -103,6 +103,7 @@ impl RunConfig {
                 method,
                 mass,
                 scheme,
+                contact_init: ContactInit::Consistent,
                 perturbation: None,
             }),
             SceneSetup::Fe(setup) => RunConfig::Fe(fe::FeConfig {
@@ -115,6 +116,16 @@ impl RunConfig {
                 perturbation: None,
             }),
         }
+    }
+
+    /// The initial value of a massless contact node (SPEC §2.2). The FE scenes start from
+    /// rest and unloaded, where the interpolant of u⁰ = 0 is already the quasi-static value:
+    /// both starts are the same state there.
+    pub fn with_contact_init(mut self, init: ContactInit) -> RunConfig {
+        if let RunConfig::Bar1d(c) = &mut self {
+            c.contact_init = init;
+        }
+        self
     }
 
     /// Ensemble member: relative amplitude of a perturbation of u⁰ and its seed.
@@ -151,6 +162,47 @@ pub struct RunContext {
     pub reference: Option<std::sync::Arc<reference::ReferenceData>>,
     /// Record the solution on this lattice (space stride, time stride).
     pub record_reference: Option<(usize, usize)>,
+}
+
+/// Why an engine's time loop stopped before its last step.
+pub(crate) enum Stop<E> {
+    /// The contact problem of this step had no (or several) solutions.
+    Solver(usize, E),
+    Diverged(observe::Divergence),
+    Timeout(usize),
+    Cancelled,
+}
+
+impl<E: std::fmt::Display> Stop<E> {
+    /// The run's status and message for how its loop ended (`tau` and `steps` for the
+    /// message); a solver failure is counted in `metrics`.
+    pub(crate) fn status(
+        end: Result<(), Stop<E>>,
+        tau: f64,
+        steps: usize,
+        start: std::time::Instant,
+        metrics: &mut Metrics,
+    ) -> (Status, Option<String>) {
+        match end {
+            Ok(()) => (Status::Ok, None),
+            Err(Stop::Solver(n, e)) => {
+                metrics.solver_failures = 1;
+                (
+                    Status::SolverFailed,
+                    Some(format!("step {n} (t = {:.6}): {e}", n as f64 * tau)),
+                )
+            }
+            Err(Stop::Diverged(d)) => (Status::Diverged, Some(d.0)),
+            Err(Stop::Cancelled) => (Status::Cancelled, Some("interrupted".into())),
+            Err(Stop::Timeout(n)) => (
+                Status::Timeout,
+                Some(format!(
+                    "run timeout after {:.3} s at step {n} of {steps}",
+                    start.elapsed().as_secs_f64()
+                )),
+            ),
+        }
+    }
 }
 
 /// What a run produced.

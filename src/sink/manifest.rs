@@ -52,6 +52,28 @@ impl Manifest {
         Ok(doc["sweep"].as_str().map(String::from))
     }
 
+    /// The sweep file's text of DIR's latest session that recorded one (`None` without a
+    /// manifest or without such a session): where `summarize DIR` finds the `[summary]` table.
+    pub fn latest_sweep_text(dir: &Path) -> Result<Option<String>, SinkError> {
+        let path = dir.join("manifest.json");
+        if !path.exists() {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let doc: Json = serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        Ok(doc["sessions"].as_array().and_then(|s| {
+            s.iter()
+                .rev()
+                .find_map(|x| x["sweep_text"].as_str().map(String::from))
+        }))
+    }
+
     /// Start a session: create or extend the manifest. `shard` is (k, n) for one shard of a
     /// job array.
     pub fn begin(
@@ -113,13 +135,7 @@ impl Manifest {
             let path = path.to_path_buf();
             move |source| SinkError::Io { path, source }
         };
-        let lock = std::fs::File::options()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&lock_path)
-            .map_err(io(&lock_path))?;
-        lock.lock().map_err(io(&lock_path))?;
+        let _lock = super::lock_exclusive(&lock_path).map_err(io(&lock_path))?;
         let mut doc = if self.path.exists() {
             let text = std::fs::read_to_string(&self.path).map_err(io(&self.path))?;
             serde_json::from_str(&text).map_err(|e| SinkError::Manifest {

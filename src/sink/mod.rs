@@ -105,6 +105,18 @@ fn sync_dir(dir: &Path) -> Result<(), SinkError> {
     File::open(dir).and_then(|f| f.sync_all()).map_err(io(dir))
 }
 
+/// Open (creating it) and lock `path` exclusively, waiting for other holders: a lock file
+/// that serialises processes sharing an output folder. Released when the file drops.
+pub fn lock_exclusive(path: &Path) -> std::io::Result<File> {
+    let f = File::options()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(path)?;
+    f.lock()?;
+    Ok(f)
+}
+
 /// Write bytes atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
     let dir = path.parent().unwrap_or(Path::new("."));

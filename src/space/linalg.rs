@@ -82,7 +82,7 @@ pub enum FactorKind {
     Supernodal,
 }
 
-/// Choices of the symbolic analysis. Measured on the bars (see the crate README/CHANGELOG and
+/// Choices of the symbolic analysis. Measured on the bars (README "Performance",
 /// `tests/fe_elements.rs::cholesky_timings`): a triangular solve costs ≈ 1.5–2.6 ns per stored
 /// entry of L, so the smallest factor wins — AMD + simplicial for the 2D bar, nested dissection
 /// + supernodal for the 3D bar.

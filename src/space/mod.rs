@@ -105,3 +105,39 @@ impl MassVariant {
         !matches!(self, MassVariant::Consistent | MassVariant::Lumped)
     }
 }
+
+/// Initial value of a contact node without inertia (SPEC §2.2, `contact_init`). Only runs whose
+/// mass variant has a zero contact row use it; a contact node with mass starts at the
+/// interpolant, its equation having an acceleration to absorb the difference.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactInit {
+    /// u₀(0) solves the node's quasi-static equation at t = 0 (u₀ = max(−g, u₁) for `mixed` and
+    /// the default bar), so the discrete state is consistent from the start: E⁰ = 1/8 − O(h).
+    #[default]
+    Consistent,
+    /// u₀(0) = u0(0) = a, the nodal interpolant (GetFEM's demo): E⁰ is the exact energy, a⁰ is
+    /// computed from this state on the free nodes, and the first step of a scheme enforcing the
+    /// node's equation at t^{n+1} moves the node to its quasi-static value, costing energy once.
+    /// The hybrid scheme with Nitsche or penalty enforces it at t^{n+½} and keeps the defect,
+    /// alternating in sign (see [`crate::run::bar1d`]).
+    Interpolant,
+}
+
+impl ContactInit {
+    pub const NAMES: [&'static str; 2] = ["consistent", "interpolant"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ContactInit::Consistent => "consistent",
+            ContactInit::Interpolant => "interpolant",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<ContactInit> {
+        match name {
+            "consistent" => Some(ContactInit::Consistent),
+            "interpolant" => Some(ContactInit::Interpolant),
+            _ => None,
+        }
+    }
+}

@@ -1,8 +1,12 @@
 //! Convergence tables: observed rates, least-squares slopes and flags per refinement path and
-//! error column (the maths is in the module header of [`super`]).
+//! error column (the maths is in the module header of [`super`]). The Parquet/CSV long table
+//! holds every error column; the Markdown and LaTeX tables show the columns chosen by
+//! [`SummaryOptions`] (the LaTeX layout is in [`latex`]).
 
 use std::fmt::Write as _;
 
+use super::latex;
+use super::options::SummaryOptions;
 use super::runs::{RefPath, Runs, group_heading};
 use super::table::{self, Align, Kind, Table};
 
@@ -194,12 +198,58 @@ const TERMINAL_ERRORS: &[&str] = &["err_u_l2l2", "err_u_l2h1", "err_sigma_mid_l2
 /// The message when nothing can be fitted.
 pub const NO_REFINEMENT: &str = "no refinement axis: every group has a single (h, dt) level";
 
-/// The convergence section: long table, Markdown, LaTeX and the terminal lines.
+/// The convergence section: long table, Markdown, LaTeX (fragment and stand-alone document)
+/// and the terminal lines.
 pub(crate) struct Section {
     pub table: Table,
     pub markdown: String,
     pub latex: String,
+    pub latex_doc: String,
     pub terminal: String,
+}
+
+/// The error columns the text tables show: the chosen ones that have values in the folder
+/// (indices into [`Runs::errors`], in the chosen order), and sentences about the rest. When
+/// none of the *default* columns has a value (a scene or version without them), every column
+/// with values is shown rather than an empty table.
+fn displayed(runs: &Runs, opts: &SummaryOptions) -> (Vec<usize>, Vec<String>) {
+    let chosen = opts.chosen();
+    let mut show: Vec<usize> = chosen
+        .iter()
+        .filter_map(|c| runs.errors.iter().position(|e| e == c))
+        .collect();
+    let missing: Vec<&str> = chosen
+        .iter()
+        .copied()
+        .filter(|c| !runs.errors.contains(c))
+        .collect();
+    let mut notes = Vec::new();
+    if runs.errors.is_empty() || runs.paths.is_empty() {
+        return (show, notes);
+    }
+    if show.is_empty() && opts.errors.is_none() {
+        show = (0..runs.errors.len()).collect();
+        notes.push(format!(
+            "None of the default error columns ({}) has a value in this folder: every column with values is shown.",
+            chosen.join(", ")
+        ));
+    } else if !missing.is_empty() {
+        notes.push(format!(
+            "No value in this folder for {}.",
+            missing.join(", ")
+        ));
+    }
+    let hidden: Vec<&str> = (0..runs.errors.len())
+        .filter(|e| !show.contains(e))
+        .map(|e| runs.errors[e])
+        .collect();
+    if !hidden.is_empty() {
+        notes.push(format!(
+            "Not shown here (in convergence.parquet and .csv): {}.",
+            hidden.join(", ")
+        ));
+    }
+    (show, notes)
 }
 
 fn columns(runs: &Runs) -> Vec<(String, Kind)> {
@@ -269,25 +319,13 @@ fn short_flags(f: &Fit) -> String {
     }
 }
 
-/// LaTeX column head of an error column.
-fn tex_error(name: &str) -> &'static str {
-    match name {
-        "err_u_l2l2" => "$u$: $l^2(\\tau;L^2)$",
-        "err_u_l2h1" => "$u$: $l^2(\\tau;H^1)$",
-        "err_u_linfl2" => "$u$: $l^\\infty(L^2)$",
-        "err_sigma_l2" => "$\\sigma_C$: $l^2(\\tau)$",
-        "err_sigma_mid_l2" => "$\\sigma_C^{n-1/2}$: $l^2(\\tau)$",
-        "err_energy_l2" => "$E$: $l^2(\\tau)$",
-        "err_u_contact_max" => "$u_C$: max",
-        _ => "error",
-    }
-}
-
-/// Build the convergence section.
-pub(crate) fn section(runs: &Runs) -> Section {
+/// Build the convergence section; `title` heads the stand-alone LaTeX document.
+pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Section {
     let mut t = Table::new(&columns(runs));
     let mut md = String::new();
-    let mut tex = String::new();
+    let mut tex_notes: Vec<String> = Vec::new();
+    let mut tex_paths: Vec<latex::PathTex> = Vec::new();
+    let (display, notes) = displayed(runs, opts);
     let mut term_rows: Vec<Vec<String>> = Vec::new();
     let mut hidden = 0usize;
     let mut last_group: Option<usize> = None;
@@ -306,10 +344,28 @@ pub(crate) fn section(runs: &Runs) -> Section {
          error ≤ {ROUNDOFF_RELATIVE:e}·coarsest, or < {ROUNDOFF_ABSOLUTE:e}, or exactly 0). \
          Levels whose status is not ok are kept, marked ✗, and excluded from rates and fits.\n"
     );
-    tex.push_str(
-        "% Convergence tables written by `contact-sweep summarize` (one table per refinement path).\n\
-         % Needs \\usepackage{booktabs}.\n\n",
-    );
+    if !runs.paths.is_empty() && !runs.errors.is_empty() {
+        let _ = writeln!(
+            md,
+            "Error columns: {} ({}; choose with `[summary] errors = [...]` in the sweep file or \
+             `contact-sweep summarize DIR --errors a,b,c`; every column is in convergence.parquet \
+             and .csv).\n",
+            display
+                .iter()
+                .map(|&e| runs.errors[e])
+                .collect::<Vec<_>>()
+                .join(", "),
+            if opts.errors.is_some() {
+                "chosen"
+            } else {
+                "the default"
+            }
+        );
+        for n in &notes {
+            let _ = writeln!(md, "{n}\n");
+        }
+    }
+    tex_notes.extend(notes);
 
     let single = runs.groups.iter().filter(|g| g.levels < 2).count();
     let multi_without_path: Vec<usize> = (0..runs.groups.len())
@@ -320,7 +376,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
     if runs.paths.is_empty() {
         if multi_without_path.is_empty() {
             let _ = writeln!(md, "**{NO_REFINEMENT}** ({} groups).\n", runs.groups.len());
-            let _ = writeln!(tex, "% {NO_REFINEMENT}");
+            tex_notes.push(format!("{NO_REFINEMENT} ({} groups).", runs.groups.len()));
             let _ = writeln!(
                 terminal,
                 "convergence: {NO_REFINEMENT} ({} groups) — no rates to compute",
@@ -329,12 +385,13 @@ pub(crate) fn section(runs: &Runs) -> Section {
         } else {
             let msg = "no refinement path: no group holds courant, dt or h fixed over ≥ 2 levels";
             let _ = writeln!(md, "**{msg}**.\n");
-            let _ = writeln!(tex, "% {msg}");
+            tex_notes.push(format!("{msg}."));
             let _ = writeln!(terminal, "convergence: {msg}");
         }
     } else if runs.errors.is_empty() {
         let msg = "no error columns with values (no reference solution): rates cannot be computed";
         let _ = writeln!(md, "**{msg}**.\n");
+        tex_notes.push(format!("{msg}."));
         let _ = writeln!(terminal, "convergence: {msg}");
     }
     if single > 0 && !runs.paths.is_empty() {
@@ -439,14 +496,25 @@ pub(crate) fn section(runs: &Runs) -> Section {
             }
         }
 
-        // Markdown: one table per path, deal.II ConvergenceTable style.
+        // Markdown: one table per path, deal.II ConvergenceTable style, with the chosen
+        // columns (every one is in the long table above).
+        let shown: Vec<&(usize, Fit)> = display
+            .iter()
+            .filter_map(|d| fits.iter().find(|(e, _)| e == d))
+            .collect();
+        if shown.is_empty() {
+            md.push_str("None of the error columns shown has a value on this path.\n\n");
+        }
         let mut header: Vec<String> =
             vec!["level".into(), "h".into(), "dt".into(), "status".into()];
         let mut align = vec![Align::Right, Align::Right, Align::Right, Align::Left];
-        for (e, _) in &fits {
+        for (e, _) in &shown {
             header.push(runs.errors[*e].into());
-            header.push("rate".into());
-            align.extend([Align::Right, Align::Right]);
+            align.push(Align::Right);
+            if opts.rates {
+                header.push("rate".into());
+                align.push(Align::Right);
+            }
         }
         let mut rows: Vec<Vec<String>> = Vec::new();
         let mut skipped = false;
@@ -462,7 +530,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
                     format!("{} ✗", r.status)
                 },
             ];
-            for (e, f) in &fits {
+            for (e, f) in &shown {
                 let lf = &f.levels[li];
                 let v = table::sci(r.errors[*e]);
                 row.push(if lf.used || v.is_empty() {
@@ -470,51 +538,61 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 } else {
                     format!("({v}) ✗")
                 });
-                let mut rt = table::rate(lf.rate);
-                if lf.rate_from.is_some_and(|from| from + 1 != li) {
-                    rt.push_str(" †");
-                    skipped = true;
+                if opts.rates {
+                    let mut rt = table::rate(lf.rate);
+                    if lf.rate_from.is_some_and(|from| from + 1 != li) {
+                        rt.push_str(" †");
+                        skipped = true;
+                    }
+                    row.push(rt);
                 }
-                row.push(rt);
             }
             rows.push(row);
         }
-        let mut lsq_all = vec![
-            "LSQ slope, all usable levels".to_string(),
-            String::new(),
-            String::new(),
-            String::new(),
-        ];
-        let mut lsq_fine = vec![
-            "LSQ slope, finest 3".to_string(),
-            String::new(),
-            String::new(),
-            String::new(),
-        ];
-        let mut spread = vec![
-            "rate spread".to_string(),
-            String::new(),
-            String::new(),
-            String::new(),
-        ];
-        let mut flags = vec![
-            "flags".to_string(),
-            String::new(),
-            String::new(),
-            String::new(),
-        ];
-        for (_, f) in &fits {
-            lsq_all.extend([format!("({} levels)", f.used), table::rate(f.slope_all)]);
-            lsq_fine.extend([
-                format!("({} levels)", f.fine_levels),
-                table::rate(f.slope_fine3),
-            ]);
-            spread.extend([String::new(), table::rate(f.spread)]);
-            flags.extend([f.flags(), String::new()]);
+        // A statistics row: its name, then one cell per shown column (two with rates: the
+        // statistic sits under the rate, a note under the value).
+        let stat_row = |name: &str, cell: &dyn Fn(&Fit) -> (String, String)| -> Vec<String> {
+            let mut row = vec![
+                name.to_string(),
+                String::new(),
+                String::new(),
+                String::new(),
+            ];
+            for (_, f) in &shown {
+                let (note, stat) = cell(f);
+                if opts.rates {
+                    row.extend([note, stat]);
+                } else if stat.is_empty() {
+                    row.push(note);
+                } else {
+                    row.push(stat);
+                }
+            }
+            row
+        };
+        if opts.slopes {
+            rows.push(stat_row("LSQ slope, all usable levels", &|f| {
+                (format!("({} levels)", f.used), table::rate(f.slope_all))
+            }));
+            rows.push(stat_row("LSQ slope, finest 3", &|f| {
+                (
+                    format!("({} levels)", f.fine_levels),
+                    table::rate(f.slope_fine3),
+                )
+            }));
         }
-        rows.extend([lsq_all, lsq_fine, spread, flags]);
-        md.push_str(&table::markdown(&header, &align, &rows));
-        md.push('\n');
+        if opts.rates {
+            rows.push(stat_row("rate spread", &|f| {
+                (String::new(), table::rate(f.spread))
+            }));
+        }
+        if opts.flags {
+            rows.push(stat_row("flags", &|f| (f.flags(), String::new())));
+        }
+        if !shown.is_empty() {
+            md.push_str(&table::markdown(&header, &align, &rows));
+            md.push('\n');
+        }
         if skipped {
             md.push_str(
                 "†: rate against the previous usable level (a level in between is excluded).\n\n",
@@ -544,79 +622,13 @@ pub(crate) fn section(runs: &Runs) -> Section {
             md.push_str("\n\n");
         }
 
-        // LaTeX (booktabs).
-        let _ = writeln!(tex, "\\begin{{table}}[htbp]\n  \\centering");
-        let _ = writeln!(tex, "  \\caption{{{}}}", table::tex(&heading));
-        let _ = writeln!(
-            tex,
-            "  \\begin{{tabular}}{{rrl{}}}",
-            "rr".repeat(fits.len())
-        );
-        let _ = writeln!(tex, "    \\toprule");
-        let mut head = vec!["$h$".to_string(), "$\\tau$".into(), "status".into()];
-        for (e, _) in &fits {
-            head.push(tex_error(runs.errors[*e]).into());
-            head.push("rate".into());
+        if !shown.is_empty() {
+            tex_paths.push(latex::PathTex {
+                index: pi,
+                path: p,
+                fits: shown.iter().map(|(e, f)| (*e, f.clone())).collect(),
+            });
         }
-        let _ = writeln!(tex, "    {} \\\\", head.join(" & "));
-        let _ = writeln!(tex, "    \\midrule");
-        for (li, &(_, ri)) in p.levels.iter().enumerate() {
-            let r = &runs.runs[ri];
-            let mut row = vec![
-                table::tex_sci(r.h),
-                table::tex_sci(r.dt),
-                table::tex(&r.status),
-            ];
-            for (e, f) in &fits {
-                let lf = &f.levels[li];
-                let v = table::tex_sci(r.errors[*e]);
-                row.push(if lf.used || v.is_empty() {
-                    v
-                } else {
-                    format!("({v})")
-                });
-                let mut rt = table::tex_rate(lf.rate);
-                if lf.rate_from.is_some_and(|from| from + 1 != li) {
-                    rt.push_str("$^\\dagger$");
-                }
-                row.push(rt);
-            }
-            let _ = writeln!(tex, "    {} \\\\", row.join(" & "));
-        }
-        let _ = writeln!(tex, "    \\midrule");
-        let tex_line = |name: &str, cells: Vec<String>| {
-            format!(
-                "    \\multicolumn{{3}}{{l}}{{{name}}} & {} \\\\\n",
-                cells.join(" & ")
-            )
-        };
-        tex.push_str(&tex_line(
-            "LSQ slope, all",
-            fits.iter()
-                .flat_map(|(_, f)| [String::new(), table::tex_rate(f.slope_all)])
-                .collect(),
-        ));
-        tex.push_str(&tex_line(
-            "LSQ slope, finest 3",
-            fits.iter()
-                .flat_map(|(_, f)| [String::new(), table::tex_rate(f.slope_fine3)])
-                .collect(),
-        ));
-        tex.push_str(&tex_line(
-            "flags",
-            fits.iter()
-                .map(|(_, f)| {
-                    format!(
-                        "\\multicolumn{{2}}{{l}}{{\\footnotesize {}}}",
-                        table::tex(&f.flags())
-                    )
-                })
-                .collect(),
-        ));
-        let _ = writeln!(
-            tex,
-            "    \\bottomrule\n  \\end{{tabular}}\n\\end{{table}}\n"
-        );
 
         // Terminal: the LSQ slopes of the main error columns, for the longest paths of each
         // group only (a grid of h × dt also yields many two-level paths; they are in the files).
@@ -631,14 +643,14 @@ pub(crate) fn section(runs: &Runs) -> Section {
             hidden += 1;
             continue;
         }
-        let mut shown: Vec<&(usize, Fit)> = fits
+        let mut on_terminal: Vec<&(usize, Fit)> = fits
             .iter()
             .filter(|(e, _)| TERMINAL_ERRORS.contains(&runs.errors[*e]))
             .collect();
-        if shown.is_empty() {
-            shown = fits.iter().take(1).collect();
+        if on_terminal.is_empty() {
+            on_terminal = fits.iter().take(1).collect();
         }
-        for (e, f) in shown {
+        for (e, f) in on_terminal {
             // The group's number and title once, on its first line.
             let first_of_group = last_group != Some(g);
             last_group = Some(g);
@@ -672,7 +684,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
     if !term_rows.is_empty() {
         let _ = writeln!(
             terminal,
-            "convergence: {} refinement path{} in {} group{} (LSQ slopes of log e vs log h or dt; all columns in convergence.md)",
+            "convergence: {} refinement path{} in {} group{} (LSQ slopes of log e vs log h or dt; every column in convergence.parquet)",
             runs.paths.len(),
             if runs.paths.len() == 1 { "" } else { "s" },
             runs.groups.len(),
@@ -710,10 +722,12 @@ pub(crate) fn section(runs: &Runs) -> Section {
             );
         }
     }
+    let tex = latex::render(runs, opts, &display, &tex_paths, &tex_notes, title);
     Section {
         table: t,
         markdown: md,
-        latex: tex,
+        latex: tex.fragment,
+        latex_doc: tex.document,
         terminal,
     }
 }

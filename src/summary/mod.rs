@@ -49,12 +49,12 @@
 //! same power-law model as the rates).
 //!
 //! # Files (all written atomically: temporary dot-file, fsync, rename)
-//! `convergence.{parquet,csv,md,tex}`, `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
+//! `convergence.{parquet,csv,md,tex}`, `convergence_doc.tex` (the LaTeX tables as a complete
+//! document, see [`latex`]), `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
 //! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `stability_map.{parquet,csv,md}`
 //! ([`stability`]: per method and pair of swept axes, the state of every cell),
 //! `search.{parquet,csv,md}` (the boundaries of a `[search]`),
-//! `work_precision.{parquet,csv,md}`,
-//! `cost_to_error.{parquet,csv}`.
+//! `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`.
 
 use std::path::{Path, PathBuf};
 
@@ -63,6 +63,8 @@ use anyhow::Context as _;
 pub mod convergence;
 pub mod energy;
 pub mod ensemble;
+mod latex;
+pub mod options;
 mod runs;
 mod search;
 pub mod stability;
@@ -70,6 +72,7 @@ mod table;
 pub mod work;
 
 pub use convergence::{NO_REFINEMENT, lsq_slope, observed_rate};
+pub use options::{DEFAULT_ERRORS, ERROR_COLUMNS, SummaryOptions, parse_errors};
 pub use work::{loglog_cost, pareto_front};
 
 /// What `summarize` produced.
@@ -91,20 +94,56 @@ pub struct Summary {
     pub ignored_columns: Vec<String>,
 }
 
-/// Summarize DIR: read `DIR/runs` (and `DIR/series`), write the tables under `DIR/summary/`.
+/// The column choice stored with DIR: the `[summary]` table of the sweep file of DIR's latest
+/// session (its text is in `DIR/manifest.json`); the default for a folder without one.
+///
+/// Errors: an unreadable manifest, or a `[summary]` table this version refuses (a
+/// [`crate::sweep::SweepError`] naming the manifest, the key and the line in the stored text).
+pub fn stored_options(dir: &Path) -> anyhow::Result<SummaryOptions> {
+    match crate::sink::Manifest::latest_sweep_text(dir)? {
+        None => Ok(SummaryOptions::default()),
+        Some(text) => {
+            let name = PathBuf::from(format!(
+                "{} (the sweep file stored in it)",
+                dir.join("manifest.json").display()
+            ));
+            Ok(crate::sweep::summary_options(&name, &text)?)
+        }
+    }
+}
+
+/// Summarize DIR with the column choice stored with it ([`stored_options`]).
+pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
+    let opts = stored_options(dir)?;
+    summarize_with(dir, &opts)
+}
+
+/// Summarize DIR: read `DIR/runs` (and `DIR/series`), write the tables under `DIR/summary/`;
+/// `opts` chooses the error columns of the Markdown and LaTeX tables.
 ///
 /// Errors: DIR missing or without runs (the message names the folder), or an I/O failure.
 /// A folder without a refinement axis is not an error: the convergence section says so.
-pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
+pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summary> {
     let runs = runs::load(dir)?;
     let out = dir.join("summary");
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
     let mut files = Vec::new();
 
-    let conv = convergence::section(&runs);
+    // The folder's name heads the stand-alone LaTeX document.
+    let title = dir
+        .canonicalize()
+        .ok()
+        .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| dir.display().to_string());
+    let conv = convergence::section(&runs, opts, &title);
     files.extend(table::write_table(&out, "convergence", &conv.table)?);
     files.push(table::write_text(&out, "convergence.md", &conv.markdown)?);
     files.push(table::write_text(&out, "convergence.tex", &conv.latex)?);
+    files.push(table::write_text(
+        &out,
+        "convergence_doc.tex",
+        &conv.latex_doc,
+    )?);
 
     let en = energy::section(dir, &runs)?;
     files.extend(table::write_table(&out, "energy", &en.runs)?);
@@ -158,7 +197,7 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     terminal.push_str(&se.terminal);
     terminal.push_str(&wp.terminal);
     terminal.push_str(&format!(
-        "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex)\n",
+        "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
         out.display()
     ));
     Ok(Summary {

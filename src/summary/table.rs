@@ -288,7 +288,14 @@ pub(crate) fn rate(x: Option<f64>) -> String {
 /// LaTeX-safe text: the ASCII specials and the non-ASCII characters of the run labels.
 pub(crate) fn tex(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
-    for c in s.chars() {
+    let mut chars = s.chars().peekable();
+    while let Some(c) = chars.next() {
+        // γ0 in the labels is the Nitsche parameter γ₀.
+        if c == 'γ' && chars.peek() == Some(&'0') {
+            chars.next();
+            out.push_str("$\\gamma_0$");
+            continue;
+        }
         match c {
             '\\' => out.push_str("\\textbackslash{}"),
             '&' | '%' | '$' | '#' | '_' | '{' | '}' => {
@@ -312,24 +319,6 @@ pub(crate) fn tex(s: &str) -> String {
         }
     }
     out
-}
-
-/// A number in LaTeX: `$1.2346\cdot10^{-2}$`.
-pub(crate) fn tex_sci(x: Option<f64>) -> String {
-    match x {
-        Some(x) if x.is_finite() && x != 0.0 => {
-            let s = format!("{x:.4e}");
-            let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-            if e == "0" {
-                format!("${m}$")
-            } else {
-                format!("${m}\\cdot10^{{{e}}}$")
-            }
-        }
-        Some(0.0) => "$0$".into(),
-        Some(x) => tex(&format!("{x}")),
-        None => String::new(),
-    }
 }
 
 /// A rate in LaTeX (math minus sign).

@@ -29,6 +29,8 @@ pub enum Key {
     LameLambda,
     LameMu,
     Gravity,
+    /// Last: ids hash parameters in key order, so new keys go at the end.
+    ContactInit,
 }
 
 /// What a key's value must look like.
@@ -114,7 +116,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 24] = [
+    pub const ALL: [Key; 25] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -139,6 +141,7 @@ impl Key {
         Key::LameLambda,
         Key::LameMu,
         Key::Gravity,
+        Key::ContactInit,
     ];
 
     pub fn name(self) -> &'static str {
@@ -167,6 +170,7 @@ impl Key {
             Key::LameLambda => "lame_lambda",
             Key::LameMu => "lame_mu",
             Key::Gravity => "gravity",
+            Key::ContactInit => "contact_init",
         }
     }
 
@@ -192,7 +196,7 @@ impl Key {
     pub fn value_type(self) -> ValueType {
         match self {
             Key::Elements => ValueType::Int,
-            Key::Space | Key::Mass | Key::Scheme => ValueType::Str,
+            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -253,6 +257,15 @@ impl Key {
                     Err(format!(
                         "unknown mass `{s}` (expected one of {})",
                         crate::space::MassVariant::NAMES.join(", ")
+                    ))
+                }
+            }
+            (Key::ContactInit, Value::Str(s)) => {
+                if crate::space::ContactInit::from_name(s).is_some() {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown contact_init `{s}` (expected consistent or interpolant: the massless contact node starts at its quasi-static value or at the interpolant u0(0))"
                     ))
                 }
             }

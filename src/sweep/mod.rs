@@ -2,7 +2,9 @@
 //!
 //! A sweep file names a scene and a parameter space: `[fixed]` values, a cartesian `[grid]`
 //! (items may be bundles — inline tables setting several parameters at once), equal-length
-//! `[zip]` lists advanced together, and `exclude` filters. Everything is checked before
+//! `[zip]` lists advanced together, and `exclude` filters; a `[summary]` table chooses the
+//! columns of the convergence tables ([`crate::summary::SummaryOptions`]; [`summary_options`]
+//! reads it back from the text stored in a results folder). Everything is checked before
 //! anything runs: each problem is reported with the file, the key path, the line and the
 //! reason ([`SweepError`]). [`plan::expand`] turns the file into [`plan::Plan`]: deterministic
 //! order, meaningless combinations dropped, parameters that do not apply to a run's method
@@ -20,6 +22,7 @@ pub use plan::{Plan, RunSpec, expand};
 use tree::{Kind, Node};
 
 use crate::scene::SceneKind;
+use crate::summary::options::{SummaryOptions, parse_errors};
 
 /// Where a value was written: its key path in the file and its line.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -174,9 +177,11 @@ pub struct SweepFile {
     /// `allow_unstable = true`: an explicit scheme beyond its CFL limit runs (and ends
     /// `diverged`) instead of being refused; always so for the probes of a search.
     pub allow_unstable: bool,
+    /// `[summary]`: what the convergence tables print.
+    pub summary: SummaryOptions,
 }
 
-const TOP_KEYS: [&str; 13] = [
+const TOP_KEYS: [&str; 14] = [
     "name",
     "scene",
     "description",
@@ -190,6 +195,7 @@ const TOP_KEYS: [&str; 13] = [
     "series_every",
     "search",
     "allow_unstable",
+    "summary",
 ];
 
 /// Collects issues while parsing.
@@ -285,6 +291,79 @@ impl Checker {
             );
         }
         k
+    }
+
+    /// The `[summary]` table: `errors` (a list of error column names), `rates`, `slopes`,
+    /// `flags` (booleans). Unset keys keep their defaults.
+    fn summary(&mut self, line: usize, node: &Node) -> SummaryOptions {
+        let mut out = SummaryOptions::default();
+        let Kind::Table(entries) = &node.kind else {
+            self.issue(
+                "summary",
+                line,
+                format!(
+                    "expected a table ([summary] with errors, rates, slopes, flags), found a {}",
+                    node.kind.type_name()
+                ),
+            );
+            return out;
+        };
+        for (k, kl, v) in entries {
+            let p = format!("summary.{k}");
+            match k.as_str() {
+                "errors" => {
+                    let Kind::Array(items) = &v.kind else {
+                        self.issue(
+                            &p,
+                            *kl,
+                            format!(
+                                "expected a list of error column names, found a {}",
+                                v.kind.type_name()
+                            ),
+                        );
+                        continue;
+                    };
+                    let mut names = Vec::with_capacity(items.len());
+                    for (i, it) in items.iter().enumerate() {
+                        match &it.kind {
+                            Kind::Str(s) => names.push(s.as_str()),
+                            k => self.issue(
+                                &format!("{p}[{i}]"),
+                                it.line,
+                                format!(
+                                    "expected an error column name (a string), found a {}",
+                                    k.type_name()
+                                ),
+                            ),
+                        }
+                    }
+                    if names.len() == items.len() {
+                        match parse_errors(&names) {
+                            Ok(e) => out.errors = Some(e),
+                            Err(reason) => self.issue(&p, *kl, reason),
+                        }
+                    }
+                }
+                "rates" | "slopes" | "flags" => match v.kind {
+                    Kind::Bool(b) => match k.as_str() {
+                        "rates" => out.rates = b,
+                        "slopes" => out.slopes = b,
+                        _ => out.flags = b,
+                    },
+                    ref other => self.issue(
+                        &p,
+                        *kl,
+                        format!("expected true or false, found a {}", other.type_name()),
+                    ),
+                },
+                _ => self.issue(
+                    &p,
+                    *kl,
+                    "unknown key (expected errors, rates, slopes, flags)",
+                ),
+            }
+        }
+        out
     }
 
     /// A bundle: an inline table of parameters.
@@ -674,6 +753,10 @@ impl SweepFile {
                 );
             }
         }
+        let summary = match get("summary") {
+            Some((_, line, node)) => ck.summary(*line, node),
+            None => SummaryOptions::default(),
+        };
         let mut reference = None;
         if let Some((_, line, node)) = get("reference") {
             let uses_reference = ck.scene.map(|s| {
@@ -806,6 +889,7 @@ impl SweepFile {
                 reference,
                 search,
                 allow_unstable,
+                summary,
             })
         } else {
             let mut issues = ck.issues;
@@ -813,6 +897,37 @@ impl SweepFile {
             issues.dedup();
             Err(invalid(issues))
         }
+    }
+}
+
+/// Only the `[summary]` table of a sweep file's text (the rest is not checked): how
+/// `summarize DIR` reads the column choice back from the sweep file stored in
+/// `DIR/manifest.json`, even when that file was written for another version. `path` names the
+/// text in messages.
+pub fn summary_options(path: &Path, text: &str) -> Result<SummaryOptions, SweepError> {
+    let invalid = |issues: Vec<Issue>| SweepError::Invalid {
+        file: path.to_path_buf(),
+        issues,
+    };
+    let top = tree::parse(text).map_err(|e| {
+        invalid(vec![Issue {
+            line: e.line,
+            key: "(syntax)".into(),
+            reason: format!("invalid TOML: {}", e.message),
+        }])
+    })?;
+    let mut ck = Checker {
+        scene: None,
+        issues: Vec::new(),
+    };
+    let out = match top.iter().find(|(k, _, _)| k == "summary") {
+        Some((_, line, node)) => ck.summary(*line, node),
+        None => SummaryOptions::default(),
+    };
+    if ck.issues.is_empty() {
+        Ok(out)
+    } else {
+        Err(invalid(ck.issues))
     }
 }
 

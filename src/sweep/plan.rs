@@ -21,7 +21,7 @@ use super::keys::canonical_number;
 use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::run::RunConfig;
 use crate::scene::{Physics, Scene, SceneKind};
-use crate::space::{ContactMethod, MassVariant};
+use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
 
 /// One run of the plan.
@@ -138,6 +138,7 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::NewmarkBeta => Value::Num(0.25),
         Key::NewmarkGamma => Value::Num(0.5),
         Key::Restitution => Value::Num(1.0),
+        Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
         k if k.is_physics() => {
             Value::Num(scene.physics().iter().find(|p| p.name == k.name())?.default)
         }
@@ -295,6 +296,7 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
             Key::ThetaScheme => matches!(scheme, Scheme::Theta(_)),
             Key::Restitution => matches!(scheme, Scheme::PaoliSchatzman(_)),
             Key::MassWeights => mass_name == "weights",
+            Key::ContactInit => mass.massless_contact(),
             _ => true,
         };
         if ok {
@@ -307,6 +309,9 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
             Key::NewmarkGamma => "applies to newmark only",
             Key::ThetaScheme => "applies to the theta scheme only",
             Key::Restitution => "applies to paoli-schatzman only",
+            Key::ContactInit => {
+                "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+            }
             _ => "applies to mass = weights only",
         })
     };
@@ -318,6 +323,9 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
 
     // Meaningless combinations (SPEC §3).
     let massless = mass.massless_contact();
+    let contact_init = get(Key::ContactInit)
+        .and_then(|v| v.as_str().and_then(ContactInit::from_name))
+        .expect("checked");
     if matches!(scheme, Scheme::PaoliSchatzman(_)) && method != ContactMethod::Mixed {
         return Outcome::Inapplicable("paoli-schatzman is defined for space = mixed only".into());
     }
@@ -428,7 +436,12 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
         scheme,
         dt,
         steps,
-    );
+    )
+    .with_contact_init(if massless {
+        contact_init
+    } else {
+        ContactInit::Consistent
+    });
 
     // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
@@ -467,6 +480,13 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
     put(Key::Scheme, Value::Str(scheme.family().into()), true);
     if let MassVariant::Weights(w) = &mass {
         put(Key::MassWeights, Value::List(w.clone()), true);
+    }
+    if massless {
+        put(
+            Key::ContactInit,
+            Value::Str(contact_init.name().into()),
+            false,
+        );
     }
     match method {
         ContactMethod::Nitsche { theta, gamma0 } => {
@@ -509,6 +529,10 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
                 .join(",")
         ),
         other => other.name().to_string(),
+    };
+    let mass_label = match (massless, contact_init) {
+        (true, ContactInit::Interpolant) => format!("{mass_label} (interpolant start)"),
+        _ => mass_label,
     };
     let scheme_label = scheme.label();
     Outcome::Run(Box::new(Resolved {

@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 use contact_sweep::run::bar1d::Bar1dConfig;
 use contact_sweep::run::{Outcome, RunConfig, RunOptions, Status, simulate};
 use contact_sweep::scene::BarParams;
-use contact_sweep::space::{ContactMethod, MassVariant};
+use contact_sweep::space::{ContactInit, ContactMethod, MassVariant};
 use contact_sweep::time::Scheme;
 
 pub fn bin() -> &'static str {
@@ -42,6 +42,28 @@ pub fn bar1d(
     series_every: usize,
 ) -> Outcome {
     let cfg = Bar1dConfig::new(bar, elements, dt, t_final, method, mass, scheme);
+    simulate_with(cfg, series_every)
+}
+
+/// As [`bar1d`], with the massless contact node started by `init` (SPEC §2.2 `contact_init`).
+#[allow(clippy::too_many_arguments)]
+pub fn bar1d_start(
+    init: ContactInit,
+    bar: BarParams,
+    elements: usize,
+    dt: f64,
+    t_final: f64,
+    method: ContactMethod,
+    mass: MassVariant,
+    scheme: Scheme,
+    series_every: usize,
+) -> Outcome {
+    let cfg =
+        Bar1dConfig::new(bar, elements, dt, t_final, method, mass, scheme).with_contact_init(init);
+    simulate_with(cfg, series_every)
+}
+
+fn simulate_with(cfg: Bar1dConfig, series_every: usize) -> Outcome {
     simulate(
         &RunConfig::Bar1d(cfg),
         &RunOptions {

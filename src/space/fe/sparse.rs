@@ -15,7 +15,8 @@ use std::sync::Arc;
 
 use nalgebra::{SMatrix, SVector};
 
-use super::element::{ElementOp, element_matrix, q1_load};
+pub use super::element::ElementOp;
+use super::element::{element_matrix, q1_load};
 use super::mesh::Mesh;
 use super::{DofMap, FeError};
 
