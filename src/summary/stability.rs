@@ -183,15 +183,13 @@ pub(crate) fn section(runs: &Runs) -> Section {
         }
         // Axes that move together (bundled in one grid item, e.g. { h, T }) are one axis: an
         // axis in one-to-one correspondence with an earlier one is dropped.
-        let key_of = |i: usize, a: &str| {
-            axis_value(runs, &runs.runs[i], a).map(super::runs::float_key)
-        };
+        let key_of =
+            |i: usize, a: &str| axis_value(runs, &runs.runs[i], a).map(super::runs::float_key);
         let mut kept: Vec<(&str, usize)> = Vec::new();
         for &(b, n) in &axes {
             let tied = kept.iter().any(|&(a, _)| {
                 let mut fwd: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
-                let mut back: BTreeMap<Option<String>, BTreeSet<Option<String>>> =
-                    BTreeMap::new();
+                let mut back: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
                 for &i in idx {
                     let (ka, kb) = (key_of(i, a), key_of(i, b));
                     fwd.entry(ka.clone()).or_default().insert(kb.clone());
