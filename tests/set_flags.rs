@@ -136,7 +136,7 @@ fn run_with_flags_only_matches_the_file_and_records_the_overrides() {
             .unwrap()
             .str()
             .unwrap()
-            .into_iter()
+            .iter()
             .map(|s| s.unwrap().to_string())
             .collect()
     };

@@ -10,7 +10,8 @@
 //!    main refinement path and its least-squares slope), work-precision with the Pareto front,
 //!    contact displacement / pressure / energy against time with the exact solution;
 //! 3. the method table (one line per group with its rates, as on the terminal, with its legend);
-//! 4. the convergence, energy and work-precision tables (the summary's Markdown, rendered);
+//! 4. the energy behaviour, the stability map when the sweep has one, the convergence and
+//!    work-precision tables (the summary's Markdown, rendered);
 //! 5. the sweep file as run (with its `--set` overrides) and its plan.
 
 pub mod figures;
@@ -24,7 +25,7 @@ use anyhow::Context as _;
 use crate::summary::convergence::{self, lsq_slope};
 use crate::summary::runs::{self, Runs};
 use crate::summary::table::{self as stable, Kind};
-use crate::summary::{energy, work};
+use crate::summary::{energy, stability, work};
 use figures::Curve;
 
 /// What `report` wrote.
@@ -416,6 +417,7 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
     let conv = convergence::section(&runs, &opts, &title);
     let en = energy::section(dir, &runs)?;
     let wp = work::section(&runs);
+    let st = stability::section(&runs);
     let ses = session(dir)?;
     let name = ses.sweep.clone().unwrap_or_else(|| title.clone());
     let mut figures = 0usize;
@@ -740,6 +742,15 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
             "<details><summary>Per run</summary>{}</details>",
             markdown(runs_md, 1)
         );
+    }
+    if st.table.height() > 0 {
+        body.push_str("<h2 id=\"stability\">Stability map</h2>\n");
+        body.push_str(&markdown(
+            st.markdown
+                .strip_prefix("# Stability maps\n")
+                .unwrap_or(&st.markdown),
+            1,
+        ));
     }
     body.push_str("<h2 id=\"tables\">Convergence and work-precision tables</h2>\n");
     let _ = writeln!(

@@ -456,9 +456,16 @@ fn group_lines(
             "rate letters: p pre-asymptotic (pair rates spread > {PRE_ASYMPTOTIC_SPREAD}), s stagnating (finest-three slope < {STAGNATION_SLOPE}), r round-off floor, f failed levels, n no fit"
         ));
     }
-    for &e in &shown {
-        let (a, what) = table::error_abbrev(runs.errors[e]);
-        legend.push(format!("{a}: {what} ({})", runs.errors[e]));
+    // Two error columns per legend line: the legend must not push the table off the screen.
+    let entries: Vec<String> = shown
+        .iter()
+        .map(|&e| {
+            let (a, what) = table::error_abbrev(runs.errors[e]);
+            format!("{a}: {what} ({})", runs.errors[e])
+        })
+        .collect();
+    for pair in entries.chunks(2) {
+        legend.push(pair.join(" · "));
     }
     legend.push(if refined {
         "E(T)/E⁰: final over initial discrete energy at the path's finest ok level".into()

@@ -143,6 +143,11 @@ impl Table {
         }
     }
 
+    /// Rows closed so far.
+    pub(crate) fn height(&self) -> usize {
+        self.rows
+    }
+
     /// Close the current row: columns not set are null.
     pub(crate) fn end_row(&mut self) {
         for v in &mut self.values {
