@@ -299,6 +299,9 @@ fn columns(runs: &Runs) -> Vec<(String, Kind)> {
     c
 }
 
+/// A group's main refinement path: its index and the fits of its error columns.
+type MainPath = (usize, Vec<(usize, Fit)>);
+
 /// The flags of a fit as letters after its rate on the terminal (explained by the legend):
 /// p pre-asymptotic, s stagnating, r round-off floor, f failed levels, n no fit.
 fn flag_letters(f: &Fit) -> String {
@@ -332,7 +335,7 @@ fn energy_ratio(r: &super::runs::Run) -> Option<f64> {
 fn group_lines(
     runs: &Runs,
     display: &[usize],
-    main: &[Option<(usize, Vec<(usize, Fit)>)>],
+    main: &[Option<MainPath>],
     hidden: usize,
     single: usize,
 ) -> GroupTable {
@@ -571,7 +574,7 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
     let (display, notes) = displayed(runs, opts);
     let mut hidden = 0usize;
     // Per group: its main refinement path (index) and the fits of its error columns.
-    let mut main: Vec<Option<(usize, Vec<(usize, Fit)>)>> = vec![None; runs.groups.len()];
+    let mut main: Vec<Option<MainPath>> = vec![None; runs.groups.len()];
 
     md.push_str("# Convergence\n\n");
     let _ = writeln!(
