@@ -81,6 +81,9 @@ fn place(file: &Path, line: Option<usize>, sets: &[String]) -> String {
                 .unwrap_or("?");
             format!("--set {arg}")
         }
+        // A sweep without a file is named by its flag (`--scene bar1d`): the lines of its
+        // generated text mean nothing to the user.
+        Some(_) if file.to_string_lossy().starts_with("--") => file.display().to_string(),
         Some(l) => format!("{}:{l}", file.display()),
         None => file.display().to_string(),
     }
