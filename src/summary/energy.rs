@@ -593,7 +593,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             range(th.0, th.1),
             summary.clone(),
         ]);
-        class_lines.push(summary.clone());
+        class_lines.push(format!("  {:<60} {summary}", g.title));
     }
 
     let mut md = String::from("# Energy\n\n");
@@ -688,26 +688,9 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     let parts: Vec<String> = counts.iter().map(|(k, v)| format!(" {v} {k}")).collect();
     terminal.push_str(&parts.join(","));
     terminal.push('\n');
-    // One line per distinct class summary, naming the groups by their number (the numbers of
-    // the convergence table above): six groups take two lines, not six.
-    let mut by_summary: Vec<(String, Vec<usize>)> = Vec::new();
-    for (gi, l) in class_lines.iter().enumerate() {
-        match by_summary.iter_mut().find(|(s, _)| s == l) {
-            Some((_, gs)) => gs.push(gi + 1),
-            None => by_summary.push((l.clone(), vec![gi + 1])),
-        }
-    }
-    for (summary, gs) in &by_summary {
-        let _ = writeln!(
-            terminal,
-            "  {}: group{} {}",
-            summary.trim_end(),
-            if gs.len() == 1 { "" } else { "s" },
-            gs.iter()
-                .map(|g| g.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
+    for l in &class_lines {
+        terminal.push_str(l.trim_end());
+        terminal.push('\n');
     }
     if let Some(worst) = runs
         .runs
