@@ -33,7 +33,9 @@ use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
 use crate::contact::{Lcp, LcpError};
 use crate::scene::{FeGeometry, FeSetup};
-use crate::space::fe::{BoxMesh, DofMap, ElementOp, Pattern, SymMatrix, assemble, fe_pattern};
+use crate::space::fe::{
+    BallMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+};
 use crate::space::linalg::{
     Cholesky, CholeskyOptions, FactorKind, Ordering, SolveWork, SymbolicCholesky,
 };
@@ -70,6 +72,23 @@ impl FeConfig {
                 let top: usize = cells[..d - 1].iter().map(|c| c + 1).product();
                 (nodes - top) * d
             }
+            FeGeometry::Ball {
+                dim,
+                degree,
+                n_t,
+                n_r,
+                ..
+            } => {
+                // The central block's lattice, then n_r·p shells of the outer blocks: a shell is
+                // a square's perimeter (2D) or a cubed sphere's surface lattice (3D).
+                let (t, r) = (n_t * degree, n_r * degree);
+                let nodes = if *dim == 2 {
+                    (t + 1).pow(2) + 4 * t * r
+                } else {
+                    (t + 1).pow(3) + r * (6 * t * t + 2)
+                };
+                nodes * dim
+            }
         }
     }
 
@@ -104,10 +123,49 @@ impl FeConfig {
     }
 }
 
+/// The mesh of a geometry: the bars' box or the mapped disc/ball.
+#[derive(Debug)]
+enum FeMesh {
+    Box(BoxMesh),
+    Ball(BallMesh),
+}
+
+impl FeMesh {
+    fn mesh(&self) -> &dyn Mesh {
+        match self {
+            FeMesh::Box(m) => m,
+            FeMesh::Ball(m) => m,
+        }
+    }
+    fn dim(&self) -> usize {
+        self.mesh().dim()
+    }
+    /// Mass layer of element e (SPEC §2.2; layer 0 touches Γ_C).
+    fn element_layer(&self, e: usize) -> usize {
+        match self {
+            FeMesh::Box(m) => m.element_layer(e),
+            FeMesh::Ball(m) => m.layers[e],
+        }
+    }
+    fn num_layers(&self) -> usize {
+        match self {
+            FeMesh::Box(m) => m.num_layers(),
+            FeMesh::Ball(m) => m.layers.iter().max().map_or(0, |l| l + 1),
+        }
+    }
+    /// The bars' box (reference lattices are defined on it only).
+    fn as_box(&self) -> Option<&BoxMesh> {
+        match self {
+            FeMesh::Box(m) => Some(m),
+            FeMesh::Ball(_) => None,
+        }
+    }
+}
+
 /// The operators of one geometry and material, shared by every run on it.
 #[derive(Debug)]
 struct Geometry {
-    mesh: BoxMesh,
+    mesh: FeMesh,
     dofs: DofMap,
     pattern: Arc<Pattern>,
     symbolic: Arc<SymbolicCholesky>,
@@ -117,6 +175,13 @@ struct Geometry {
     grad: SymMatrix,
     /// Reduced index of the vertical dof of each Γ_C node, and the node.
     contact: Vec<usize>,
+    /// Height x_d of each Γ_C node in the reference configuration, measured from the bottom
+    /// face (box: 0, the run's `gap` is added) or from the rigid plane (ball: the gap is in it).
+    contact_height: Vec<f64>,
+    /// Whether the gap is already in `contact_height` (ball) or is the run's `gap` (box).
+    gap_in_geometry: bool,
+    /// Whether each node is on Γ_C (all nodes, clamped ones included).
+    contact_node: Vec<bool>,
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     contact_weight: Vec<f64>,
     /// Reduced dofs that belong to a Γ_C node (all components).
@@ -221,7 +286,98 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
 }
 
 fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
-    let FeGeometry::Box { extent, cells } = &s.geometry;
+    match &s.geometry {
+        FeGeometry::Box { extent, cells } => build_box(s, extent, cells),
+        FeGeometry::Ball {
+            dim,
+            degree,
+            radius,
+            centre_height,
+            n_t,
+            n_r,
+        } => {
+            let mut centre = [0.0; 3];
+            centre[dim - 1] = *centre_height;
+            let mesh = BallMesh::new(*dim, *degree, *radius, centre, *n_t, *n_r)
+                .map_err(|e| e.to_string())?;
+            build_ball(s, mesh)
+        }
+    }
+}
+
+/// The stiffness, Gram and grad-grad matrices of a mesh on its free dofs.
+fn operators(
+    s: &FeSetup,
+    mesh: &dyn Mesh,
+    dofs: &DofMap,
+    pattern: &Arc<Pattern>,
+) -> (SymMatrix, SymMatrix, SymMatrix) {
+    let one = |_: usize| 1.0;
+    let k = assemble(
+        mesh,
+        dofs,
+        pattern,
+        ElementOp::Stiffness {
+            lambda: s.lame_lambda,
+            mu: s.lame_mu,
+        },
+        &one,
+    );
+    let gram = assemble(mesh, dofs, pattern, ElementOp::Mass { rho: 1.0 }, &one);
+    let grad = assemble(mesh, dofs, pattern, ElementOp::GradGrad, &one);
+    (k, gram, grad)
+}
+
+/// The disc/ball: nothing clamped; contact on the vertical dofs of the Γ_C nodes, with gaps
+/// their heights above the plane (SPEC §1.3: g(x) = x_d, u_n = −u_d).
+fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
+    let d = mesh.dim;
+    let dofs = DofMap::all(mesh.coords.len() * d);
+    let pattern = fe_pattern(&mesh, &dofs);
+    // AMD: the mapped mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D (the
+    // bars' measurements, `cholesky_options`).
+    let opts = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if d == 2 {
+            FactorKind::Simplicial
+        } else {
+            FactorKind::Supernodal
+        },
+    };
+    let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
+    let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
+    let contact: Vec<usize> = mesh.contact_nodes.iter().map(|&n| n * d + d - 1).collect();
+    let contact_height = mesh
+        .contact_nodes
+        .iter()
+        .map(|&n| mesh.coords[n][d - 1])
+        .collect();
+    let contact_weight = mesh.contact_node_weights();
+    let mut contact_node = vec![false; mesh.coords.len()];
+    for &n in &mesh.contact_nodes {
+        contact_node[n] = true;
+    }
+    let on_contact_node = (0..dofs.n_free()).map(|r| contact_node[r / d]).collect();
+    let vertical = (0..dofs.n_free()).filter(|&r| r % d == d - 1).collect();
+    Ok(Geometry {
+        mesh: FeMesh::Ball(mesh),
+        dofs,
+        pattern,
+        symbolic,
+        k,
+        gram,
+        grad,
+        contact,
+        contact_height,
+        gap_in_geometry: true,
+        contact_node,
+        contact_weight,
+        on_contact_node,
+        vertical,
+    })
+}
+
+fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, String> {
     let mesh = BoxMesh::try_new(extent, cells).map_err(|e| e.to_string())?;
     let d = mesh.dim;
     let top = cells[d - 1];
@@ -230,19 +386,7 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     let pattern = fe_pattern(&mesh, &dofs);
     let opts = cholesky_options(&mesh, &dofs);
     let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
-    let one = |_: usize| 1.0;
-    let k = assemble(
-        &mesh,
-        &dofs,
-        &pattern,
-        ElementOp::Stiffness {
-            lambda: s.lame_lambda,
-            mu: s.lame_mu,
-        },
-        &one,
-    );
-    let gram = assemble(&mesh, &dofs, &pattern, ElementOp::Mass { rho: 1.0 }, &one);
-    let grad = assemble(&mesh, &dofs, &pattern, ElementOp::GradGrad, &one);
+    let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let bottom = mesh.nodes_on_plane(d - 1, 0);
     let free = |g: usize| dofs.free_index(g).expect("Γ_C is not clamped");
     let contact: Vec<usize> = bottom.iter().map(|&n| free(n * d + d - 1)).collect();
@@ -273,8 +417,13 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     let vertical = (0..dofs.n_free())
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
+    let contact_height = vec![0.0; contact.len()];
+    let mut contact_node = vec![false; mesh.num_nodes()];
+    for &n in &bottom {
+        contact_node[n] = true;
+    }
     Ok(Geometry {
-        mesh,
+        mesh: FeMesh::Box(mesh),
         dofs,
         pattern,
         symbolic,
@@ -282,6 +431,9 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
         gram,
         grad,
         contact,
+        contact_height,
+        gap_in_geometry: false,
+        contact_node,
         contact_weight,
         on_contact_node,
         vertical,
@@ -311,8 +463,9 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
             mass.name()
         ));
     }
-    let mesh = &g.mesh;
-    let weight = |e: usize| layer_weight(mass, mesh.element_layer(e), layers);
+    let fm = &g.mesh;
+    let mesh = fm.mesh();
+    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), layers);
     let rho = ElementOp::Mass { rho: s.density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
@@ -330,11 +483,11 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
         _ => {}
     }
     // 1ᵀM1 over one component, clamped nodes included: assembled on the full dof set.
-    let d = mesh.dim;
+    let d = mesh.dim();
     let all = DofMap::all(mesh.num_nodes() * d);
     let full_pattern = fe_pattern(mesh, &all);
     let full = assemble(mesh, &all, &full_pattern, rho, &weight);
-    let bottom_node = |dof: usize| mesh.node_index(dof / d)[d - 1] == 0;
+    let bottom_node = |dof: usize| g.contact_node[dof / d];
     let mut total = 0.0;
     for j in (0..full_pattern.n).filter(|j| j % d == 0) {
         for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
@@ -393,7 +546,11 @@ struct RefMap {
 }
 
 fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
-    let d = g.mesh.dim;
+    let mesh = g
+        .mesh
+        .as_box()
+        .ok_or_else(|| format!("scene {} has no reference runs", cfg.setup.scene))?;
+    let d = mesh.dim;
     let ratio = |coarse: f64, fine: f64, stride: usize, what: &str| {
         let q = coarse / fine;
         let r = q.round() as usize;
@@ -407,7 +564,7 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
     };
     let rs = ratio(cfg.setup.h, data.h, data.space_stride, "mesh size")?;
     let rt = ratio(cfg.dt, data.dt, data.time_stride, "time step")?;
-    if data.dim != d || (0..d).any(|a| g.mesh.cells[a] * rs + 1 != data.lattice[a]) {
+    if data.dim != d || (0..d).any(|a| mesh.cells[a] * rs + 1 != data.lattice[a]) {
         return Err("the reference's lattice does not cover the run's mesh".into());
     }
     if cfg.steps * rt >= data.times {
@@ -424,7 +581,7 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
         .free
         .iter()
         .map(|&gd| {
-            let idx = g.mesh.node_index(gd / d);
+            let idx = mesh.node_index(gd / d);
             let l = [idx[0] * rs, idx[1] * rs, idx[2] * rs];
             let node = l[0] + data.lattice[0] * (l[1] + data.lattice[1] * l[2]);
             node * d + gd % d
@@ -491,14 +648,20 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let g = &*geo;
     let n = g.dofs.n_free();
     let nc = g.contact.len();
-    let d = g.mesh.dim;
+    let d = g.mesh.dim();
     metrics.contact_dofs = Some(nc as i64);
-    let gap = cfg.setup.gap;
+    // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
+    let base_gap = if g.gap_in_geometry {
+        0.0
+    } else {
+        cfg.setup.gap
+    };
+    let gaps: Vec<f64> = g.contact_height.iter().map(|h| h + base_gap).collect();
 
     // Workspace: every vector of the time loop, allocated once. M u, M v and M a are carried
     // along the recursions of u, v, a, so a step costs one product with M (M a^{n+1}) besides
     // the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at all,
-    // uᵀKu = uᵀ(Bᵀλ − M a) by the equation at t^{n+1} (F = 0).
+    // uᵀKu = uᵀ(F + Bᵀλ − M a) by the equation at t^{n+1}.
     let mut u = vec![0.0; n];
     let mut v = vec![0.0; n];
     let mut a = vec![0.0; n];
@@ -523,20 +686,51 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         }
     }
     fac.m.matvec_into(&v, &mut mv);
-    // a⁰ = M⁻¹(F − Ku⁰) = 0: u⁰ = 0 and no volume load in the bars.
-    if cfg.setup.gravity != 0.0 {
+    // Gravity: F = M (f e_d) with the run's mass, f = −gravity — the load ∫ρ f·v of the
+    // consistent mass, whose row sums the lumped mass keeps. Then a⁰ = M⁻¹(F − Ku⁰) = f e_d
+    // exactly (u⁰ = 0): the rigid acceleration, and M a⁰ = F. The bars have no load (F = 0).
+    let fall = -cfg.setup.gravity;
+    let mut force_vec = vec![0.0; n];
+    if fall != 0.0 {
+        if g.mesh.as_box().is_some() {
+            return fail(
+                Status::Invalid,
+                format!(
+                    "scene {}: a volume load on the clamped bar is not supported",
+                    cfg.setup.scene
+                ),
+                metrics,
+            );
+        }
+        for &r in &g.vertical {
+            a[r] = fall;
+        }
+        fac.m.matvec_into(&a, &mut force_vec);
+        ma.copy_from_slice(&force_vec);
+    }
+    // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
+    let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
+    let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
+    if record_requested(ctx) && g.mesh.as_box().is_none() {
         return fail(
             Status::Invalid,
-            "a volume load is not supported by this engine yet".into(),
+            format!(
+                "scene {} cannot be recorded as a reference run",
+                cfg.setup.scene
+            ),
             metrics,
         );
     }
 
     // The reference lattice this run records, if it is one.
     let record = ctx.record_reference.map(|(space_stride, time_stride)| {
+        let bx = g
+            .mesh
+            .as_box()
+            .expect("checked above: references are boxes");
         let lattice = [0, 1, 2].map(|ax| {
             if ax < d {
-                g.mesh.cells[ax] / space_stride + 1
+                bx.cells[ax] / space_stride + 1
             } else {
                 1
             }
@@ -545,9 +739,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         for k in 0..lattice[2] {
             for j in 0..lattice[1] {
                 for i in 0..lattice[0] {
-                    let node =
-                        g.mesh
-                            .node_id([i * space_stride, j * space_stride, k * space_stride]);
+                    let node = bx.node_id([i * space_stride, j * space_stride, k * space_stride]);
                     for comp in 0..d {
                         slots.push(g.dofs.free_index(node * d + comp));
                     }
@@ -575,12 +767,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let loop_start = Instant::now();
 
     let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
-    // E = ½vᵀMv + ½uᵀKu with Mv carried and Ku = Bᵀλ − Ma (module header).
+    if let Some(sc) = energy_scale {
+        obs = obs.with_energy_scale(sc);
+    }
+    // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
     let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64]| {
         let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
         let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
         let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
-        0.5 * kinetic + 0.5 * (contact - uma)
+        let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
+        0.5 * kinetic + 0.5 * (contact - uma) - 0.5 * fu
     };
     let mean = |x: &[f64]| -> f64 {
         g.contact
@@ -589,11 +785,15 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             .map(|(&c, w)| w * x[c])
             .sum()
     };
+    // Centre of mass against free fall until the first contact (scenes with gravity).
+    let mut fall_error = 0.0f64;
+    let mut touched = false;
     // Observe step n with state (u, v) and contact forces λ.
     #[allow(clippy::too_many_arguments)]
     let mut observe = |step: usize,
                        u: &[f64],
                        v: &[f64],
+                       mu: &[f64],
                        mv: &[f64],
                        ma: &[f64],
                        lambda: &[f64],
@@ -603,6 +803,15 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         let e = energy(u, v, mv, ma, lambda);
         let force: f64 = lambda.iter().sum();
         let uc = mean(u);
+        if fall != 0.0 && !touched {
+            if force > 0.0 {
+                touched = true;
+            } else {
+                let t = step as f64 * tau;
+                let com: f64 = g.vertical.iter().map(|&r| mu[r]).sum::<f64>() / vertical_mass;
+                fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
+            }
+        }
         if let Some((slots, data)) = record.as_mut()
             && step.is_multiple_of(data.time_stride)
         {
@@ -647,7 +856,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let mut done = 0usize;
     let mut iterations = 0i64;
     let stop = (|| -> Result<(), Stop<LcpError>> {
-        observe(0, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+        observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
         for step in 1..=cfg.steps {
             // p^n and M p^n (the right-hand side) from the carried products.
@@ -655,11 +864,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
                 y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
             }
-            // M p^n is M u^{n+1} before the correction below; keep it.
+            // M p^n is M u^{n+1} before the correction below; keep it. Then + cτ²F.
             mu.copy_from_slice(&y);
+            if fall != 0.0 {
+                for (yi, fi) in y.iter_mut().zip(&force_vec) {
+                    *yi += c_tau2 * fi;
+                }
+            }
             fac.chol.solve_in_place(&mut y, &mut work);
-            for (qi, &ci) in q.iter_mut().zip(&g.contact) {
-                *qi = y[ci] + gap;
+            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                *qi = y[ci] + gi;
             }
             iterations += lcp
                 .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
@@ -686,7 +900,8 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             std::mem::swap(&mut a, &mut tmp);
             std::mem::swap(&mut ma, &mut pred);
             std::mem::swap(&mut u, &mut y);
-            observe(step, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
+                .map_err(Stop::Diverged)?;
             done = step;
             if step.is_multiple_of(CLOCK_EVERY) {
                 if opts.cancelled() {
@@ -704,11 +919,14 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
+    metrics.first_contact_time = obs.first_contact();
+    metrics.contact_phases = Some(obs.contact_phases());
+    metrics.free_fall_error = (fall != 0.0).then_some(fall_error);
     // The observer's pressure columns are the total force here; there is no midpoint pressure.
     metrics.err_force_l2 = metrics.err_sigma_l2.take();
     metrics.err_sigma_mid_l2 = None;
     metrics.contact_toggles = Some(metrics.contact_switches);
-    metrics.energy_scale = metrics.energy_initial;
+    metrics.energy_scale = energy_scale.or(metrics.energy_initial);
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
         _ => None,
@@ -720,6 +938,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: std::mem::take(&mut obs.series),
         reference,
     }
+}
+
+/// Whether the run must record itself as a reference.
+fn record_requested(ctx: &RunContext) -> bool {
+    ctx.record_reference.is_some()
 }
 
 /// xᵀAx with `tmp` as scratch.

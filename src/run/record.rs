@@ -114,6 +114,7 @@ schema! {
         lame_lambda: Option<f64> => "Pa", "Lamé λ (2D/3D scenes)";
         lame_mu: Option<f64> => "Pa", "Lamé μ (2D/3D scenes)";
         gravity: Option<f64> => "m/s²", "volume load (2D/3D scenes)";
+        degree: Option<i64> => "", "polynomial degree of the elements, 1 (Q1) or 2 (Q2) (disc2d, sphere3d)";
         ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
         ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
         wall_time_s: f64 => "s", "wall time of the run (median over repeats)";
@@ -147,6 +148,9 @@ schema! {
         factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D)";
         setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set (2D/3D)";
         stepping_time_s: Option<f64> => "s", "time loop, observables included (2D/3D)";
+        first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
+        contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
+        free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -288,6 +292,7 @@ impl RunRecord {
             lame_lambda: f(Key::LameLambda),
             lame_mu: f(Key::LameMu),
             gravity: f(Key::Gravity),
+            degree: f(Key::Degree).map(|x| x as i64),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
             wall_time_s: timing.median_s,
@@ -321,6 +326,9 @@ impl RunRecord {
             factor_cache_hits: m.factor_cache_hits,
             setup_time_s: m.setup_time_s,
             stepping_time_s: m.stepping_time_s,
+            first_contact_time: m.first_contact_time,
+            contact_phases: m.contact_phases,
+            free_fall_error: m.free_fall_error,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

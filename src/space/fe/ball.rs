@@ -416,6 +416,32 @@ impl BallMesh {
             .expect("a mesh has nodes")
     }
 
+    /// ∫_ΓC N_b dS / |Γ_C| for each node b of `contact_nodes` (same order; sum 1): the weights
+    /// of the mean of a nodal field over Γ_C, with the faces' quadrature of order 5.
+    pub fn contact_node_weights(&self) -> Vec<f64> {
+        let d = self.dim;
+        let n1 = self.degree + 1;
+        let mut w = vec![0.0; self.coords.len()];
+        let mut total = 0.0;
+        for &f in &self.contact_faces {
+            let face = &self.boundary_faces[f];
+            let free: Vec<usize> = (0..d).filter(|&k| k != face.axis).collect();
+            for q in self.face_points(face, 3) {
+                total += q.weight;
+                for (b, &node) in face.nodes.iter().enumerate() {
+                    let mut r = b;
+                    let mut nb = 1.0;
+                    for &ax in &free {
+                        nb *= lagrange_1d(n1, r % n1, q.xi[ax]).0;
+                        r /= n1;
+                    }
+                    w[node] += nb * q.weight;
+                }
+            }
+        }
+        self.contact_nodes.iter().map(|&n| w[n] / total).collect()
+    }
+
     /// The Gauss points of boundary face `face` (`points` per direction; 3 gives order 5 ≥ 4,
     /// SPEC §1.3), with the weight times the discrete face's length/area element and the unit
     /// normal pointing out of the body (away from the centre: the body is star-shaped about it).
