@@ -6,6 +6,8 @@
 //! - [`ball`]: the block-structured mapped disc (five-block O-grid) and ball (seven-block cubed
 //!   sphere) of `disc2d`/`sphere3d`, Q1 or Q2, with the boundary faces of Γ_C and their
 //!   quadrature;
+//! - [`nitsche`]: the Γ_C quadrature points of the disc/ball with the linear functionals u_n and
+//!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
@@ -19,6 +21,7 @@
 pub mod ball;
 pub mod element;
 pub mod mesh;
+pub mod nitsche;
 pub mod sparse;
 
 pub use ball::{BallMesh, BoundaryFace, FacePoint};
