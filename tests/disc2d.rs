@@ -98,3 +98,69 @@ fn free_fall_conserves_energy_with_crank_nicolson() {
         assert!(dev < 1e-10, "Q{:?}: energy_max_dev {dev:e}", r.degree);
     }
 }
+
+/// 003 §4.2 (Figs 11, 12): the paper's setting, degree 2, τ = 0.1, T = 40, mixed + CN against
+/// Nitsche (Θ = 1, γ0 = 1e-3) + CN.
+fn impacts(scene: &str, h: f64) -> (RunRecord, RunRecord) {
+    let rows = run_sweep_text(&format!(
+        r#"
+name = "impacts"
+scene = "{scene}"
+[fixed]
+T = 40.0
+h = {h}
+dt = {TAU}
+[grid]
+method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 }}]
+"#
+    ));
+    let find = |space: &str| {
+        rows.iter()
+            .find(|r| r.space == space)
+            .cloned()
+            .unwrap_or_else(|| panic!("no {space} run"))
+    };
+    (find("mixed"), find("nitsche"))
+}
+
+fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
+    let (mixed, nitsche) = impacts(scene, h);
+    for r in [&mixed, &nitsche] {
+        assert_eq!(r.status, "ok", "{scene} {}: {:?}", r.space, r.message);
+        assert_eq!(r.degree, Some(2));
+        // Both fall freely until t = 10 (Nitsche's P_γ = −u_d while σ_n(rigid) = 0).
+        assert!(r.free_fall_error.unwrap() < 1e-10 * GAP);
+        println!(
+            "{scene} {}: energy drift {:.3e}, max dev {:.3e} (× energy_scale), contact phases {:?}, iterations {} (max {:?}/step), setup {:.2} s, steps {:.2} s",
+            r.space,
+            r.energy_drift.unwrap(),
+            r.energy_max_dev.unwrap(),
+            r.contact_phases,
+            r.iterations,
+            r.iterations_max_step,
+            r.setup_time_s.unwrap(),
+            r.stepping_time_s.unwrap()
+        );
+    }
+    // Nitsche + CN: E^h back to its initial value within 1 % of energy_scale at T (measured
+    // 3e-5 in 2D, 2e-4 in 3D); during the contact E^h dips by the energy stored in the
+    // Nitsche term (E_Θ holds it): measured 2.3 % (2D), 14.5 % (3D) — bounded by
+    // `max_dev_bound`. The semismooth Newton takes ≤ 3 iterations per step (measured 2).
+    assert!(nitsche.energy_drift.unwrap().abs() < 0.01, "{scene}");
+    assert!(nitsche.energy_max_dev.unwrap() < max_dev_bound, "{scene}");
+    assert!(nitsche.iterations_max_step.unwrap() <= 3, "{scene}");
+    assert!(nitsche.energy_theta_max_increase.is_some());
+    // Mixed + CN: the spurious energy growth of 003 §4.2 — measured E(T) = 100 (2D) and 66
+    // (3D) times energy_scale; asserted as behaviour: more than ten times.
+    assert!(mixed.energy_drift.unwrap() > 10.0, "{scene}");
+}
+
+#[test]
+fn disc_nitsche_keeps_the_energy_mixed_gains() {
+    check_impacts("disc2d", 4.0, 0.05);
+}
+
+#[test]
+fn ball_nitsche_keeps_the_energy_mixed_gains() {
+    check_impacts("sphere3d", 8.0, 0.25);
+}

@@ -28,11 +28,13 @@
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
+use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
-use crate::contact::{Lcp, LcpError};
+use crate::contact::Lcp;
 use crate::scene::{FeGeometry, FeSetup};
+use crate::space::fe::nitsche::{ContactPoint, contact_points};
 use crate::space::fe::{
     BallMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
 };
@@ -182,6 +184,8 @@ struct Geometry {
     gap_in_geometry: bool,
     /// Whether each node is on Γ_C (all nodes, clamped ones included).
     contact_node: Vec<bool>,
+    /// Nitsche's quadrature points of Γ_C with γ0 = 1 (their `gamma` is h_K); ball only.
+    points: Vec<ContactPoint>,
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     contact_weight: Vec<f64>,
     /// Reduced dofs that belong to a Γ_C node (all components).
@@ -198,8 +202,10 @@ struct Factored {
     chol: Cholesky,
     /// Z = A⁻¹Bᵀ, column-major (n × n_c).
     z: Vec<f64>,
-    /// H = cτ² B Z (n_c × n_c, row-major).
+    /// Mixed: H = cτ² B Z (n_c × n_c, row-major). Nitsche: W = P Z (Q × Q, row-major).
     h: Vec<f64>,
+    /// Nitsche's rows of the run (Θ, γ0 applied); Z's columns are then A⁻¹(−t_q).
+    nitsche: Option<NitscheOps>,
 }
 
 /// A process-wide cache: entries shared by concurrent runs (a second run waits for the first to
@@ -353,6 +359,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         .map(|&n| mesh.coords[n][d - 1])
         .collect();
     let contact_weight = mesh.contact_node_weights();
+    let points = contact_points(&mesh, s.lame_lambda, s.lame_mu, 1.0);
     let mut contact_node = vec![false; mesh.coords.len()];
     for &n in &mesh.contact_nodes {
         contact_node[n] = true;
@@ -371,6 +378,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         contact_height,
         gap_in_geometry: true,
         contact_node,
+        points,
         contact_weight,
         on_contact_node,
         vertical,
@@ -434,6 +442,7 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         contact_height,
         gap_in_geometry: false,
         contact_node,
+        points: Vec::new(),
         contact_weight,
         on_contact_node,
         vertical,
@@ -503,6 +512,9 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
 }
 
 fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
+    if let ContactMethod::Nitsche { theta, gamma0 } = cfg.method {
+        return factor_nitsche(g, cfg, c_tau2, theta, gamma0);
+    }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| e.to_string())?;
@@ -534,6 +546,77 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
         chol,
         z,
         h,
+        nitsche: None,
+    })
+}
+
+/// A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ) factored once, Z = A⁻¹C and W = P Z
+/// ([`super::fe_nitsche`]). Each s_q lives on one element's dofs, so the rank-one updates stay
+/// in the FE pattern.
+fn factor_nitsche(
+    g: &Geometry,
+    cfg: &FeConfig,
+    c_tau2: f64,
+    theta: f64,
+    gamma0: f64,
+) -> Result<Factored, String> {
+    if g.points.is_empty() {
+        return Err(format!(
+            "space = nitsche is not available for scene {}",
+            cfg.setup.scene
+        ));
+    }
+    let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
+    let mut a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
+    let ops = NitscheOps::new(&g.points, theta, gamma0);
+    let (k, nq, n) = (ops.k, ops.len(), g.dofs.n_free());
+    let red = |gd: usize| {
+        g.dofs
+            .free_index(gd)
+            .expect("the ball has no constrained dof")
+    };
+    if theta != 0.0 {
+        for q in 0..nq {
+            let f = c_tau2 * theta * ops.w[q] * ops.gamma[q];
+            let (d, sq) = (&ops.dofs[q * k..(q + 1) * k], &ops.s[q * k..(q + 1) * k]);
+            for (i, &gi) in d.iter().enumerate() {
+                for (j, &gj) in d.iter().enumerate() {
+                    let pos = a
+                        .pattern
+                        .position(red(gi), red(gj))
+                        .expect("element dofs are in the pattern");
+                    a.values[pos] -= f * sq[i] * sq[j];
+                }
+            }
+        }
+    }
+    let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| {
+        format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
+    })?;
+    let mut z = vec![0.0; n * nq];
+    for q in 0..nq {
+        for (&gd, &c) in ops.dofs[q * k..(q + 1) * k]
+            .iter()
+            .zip(&ops.c[q * k..(q + 1) * k])
+        {
+            z[q * n + red(gd)] += c;
+        }
+    }
+    let mut work = chol.work_for(nq);
+    chol.solve_many_in_place(&mut z, nq, &mut work);
+    let mut h = vec![0.0; nq * nq];
+    for q in 0..nq {
+        for r in 0..nq {
+            h[q * nq + r] = ops.apply(&ops.p, q, &z[r * n..(r + 1) * n]);
+        }
+    }
+    Ok(Factored {
+        m,
+        mass_total,
+        chol,
+        z,
+        h,
+        nitsche: Some(ops),
     })
 }
 
@@ -608,7 +691,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: Vec::new(),
         reference: None,
     };
-    if cfg.method != ContactMethod::Mixed {
+    if matches!(cfg.method, ContactMethod::Penalty { .. }) {
         return fail(
             Status::Invalid,
             format!(
@@ -630,7 +713,13 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         Ok(g) => g,
         Err(e) => return fail(Status::Invalid, e, metrics),
     };
-    let factor_key = format!("{}|{:?}|{:e}", geometry_key(&cfg.setup), cfg.mass, c_tau2);
+    let factor_key = format!(
+        "{}|{:?}|{:?}|{:e}",
+        geometry_key(&cfg.setup),
+        cfg.mass,
+        cfg.method,
+        c_tau2
+    );
     let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
     let fac = match fac {
         Ok(f) => f,
@@ -647,7 +736,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let g = &*geo;
     let n = g.dofs.n_free();
-    let nc = g.contact.len();
+    let nit = fac.nitsche.as_ref();
+    // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
+    let nc = nit.map_or(g.contact.len(), NitscheOps::len);
     let d = g.mesh.dim();
     metrics.contact_dofs = Some(nc as i64);
     // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
@@ -674,7 +765,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let mut err = vec![0.0; n];
     let mut q = vec![0.0; nc];
     let mut lambda = vec![0.0; nc];
-    let mut lcp = Lcp::new(nc, fac.h.clone());
+    let mut lcp = Lcp::new(
+        g.contact.len(),
+        if nit.is_some() {
+            vec![0.0; g.contact.len().pow(2)]
+        } else {
+            fac.h.clone()
+        },
+    );
+    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+    let mut newton_max = 0usize;
     let mut work: SolveWork = fac.chol.work();
     for &r in &g.vertical {
         v[r] = cfg.setup.v0;
@@ -771,12 +871,19 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         obs = obs.with_energy_scale(sc);
     }
     // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
-    let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64]| {
+    // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product with
+    // K (into the scratch `tmp`) instead.
+    let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64], tmp: &mut [f64]| {
         let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
-        let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
-        let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
         let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
-        0.5 * kinetic + 0.5 * (contact - uma) - 0.5 * fu
+        let uku = if nit.is_some() {
+            quad(&g.k, u, tmp)
+        } else {
+            let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
+            let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
+            fu + contact - uma
+        };
+        0.5 * kinetic + 0.5 * uku - fu
     };
     let mean = |x: &[f64]| -> f64 {
         g.contact
@@ -800,8 +907,15 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                        tmp: &mut [f64],
                        err: &mut [f64]|
      -> Result<(), Divergence> {
-        let e = energy(u, v, mv, ma, lambda);
-        let force: f64 = lambda.iter().sum();
+        let e = energy(u, v, mv, ma, lambda, tmp);
+        // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
+        let (theta_term, force) = match nit {
+            Some(ops) => {
+                let (t, f) = ops.theta_term_and_force(u);
+                (Some(t), f)
+            }
+            None => (None, lambda.iter().sum()),
+        };
         let uc = mean(u);
         if fall != 0.0 && !touched {
             if force > 0.0 {
@@ -847,7 +961,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 sigma_contact: -force,
                 sigma_mid: None,
                 energy: e,
-                energy_theta: None,
+                energy_theta: theta_term.map(|t| e + t),
             },
             exact,
         )
@@ -855,7 +969,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let mut done = 0usize;
     let mut iterations = 0i64;
-    let stop = (|| -> Result<(), Stop<LcpError>> {
+    let stop = (|| -> Result<(), Stop<String>> {
         observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
         for step in 1..=cfg.steps {
@@ -872,12 +986,25 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 }
             }
             fac.chol.solve_in_place(&mut y, &mut work);
-            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                *qi = y[ci] + gi;
+            if let Some(ops) = nit {
+                // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
+                for (k, qk) in q.iter_mut().enumerate() {
+                    *qk = ops.apply(&ops.p, k, &y);
+                }
+                let it = newton(ops, &fac.h, c_tau2, &q, &mut lambda, &mut newton_work)
+                    .map_err(|e| Stop::Solver(step, e))?;
+                newton_max = newton_max.max(it);
+                iterations += it as i64;
+            } else {
+                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                    *qi = y[ci] + gi;
+                }
+                let it = lcp
+                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                newton_max = newton_max.max(it);
+                iterations += it as i64;
             }
-            iterations += lcp
-                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                .map_err(|e| Stop::Solver(step, e))? as i64;
             for (j, &l) in lambda.iter().enumerate() {
                 if l > 0.0 {
                     let zj = &fac.z[j * n..(j + 1) * n];
@@ -916,6 +1043,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     })();
     metrics.steps = done as i64;
     metrics.iterations = iterations;
+    metrics.iterations_max_step = Some(newton_max as i64);
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);

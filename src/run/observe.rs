@@ -55,6 +55,8 @@ pub struct Metrics {
     pub contact_phases: Option<i64>,
     /// Centre of mass against free fall before the first contact (scenes with gravity).
     pub free_fall_error: Option<f64>,
+    /// Most contact-solver iterations in one step (FE scenes).
+    pub iterations_max_step: Option<i64>,
 }
 
 /// One row of the time series (SPEC §5).

@@ -151,6 +151,7 @@ schema! {
         first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
         contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
+        iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -329,6 +330,7 @@ impl RunRecord {
             first_contact_time: m.first_contact_time,
             contact_phases: m.contact_phases,
             free_fall_error: m.free_fall_error,
+            iterations_max_step: m.iterations_max_step,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

@@ -20,8 +20,12 @@
 //! Γ_C is the boundary below the centre's height (SPEC §1.3). n_t is always even, so the
 //! equator is a union of element edges (no face straddles it) and the lowest point of the ball
 //! is a node. Sizes from a nominal h: n_t = 2·max(1, round(πR/(4h))) (an arc of the boundary per
-//! element ≈ h) and n_r = max(1, ⌈(R − a)/h⌉). The paper's disc (R = 20, h = 4) gives n_t = 8,
-//! n_r = 3, 160 elements; its ball (h = 8) n_t = 4, n_r = 2, 256 elements.
+//! element ≈ h) and n_r = max(1, round((R − a)/h)) (radial thickness ≈ h, rounded half up: the
+//! outer elements stay close to isotropic, which Nitsche's method needs — γ_h = γ0·h_K uses the
+//! diameter, while the inverse trace inequality it must beat scales with the thickness normal
+//! to Γ_C; with n_r = 2 at h = 8 the Q2 ball loses coercivity at Θ = 1, γ0 = 1e-3). The
+//! paper's disc (R = 20, h = 4) gives n_t = 8, n_r = 3, 160 elements; its ball (h = 8) n_t = 4,
+//! n_r = 1, 160 elements (the paper's 3D mesh has 400).
 //!
 //! Mass layers (SPEC §2.2): layer 0 = the elements with a node on Γ_C (so that every Γ_C node
 //! is massless when layer 0 is), layer k + 1 = the remaining elements sharing a node with layer
@@ -102,7 +106,7 @@ impl BallMesh {
     pub fn counts_for_size(radius: f64, h: f64) -> (usize, usize) {
         let a = 0.5 * radius;
         let n_t = 2 * ((std::f64::consts::PI * radius / (4.0 * h)).round() as usize).max(1);
-        let n_r = (((radius - a) / h - 1e-9).ceil() as usize).max(1);
+        let n_r = (((radius - a) / h).round() as usize).max(1);
         (n_t, n_r)
     }
 
@@ -585,7 +589,7 @@ mod tests {
     fn counts_of_the_paper_settings() {
         // Module header: the disc R = 20, h = 4 and the ball h = 8.
         assert_eq!(BallMesh::counts_for_size(20.0, 4.0), (8, 3));
-        assert_eq!(BallMesh::counts_for_size(20.0, 8.0), (4, 2));
+        assert_eq!(BallMesh::counts_for_size(20.0, 8.0), (4, 1));
         let disc = BallMesh::with_size(2, 2, 20.0, [0.0, 25.0, 0.0], 4.0).unwrap();
         assert_eq!(disc.num_elements(), 8 * 8 + 4 * 8 * 3);
         // Nodes of the Q2 O-grid: (2·8+1)² in the square, 4 × (2·8)·(2·3) more outside (each
@@ -593,10 +597,10 @@ mod tests {
         // neighbour).
         assert_eq!(disc.coords.len(), 17 * 17 + 4 * 16 * 6);
         let ball = BallMesh::with_size(3, 1, 20.0, [0.0, 0.0, 25.0], 8.0).unwrap();
-        assert_eq!(ball.num_elements(), 64 + 6 * 16 * 2);
-        // Q1 nodes: 5³ in the cube, and on each of the 2 outer shells the 6·4² + 2 vertices of
-        // a cubed sphere with 4 × 4 cells per face.
-        assert_eq!(ball.coords.len(), 125 + 2 * (6 * 16 + 2));
+        assert_eq!(ball.num_elements(), 64 + 6 * 16);
+        // Q1 nodes: 5³ in the cube, and on the one outer shell the 6·4² + 2 vertices of a cubed
+        // sphere with 4 × 4 cells per face.
+        assert_eq!(ball.coords.len(), 125 + (6 * 16 + 2));
     }
 
     #[test]
