@@ -116,6 +116,10 @@ impl FeConfig {
             Scheme::Theta(p) if p.theta > 0.0 => {
                 Ok((p.theta * (1.0 - p.theta), p.theta * p.theta, p.theta))
             }
+            // The hybrid scheme has its own loop with Crank–Nicolson's step matrix (c = ¼).
+            Scheme::Hybrid if matches!(self.method, ContactMethod::Nitsche { .. }) => {
+                Ok((0.25, 0.25, 0.5))
+            }
             s => Err(format!(
                 "scheme {} is not available for scene {}",
                 s.label(),
@@ -774,6 +778,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         },
     );
     let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+    // Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
+    let mut kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
+    let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
     let mut newton_max = 0usize;
     let mut work: SolveWork = fac.chol.work();
     for &r in &g.vertical {
@@ -973,16 +980,38 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
         for step in 1..=cfg.steps {
-            // p^n and M p^n (the right-hand side) from the carried products.
-            for i in 0..n {
-                pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
-                y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
-            }
-            // M p^n is M u^{n+1} before the correction below; keep it. Then + cτ²F.
-            mu.copy_from_slice(&y);
-            if fall != 0.0 {
-                for (yi, fi) in y.iter_mut().zip(&force_vec) {
-                    *yi += c_tau2 * fi;
+            if hybrid {
+                // Midpoint rule: (M + τ²/4 K_Θ) u^{n+1} = M(u + τv) − τ²/4 K_Θ u + τ²/2 F − τ²/2 N_Φ
+                // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u).
+                g.k.matvec_into(&u, &mut tmp);
+                if let Some(ops) = nit
+                    && ops.theta != 0.0
+                {
+                    for k in 0..ops.len() {
+                        let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &u);
+                        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                            .iter()
+                            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+                        {
+                            tmp[gd] -= f * sk;
+                        }
+                    }
+                }
+                for i in 0..n {
+                    y[i] = mu[i] + tau * mv[i] - c_tau2 * tmp[i] + 2.0 * c_tau2 * force_vec[i];
+                }
+            } else {
+                // p^n and M p^n (the right-hand side) from the carried products.
+                for i in 0..n {
+                    pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
+                    y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
+                }
+                // M p^n is M u^{n+1} before the correction below; keep it. Then + cτ²F.
+                mu.copy_from_slice(&y);
+                if fall != 0.0 {
+                    for (yi, fi) in y.iter_mut().zip(&force_vec) {
+                        *yi += c_tau2 * fi;
+                    }
                 }
             }
             fac.chol.solve_in_place(&mut y, &mut work);
@@ -991,8 +1020,23 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 for (k, qk) in q.iter_mut().enumerate() {
                     *qk = ops.apply(&ops.p, k, &y);
                 }
-                let it = newton(ops, &fac.h, c_tau2, &q, &mut lambda, &mut newton_work)
-                    .map_err(|e| Stop::Solver(step, e))?;
+                if hybrid {
+                    // Kinks g − max(P̃ⁿ, 0) from u^n (fe_nitsche header).
+                    for (k, kk) in kink.iter_mut().enumerate() {
+                        let pn = ops.apply(&ops.p, k, &u) - ops.gap[k];
+                        *kk = ops.gap[k] - pn.max(0.0);
+                    }
+                }
+                let it = newton(
+                    ops,
+                    &fac.h,
+                    c_tau2,
+                    &q,
+                    &kink,
+                    &mut lambda,
+                    &mut newton_work,
+                )
+                .map_err(|e| Stop::Solver(step, e))?;
                 newton_max = newton_max.max(it);
                 iterations += it as i64;
             } else {
@@ -1014,19 +1058,29 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                     }
                 }
             }
-            // y = u^{n+1}; tmp = a^{n+1} = (u^{n+1} − p^n)/(cτ²), then M a^{n+1} into pred.
-            for i in 0..n {
-                tmp[i] = (y[i] - pred[i]) / c_tau2;
+            if hybrid {
+                // v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n; M u and M v by products (a is not used).
+                for i in 0..n {
+                    v[i] = 2.0 * (y[i] - u[i]) / tau - v[i];
+                }
+                std::mem::swap(&mut u, &mut y);
+                fac.m.matvec_into(&u, &mut mu);
+                fac.m.matvec_into(&v, &mut mv);
+            } else {
+                // y = u^{n+1}; tmp = a^{n+1} = (u^{n+1} − p^n)/(cτ²), then M a^{n+1} into pred.
+                for i in 0..n {
+                    tmp[i] = (y[i] - pred[i]) / c_tau2;
+                }
+                fac.m.matvec_into(&tmp, &mut pred);
+                for i in 0..n {
+                    v[i] += tau * ((1.0 - gamma) * a[i] + gamma * tmp[i]);
+                    mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * pred[i]);
+                    mu[i] += c_tau2 * pred[i];
+                }
+                std::mem::swap(&mut a, &mut tmp);
+                std::mem::swap(&mut ma, &mut pred);
+                std::mem::swap(&mut u, &mut y);
             }
-            fac.m.matvec_into(&tmp, &mut pred);
-            for i in 0..n {
-                v[i] += tau * ((1.0 - gamma) * a[i] + gamma * tmp[i]);
-                mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * pred[i]);
-                mu[i] += c_tau2 * pred[i];
-            }
-            std::mem::swap(&mut a, &mut tmp);
-            std::mem::swap(&mut ma, &mut pred);
-            std::mem::swap(&mut u, &mut y);
             observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
                 .map_err(Stop::Diverged)?;
             done = step;

@@ -14,6 +14,12 @@
 //! (inactive columns of W D vanish, so only the active block is factored), warm-started from
 //! the previous step; tolerance 1e-12 relative to max(|P y|, |g|), at most 100 iterations. The
 //! total contact force is Σ_q φ_q (the integral of the pressure −σ_C = (1/γ)[P_γ − g]_+).
+//!
+//! The hybrid scheme (003 (10)–(11), SPEC §3) is the midpoint rule with the contact term
+//! (1/γ)Φ P_Θγ(v), Φ = H(P̃ⁿ)[(P̃ⁿ + P̃ⁿ⁺¹)/2]_+ + H(−P̃ⁿ)([P̃ⁿ]_+ + [P̃ⁿ⁺¹]_+)/2, P̃ = P_γ − g.
+//! Its step matrix is Crank–Nicolson's (c = ¼), and since P̃ⁿ is known, Φ = ½[P̃ⁿ⁺¹ − k]_+ with
+//! the kink k = −max(P̃ⁿ, 0) (H(0) = ½ gives the same value as P̃ⁿ < 0): the same Newton with
+//! per-step kinks g − max(P̃ⁿ, 0), the factor ½ absorbed by τ²/2·½ = cτ².
 
 use crate::space::fe::nitsche::ContactPoint;
 
@@ -84,11 +90,6 @@ impl NitscheOps {
             .sum()
     }
 
-    /// φ_q(s) = (w_q/γ_q)[s − g_q]_+.
-    pub fn phi(&self, q: usize, s: f64) -> f64 {
-        self.w[q] / self.gamma[q] * (s - self.gap[q]).max(0.0)
-    }
-
     /// E_Θ − E^h = −(Θ/2)(Σ w γ σ_n² − Σ (w/γ)[P_γ − g]_+²) at u (SPEC §2.3), and the total
     /// contact force Σ φ_q(P_γ,q(u)).
     pub fn theta_term_and_force(&self, u: &[f64]) -> (f64, f64) {
@@ -128,30 +129,32 @@ impl NewtonWork {
     }
 }
 
-/// Solve G(s) = s − s0 − cτ² W φ(s) = 0 (module header); `phi` receives φ(s). Returns the
-/// iteration count. Allocates nothing.
+/// Solve G(s) = s − s0 − cτ² W φ(s) = 0 with φ_q(s) = (w_q/γ_q)[s − k_q]_+ (module header;
+/// the kinks k are the gaps for Newmark/θ, shifted per step for the hybrid scheme); `phi`
+/// receives φ(s). Returns the iteration count. Allocates nothing.
 pub(crate) fn newton(
     ops: &NitscheOps,
     w: &[f64],
     c_tau2: f64,
     s0: &[f64],
+    kink: &[f64],
     phi: &mut [f64],
     work: &mut NewtonWork,
 ) -> Result<usize, String> {
     let nq = ops.len();
     let scale = s0
         .iter()
-        .chain(&ops.gap)
+        .chain(kink)
         .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
     // Warm start: the previous step's s where it was active, s0 elsewhere (first step: s0).
     for q in 0..nq {
         let prev = work.s[q];
-        work.s[q] = if prev > ops.gap[q] { prev } else { s0[q] };
+        work.s[q] = if prev > kink[q] { prev } else { s0[q] };
     }
     let mut res = f64::INFINITY;
     for it in 0..=NEWTON_MAX_ITER {
         for q in 0..nq {
-            phi[q] = ops.phi(q, work.s[q]);
+            phi[q] = ops.w[q] / ops.gamma[q] * (work.s[q] - kink[q]).max(0.0);
         }
         res = 0.0;
         for q in 0..nq {
@@ -171,8 +174,7 @@ pub(crate) fn newton(
             break;
         }
         work.active.clear();
-        work.active
-            .extend((0..nq).filter(|&q| work.s[q] > ops.gap[q]));
+        work.active.extend((0..nq).filter(|&q| work.s[q] > kink[q]));
         let na = work.active.len();
         // Active block: (I − cτ² W_AA D_A) δ_A = −G_A.
         for (i, &qi) in work.active.iter().enumerate() {
@@ -191,7 +193,7 @@ pub(crate) fn newton(
         .map_err(|e| format!("semismooth Newton: {e} (iteration {it})"))?;
         // Inactive points: δ_I = −G_I + cτ² W_IA D_A δ_A; then s += δ.
         for q in 0..nq {
-            if work.s[q] > ops.gap[q] {
+            if work.s[q] > kink[q] {
                 continue;
             }
             let mut acc = -work.g[q];
@@ -282,10 +284,10 @@ mod tests {
         };
         let mut work = NewtonWork::new(1);
         let mut phi = [0.0];
-        let it = newton(&ops, &[-2.0], 1.0, &[4.0], &mut phi, &mut work).unwrap();
+        let it = newton(&ops, &[-2.0], 1.0, &[4.0], &[1.0], &mut phi, &mut work).unwrap();
         assert_eq!(phi, [1.0]);
         assert!(it <= 2, "{it}");
-        newton(&ops, &[-2.0], 1.0, &[0.5], &mut phi, &mut work).unwrap();
+        newton(&ops, &[-2.0], 1.0, &[0.5], &[1.0], &mut phi, &mut work).unwrap();
         assert_eq!(phi, [0.0]);
     }
 }

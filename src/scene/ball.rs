@@ -14,8 +14,8 @@
 //! run yet: the runs report energies and contact observables, not errors.
 //!
 //! Implemented so far (issue 8, in stages): `mixed` and `nitsche` contact with the consistent or
-//! lumped mass and the Newmark / θ schemes. Penalty, the massless-contact masses and the hybrid
-//! scheme are refused with that reason until they exist.
+//! lumped mass and the Newmark / θ schemes, and the hybrid scheme with `nitsche`. Penalty and
+//! the massless-contact masses are refused with that reason until they exist.
 
 use super::{ErrorSource, FeGeometry, FeSetup, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 use crate::space::fe::BallMesh;
@@ -110,11 +110,11 @@ impl Scene for BallScene {
                 ),
             ));
         }
-        if !matches!(scheme, "newmark" | "theta") {
+        if !(matches!(scheme, "newmark" | "theta") || (scheme == "hybrid" && space == "nitsche")) {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} is not available for scene {} (newmark and theta schemes so far)",
+                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes; hybrid with nitsche)",
                     self.name()
                 ),
             ));
