@@ -29,7 +29,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
-use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
 use crate::contact::Lcp;
@@ -976,6 +976,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let mut done = 0usize;
     let mut iterations = 0i64;
+    let mut observe_timer = SampledTimer::default();
     let stop = (|| -> Result<(), Stop<String>> {
         observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
@@ -1081,7 +1082,10 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 std::mem::swap(&mut ma, &mut pred);
                 std::mem::swap(&mut u, &mut y);
             }
-            observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
+            observe_timer
+                .time(step, || {
+                    observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
+                })
                 .map_err(Stop::Diverged)?;
             done = step;
             if step.is_multiple_of(CLOCK_EVERY) {
@@ -1099,6 +1103,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.iterations = iterations;
     metrics.iterations_max_step = Some(newton_max as i64);
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
     metrics.first_contact_time = obs.first_contact();

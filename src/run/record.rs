@@ -14,6 +14,8 @@ pub enum ColumnData {
     F64(Vec<Option<f64>>),
     I64(Vec<Option<i64>>),
     Str(Vec<Option<String>>),
+    /// A string column given as runs of equal values (value, count): the run_id of a series.
+    StrRuns(Vec<(String, usize)>),
 }
 
 /// Rust types that can fill a column.
@@ -117,6 +119,7 @@ schema! {
         degree: Option<i64> => "", "polynomial degree of the elements, 1 (Q1) or 2 (Q2) (disc2d, sphere3d)";
         ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
         ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
+        search: Option<String> => "", "the [search] this run is a probe of (name, key, criterion, bracket, method index; null for grid runs)";
         wall_time_s: f64 => "s", "wall time of the run (median over repeats)";
         wall_time_min_s: f64 => "s", "fastest of the repeats";
         wall_time_max_s: f64 => "s", "slowest of the repeats";
@@ -134,6 +137,7 @@ schema! {
         energy_max_dev: Option<f64> => "", "max_n |E^n − E⁰|/E⁰";
         energy_max_increase: Option<f64> => "", "max_n (E^{n+1} − E^n)/E⁰";
         energy_theta_max_increase: Option<f64> => "", "same for the augmented energy E_Θ (Nitsche)";
+        energy_theta_drift: Option<f64> => "", "(E_Θ^N − E_Θ⁰)/E_Θ⁰, the drift of the augmented energy (Nitsche)";
         err_u_l2l2: Option<f64> => "m·s^½", "(τ Σ_n ‖u^n − u(t^n)‖²_L2)^½, n = 0…N";
         err_u_l2h1: Option<f64> => "", "same with the full H1 norm";
         err_u_linfl2: Option<f64> => "m^{3/2}", "max_n ‖u^n − u(t^n)‖_L2";
@@ -146,8 +150,9 @@ schema! {
         contact_dofs: Option<i64> => "", "unknowns the contact problem is condensed onto (2D/3D: vertical dofs of Γ_C)";
         contact_toggles: Option<i64> => "", "times the total contact force switched between zero and non-zero (2D/3D; 002's chatter)";
         factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D)";
-        setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set (2D/3D)";
-        stepping_time_s: Option<f64> => "s", "time loop, observables included (2D/3D)";
+        setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
+        stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
+        observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
         first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
         contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
@@ -205,19 +210,23 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
     ),
 ];
 
-/// The time series of a batch as typed columns.
-pub fn series_columns(rows: &[(String, SeriesRow)]) -> Vec<(&'static str, ColumnData)> {
+/// The time series of a batch (each run's id with its rows) as typed columns.
+pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, ColumnData)> {
     let f = |g: fn(&SeriesRow) -> Option<f64>| {
-        ColumnData::F64(rows.iter().map(|(_, r)| g(r)).collect())
+        ColumnData::F64(runs.iter().flat_map(|(_, s)| s.iter().map(g)).collect())
     };
     vec![
         (
             "run_id",
-            ColumnData::Str(rows.iter().map(|(id, _)| Some(id.clone())).collect()),
+            ColumnData::StrRuns(runs.iter().map(|(id, s)| (id.clone(), s.len())).collect()),
         ),
         (
             "step",
-            ColumnData::I64(rows.iter().map(|(_, r)| Some(r.step)).collect()),
+            ColumnData::I64(
+                runs.iter()
+                    .flat_map(|(_, s)| s.iter().map(|r| Some(r.step)))
+                    .collect(),
+            ),
         ),
         ("t", f(|r| Some(r.t))),
         ("u_contact", f(|r| Some(r.u_contact))),
@@ -296,6 +305,7 @@ impl RunRecord {
             degree: f(Key::Degree).map(|x| x as i64),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
+            search: spec.search.clone(),
             wall_time_s: timing.median_s,
             wall_time_min_s: timing.min_s,
             wall_time_max_s: timing.max_s,
@@ -313,6 +323,7 @@ impl RunRecord {
             energy_max_dev: m.energy_max_dev,
             energy_max_increase: m.energy_max_increase,
             energy_theta_max_increase: m.energy_theta_max_increase,
+            energy_theta_drift: m.energy_theta_drift,
             err_u_l2l2: m.err_u_l2l2,
             err_u_l2h1: m.err_u_l2h1,
             err_u_linfl2: m.err_u_linfl2,
@@ -327,6 +338,7 @@ impl RunRecord {
             factor_cache_hits: m.factor_cache_hits,
             setup_time_s: m.setup_time_s,
             stepping_time_s: m.stepping_time_s,
+            observe_time_s: m.observe_time_s,
             first_contact_time: m.first_contact_time,
             contact_phases: m.contact_phases,
             free_fall_error: m.free_fall_error,
