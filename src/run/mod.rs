@@ -8,6 +8,7 @@
 
 pub mod bar1d;
 pub mod fe;
+mod fe_nitsche;
 pub mod observe;
 pub mod record;
 pub mod reference;
