@@ -117,7 +117,12 @@ impl FeConfig {
                 Ok((p.theta * (1.0 - p.theta), p.theta * p.theta, p.theta))
             }
             // The hybrid scheme has its own loop with Crank–Nicolson's step matrix (c = ¼).
-            Scheme::Hybrid if matches!(self.method, ContactMethod::Nitsche { .. }) => {
+            Scheme::Hybrid
+                if matches!(
+                    self.method,
+                    ContactMethod::Nitsche { .. } | ContactMethod::Penalty { .. }
+                ) =>
+            {
                 Ok((0.25, 0.25, 0.5))
             }
             s => Err(format!(
@@ -516,8 +521,22 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
 }
 
 fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
-    if let ContactMethod::Nitsche { theta, gamma0 } = cfg.method {
-        return factor_nitsche(g, cfg, c_tau2, theta, gamma0);
+    match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => {
+            return factor_nitsche(g, cfg, c_tau2, NitscheOps::new(&g.points, theta, gamma0));
+        }
+        ContactMethod::Penalty { gamma0 } => {
+            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (SPEC §2.4).
+            let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
+            let young = m * (3.0 * l + 2.0 * m) / (l + m);
+            return factor_nitsche(
+                g,
+                cfg,
+                c_tau2,
+                NitscheOps::penalty(&g.points, young, gamma0),
+            );
+        }
+        ContactMethod::Mixed => {}
     }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
@@ -555,24 +574,27 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
 }
 
 /// A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ) factored once, Z = A⁻¹C and W = P Z
-/// ([`super::fe_nitsche`]). Each s_q lives on one element's dofs, so the rank-one updates stay
-/// in the FE pattern.
+/// ([`super::fe_nitsche`]; the penalty is the case Θ = 0 with its own rows). Each s_q lives on
+/// one element's dofs, so the rank-one updates stay in the FE pattern.
 fn factor_nitsche(
     g: &Geometry,
     cfg: &FeConfig,
     c_tau2: f64,
-    theta: f64,
-    gamma0: f64,
+    ops: NitscheOps,
 ) -> Result<Factored, String> {
     if g.points.is_empty() {
         return Err(format!(
-            "space = nitsche is not available for scene {}",
+            "space = {} is not available for scene {}",
+            cfg.method.name(),
             cfg.setup.scene
         ));
     }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let mut a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
-    let ops = NitscheOps::new(&g.points, theta, gamma0);
+    let (theta, gamma0) = match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => (theta, gamma0),
+        _ => (0.0, 0.0),
+    };
     let (k, nq, n) = (ops.k, ops.len(), g.dofs.n_free());
     let red = |gd: usize| {
         g.dofs
@@ -695,17 +717,6 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: Vec::new(),
         reference: None,
     };
-    if matches!(cfg.method, ContactMethod::Penalty { .. }) {
-        return fail(
-            Status::Invalid,
-            format!(
-                "space = {} is not available for scene {}",
-                cfg.method.name(),
-                cfg.setup.scene
-            ),
-            metrics,
-        );
-    }
     let (c1, c, gamma) = match cfg.coefficients() {
         Ok(x) => x,
         Err(e) => return fail(Status::Invalid, e, metrics),
@@ -916,12 +927,13 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
      -> Result<(), Divergence> {
         let e = energy(u, v, mv, ma, lambda, tmp);
         // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
-        let (theta_term, force) = match nit {
+        // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
+        let (e, theta_term, force) = match nit {
             Some(ops) => {
-                let (t, f) = ops.theta_term_and_force(u);
-                (Some(t), f)
+                let (pot, t, f) = ops.energy_terms_and_force(u);
+                (e + pot, t, f)
             }
-            None => (None, lambda.iter().sum()),
+            None => (e, None, lambda.iter().sum()),
         };
         let uc = mean(u);
         if fall != 0.0 && !touched {
