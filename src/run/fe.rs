@@ -458,18 +458,69 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
     })
 }
 
+/// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
+/// layer (mod2) and the weight of layer 1 (mod3).
+#[derive(Debug, Clone, Copy)]
+struct Redistribution {
+    mod2: f64,
+    mod3: f64,
+}
+
+impl Redistribution {
+    /// Layers of equal mass m/L (the bars' box: uniform elements, as many per layer):
+    /// mod2 = L/(L−1), mod3 = 2 — the 1D weights of 000 §3.
+    fn equal_layers(layers: usize) -> Redistribution {
+        Redistribution {
+            mod2: layers as f64 / (layers as f64 - 1.0),
+            mod3: 2.0,
+        }
+    }
+
+    /// From the measured masses: total m, layer 0 m₀, layer 1 m₁ (the disc/ball, whose layers
+    /// differ): mod2 = m/(m − m₀), mod3 = 1 + m₀/m₁, so the total mass is conserved.
+    fn measured(total: f64, m0: f64, m1: f64) -> Redistribution {
+        Redistribution {
+            mod2: total / (total - m0),
+            mod3: 1.0 + m0 / m1,
+        }
+    }
+}
+
 /// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (SPEC §2.2).
-fn layer_weight(mass: &MassVariant, layer: usize, layers: usize) -> f64 {
+fn layer_weight(mass: &MassVariant, layer: usize, r: Redistribution) -> f64 {
     match (mass, layer) {
         (
             MassVariant::Mod1 | MassVariant::Mod2 | MassVariant::Mod3 | MassVariant::Weights(_),
             0,
         ) => 0.0,
-        (MassVariant::Mod2, _) => layers as f64 / (layers as f64 - 1.0),
-        (MassVariant::Mod3, 1) => 2.0,
+        (MassVariant::Mod2, _) => r.mod2,
+        (MassVariant::Mod3, 1) => r.mod3,
         (MassVariant::Weights(w), k) => w[(k - 1).min(w.len() - 1)],
         _ => 1.0,
     }
+}
+
+/// 1ᵀM1 over one component of the mass assembled with the element weights `weight` on the full
+/// dof set (clamped nodes included), leaving out the entries `zeroed(i, j)` (dofs).
+fn component_total(
+    mesh: &dyn Mesh,
+    rho: f64,
+    weight: &dyn Fn(usize) -> f64,
+    zeroed: &dyn Fn(usize, usize) -> bool,
+) -> f64 {
+    let d = mesh.dim();
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let full_pattern = fe_pattern(mesh, &all);
+    let full = assemble(mesh, &all, &full_pattern, ElementOp::Mass { rho }, weight);
+    let mut total = 0.0;
+    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
+        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
+            if !zeroed(full_pattern.row_idx[k], j) {
+                total += full.values[k];
+            }
+        }
+    }
+    total
 }
 
 /// The run's mass matrix and 1ᵀM1 (per component: the total mass it represents).
@@ -483,7 +534,19 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     }
     let fm = &g.mesh;
     let mesh = fm.mesh();
-    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), layers);
+    let never = |_: usize, _: usize| false;
+    let redistribution = match fm {
+        FeMesh::Ball(_) if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) => {
+            let layer_mass = |l: usize| {
+                let w = |e: usize| f64::from(u8::from(fm.element_layer(e) == l));
+                component_total(mesh, s.density, &w, &never)
+            };
+            let total = component_total(mesh, s.density, &|_| 1.0, &never);
+            Redistribution::measured(total, layer_mass(0), layer_mass(1))
+        }
+        _ => Redistribution::equal_layers(layers),
+    };
+    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), redistribution);
     let rho = ElementOp::Mass { rho: s.density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
@@ -502,21 +565,11 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     }
     // 1ᵀM1 over one component, clamped nodes included: assembled on the full dof set.
     let d = mesh.dim();
-    let all = DofMap::all(mesh.num_nodes() * d);
-    let full_pattern = fe_pattern(mesh, &all);
-    let full = assemble(mesh, &all, &full_pattern, rho, &weight);
     let bottom_node = |dof: usize| g.contact_node[dof / d];
-    let mut total = 0.0;
-    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
-        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
-            let i = full_pattern.row_idx[k];
-            let zeroed =
-                matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j));
-            if !zeroed {
-                total += full.values[k];
-            }
-        }
-    }
+    let zeroed = |i: usize, j: usize| {
+        matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j))
+    };
+    let total = component_total(mesh, s.density, &weight, &zeroed);
     Ok((m, total))
 }
 
