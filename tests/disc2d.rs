@@ -99,9 +99,18 @@ fn free_fall_conserves_energy_with_crank_nicolson() {
     }
 }
 
-/// 003 §4.2 (Figs 11, 12): the paper's setting, degree 2, τ = 0.1, T = 40, mixed + CN against
-/// Nitsche (Θ = 1, γ0 = 1e-3) + CN.
-fn impacts(scene: &str, h: f64) -> (RunRecord, RunRecord) {
+/// 003 §4.2 (Figs 11, 12): the paper's setting, degree 2, τ = 0.1, T = 40, its four methods:
+/// mixed + CN, Nitsche (Θ = 1, γ0 = 1e-3) + CN, Nitsche-Hybrid, and the modified mass
+/// (003 §4.1.2d: the Γ_C nodes' rows of M zeroed, nothing redistributed — `zero-contact`)
+/// with mixed + CN.
+struct Impacts {
+    mixed: RunRecord,
+    nitsche: RunRecord,
+    hybrid: RunRecord,
+    modified: RunRecord,
+}
+
+fn impacts(scene: &str, h: f64) -> Impacts {
     let rows = run_sweep_text(&format!(
         r#"
 name = "impacts"
@@ -111,28 +120,46 @@ T = 40.0
 h = {h}
 dt = {TAU}
 [grid]
-method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 }}]
+method = [
+  {{ space = "mixed", scheme = "crank-nicolson" }},
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "crank-nicolson" }},
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "hybrid" }},
+  {{ space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" }},
+]
 "#
     ));
-    let find = |space: &str| {
+    assert_eq!(rows.len(), 4);
+    let find = |space: &str, mass: &str, scheme: &str| {
         rows.iter()
-            .find(|r| r.space == space)
+            .find(|r| r.space == space && r.mass == mass && r.scheme_label == scheme)
             .cloned()
-            .unwrap_or_else(|| panic!("no {space} run"))
+            .unwrap_or_else(|| panic!("no {space} {mass} {scheme} run"))
     };
-    (find("mixed"), find("nitsche"))
+    Impacts {
+        mixed: find("mixed", "consistent", "crank-nicolson"),
+        nitsche: find("nitsche", "consistent", "crank-nicolson"),
+        hybrid: find("nitsche", "consistent", "hybrid"),
+        modified: find("mixed", "zero-contact", "crank-nicolson"),
+    }
 }
 
 fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
-    let (mixed, nitsche) = impacts(scene, h);
-    for r in [&mixed, &nitsche] {
-        assert_eq!(r.status, "ok", "{scene} {}: {:?}", r.space, r.message);
+    let Impacts {
+        mixed,
+        nitsche,
+        hybrid,
+        modified,
+    } = impacts(scene, h);
+    for r in [&mixed, &nitsche, &hybrid, &modified] {
+        assert_eq!(r.status, "ok", "{scene} {}: {:?}", r.label, r.message);
         assert_eq!(r.degree, Some(2));
-        // Both fall freely until t = 10 (Nitsche's P_γ = −u_d while σ_n(rigid) = 0).
+        // All fall freely until t = 10 (Nitsche's P_γ = −u_d while σ_n(rigid) = 0).
         assert!(r.free_fall_error.unwrap() < 1e-10 * GAP);
         println!(
-            "{scene} {}: energy drift {:.3e}, max dev {:.3e} (× energy_scale), contact phases {:?}, iterations {} (max {:?}/step), setup {:.2} s, steps {:.2} s",
+            "{scene} {} {} {}: energy drift {:.3e}, max dev {:.3e} (× energy_scale), contact phases {:?}, iterations {} (max {:?}/step), setup {:.2} s, steps {:.2} s",
             r.space,
+            r.mass,
+            r.scheme_label,
             r.energy_drift.unwrap(),
             r.energy_max_dev.unwrap(),
             r.contact_phases,
@@ -150,18 +177,34 @@ fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
     assert!(nitsche.energy_max_dev.unwrap() < max_dev_bound, "{scene}");
     assert!(nitsche.iterations_max_step.unwrap() <= 3, "{scene}");
     assert!(nitsche.energy_theta_max_increase.is_some());
+    // Nitsche-Hybrid: the same E^h within 1 % at T (measured −6.4e-4 in 2D, 2.3e-5 in 3D: E^h
+    // may rise slightly, E_Θ may not) and the same dip during the contact; E_Θ never
+    // increases (003 Cor 3.8; rounding bound of the property test, 1e-12).
+    assert!(hybrid.energy_drift.unwrap().abs() < 0.01, "{scene}");
+    assert!(hybrid.energy_max_dev.unwrap() < max_dev_bound, "{scene}");
+    assert!(
+        hybrid.energy_theta_max_increase.unwrap() <= 1e-12,
+        "{scene}"
+    );
+    // Modified mass + CN: the massless Γ_C nodes make the semi-discrete problem well posed and
+    // energy conserving (003 §1, [18]); what remains is CN's error at the impacts and
+    // releases: within 1 % of energy_scale at every step (measured max deviation 5.2e-4 in
+    // 2D, 2.7e-4 in 3D), and no chatter: one contact phase (t ≈ 10.1–28 in 2D, then the
+    // flight beyond T) where mixed + CN has 24.
+    assert!(modified.energy_max_dev.unwrap() < 0.01, "{scene}");
+    assert!(modified.contact_phases.unwrap() <= 2, "{scene}");
     // Mixed + CN: the spurious energy growth of 003 §4.2 — measured E(T) = 100 (2D) and 66
     // (3D) times energy_scale; asserted as behaviour: more than ten times.
     assert!(mixed.energy_drift.unwrap() > 10.0, "{scene}");
 }
 
 #[test]
-fn disc_nitsche_keeps_the_energy_mixed_gains() {
+fn disc_nitsche_hybrid_and_modified_mass_keep_the_energy_mixed_gains() {
     check_impacts("disc2d", 4.0, 0.05);
 }
 
 #[test]
-fn ball_nitsche_keeps_the_energy_mixed_gains() {
+fn ball_nitsche_hybrid_and_modified_mass_keep_the_energy_mixed_gains() {
     check_impacts("sphere3d", 8.0, 0.25);
 }
 
@@ -341,11 +384,12 @@ scheme = ["crank-nicolson", "hybrid"]
         assert!(r.free_fall_error.unwrap() < 1e-10 * GAP);
         assert_eq!(r.energy_theta_max_increase, None);
         // Contact from t = 10 (the gap 5 after free fall; the force is positive from the step
-        // after the lowest node touches), an elastic rebound at ≈ |v| = 1 and a flight of
-        // 2|v|/g ≈ 20: the second impact near t = 30, both within T = 40.
+        // after the lowest node touches) to the release near t = 27.5 (the soft disc squashes
+        // for a long time; measured with CN: 10.1–27.5, then a one-step touch at 27.7), then
+        // the flight beyond T: no chatter (mixed + CN: 24 phases).
         let t_fc = r.first_contact_time.unwrap();
         assert!((t_fc - 10.0).abs() < 1e-9 || (t_fc - 10.1).abs() < 1e-9);
-        assert_eq!(r.contact_phases, Some(2));
+        assert!(r.contact_phases.unwrap() <= 2, "{:?}", r.contact_phases);
         assert!(r.iterations_max_step.unwrap() <= 3);
         // The energy stays within 1 % of energy_scale (measured: CN drift −2.4e-4, max
         // deviation 8.4e-4; hybrid −1.2e-3, its slight dissipation).
