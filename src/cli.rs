@@ -16,7 +16,7 @@ use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::exec::{self, ExecOptions};
-use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS};
+use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS, estimate};
 use crate::sink::{BatchPolicy, Manifest, Sink, SinkError};
 use crate::summary;
 use crate::sweep::{self, Plan, SweepError, SweepFile};
@@ -38,6 +38,8 @@ pub enum Command {
     Plan {
         /// The sweep file (TOML, see README).
         sweep: PathBuf,
+        #[command(flatten)]
+        limits: LimitArgs,
     },
     /// Run a sweep: every run in parallel, results as Parquet under --out.
     Run(RunArgs),
@@ -55,6 +57,41 @@ pub enum Command {
     Schema,
     /// Write (and with --submit, submit) a Slurm job array running the sweep in shards.
     Slurm(SlurmArgs),
+}
+
+/// What the planner refuses before anything runs (shared by plan, run and slurm).
+#[derive(Debug, Args, Clone)]
+pub struct LimitArgs {
+    /// Refuse plans with more combinations than this (counted from the file before expanding).
+    #[arg(long, value_name = "N", default_value_t = sweep::plan::DEFAULT_MAX_RUNS)]
+    pub max_runs: u64,
+    /// Refuse runs whose estimated memory exceeds this (e.g. 4G, 512M; default: half of the
+    /// available memory, /proc/meminfo's MemAvailable).
+    #[arg(long, value_name = "SIZE")]
+    pub max_run_memory: Option<String>,
+}
+
+impl LimitArgs {
+    /// The planner's limits, for runs keeping every `series_every`-th step (None: the sweep's).
+    fn limits(&self, series_every: Option<usize>) -> Result<sweep::PlanLimits> {
+        let max_run_bytes = match &self.max_run_memory {
+            Some(text) => Some(estimate::parse_bytes(text).ok_or_else(|| {
+                UsageError(format!(
+                    "--max-run-memory must be a size such as 4G or 512M, got `{text}`"
+                ))
+            })?),
+            None => estimate::available_memory().map(|b| 0.5 * b),
+        };
+        if self.max_runs == 0 {
+            return Err(UsageError("--max-runs must be at least 1".into()).into());
+        }
+        Ok(sweep::PlanLimits {
+            max_runs: self.max_runs,
+            max_run_bytes,
+            series_every,
+            max_plan_bytes: estimate::available_memory().map(|b| 0.5 * b),
+        })
+    }
 }
 
 #[derive(Debug, Args)]
@@ -79,6 +116,8 @@ pub struct SlurmArgs {
     /// Submit with sbatch (the summary job depends on the array).
     #[arg(long)]
     pub submit: bool,
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 #[derive(Debug, Args)]
@@ -115,6 +154,8 @@ pub struct RunArgs {
     /// Slurm submission; the array depends on it).
     #[arg(long)]
     pub references_only: bool,
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// Bad input detected by the CLI itself.
@@ -156,7 +197,10 @@ struct RunConfig {
 impl RunArgs {
     fn validate(self) -> Result<RunConfig> {
         let sweep = SweepFile::load(&self.sweep)?;
-        let plan = sweep::expand(&sweep)?;
+        let limits = self
+            .limits
+            .limits(Some(self.series_every.unwrap_or(sweep.series_every)))?;
+        let plan = sweep::expand_with(&sweep, &limits)?;
         if let Some(t) = self.run_timeout
             && !(t.is_finite() && t > 0.0)
         {
@@ -218,9 +262,9 @@ impl RunArgs {
 /// Run a subcommand.
 pub fn main(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Plan { sweep } => {
+        Command::Plan { sweep, limits } => {
             let sf = SweepFile::load(&sweep)?;
-            let plan = sweep::expand(&sf)?;
+            let plan = sweep::expand_with(&sf, &limits.limits(None)?)?;
             print!("{}", plan.summary());
             println!();
             print!("{}", plan_table(&plan));
@@ -417,7 +461,7 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
         return Err(UsageError("--tasks and --cpus-per-task must be at least 1".into()).into());
     }
     let sf = SweepFile::load(&args.sweep)?;
-    let plan = sweep::expand(&sf)?;
+    let plan = sweep::expand_with(&sf, &args.limits.limits(None)?)?;
     let out = args
         .out
         .unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
