@@ -17,7 +17,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::exec::{self, ExecOptions};
 use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS, estimate};
-use crate::sink::{BatchPolicy, Manifest, Sink, SinkError};
+use crate::sink::{BatchPolicy, Manifest, ManifestState, Sink, SinkError};
 use crate::summary;
 use crate::sweep::{self, Plan, SweepError, SweepFile};
 
@@ -277,6 +277,9 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
         Command::Summarize { dir, errors } => {
             let opts = summarize_options(&dir, errors.as_deref())?;
             let s = summary::summarize_with(&dir, &opts)?;
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
             print!("{}", s.terminal);
             Ok(ExitCode::SUCCESS)
         }
@@ -309,8 +312,31 @@ fn summarize_options(dir: &Path, errors: Option<&[String]>) -> Result<summary::S
 fn run(cfg: RunConfig) -> Result<ExitCode> {
     let plan = &cfg.plan;
     let dir = &cfg.out;
+    let had_results = dir.join("runs").is_dir();
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    if let Some(found) = Manifest::existing_sweep(dir)?
+    let found = match Manifest::inspect(dir)? {
+        ManifestState::Sweep(found) => found,
+        ManifestState::Missing => {
+            if had_results {
+                eprintln!(
+                    "warning: {} has no manifest.json: rebuilt from {}",
+                    dir.display(),
+                    plan.sweep.path.display()
+                );
+            }
+            None
+        }
+        ManifestState::MovedAside { to, reason } => {
+            eprintln!(
+                "warning: {} is damaged ({reason}): moved aside to {}, rebuilt from {}",
+                dir.join("manifest.json").display(),
+                to.display(),
+                plan.sweep.path.display()
+            );
+            None
+        }
+    };
+    if let Some(found) = found
         && found != plan.sweep.name
         && !cfg.resume
     {
@@ -332,6 +358,9 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let (mut sink, done) = Sink::open(dir, cfg.batch)?;
+    for d in &sink.damaged {
+        eprintln!("warning: {}", d.warning());
+    }
     // Round-robin shards: neighbouring plan entries (levels of one ladder) have similar costs,
     // so every shard gets a share of the expensive ones.
     let mine: Vec<&sweep::RunSpec> = plan

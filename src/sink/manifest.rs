@@ -34,7 +34,49 @@ pub struct Manifest {
     id: String,
 }
 
+/// What a run found of DIR's manifest before its session starts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ManifestState {
+    /// No manifest (a new folder, or one whose manifest was lost).
+    Missing,
+    /// A readable manifest, recording this sweep name (if any).
+    Sweep(Option<String>),
+    /// Not valid JSON: moved aside to the given path, to be rebuilt by the session.
+    MovedAside {
+        to: std::path::PathBuf,
+        reason: String,
+    },
+}
+
 impl Manifest {
+    /// Inspect DIR's manifest before a session: a damaged one is moved aside to
+    /// `DIR/.damaged-manifest.json` (the session rebuilds it from its sweep file; the sessions
+    /// it recorded are lost, the results are not).
+    pub fn inspect(dir: &Path) -> Result<ManifestState, SinkError> {
+        let path = dir.join("manifest.json");
+        let lock_path = dir.join(".manifest.lock");
+        let _lock = super::lock_exclusive(&lock_path).map_err(|source| SinkError::Io {
+            path: lock_path.clone(),
+            source,
+        })?;
+        match Self::existing_sweep(dir) {
+            Ok(None) if !path.exists() => Ok(ManifestState::Missing),
+            Ok(name) => Ok(ManifestState::Sweep(name)),
+            Err(SinkError::Manifest { message, .. }) => {
+                let to = dir.join(".damaged-manifest.json");
+                std::fs::rename(&path, &to).map_err(|source| SinkError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                Ok(ManifestState::MovedAside {
+                    to,
+                    reason: message,
+                })
+            }
+            Err(e) => Err(e),
+        }
+    }
+
     /// Read DIR's manifest if any: the sweep name it records.
     pub fn existing_sweep(dir: &Path) -> Result<Option<String>, SinkError> {
         let path = dir.join("manifest.json");
