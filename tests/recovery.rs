@@ -153,3 +153,78 @@ fn a_corrupt_or_missing_manifest_is_rebuilt_with_a_warning() {
         "{err}"
     );
 }
+
+#[test]
+fn status_counts_done_failed_and_missing_per_shard_and_prints_what_completes_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(tmp.path(), "s.toml", SWEEP);
+    // Shards 0 and 2 of 3 ran; shard 1 never did. A run timeout of 1 µs in shard 2 makes
+    // its runs `timeout` rows: done (a result), and counted as failed.
+    assert!(run(tmp.path(), &["--shard", "0/3"]).status.success());
+    assert!(
+        run(tmp.path(), &["--shard", "2/3", "--run-timeout", "0.000001"])
+            .status
+            .success()
+    );
+    let o = cli(tmp.path(), &["status", "o"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The shards as `run --shard k/3` cuts them (balanced by work: 5, 8 and 11 runs here).
+    let st = contact_sweep::exec::status::status(&tmp.path().join("o"), None).unwrap();
+    assert_eq!(st.shards, 3);
+    assert_eq!(st.planned, 24);
+    let counts: Vec<(usize, usize, usize, usize)> = st
+        .per_shard
+        .iter()
+        .map(|c| (c.planned, c.done, c.failed, c.missing))
+        .collect();
+    assert_eq!(counts, [(5, 5, 0, 0), (8, 0, 0, 8), (11, 11, 11, 0)]);
+    assert_eq!(st.by_status.get("ok"), Some(&5));
+    assert_eq!(st.by_status.get("timeout"), Some(&11));
+    assert_eq!(st.missing_shards(), [1]);
+    assert_eq!(st.sessions.len(), 2);
+    for needle in [
+        "done 16 (ok 5, timeout 11), failed 11, missing 8",
+        "1/3       8     0       0        8",
+        "damaged files: none",
+        "sessions: 2 (2 finished",
+        "contact-sweep run s.toml --out o",
+        "contact-sweep slurm s.toml --out o --only-shards 1/3 --submit",
+    ] {
+        assert!(text.contains(needle), "`{needle}` not in\n{text}");
+    }
+    // A damaged part shows, and the local command completes exactly what is missing.
+    let parts = parquet_parts(&tmp.path().join("o/runs")).unwrap();
+    truncate_half(&parts[0]);
+    let o = cli(tmp.path(), &["status", "o"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    let name = parts[0].file_name().unwrap().to_str().unwrap();
+    assert!(
+        text.contains(name) && text.contains("cannot be read"),
+        "{text}"
+    );
+    let o = cli(tmp.path(), &["run", "s.toml", "--out", "o", "--no-summary"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Every run once (the timeout rows have no series: assert_complete does not apply).
+    let runs = contact_sweep::sink::read_runs(&tmp.path().join("o")).unwrap();
+    let ids = runs.column("run_id").unwrap().str().unwrap().clone();
+    let distinct: std::collections::HashSet<_> = ids.iter().flatten().collect();
+    assert_eq!((runs.height(), distinct.len()), (24, 24));
+    let o = cli(tmp.path(), &["status", "o"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(
+        text.contains("missing 0") && text.contains("complete: nothing to resubmit"),
+        "{text}"
+    );
+    assert!(
+        text.contains("(moved aside; its runs count as missing)"),
+        "{text}"
+    );
+    // Without a manifest and without --sweep, status says what it needs (exit 2).
+    std::fs::remove_file(tmp.path().join("o/manifest.json")).unwrap();
+    let o = cli(tmp.path(), &["status", "o"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--sweep FILE"), "{}", stderr(&o));
+    let o = cli(tmp.path(), &["status", "o", "--sweep", "s.toml"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}

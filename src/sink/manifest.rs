@@ -77,6 +77,24 @@ impl Manifest {
         }
     }
 
+    /// DIR's manifest as JSON (`None` without one).
+    pub fn read(dir: &Path) -> Result<Option<Json>, SinkError> {
+        let path = dir.join("manifest.json");
+        if !path.exists() {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| SinkError::Manifest {
+                path,
+                message: e.to_string(),
+            })
+    }
+
     /// Read DIR's manifest if any: the sweep name it records.
     pub fn existing_sweep(dir: &Path) -> Result<Option<String>, SinkError> {
         let path = dir.join("manifest.json");
@@ -116,15 +134,15 @@ impl Manifest {
         }))
     }
 
-    /// Start a session: create or extend the manifest. `shard` is (k, n) for one shard of a
-    /// job array.
+    /// Start a session: create or extend the manifest. `shard` is the shards it runs (`K/N`,
+    /// `A-B/N`, … of a job array).
     pub fn begin(
         dir: &Path,
         plan: &Plan,
         planned: usize,
         skipped: usize,
         threads: usize,
-        shard: Option<(usize, usize)>,
+        shard: Option<String>,
     ) -> Result<Manifest, SinkError> {
         let path = dir.join("manifest.json");
         let id = format!(
@@ -144,7 +162,7 @@ impl Manifest {
             "git_commit": if commit.is_empty() { Json::Null } else { Json::from(commit) },
             "machine": machine(),
             "threads": threads,
-            "shard": shard.map(|(k, n)| format!("{k}/{n}")),
+            "shard": shard,
             "sweep_file": plan.sweep.path.display().to_string(),
             "sweep_text": plan.sweep.text,
             "runs_planned": planned,
