@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Run every sweep of the papers (sweeps/000_*.toml, sweeps/003_*.toml) and draw their figures:
 # time series (displacement, pressure, energy with the exact solution), convergence with slope
-# triangles, work-precision with the Pareto front. Then check that no figure is blank.
+# triangles, work-precision with the Pareto front, stability maps. Then check that no figure is blank.
 #
 #   bash analysis/paper_figures.sh [OUT]      (default OUT = out)
 set -euo pipefail
@@ -14,9 +14,10 @@ bin="${CONTACT_SWEEP:-$repo/target/release/contact-sweep}"
 for sweep in "$repo"/sweeps/000_*.toml "$repo"/sweeps/003_*.toml; do
   name=$(sed -n 's/^name *= *"\(.*\)".*/\1/p' "$sweep" | head -n1)
   dir="$out/$name"
-  "$bin" run "$sweep" --out "$dir" --no-summary >/dev/null
+  "$bin" run "$sweep" --out "$dir" >/dev/null
   "$py" "$here/plot_series.py" "$dir" --out "$out/figures" --include-failed
   "$py" "$here/plot_convergence.py" "$dir" --out "$out/figures"
   "$py" "$here/plot_work_precision.py" "$dir" --out "$out/figures"
+  "$py" "$here/plot_stability_map.py" "$dir" --out "$out/figures"
 done
 "$py" "$here/check_figures.py" "$out/figures"

@@ -481,16 +481,30 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
             sink.push(res)
         },
     );
-    let flushed = sink.flush();
+    let mut flushed = sink.flush();
     bar.finish_and_clear();
+    let mut searched = Ok(());
+    if result.is_ok() && flushed.is_ok() && !plan.searches.is_empty() {
+        if cfg.shard.is_some() {
+            eprintln!(
+                "(a shard runs only the bracket ends of the [search]; run the sweep without --shard to bisect)"
+            );
+        } else {
+            searched = bisect(dir, plan, &refs, &cfg.exec, threads, &mut sink);
+            if searched.is_ok() {
+                flushed = sink.flush();
+            }
+        }
+    }
     let interrupted = INTERRUPTED.load(Ordering::SeqCst);
     manifest.finish(
         dir,
         sink.written,
-        interrupted || result.is_err() || flushed.is_err(),
+        interrupted || result.is_err() || flushed.is_err() || searched.is_err(),
     )?;
     result?;
     flushed?;
+    searched?;
     if interrupted {
         eprintln!(
             "interrupted: {} finished runs committed to {}; the runs in flight were dropped — run the same command to resume",
@@ -506,7 +520,9 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         failed,
         diverged
     );
-    let ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
+    let mut ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
+    let probes = searched_ids(dir, plan)?;
+    ids.extend(probes.iter().map(String::as_str));
     print!("{}", result_table(dir, plan, &ids)?);
     if cfg.shard.is_some() {
         eprintln!(
@@ -795,4 +811,132 @@ pub fn schema_markdown() -> String {
         s.push_str(&format!("| `{c}` | {t} | {u} | {d} |\n"));
     }
     s
+}
+
+/// The (value, criterion holds) of every probe of each search base committed in DIR.
+fn probe_results(dir: &Path, plan: &Plan) -> Result<Vec<Vec<(f64, bool)>>> {
+    let mut out = vec![Vec::new(); plan.searches.len()];
+    let Some(search) = &plan.sweep.search else {
+        return Ok(out);
+    };
+    let df = crate::sink::read_runs(dir)?;
+    let Ok(tags) = df.column("search") else {
+        return Ok(out);
+    };
+    let tags = tags.str()?;
+    let f = |name: &str| -> Vec<Option<f64>> {
+        df.column(name)
+            .ok()
+            .and_then(|c| c.f64().ok().map(|c| c.iter().collect()))
+            .unwrap_or_else(|| vec![None; df.height()])
+    };
+    let key = f(search.key.name());
+    let (e0, ef) = (f("energy_initial"), f("energy_final"));
+    let column = match &search.criterion {
+        sweep::Criterion::ErrorBelow { column, .. } => f(column),
+        _ => vec![None; df.height()],
+    };
+    let status = df.column("status")?.str()?;
+    for (i, tag) in tags.iter().enumerate() {
+        let Some(b) = tag.and_then(|t| plan.searches.iter().position(|b| b.tag == t)) else {
+            continue;
+        };
+        let (Some(v), Some(st)) = (key[i], status.get(i)) else {
+            continue;
+        };
+        let holds = search.criterion.holds(st, e0[i], ef[i], |_| column[i]);
+        out[b].push((v, holds));
+    }
+    Ok(out)
+}
+
+/// Run ids of the committed probes of this sweep's searches (for the result table).
+fn searched_ids(dir: &Path, plan: &Plan) -> Result<Vec<String>> {
+    if plan.searches.is_empty() {
+        return Ok(Vec::new());
+    }
+    let df = crate::sink::read_runs(dir)?;
+    let (Ok(tags), Ok(ids)) = (df.column("search"), df.column("run_id")) else {
+        return Ok(Vec::new());
+    };
+    let tags: Vec<Option<String>> = tags.str()?.iter().map(|t| t.map(String::from)).collect();
+    Ok(ids
+        .str()?
+        .iter()
+        .zip(tags)
+        .filter(|(_, t)| {
+            t.as_deref()
+                .is_some_and(|t| plan.searches.iter().any(|b| b.tag == t))
+        })
+        .filter_map(|(id, _)| id.map(String::from))
+        .collect())
+}
+
+/// Bracket then bisect every search base: each round runs the next probe of every base still
+/// open (in parallel), commits them like any run, and re-reads what is committed — so an
+/// interrupted search resumes where it stopped.
+fn bisect(
+    dir: &Path,
+    plan: &Plan,
+    refs: &exec::References,
+    opts: &ExecOptions,
+    threads: usize,
+    sink: &mut Sink,
+) -> Result<()> {
+    let search = plan
+        .sweep
+        .search
+        .as_ref()
+        .expect("searches need a [search]");
+    // Each round halves every open bracket: log2(range/rel_tol) rounds suffice; the cap only
+    // guards against a criterion that is not monotone in the key.
+    for _round in 0..200 {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            return Ok(());
+        }
+        let known = probe_results(dir, plan)?;
+        let mut todo = Vec::new();
+        for (base, k) in plan.searches.iter().zip(&known) {
+            if let sweep::SearchState::Probe(v) = search.state(k) {
+                todo.push(sweep::plan::probe(plan, base, v)?);
+            }
+        }
+        if todo.is_empty() {
+            break;
+        }
+        let specs: Vec<&sweep::RunSpec> = todo.iter().collect();
+        exec::execute(
+            &plan.sweep.name,
+            &specs,
+            refs,
+            &ExecOptions { threads, ..*opts },
+            |res| sink.push(res),
+        )?;
+        sink.flush()?;
+    }
+    let known = probe_results(dir, plan)?;
+    for (base, k) in plan.searches.iter().zip(&known) {
+        let what = match search.state(k) {
+            sweep::SearchState::Found { holding, failing } => format!(
+                "{} holds up to {holding:.6e}, fails at {failing:.6e}",
+                search.criterion.name()
+            ),
+            sweep::SearchState::NotBracketed(h) => format!(
+                "{} {} on all of [{}, {}]: no boundary",
+                search.criterion.name(),
+                if h { "holds" } else { "fails" },
+                search.lo,
+                search.hi
+            ),
+            sweep::SearchState::Probe(_) => "search not finished".into(),
+        };
+        eprintln!(
+            "search {} ({}): {} — {what} ({} probes)",
+            search.name,
+            search.key.name(),
+            base.label,
+            k.len()
+        );
+    }
+    Ok(())
 }

@@ -26,11 +26,15 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
         ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The stability maps are drawn from the summary's table.
+    let o = cli(repo, &["summarize", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let figs = out.join("figures");
     for script in [
         "plot_series.py",
         "plot_convergence.py",
         "plot_work_precision.py",
+        "plot_stability_map.py",
     ] {
         let o = Command::new("python3")
             .arg(repo.join("analysis").join(script))
@@ -69,6 +73,7 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
         "convergence_quickstart.png",
         "convergence_quickstart.pdf",
         "work_precision_quickstart_err_u_l2h1.png",
+        "stability_map_qs_mixed_mod3_crank-nicolson.png",
     ] {
         assert!(figs.join(f).exists(), "{f} missing");
     }

@@ -723,18 +723,27 @@ fn a_folder_without_runs_is_an_error_naming_it() {
 }
 
 #[test]
-fn energy_flags_and_impact_losses() {
+fn energy_classes_and_impact_losses() {
     let tmp = tempfile::tempdir().unwrap();
     let mut rows = vec![
         run(CN, "crank-nicolson", 0.25, 0.25, [None; 4]),
         run(CN, "crank-nicolson", 0.125, 0.125, [None; 4]),
         run(HY, "hybrid", 0.25, 0.25, [None; 4]),
+        run(HY, "hybrid", 0.125, 0.125, [None; 4]),
+        run(CN, "crank-nicolson", 0.0625, 0.0625, [None; 4]),
     ];
-    // growth: one step gains 2e-10·E0 > 1e-10.
+    // ν = dt/h = 1 and L = 1, so δ = max(1, ν)·h/L = h.
+    // growing: drift 0.3 > δ = 0.25 (CN has no monotonicity proof: one-step gains alone do not
+    // count).
     (rows[0].max_inc, rows[0].drift, rows[0].max_dev) = (Some(2e-10), Some(0.3), Some(0.4));
-    // monotone decay: no gain above 1e-10, E^N < E0 by more than the tolerance.
-    (rows[1].max_inc, rows[1].drift, rows[1].max_dev) = (Some(5e-11), Some(-0.02), Some(0.02));
-    // rows[2]: conserved (max dev 3e-16).
+    // dissipative: drift −0.2 < −δ = −0.125.
+    (rows[1].max_inc, rows[1].drift, rows[1].max_dev) = (Some(5e-11), Some(-0.2), Some(0.2));
+    // rows[2]: conservative (drift −1e-16, max one-step increase 1e-16 ≤ 1e-10).
+    // rows[3]: the 000 §5 hybrid (mixed, scheme hybrid) provably never gains E^h: one step
+    // raising it by 2e-10·E0 is growth although the drift (−1e-3) is inside δ = 0.125.
+    (rows[3].max_inc, rows[3].drift, rows[3].max_dev) = (Some(2e-10), Some(-1e-3), Some(1e-3));
+    // conservative: drift +0.05 within δ = 0.0625, and 2e-10 one-step gains do not count.
+    (rows[4].max_inc, rows[4].drift, rows[4].max_dev) = (Some(2e-10), Some(0.05), Some(0.05));
     write_runs(tmp.path(), "part-0.parquet", &mut runs_frame(&rows));
 
     // Series of the hybrid run, decimated by 2 (steps 0, 2, …, 18): two contact phases.
@@ -774,35 +783,51 @@ fn energy_flags_and_impact_losses() {
         .collect()
         .unwrap();
     assert_eq!(
-        strs(&e, "behaviour"),
+        strs(&e, "energy_class"),
+        [
+            "growing",
+            "dissipative",
+            "conservative",
+            "conservative",
+            "growing"
+        ]
+        .map(|s| Some(s.to_string()))
+        .to_vec()
+    );
+    assert_eq!(
+        bools(&e, "energy_monotone_by_proof"),
         vec![
-            Some("growth".into()),
-            Some("monotone decay".into()),
-            Some("conserved".into())
+            Some(false),
+            Some(false),
+            Some(false),
+            Some(true),
+            Some(true)
         ]
     );
+    close(f64s(&e, "energy_tolerance")[1].unwrap(), 0.125, "δ = h");
     assert_eq!(
-        bools(&e, "energy_growth"),
-        vec![Some(true), Some(false), Some(false)]
+        strs(&e, "energy_functional"),
+        vec![Some("E^h".to_string()); 5]
     );
-    assert_eq!(
-        bools(&e, "monotone_decay"),
-        vec![Some(false), Some(true), Some(false)]
-    );
-    assert_eq!(i64s(&e, "impacts"), vec![None, None, Some(2)]);
-    assert_eq!(bools(&e, "series_decimated")[2], Some(true));
+    assert_eq!(i64s(&e, "impacts"), vec![None, None, None, Some(2), None]);
+    assert_eq!(bools(&e, "series_decimated")[3], Some(true));
     close(
-        f64s(&e, "impact_loss_total")[2].unwrap(),
+        f64s(&e, "impact_loss_total")[3].unwrap(),
         0.4,
         "total impact loss",
     );
 
     let g = read(&tmp.path().join("summary/energy_groups.parquet"));
     let cn = g.lazy().filter(col("label").eq(lit(CN))).collect().unwrap();
-    assert_eq!(f64s(&cn, "energy_drift_min"), vec![Some(-0.02)]);
+    assert_eq!(f64s(&cn, "energy_drift_min"), vec![Some(-0.2)]);
     assert_eq!(f64s(&cn, "energy_drift_max"), vec![Some(0.3)]);
-    assert_eq!(i64s(&cn, "growth_runs"), vec![Some(1)]);
-    assert_eq!(i64s(&cn, "monotone_decay_runs"), vec![Some(1)]);
+    assert_eq!(i64s(&cn, "growing_runs"), vec![Some(1)]);
+    assert_eq!(i64s(&cn, "dissipative_runs"), vec![Some(1)]);
+    assert_eq!(i64s(&cn, "conservative_runs"), vec![Some(1)]);
+    assert_eq!(
+        strs(&cn, "energy_classes"),
+        vec![Some("1 conservative, 1 dissipative, 1 growing".to_string())]
+    );
 
     let imp = read(&tmp.path().join("summary/impacts.parquet"));
     assert_eq!(imp.height(), 2);

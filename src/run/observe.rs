@@ -27,6 +27,9 @@ pub struct Metrics {
     pub energy_max_dev: Option<f64>,
     pub energy_max_increase: Option<f64>,
     pub energy_theta_max_increase: Option<f64>,
+    /// (E_Θ^N − E_Θ⁰)/E_Θ⁰: the drift of the augmented energy (Nitsche), the functional the
+    /// energy classification of a Nitsche run is judged by.
+    pub energy_theta_drift: Option<f64>,
     pub contact_switches: i64,
     pub err_u_l2l2: Option<f64>,
     pub err_u_l2h1: Option<f64>,
@@ -107,6 +110,7 @@ pub struct Observer {
     prev_e: f64,
     prev_et: Option<f64>,
     last_e: f64,
+    last_et: Option<f64>,
     max_dev: f64,
     max_inc: f64,
     max_inc_theta: Option<f64>,
@@ -140,6 +144,7 @@ impl Observer {
             prev_e: f64::NAN,
             prev_et: None,
             last_e: f64::NAN,
+            last_et: None,
             max_dev: 0.0,
             max_inc: f64::NEG_INFINITY,
             max_inc_theta: None,
@@ -187,6 +192,7 @@ impl Observer {
         self.prev_e = v.energy;
         self.prev_et = v.energy_theta;
         self.last_e = v.energy;
+        self.last_et = v.energy_theta;
         self.prev_sigma = v.sigma_contact;
         self.max_dev = self.max_dev.max((v.energy - self.e0).abs());
         let contact = v.sigma_contact < 0.0;
@@ -246,6 +252,11 @@ impl Observer {
         metrics.energy_final = Some(self.last_e);
         metrics.energy_drift = Some((self.last_e - e0) / e0);
         metrics.energy_max_dev = Some(self.max_dev / e0);
+        metrics.energy_theta_drift = self
+            .last_et
+            .zip(self.e0_theta)
+            .filter(|(_, e0t)| *e0t != 0.0)
+            .map(|(et, e0t)| (et - e0t) / e0t);
         if self.observed > 1 {
             metrics.energy_max_increase = Some(self.max_inc / e0);
             metrics.energy_theta_max_increase = self

@@ -116,6 +116,7 @@ schema! {
         gravity: Option<f64> => "m/s²", "volume load (2D/3D scenes)";
         ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
         ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
+        search: Option<String> => "", "the [search] this run is a probe of (name, key, criterion, bracket, method index; null for grid runs)";
         wall_time_s: f64 => "s", "wall time of the run (median over repeats)";
         wall_time_min_s: f64 => "s", "fastest of the repeats";
         wall_time_max_s: f64 => "s", "slowest of the repeats";
@@ -133,6 +134,7 @@ schema! {
         energy_max_dev: Option<f64> => "", "max_n |E^n − E⁰|/E⁰";
         energy_max_increase: Option<f64> => "", "max_n (E^{n+1} − E^n)/E⁰";
         energy_theta_max_increase: Option<f64> => "", "same for the augmented energy E_Θ (Nitsche)";
+        energy_theta_drift: Option<f64> => "", "(E_Θ^N − E_Θ⁰)/E_Θ⁰, the drift of the augmented energy (Nitsche)";
         err_u_l2l2: Option<f64> => "m·s^½", "(τ Σ_n ‖u^n − u(t^n)‖²_L2)^½, n = 0…N";
         err_u_l2h1: Option<f64> => "", "same with the full H1 norm";
         err_u_linfl2: Option<f64> => "m^{3/2}", "max_n ‖u^n − u(t^n)‖_L2";
@@ -290,6 +292,7 @@ impl RunRecord {
             gravity: f(Key::Gravity),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
+            search: spec.search.clone(),
             wall_time_s: timing.median_s,
             wall_time_min_s: timing.min_s,
             wall_time_max_s: timing.max_s,
@@ -307,6 +310,7 @@ impl RunRecord {
             energy_max_dev: m.energy_max_dev,
             energy_max_increase: m.energy_max_increase,
             energy_theta_max_increase: m.energy_theta_max_increase,
+            energy_theta_drift: m.energy_theta_drift,
             err_u_l2l2: m.err_u_l2l2,
             err_u_l2h1: m.err_u_l2h1,
             err_u_linfl2: m.err_u_linfl2,

@@ -1,6 +1,29 @@
 //! Energy tables: per run and per group (drift, largest deviation, largest one-step increase,
-//! with growth / decay flags), and for bar1d the energy lost at each impact, read from the
+//! and the run's energy class), and for bar1d the energy lost at each impact, read from the
 //! time series.
+//!
+//! # Energy classes
+//! Every run is classified by the energy functional F its scheme controls — E_Θ for Nitsche
+//! (003 §2.3; E^h itself may rise within a step although the scheme is stable), E^h plus the
+//! penalty potential for penalty (the `energy` column already holds it), E^h otherwise — into
+//! `conservative`, `dissipative`, `growing` or `diverged` (status `diverged`; the other non-ok
+//! statuses are carried as the class). With the relative drift d = (F^N − F⁰)/F⁰ and
+//!
+//! ```text
+//!     δ = max(h, c0 τ) / L = max(1, ν) · h / L
+//! ```
+//!
+//! (L the bar length, 1 for scenes without one), a run is growing if d > δ, dissipative if
+//! d < −δ, conservative otherwise. δ is the consistency error of the contact discretisation:
+//! the contact node is resolved to one cell and one step, and the energy it exchanges over an
+//! impact is exact only up to O(max(h, c0τ)) — mod3 + CN, whose energy is conserved up to
+//! that error, moves by up to 0.31 δ on the quickstart ladder (+3.9 % at h = 1/8, ν = 1),
+//! while an ill-posed method (consistent mass or Nitsche with γ0 → 0, with CN) gains 15 % to
+//! 1100 %, far above δ at every h. For the schemes with a proven non-increasing functional —
+//! the hybrid with Nitsche Θ = 1 and E_Θ (003 Cor 3.8), the 000 §5 hybrid (mixed, massless
+//! contact node) and E^h (Lemma 5.1), backward Euler with Nitsche Θ = 1 and E_Θ (003 Cor 3.2)
+//! — a single step that raises F by more than [`ENERGY_TOL`]·F⁰ is growth as well: the proof
+//! forbids it, and rounding stays below 1e-12 (SPEC §6).
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
@@ -11,27 +34,79 @@ use polars::prelude::*;
 use super::runs::{Run, Runs};
 use super::table::{self, Align, Kind, Table};
 
-/// A one-step increase of the energy above this fraction of E⁰ is growth. SPEC §6: the
-/// schemes that provably do not gain energy stay below 1e-12·E⁰ (worst seen 5e-13), so 1e-10
-/// leaves two decades for rounding and flags nothing a proof forbids; a scheme that gains
-/// energy does so by ≥ 1e-4·E⁰ per contact phase.
+/// A one-step increase of a provably non-increasing functional above this fraction of its
+/// initial value is growth. SPEC §6: the schemes that provably do not gain energy stay below
+/// 1e-12·E⁰ (worst seen 5e-13), so 1e-10 leaves two decades for rounding.
 pub const ENERGY_TOL: f64 = 1e-10;
 
-/// How the energy E^h of a run behaved.
-fn behaviour(r: &Run) -> Option<&'static str> {
-    let inc = r.energy_max_increase?;
-    Some(if inc > ENERGY_TOL {
-        "growth"
-    } else if r.energy_max_dev.is_some_and(|d| d <= ENERGY_TOL) {
-        // Never more than the tolerance away from E⁰: conserved (a drift of −1e-15 is not
-        // decay).
-        "conserved"
-    } else if r.energy_drift.is_some_and(|d| d < 0.0) {
-        "monotone decay"
-    } else {
-        // No step gains more than the tolerance, yet E^N ≥ E⁰: many tiny gains.
-        "slow growth (every step ≤ tol)"
-    })
+/// The energy classes, in the order tables list them.
+pub const CLASSES: [&str; 4] = ["conservative", "dissipative", "growing", "diverged"];
+
+/// How a run's energy behaved, judged by its scheme's functional.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct EnergyClass {
+    /// conservative | dissipative | growing | diverged, or the run's status when it ended
+    /// otherwise (solver-failed, invalid, timeout); None when the row has no energies.
+    pub class: Option<String>,
+    /// Which functional: "E_Θ", "E^h + penalty", "E^h".
+    pub functional: &'static str,
+    pub drift: Option<f64>,
+    pub max_increase: Option<f64>,
+    /// δ = max(1, ν)·h/L.
+    pub tolerance: Option<f64>,
+    /// The functional provably never increases for this method and scheme.
+    pub monotone: bool,
+}
+
+/// Classify one run (see the module header).
+pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
+    let space = runs.param_str(r, "space").unwrap_or("");
+    let scheme = runs.param_str(r, "scheme").unwrap_or("");
+    let scheme_label = runs.param_str(r, "scheme_label").unwrap_or("");
+    let hybrid = scheme == "hybrid" || scheme_label == "hybrid";
+    let backward_euler = scheme_label == "backward-euler";
+    let theta = runs.param_f64(r, "nitsche_theta");
+    let theta_scheme = runs.param_f64(r, "theta_scheme");
+    let (functional, drift, max_increase) = match space {
+        "nitsche" if r.energy_theta_drift.is_some() => {
+            ("E_Θ", r.energy_theta_drift, r.energy_theta_max_increase)
+        }
+        "penalty" => ("E^h + penalty", r.energy_drift, r.energy_max_increase),
+        _ => ("E^h", r.energy_drift, r.energy_max_increase),
+    };
+    let nitsche_theta_one = space == "nitsche" && theta == Some(1.0) && functional == "E_Θ";
+    let monotone = (hybrid && (space == "mixed" || nitsche_theta_one))
+        || ((backward_euler || scheme == "theta" && theta_scheme == Some(1.0))
+            && nitsche_theta_one);
+    let length = runs
+        .param_f64(r, "length")
+        .filter(|l| *l > 0.0)
+        .unwrap_or(1.0);
+    let tolerance = r.h.map(|h| r.courant.unwrap_or(1.0).max(1.0) * h / length);
+    let class = match r.status.as_str() {
+        "ok" => match (drift, tolerance) {
+            (Some(d), Some(tol)) => Some(
+                if d > tol || (monotone && max_increase.is_some_and(|m| m > ENERGY_TOL)) {
+                    "growing"
+                } else if d < -tol {
+                    "dissipative"
+                } else {
+                    "conservative"
+                }
+                .to_string(),
+            ),
+            _ => None,
+        },
+        other => Some(other.to_string()),
+    };
+    EnergyClass {
+        class,
+        functional,
+        drift,
+        max_increase,
+        tolerance,
+        monotone,
+    }
 }
 
 /// One contact phase of a run.
@@ -216,6 +291,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             ("run_id", Kind::Str),
             ("label", Kind::Str),
             ("status", Kind::Str),
+            ("search", Kind::Str),
             ("h", Kind::F64),
             ("dt", Kind::F64),
             ("courant", Kind::F64),
@@ -225,11 +301,13 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             ("energy_max_dev", Kind::F64),
             ("energy_max_increase", Kind::F64),
             ("energy_theta_max_increase", Kind::F64),
-            ("energy_growth", Kind::Bool),
-            ("energy_theta_growth", Kind::Bool),
-            ("monotone_decay", Kind::Bool),
-            ("conserved", Kind::Bool),
-            ("behaviour", Kind::Str),
+            ("energy_theta_drift", Kind::F64),
+            ("energy_class", Kind::Str),
+            ("energy_functional", Kind::Str),
+            ("energy_functional_drift", Kind::F64),
+            ("energy_functional_max_increase", Kind::F64),
+            ("energy_tolerance", Kind::F64),
+            ("energy_monotone_by_proof", Kind::Bool),
             ("impacts", Kind::I64),
             ("impact_loss_total", Kind::F64),
             ("series_decimated", Kind::Bool),
@@ -345,16 +423,17 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         run_impacts[ri] = Some((list.len(), total, decimated, stride));
     }
 
+    let classes: Vec<EnergyClass> = runs.runs.iter().map(|r| classify(runs, r)).collect();
     for (ri, r) in runs.runs.iter().enumerate() {
-        let b = behaviour(r);
-        if r.ok() {
-            *counts.entry(b.unwrap_or("unknown")).or_default() += 1;
-        }
+        let c = &classes[ri];
+        let b = c.class.as_deref();
+        *counts.entry(b.unwrap_or("unknown")).or_default() += 1;
         per_run.i64("group", Some(r.group as i64 + 1));
         per_run.str("group_title", Some(&runs.groups[r.group].title));
         per_run.str("run_id", Some(&r.run_id));
         per_run.str("label", Some(&r.label));
         per_run.str("status", Some(&r.status));
+        per_run.str("search", r.search.as_deref());
         per_run.f64("h", r.h);
         per_run.f64("dt", r.dt);
         per_run.f64("courant", r.courant);
@@ -364,17 +443,13 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         per_run.f64("energy_max_dev", r.energy_max_dev);
         per_run.f64("energy_max_increase", r.energy_max_increase);
         per_run.f64("energy_theta_max_increase", r.energy_theta_max_increase);
-        per_run.bool(
-            "energy_growth",
-            r.energy_max_increase.map(|x| x > ENERGY_TOL),
-        );
-        per_run.bool(
-            "energy_theta_growth",
-            r.energy_theta_max_increase.map(|x| x > ENERGY_TOL),
-        );
-        per_run.bool("monotone_decay", b.map(|b| b == "monotone decay"));
-        per_run.bool("conserved", b.map(|b| b == "conserved"));
-        per_run.str("behaviour", b);
+        per_run.f64("energy_theta_drift", r.energy_theta_drift);
+        per_run.str("energy_class", b);
+        per_run.str("energy_functional", Some(c.functional));
+        per_run.f64("energy_functional_drift", c.drift);
+        per_run.f64("energy_functional_max_increase", c.max_increase);
+        per_run.f64("energy_tolerance", c.tolerance);
+        per_run.bool("energy_monotone_by_proof", Some(c.monotone));
         let imp = run_impacts[ri];
         per_run.i64("impacts", imp.map(|i| i.0 as i64));
         per_run.f64("impact_loss_total", imp.map(|i| i.1));
@@ -393,7 +468,8 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             table::sci(r.energy_drift),
             table::sci(r.energy_max_dev),
             table::sci(r.energy_max_increase),
-            table::sci(r.energy_theta_max_increase),
+            format!("{} {}", c.functional, table::sci(c.drift)),
+            table::sci(c.tolerance),
             b.unwrap_or("").to_string(),
             imp.map(|i| i.0.to_string()).unwrap_or_default(),
             imp.map(|i| table::sci(Some(i.1))).unwrap_or_default(),
@@ -425,14 +501,17 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             ("energy_max_increase_max", Kind::F64),
             ("energy_theta_max_increase_min", Kind::F64),
             ("energy_theta_max_increase_max", Kind::F64),
-            ("growth_runs", Kind::I64),
-            ("theta_growth_runs", Kind::I64),
-            ("monotone_decay_runs", Kind::I64),
-            ("conserved_runs", Kind::I64),
+            ("conservative_runs", Kind::I64),
+            ("dissipative_runs", Kind::I64),
+            ("growing_runs", Kind::I64),
+            ("diverged_runs", Kind::I64),
+            ("failed_runs", Kind::I64),
+            ("energy_classes", Kind::Str),
         ],
         runs,
     ));
     let mut group_rows_md: Vec<Vec<String>> = Vec::new();
+    let mut class_lines: Vec<String> = Vec::new();
     for (gi, g) in runs.groups.iter().enumerate() {
         let ok: Vec<&Run> = g
             .runs
@@ -444,11 +523,18 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         let dev = minmax(ok.iter().map(|r| r.energy_max_dev));
         let inc = minmax(ok.iter().map(|r| r.energy_max_increase));
         let th = minmax(ok.iter().map(|r| r.energy_theta_max_increase));
-        let count = |f: &dyn Fn(&Run) -> bool| ok.iter().filter(|r| f(r)).count();
-        let growth = count(&|r| behaviour(r) == Some("growth"));
-        let tgrowth = count(&|r| r.energy_theta_max_increase.is_some_and(|x| x > ENERGY_TOL));
-        let decay = count(&|r| behaviour(r) == Some("monotone decay"));
-        let conserved = count(&|r| behaviour(r) == Some("conserved"));
+        let mut per_class: BTreeMap<String, usize> = BTreeMap::new();
+        for &i in &g.runs {
+            let c = classes[i].class.clone().unwrap_or_else(|| "unknown".into());
+            *per_class.entry(c).or_default() += 1;
+        }
+        let count = |c: &str| per_class.get(c).copied().unwrap_or(0);
+        let failed: usize = per_class
+            .iter()
+            .filter(|(k, _)| !CLASSES.contains(&k.as_str()))
+            .map(|(_, v)| v)
+            .sum();
+        let summary = class_summary(&per_class);
         let first = &runs.runs[g.runs[0]];
         groups.i64("group", Some(gi as i64 + 1));
         groups.str("group_title", Some(&g.title));
@@ -463,10 +549,12 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         groups.f64("energy_max_increase_max", inc.1);
         groups.f64("energy_theta_max_increase_min", th.0);
         groups.f64("energy_theta_max_increase_max", th.1);
-        groups.i64("growth_runs", Some(growth as i64));
-        groups.i64("theta_growth_runs", Some(tgrowth as i64));
-        groups.i64("monotone_decay_runs", Some(decay as i64));
-        groups.i64("conserved_runs", Some(conserved as i64));
+        groups.i64("conservative_runs", Some(count("conservative") as i64));
+        groups.i64("dissipative_runs", Some(count("dissipative") as i64));
+        groups.i64("growing_runs", Some(count("growing") as i64));
+        groups.i64("diverged_runs", Some(count("diverged") as i64));
+        groups.i64("failed_runs", Some(failed as i64));
+        groups.str("energy_classes", Some(&summary));
         for ((n, _), c) in runs.params.iter().zip(&first.params) {
             groups.cell(n, c);
         }
@@ -479,10 +567,9 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             range(dev.0, dev.1),
             range(inc.0, inc.1),
             range(th.0, th.1),
-            growth.to_string(),
-            decay.to_string(),
-            conserved.to_string(),
+            summary.clone(),
         ]);
+        class_lines.push(format!("  {:<60} {summary}", g.title));
     }
 
     let mut md = String::from("# Energy\n\n");
@@ -490,8 +577,13 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         md,
         "Relative to E⁰ (the run's initial discrete energy): drift = (E^N − E⁰)/E⁰, max dev = \
          max |E^n − E⁰|/E⁰, max increase = max (E^(n+1) − E^n)/E⁰ (E_Θ for the Θ column). \
-         Behaviour: growth (max increase > {ENERGY_TOL:e}), conserved (max dev ≤ {ENERGY_TOL:e}), \
-         monotone decay (no growth, not conserved, drift < 0). Group ranges are over the ok runs.\n"
+         Energy class, by the functional F the scheme controls (E_Θ for Nitsche, E^h + penalty \
+         potential for penalty, E^h otherwise) with d = (F^N − F⁰)/F⁰ and δ = max(1, ν)·h/L, \
+         the contact's consistency error: growing if d > δ (or, for a functional proven \
+         non-increasing — hybrid with Nitsche Θ = 1 or the 000 §5 hybrid, backward Euler with \
+         Nitsche Θ = 1 — if one step raises F by more than {ENERGY_TOL:e}·F⁰), dissipative if \
+         d < −δ, conservative otherwise; diverged and failed runs by their status. Group ranges \
+         are over the ok runs.\n"
     );
     md.push_str("## Per group (across refinement)\n\n");
     let gh: Vec<String> = [
@@ -502,15 +594,14 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         "max dev",
         "max increase",
         "max increase E_Θ",
-        "growth",
-        "decay",
-        "conserved",
+        "energy classes",
     ]
     .iter()
     .map(|s| s.to_string())
     .collect();
     let mut ga = vec![Align::Right, Align::Left];
-    ga.extend([Align::Right; 8]);
+    ga.extend([Align::Right; 5]);
+    ga.push(Align::Left);
     md.push_str(&table::markdown(&gh, &ga, &group_rows_md));
     md.push_str("\n## Per run\n\n");
     match &series {
@@ -545,8 +636,9 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         "drift",
         "max dev",
         "max increase",
-        "max increase E_Θ",
-        "behaviour",
+        "functional drift",
+        "δ",
+        "class",
         "impacts",
         "impact loss",
         "decimated",
@@ -561,15 +653,21 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         Align::Right,
         Align::Left,
     ];
-    ra.extend([Align::Right; 4]);
+    ra.extend([Align::Right; 5]);
     ra.extend([Align::Left, Align::Right, Align::Right, Align::Left]);
     md.push_str(&table::markdown(&rh, &ra, &run_rows_md));
 
-    let ok_runs = runs.runs.iter().filter(|r| r.ok()).count();
-    let mut terminal = format!("energy: {ok_runs} ok runs —");
+    let mut terminal = format!(
+        "energy classes (scheme's functional, δ = max(1, ν)·h/L): {} runs —",
+        runs.runs.len()
+    );
     let parts: Vec<String> = counts.iter().map(|(k, v)| format!(" {v} {k}")).collect();
     terminal.push_str(&parts.join(","));
     terminal.push('\n');
+    for l in &class_lines {
+        terminal.push_str(l.trim_end());
+        terminal.push('\n');
+    }
     if let Some(worst) = runs
         .runs
         .iter()
@@ -614,4 +712,14 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         markdown: md,
         terminal,
     })
+}
+
+/// "10 conservative, 2 growing" in the order of [`CLASSES`], then the other statuses.
+fn class_summary(per_class: &BTreeMap<String, usize>) -> String {
+    let mut keys: Vec<&String> = per_class.keys().collect();
+    keys.sort_by_key(|k| CLASSES.iter().position(|c| c == k).unwrap_or(CLASSES.len()));
+    keys.iter()
+        .map(|k| format!("{} {k}", per_class[*k]))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

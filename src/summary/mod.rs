@@ -3,7 +3,9 @@
 //!
 //! # Groups and refinement paths
 //! Runs are grouped by every parameter column except the refinement axes (h/elements,
-//! dt/courant); `label` is derived from the parameters and carried, not grouped by. Columns
+//! dt/courant) and the ensemble sample index (the members of a round-off ensemble are one
+//! method; [`ensemble`] summarises their spread, and a refinement path takes the ok member of
+//! lowest index per level); `label` is derived from the parameters and carried, not grouped by. Columns
 //! this version does not know are ignored. Inside a group a *refinement path* holds one axis
 //! fixed — the Courant number (h refined, τ ∝ h), dt (h refined) or h (dt refined) — and needs
 //! ≥ 2 distinct levels; levels are ordered coarse → fine by the refined value x (h or dt).
@@ -41,15 +43,18 @@
 //!   run's "error" is where it stopped, not a discretisation error.
 //!
 //! # Energy, speed against error
-//! See [`energy`] (drift, growth/decay flags with tolerance 1e-10·E⁰, energy lost per impact
-//! from the time series) and [`work`] (Pareto front in (error, wall time) and (error,
+//! See [`energy`] (drift, the energy class of each run judged by its scheme's functional,
+//! energy lost per impact from the time series), [`ensemble`] (round-off spread) and [`work`] (Pareto front in (error, wall time) and (error,
 //! steps × dofs); cost to reach ε by log-log interpolation between consecutive levels, the
 //! same power-law model as the rates).
 //!
 //! # Files (all written atomically: temporary dot-file, fsync, rename)
 //! `convergence.{parquet,csv,md,tex}`, `convergence_doc.tex` (the LaTeX tables as a complete
 //! document, see [`latex`]), `energy.{parquet,csv,md}`, `energy_groups.{parquet,csv}`,
-//! `impacts.{parquet,csv}`, `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`.
+//! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `stability_map.{parquet,csv,md}`
+//! ([`stability`]: per method and pair of swept axes, the state of every cell),
+//! `search.{parquet,csv,md}` (the boundaries of a `[search]`),
+//! `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`.
 
 use std::path::{Path, PathBuf};
 
@@ -57,9 +62,12 @@ use anyhow::Context as _;
 
 pub mod convergence;
 pub mod energy;
+pub mod ensemble;
 mod latex;
 pub mod options;
 mod runs;
+mod search;
+pub mod stability;
 mod table;
 pub mod work;
 
@@ -159,6 +167,18 @@ pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summa
     files.extend(table::write_table(&out, "impacts", &en.impacts)?);
     files.push(table::write_text(&out, "energy.md", &en.markdown)?);
 
+    let ens = ensemble::section(&runs);
+    files.extend(table::write_table(&out, "ensemble", &ens.table)?);
+    files.push(table::write_text(&out, "ensemble.md", &ens.markdown)?);
+
+    let st = stability::section(&runs);
+    files.extend(table::write_table(&out, "stability_map", &st.table)?);
+    files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
+
+    let se = search::section(&runs);
+    files.extend(table::write_table(&out, "search", &se.table)?);
+    files.push(table::write_text(&out, "search.md", &se.markdown)?);
+
     let wp = work::section(&runs);
     files.extend(table::write_table(&out, "work_precision", &wp.table)?);
     files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
@@ -188,9 +208,12 @@ pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summa
     }
     terminal.push_str(&conv.terminal);
     terminal.push_str(&en.terminal);
+    terminal.push_str(&ens.terminal);
+    terminal.push_str(&st.terminal);
+    terminal.push_str(&se.terminal);
     terminal.push_str(&wp.terminal);
     terminal.push_str(&format!(
-        "tables: {} (convergence, energy, impacts, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
+        "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
         out.display()
     ));
     Ok(Summary {

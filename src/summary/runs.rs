@@ -101,6 +101,8 @@ const MEASURED: &[(&str, Kind)] = &[
     ("energy_max_dev", Kind::F64),
     ("energy_max_increase", Kind::F64),
     ("energy_theta_max_increase", Kind::F64),
+    ("energy_theta_drift", Kind::F64),
+    ("search", Kind::Str),
 ];
 
 /// One parameter value.
@@ -167,6 +169,11 @@ pub(crate) struct Run {
     pub energy_max_dev: Option<f64>,
     pub energy_max_increase: Option<f64>,
     pub energy_theta_max_increase: Option<f64>,
+    pub energy_theta_drift: Option<f64>,
+    /// Ensemble member index (null outside ensembles).
+    pub ensemble_sample: Option<i64>,
+    /// The `[search]` whose probe this run is (null for grid runs).
+    pub search: Option<String>,
     /// Index into [`Runs::groups`].
     pub group: usize,
 }
@@ -174,6 +181,31 @@ pub(crate) struct Run {
 impl Run {
     pub(crate) fn ok(&self) -> bool {
         self.status == "ok"
+    }
+}
+
+impl Runs {
+    /// A run's value of the parameter column `name` (None when the folder lacks the column).
+    pub(crate) fn param<'a>(&self, r: &'a Run, name: &str) -> Option<&'a Cell> {
+        let j = self.params.iter().position(|(n, _)| *n == name)?;
+        r.params.get(j)
+    }
+
+    /// A text parameter of a run.
+    pub(crate) fn param_str<'a>(&self, r: &'a Run, name: &str) -> Option<&'a str> {
+        match self.param(r, name)? {
+            Cell::Str(s) => s.as_deref(),
+            _ => None,
+        }
+    }
+
+    /// A numeric parameter of a run.
+    pub(crate) fn param_f64(&self, r: &Run, name: &str) -> Option<f64> {
+        match self.param(r, name)? {
+            Cell::F64(x) => *x,
+            Cell::I64(i) => i.map(|i| i as f64),
+            Cell::Str(_) => None,
+        }
     }
 }
 
@@ -282,6 +314,7 @@ impl Runs {
     fn varying(&self) -> Vec<usize> {
         (0..self.params.len())
             .filter(|&i| !IN_LABEL.contains(&self.params[i].0))
+            .filter(|&i| self.params[i].0 != "ensemble_sample")
             .filter(|&i| {
                 let keys: HashSet<String> = self.runs.iter().map(|r| r.params[i].key()).collect();
                 keys.len() > 1
@@ -468,6 +501,9 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         get_f("wall_time_max_s")?,
     );
     let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
+    let theta_drift = get_f("energy_theta_drift")?;
+    let sample = get_i("ensemble_sample")?;
+    let search = strs(&df, "search")?;
     let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
         get_f("energy_initial")?,
         get_f("energy_final")?,
@@ -550,6 +586,9 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             energy_max_dev: max_dev[i],
             energy_max_increase: max_inc[i],
             energy_theta_max_increase: theta_inc[i],
+            energy_theta_drift: theta_drift[i],
+            ensemble_sample: sample[i],
+            search: search.as_ref().and_then(|v| v[i].clone()),
             group: 0,
         });
     }
@@ -570,12 +609,16 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
 /// Group the runs and find the refinement paths of every group.
 fn group(r: &mut Runs) {
     let varying = r.varying();
+    // Ensemble members are one method: the sample index is not part of a group's identity.
+    let sample_col = r.params.iter().position(|(n, _)| *n == "ensemble_sample");
     let mut by_key: BTreeMap<String, Vec<usize>> = BTreeMap::new();
     for (i, run) in r.runs.iter().enumerate() {
         let key = run
             .params
             .iter()
-            .map(Cell::key)
+            .enumerate()
+            .filter(|(j, _)| Some(*j) != sample_col)
+            .map(|(_, c)| c.key())
             .collect::<Vec<_>>()
             .join("|");
         by_key.entry(key).or_default().push(i);
@@ -663,13 +706,16 @@ fn paths_of(runs: &[Run], group: usize, idx: &[usize]) -> Vec<RefPath> {
         }
         let mut found: Vec<RefPath> = Vec::new();
         for (_, (f, members)) in sub {
-            // One run per level; should two share a level (they cannot after dropping
-            // duplicate run ids, unless another version hashed differently), an ok one wins.
+            // One run per level. Ensemble members share a level: the ok member of lowest
+            // sample index represents it (the spread over the members is the ensemble
+            // table's business); otherwise two runs share a level only when another version
+            // hashed differently, and an ok one wins.
             let mut levels: BTreeMap<String, (f64, usize)> = BTreeMap::new();
             for i in members {
                 let x = refined(&runs[i]).expect("filtered above");
                 let e = levels.entry(float_key(x)).or_insert((x, i));
-                if !runs[e.1].ok() && runs[i].ok() {
+                let rank = |r: &Run| (!r.ok(), r.ensemble_sample.unwrap_or(-1));
+                if rank(&runs[i]) < rank(&runs[e.1]) {
                     *e = (x, i);
                 }
             }

@@ -102,6 +102,55 @@ pub struct Ensemble {
     pub seed: u64,
 }
 
+/// What a `[search]` looks for: the boundary where this stops holding.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Criterion {
+    /// The run ends `ok` (no divergence, no solver failure).
+    NoDivergence,
+    /// The run ends ok with E(T)/E⁰ ≤ 1 + tol.
+    EnergyRatioBelow(f64),
+    /// The run ends ok with `column` ≤ eps.
+    ErrorBelow { column: String, eps: f64 },
+}
+
+impl Criterion {
+    /// The name written in sweep files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Criterion::NoDivergence => "no-divergence",
+            Criterion::EnergyRatioBelow(_) => "energy-ratio-below",
+            Criterion::ErrorBelow { .. } => "error-below",
+        }
+    }
+}
+
+/// `[search]`: for every method of the grid, the boundary in `key` ∈ [lo, hi] where the
+/// criterion changes, found by bracketing then bisection to a relative tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Search {
+    pub name: String,
+    pub key: Key,
+    pub lo: f64,
+    pub hi: f64,
+    pub criterion: Criterion,
+    pub rel_tol: f64,
+    /// Bisect in log(key) (geometric midpoints): the default when lo > 0.
+    pub log: bool,
+}
+
+/// Error columns an `error-below` criterion may name (SPEC §5).
+pub const ERROR_COLUMNS: [&str; 9] = [
+    "err_u_l2l2",
+    "err_u_l2h1",
+    "err_u_linfl2",
+    "err_sigma_l2",
+    "err_sigma_mid_l2",
+    "err_energy_l2",
+    "err_u_contact_max",
+    "err_force_l2",
+    "energy_drift",
+];
+
 /// A parsed and value-checked sweep file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SweepFile {
@@ -123,11 +172,16 @@ pub struct SweepFile {
     /// `reference = {…}`: the parameters that turn each run into its reference run (SPEC §7;
     /// scenes without a closed form).
     pub reference: Option<Vec<Entry>>,
+    /// `[search]`: a boundary to find by bisection for every method of the grid.
+    pub search: Option<Search>,
+    /// `allow_unstable = true`: an explicit scheme beyond its CFL limit runs (and ends
+    /// `diverged`) instead of being refused; always so for the probes of a search.
+    pub allow_unstable: bool,
     /// `[summary]`: what the convergence tables print.
     pub summary: SummaryOptions,
 }
 
-const TOP_KEYS: [&str; 12] = [
+const TOP_KEYS: [&str; 14] = [
     "name",
     "scene",
     "description",
@@ -139,6 +193,8 @@ const TOP_KEYS: [&str; 12] = [
     "repeats",
     "ensemble",
     "series_every",
+    "search",
+    "allow_unstable",
     "summary",
 ];
 
@@ -736,6 +792,52 @@ impl SweepFile {
                 ),
             }
         }
+        let allow_unstable = match get("allow_unstable") {
+            None => false,
+            Some((
+                _,
+                _,
+                Node {
+                    kind: Kind::Bool(b),
+                    ..
+                },
+            )) => *b,
+            Some((_, line, node)) => {
+                ck.issue(
+                    "allow_unstable",
+                    *line,
+                    format!("expected true or false, found a {}", node.kind.type_name()),
+                );
+                false
+            }
+        };
+        let search = match get("search") {
+            None => None,
+            Some((_, line, node)) => parse_search(&mut ck, *line, node),
+        };
+        if let Some(sr) = &search {
+            let set_elsewhere = fixed
+                .iter()
+                .chain(grid.iter().flat_map(|a| a.items.iter().flatten()))
+                .chain(zip.iter().flat_map(|a| a.items.iter().flatten()))
+                .find(|e| e.key == sr.key);
+            if let Some(e) = set_elsewhere {
+                ck.issues.push(Issue::at(
+                    &e.origin,
+                    format!(
+                        "`{}` is the key of [search]: the search sets it, remove it here",
+                        sr.key.name()
+                    ),
+                ));
+            }
+            if ensemble.is_some() {
+                ck.issue(
+                    "search",
+                    *line_of_search(&top),
+                    "a [search] cannot be combined with an ensemble (each probe would be a whole ensemble)",
+                );
+            }
+        }
         // [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
         // in both [fixed] and [zip]); two axes setting one parameter would be ambiguous.
         let mut sources: Vec<(Key, Origin, String)> = Vec::new();
@@ -785,6 +887,8 @@ impl SweepFile {
                 series_every,
                 overridden,
                 reference,
+                search,
+                allow_unstable,
                 summary,
             })
         } else {
@@ -833,5 +937,354 @@ impl fmt::Display for Origin {
             Some(l) => write!(f, "{} (line {l})", self.path),
             None => write!(f, "{}", self.path),
         }
+    }
+}
+
+fn line_of_search(top: &[(String, usize, Node)]) -> &usize {
+    top.iter()
+        .find(|(k, _, _)| k == "search")
+        .map(|(_, l, _)| l)
+        .expect("called when [search] exists")
+}
+
+/// Check a `[search]` table.
+fn parse_search(ck: &mut Checker, line: usize, node: &Node) -> Option<Search> {
+    let Kind::Table(t) = &node.kind else {
+        ck.issue(
+            "search",
+            line,
+            format!("expected a table, found a {}", node.kind.type_name()),
+        );
+        return None;
+    };
+    let before = ck.issues.len();
+    let mut name = "search".to_string();
+    let (mut key, mut lo, mut hi, mut criterion) = (None, None, None, None);
+    let (mut tol, mut eps, mut column) = (None, None, None::<String>);
+    let mut rel_tol = 1e-3;
+    let mut scale: Option<String> = None;
+    let number = |ck: &mut Checker, p: &str, v: &Node| -> Option<f64> {
+        match v.kind {
+            Kind::Float(x) if x.is_finite() => Some(x),
+            Kind::Int(i) => Some(i as f64),
+            ref k => {
+                ck.issue(
+                    p,
+                    v.line,
+                    format!("expected a number, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    };
+    let text = |ck: &mut Checker, p: &str, v: &Node| -> Option<String> {
+        match &v.kind {
+            Kind::Str(s) => Some(s.clone()),
+            k => {
+                ck.issue(
+                    p,
+                    v.line,
+                    format!("expected a string, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    };
+    for (k, kl, v) in t {
+        let p = format!("search.{k}");
+        match k.as_str() {
+            "name" => {
+                if let Some(n) = text(ck, &p, v) {
+                    name = n;
+                }
+            }
+            "key" => {
+                if let Some(n) = text(ck, &p, v) {
+                    match Key::from_name(&n) {
+                        Some(kk)
+                            if kk.value_type() == ValueType::Float
+                                && !matches!(kk, Key::H | Key::Elements) =>
+                        {
+                            key = Some(kk)
+                        }
+                        Some(_) => ck.issue(
+                            &p,
+                            *kl,
+                            format!("`{n}` cannot be searched: the key must be a real-valued parameter other than h (e.g. courant, dt, nitsche_gamma0)"),
+                        ),
+                        None => ck.issue(&p, *kl, format!("unknown parameter `{n}`{}", suggest(&n))),
+                    }
+                }
+            }
+            "lo" => lo = number(ck, &p, v),
+            "hi" => hi = number(ck, &p, v),
+            "tol" => tol = number(ck, &p, v),
+            "eps" => eps = number(ck, &p, v),
+            "rel_tol" => {
+                if let Some(x) = number(ck, &p, v) {
+                    if x > 0.0 && x < 1.0 {
+                        rel_tol = x;
+                    } else {
+                        ck.issue(&p, *kl, format!("must lie in (0, 1), got {x}"));
+                    }
+                }
+            }
+            "error" => column = text(ck, &p, v),
+            "scale" => scale = text(ck, &p, v),
+            "criterion" => criterion = text(ck, &p, v),
+            _ => ck.issue(
+                &p,
+                *kl,
+                "unknown key (expected name, key, lo, hi, criterion, tol, eps, error, rel_tol, scale)",
+            ),
+        }
+    }
+    let missing = |ck: &mut Checker, what: &str| {
+        ck.issue("search", line, format!("needs `{what}`"));
+    };
+    if key.is_none() && !t.iter().any(|(k, _, _)| k == "key") {
+        missing(ck, "key");
+    }
+    match (lo, hi) {
+        (Some(a), Some(b)) if a < b => {}
+        (Some(a), Some(b)) => ck.issue("search.hi", line, format!("must exceed lo ({a}), got {b}")),
+        _ => missing(ck, "lo and hi"),
+    }
+    let log = match scale.as_deref() {
+        None | Some("log") => lo.is_some_and(|a| a > 0.0),
+        Some("linear") => false,
+        Some(other) => {
+            ck.issue(
+                "search.scale",
+                line,
+                format!("expected \"log\" or \"linear\", got `{other}`"),
+            );
+            false
+        }
+    };
+    if scale.as_deref() == Some("log") && lo.is_some_and(|a| a <= 0.0) {
+        ck.issue("search.scale", line, "a log scale needs lo > 0");
+    }
+    let criterion = match criterion.as_deref() {
+        Some("no-divergence") => Some(Criterion::NoDivergence),
+        Some("energy-ratio-below") => match tol {
+            Some(t) if t >= 0.0 => Some(Criterion::EnergyRatioBelow(t)),
+            _ => {
+                ck.issue(
+                    "search.tol",
+                    line,
+                    "energy-ratio-below needs tol ≥ 0 (holds when E(T)/E⁰ ≤ 1 + tol)",
+                );
+                None
+            }
+        },
+        Some("error-below") => {
+            let column = column.unwrap_or_else(|| "err_u_l2h1".into());
+            if !ERROR_COLUMNS.contains(&column.as_str()) {
+                ck.issue(
+                    "search.error",
+                    line,
+                    format!(
+                        "unknown error column `{column}` (one of {})",
+                        ERROR_COLUMNS.join(", ")
+                    ),
+                );
+            }
+            match eps {
+                Some(e) if e > 0.0 => Some(Criterion::ErrorBelow { column, eps: e }),
+                _ => {
+                    ck.issue("search.eps", line, "error-below needs eps > 0");
+                    None
+                }
+            }
+        }
+        Some(other) => {
+            ck.issue(
+                "search.criterion",
+                line,
+                format!(
+                    "unknown criterion `{other}` (no-divergence, energy-ratio-below, error-below)"
+                ),
+            );
+            None
+        }
+        None => {
+            missing(ck, "criterion");
+            None
+        }
+    };
+    if ck.issues.len() > before {
+        return None;
+    }
+    Some(Search {
+        name,
+        key: key?,
+        lo: lo?,
+        hi: hi?,
+        criterion: criterion?,
+        rel_tol,
+        log,
+    })
+}
+
+impl Criterion {
+    /// Whether a probe satisfies the criterion: it ended `ok` and, for the energy and error
+    /// criteria, E(T)/E⁰ ≤ 1 + tol or the named column ≤ eps. `column` reads a column of the
+    /// probe's row.
+    pub fn holds(
+        &self,
+        status: &str,
+        energy_initial: Option<f64>,
+        energy_final: Option<f64>,
+        column: impl Fn(&str) -> Option<f64>,
+    ) -> bool {
+        if status != "ok" {
+            return false;
+        }
+        match self {
+            Criterion::NoDivergence => true,
+            Criterion::EnergyRatioBelow(tol) => match (energy_initial, energy_final) {
+                (Some(e0), Some(e)) if e0 != 0.0 => e / e0 <= 1.0 + tol,
+                _ => false,
+            },
+            Criterion::ErrorBelow { column: c, eps } => column(c).is_some_and(|x| x <= *eps),
+        }
+    }
+}
+
+/// Where a search stands, from the probes known so far.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SearchState {
+    /// Probe this value next (a bracket end not yet run, or the midpoint of the bracket).
+    Probe(f64),
+    /// The criterion is the same at lo and hi: no boundary in [lo, hi] (the value it has).
+    NotBracketed(bool),
+    /// The boundary lies between `holding` and `failing` (adjacent probes), within rel_tol.
+    Found { holding: f64, failing: f64 },
+}
+
+impl Search {
+    /// Next step of the bracket-then-bisect search, given (value, holds) of the probes run so
+    /// far. The criterion is taken to change once in [lo, hi]; the bracket is the pair of
+    /// adjacent probes, the one nearest lo where it changes, and it is halved (in log(key)
+    /// when `log`) until (b − a)/max(|a|, |b|) ≤ rel_tol.
+    pub fn state(&self, known: &[(f64, bool)]) -> SearchState {
+        let at = |v: f64| {
+            known
+                .iter()
+                .find(|(x, _)| (x - v).abs() <= 1e-12 * v.abs().max(1e-300))
+                .map(|p| p.1)
+        };
+        let Some(lo_holds) = at(self.lo) else {
+            return SearchState::Probe(self.lo);
+        };
+        let Some(hi_holds) = at(self.hi) else {
+            return SearchState::Probe(self.hi);
+        };
+        if lo_holds == hi_holds {
+            return SearchState::NotBracketed(lo_holds);
+        }
+        let mut pts: Vec<(f64, bool)> = known
+            .iter()
+            .copied()
+            .filter(|(x, _)| *x >= self.lo && *x <= self.hi)
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // The first change of the criterion, walking up from lo.
+        let k = pts
+            .windows(2)
+            .position(|w| w[0].1 == lo_holds && w[1].1 != lo_holds)
+            .expect("lo and hi differ, so the criterion changes somewhere");
+        let (a, b) = (pts[k].0, pts[k + 1].0);
+        let (holding, failing) = if lo_holds { (a, b) } else { (b, a) };
+        if (b - a) / a.abs().max(b.abs()) <= self.rel_tol {
+            return SearchState::Found { holding, failing };
+        }
+        SearchState::Probe(if self.log {
+            (a * b).sqrt()
+        } else {
+            0.5 * (a + b)
+        })
+    }
+
+    /// Parse a probe's tag ([`plan::search_tag`]) back: the search and the base index.
+    pub fn from_tag(tag: &str) -> Option<(Search, usize)> {
+        let mut map = std::collections::HashMap::new();
+        for part in tag.split(';') {
+            let (k, v) = part.split_once('=')?;
+            map.insert(k, v);
+        }
+        let num = |k: &str| map.get(k)?.parse::<f64>().ok();
+        let criterion = match *map.get("criterion")? {
+            "no-divergence" => Criterion::NoDivergence,
+            "energy-ratio-below" => Criterion::EnergyRatioBelow(num("tol")?),
+            "error-below" => Criterion::ErrorBelow {
+                column: map.get("error")?.to_string(),
+                eps: num("eps")?,
+            },
+            _ => return None,
+        };
+        let (lo, hi) = (num("lo")?, num("hi")?);
+        Some((
+            Search {
+                name: map.get("name")?.to_string(),
+                key: Key::from_name(map.get("key")?)?,
+                lo,
+                hi,
+                criterion,
+                rel_tol: num("rel_tol")?,
+                log: lo > 0.0,
+            },
+            map.get("base")?.parse().ok()?,
+        ))
+    }
+}
+
+#[cfg(test)]
+mod search_tests {
+    use super::*;
+
+    fn search(log: bool) -> Search {
+        Search {
+            name: "s".into(),
+            key: Key::Courant,
+            lo: 0.5,
+            hi: 8.0,
+            criterion: Criterion::NoDivergence,
+            rel_tol: 1e-3,
+            log,
+        }
+    }
+
+    /// Bisection against a step function at 1.7 converges to it within rel_tol, probing
+    /// lo, hi, then geometric midpoints: log2(log(16)/1e-3) ≈ 12 halvings.
+    #[test]
+    fn bisection_brackets_a_threshold_to_the_relative_tolerance() {
+        for log in [true, false] {
+            let s = search(log);
+            let mut known = Vec::new();
+            let mut probes = 0;
+            let found = loop {
+                match s.state(&known) {
+                    SearchState::Probe(v) => {
+                        probes += 1;
+                        known.push((v, v <= 1.7));
+                    }
+                    SearchState::Found { holding, failing } => break (holding, failing),
+                    SearchState::NotBracketed(_) => panic!("bracketed"),
+                }
+                assert!(probes < 40);
+            };
+            assert!(found.0 <= 1.7 && found.1 > 1.7, "{found:?}");
+            assert!((found.1 - found.0) / found.1 <= 1e-3);
+            assert!(probes <= 16, "{probes} probes");
+        }
+        let s = search(true);
+        assert_eq!(
+            s.state(&[(0.5, true), (8.0, true)]),
+            SearchState::NotBracketed(true)
+        );
+        let tag = plan::search_tag(&s, 3);
+        assert_eq!(Search::from_tag(&tag), Some((s, 3)));
     }
 }

@@ -42,6 +42,19 @@ pub struct RunSpec {
     pub scene: SceneKind,
     /// The run_id of the reference run its errors are measured against (SPEC §1.2, §7).
     pub reference: Option<String>,
+    /// The `[search]` this run is a probe of ([`search_tag`]); None for grid runs.
+    pub search: Option<String>,
+}
+
+/// One method of a sweep with a `[search]`: the grid combination without the searched key.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SearchBase {
+    /// Index among the bases (grid order).
+    pub index: usize,
+    pub label: String,
+    pub entries: Vec<Entry>,
+    /// The tag of its probes.
+    pub tag: String,
 }
 
 /// A reference run of the plan and the lattice its solution is stored on: every
@@ -59,6 +72,8 @@ pub struct ReferencePlan {
 #[derive(Debug, Clone)]
 pub struct Plan {
     pub sweep: SweepFile,
+    /// The limits it was expanded under (its search probes are checked against them too).
+    pub limits: PlanLimits,
     pub runs: Vec<RunSpec>,
     /// Number of raw combinations (before filters and merging).
     pub combinations: usize,
@@ -69,6 +84,28 @@ pub struct Plan {
     pub collapsed: BTreeMap<String, usize>,
     /// The distinct reference runs, in order of first use.
     pub references: Vec<ReferencePlan>,
+    /// With a `[search]`: the methods searched (their probes at lo and hi are in `runs`).
+    pub searches: Vec<SearchBase>,
+}
+
+/// The tag of the probes of one search base: `name=…;key=…;criterion=…[;tol=…|;error=…;eps=…];
+/// lo=…;hi=…;rel_tol=…;base=…` — everything the summary needs to re-judge the probes and find
+/// the boundary from the rows alone.
+pub fn search_tag(s: &super::Search, base: usize) -> String {
+    let crit = match &s.criterion {
+        super::Criterion::NoDivergence => String::new(),
+        super::Criterion::EnergyRatioBelow(t) => format!(";tol={t}"),
+        super::Criterion::ErrorBelow { column, eps } => format!(";error={column};eps={eps}"),
+    };
+    format!(
+        "name={};key={};criterion={}{crit};lo={};hi={};rel_tol={};base={base}",
+        s.name,
+        s.key.name(),
+        s.criterion.name(),
+        s.lo,
+        s.hi,
+        s.rel_tol
+    )
 }
 
 /// Resolved parameters of one combination.
@@ -118,7 +155,12 @@ fn same(a: &Value, b: &Value) -> bool {
 
 /// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
 /// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
-fn resolve(scene_kind: SceneKind, entries: &[&Entry], limits: &PlanLimits) -> Outcome {
+fn resolve(
+    scene_kind: SceneKind,
+    entries: &[&Entry],
+    allow_unstable: bool,
+    limits: &PlanLimits,
+) -> Outcome {
     let scene = scene_kind.get();
     let mut issues = Vec::new();
     let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
@@ -452,7 +494,7 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], limits: &PlanLimits) -> Ou
     // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
     match config.explicit_dt_limit() {
-        Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) => {
+        Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) && !allow_unstable => {
             return Outcome::Invalid(vec![Issue::at(
                 &dt_origin,
                 format!(
@@ -615,7 +657,7 @@ fn reference_of(
                 line: None,
             })
     };
-    let r = match resolve(sweep.scene, &combined, limits) {
+    let r = match resolve(sweep.scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
@@ -680,6 +722,7 @@ fn reference_of(
         sample: None,
         scene: sweep.scene,
         reference: None,
+        search: None,
     };
     Ok((spec, sx, st))
 }
@@ -757,6 +800,10 @@ impl PlanSize {
         );
         if let Some(e) = sweep.ensemble {
             axes.push(("ensemble.samples".into(), e.samples));
+        }
+        if sweep.search.is_some() {
+            // Every combination becomes the two bracket probes of a search.
+            axes.push(("search (2 probes)".into(), 2));
         }
         let combinations = axes
             .iter()
@@ -840,7 +887,6 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
     axes.extend(sweep.grid.iter());
     let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
     let combinations: usize = sizes.iter().product();
-    let mut idx = vec![0usize; axes.len()];
     let mut runs = Vec::new();
     let mut seen: HashMap<String, usize> = HashMap::new();
     let mut issues: Vec<Issue> = Vec::new();
@@ -848,12 +894,62 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
     let mut inapplicable: BTreeMap<String, usize> = BTreeMap::new();
     let mut collapsed: BTreeMap<String, usize> = BTreeMap::new();
     let mut references: Vec<ReferencePlan> = Vec::new();
-    for _ in 0..combinations {
-        let mut entries: Vec<&Entry> = sweep.fixed.iter().collect();
-        for (a, &i) in axes.iter().zip(&idx) {
-            entries.extend(a.items[i].iter());
+    let mut searches: Vec<SearchBase> = Vec::new();
+    // A search turns every combination into a base and its two bracket probes.
+    let combos: Vec<Vec<Entry>> = {
+        let mut out = Vec::new();
+        let mut idx = vec![0usize; axes.len()];
+        for _ in 0..combinations {
+            let mut entries: Vec<Entry> = sweep.fixed.clone();
+            for (a, &i) in axes.iter().zip(&idx) {
+                entries.extend(a.items[i].iter().cloned());
+            }
+            out.push(entries);
+            for d in (0..idx.len()).rev() {
+                idx[d] += 1;
+                if idx[d] < sizes[d] {
+                    break;
+                }
+                idx[d] = 0;
+            }
         }
-        match resolve(sweep.scene, &entries, limits) {
+        out
+    };
+    let mut work: Vec<(Vec<Entry>, Option<String>)> = Vec::new();
+    for entries in combos {
+        match &sweep.search {
+            None => work.push((entries, None)),
+            Some(sr) => {
+                let base = searches.len();
+                let tag = search_tag(sr, base);
+                let label = match resolve(
+                    sweep.scene,
+                    &probe_entries(&entries, sr.key, sr.lo)
+                        .iter()
+                        .collect::<Vec<_>>(),
+                    true,
+                    limits,
+                ) {
+                    Outcome::Run(r) => r.label.clone(),
+                    _ => String::new(),
+                };
+                // Bases that are meaningless or excluded are dropped with their probes below.
+                for v in [sr.lo, sr.hi] {
+                    work.push((probe_entries(&entries, sr.key, v), Some(tag.clone())));
+                }
+                searches.push(SearchBase {
+                    index: base,
+                    label,
+                    entries,
+                    tag,
+                });
+            }
+        }
+    }
+    let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
+    for (owned, search) in &work {
+        let entries: Vec<&Entry> = owned.iter().collect();
+        match resolve(sweep.scene, &entries, allow_unstable, limits) {
             Outcome::Invalid(mut is) => issues.append(&mut is),
             Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
@@ -926,20 +1022,15 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                             sample,
                             scene: sweep.scene,
                             reference: reference.clone(),
+                            search: search.clone(),
                         });
                     }
                 }
             }
         }
-        // odometer, last axis fastest
-        for d in (0..idx.len()).rev() {
-            idx[d] += 1;
-            if idx[d] < sizes[d] {
-                break;
-            }
-            idx[d] = 0;
-        }
     }
+    // A base none of whose probes is a run (meaningless, excluded) is no search.
+    searches.retain(|b| runs.iter().any(|r| r.search.as_deref() == Some(&b.tag)));
     if !issues.is_empty() {
         issues.sort();
         issues.dedup();
@@ -963,13 +1054,80 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
     }
     Ok(Plan {
         sweep: sweep.clone(),
+        limits: *limits,
         runs,
         combinations,
         excluded_by_filter,
         inapplicable,
         collapsed,
         references,
+        searches,
     })
+}
+
+/// A combination's entries with the searched key set to `value`.
+fn probe_entries(entries: &[Entry], key: Key, value: f64) -> Vec<Entry> {
+    let mut out: Vec<Entry> = entries.iter().filter(|e| e.key != key).cloned().collect();
+    out.push(Entry {
+        key,
+        value: Value::Num(value),
+        origin: Origin {
+            path: format!("search.{}", key.name()),
+            line: None,
+        },
+    });
+    out
+}
+
+/// The probe of a search base at `value`: an ordinary run (same parameters, same run_id as
+/// anywhere else), tagged with its search, allowed past a CFL limit.
+pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, SweepError> {
+    let sweep = &plan.sweep;
+    let sr = sweep
+        .search
+        .as_ref()
+        .expect("a plan with search bases has a search");
+    let owned = probe_entries(&base.entries, sr.key, value);
+    let entries: Vec<&Entry> = owned.iter().collect();
+    let invalid = |issues: Vec<Issue>| SweepError::Invalid {
+        file: sweep.path.clone(),
+        issues,
+    };
+    match resolve(sweep.scene, &entries, true, &plan.limits) {
+        Outcome::Run(r) => {
+            let reference = match &sweep.reference {
+                None => None,
+                Some(over) => Some(
+                    reference_of(sweep, &plan.limits, &entries, over, &r)
+                        .map_err(invalid)?
+                        .0
+                        .run_id,
+                ),
+            };
+            let extra = reference
+                .as_ref()
+                .map(|rid| format!("reference={rid}\n"))
+                .unwrap_or_default();
+            Ok(RunSpec {
+                run_id: run_id(sweep.scene, &r.canonical, &extra),
+                label: r.label.clone(),
+                params: r.params.clone(),
+                scheme_label: r.scheme_label.clone(),
+                config: r.config.clone(),
+                repeats: sweep.repeats,
+                sample: None,
+                scene: sweep.scene,
+                reference,
+                search: Some(base.tag.clone()),
+            })
+        }
+        Outcome::Inapplicable(why) => Err(invalid(vec![Issue {
+            line: None,
+            key: format!("search.{}", sr.key.name()),
+            reason: format!("the probe at {value} is meaningless: {why}"),
+        }])),
+        Outcome::Invalid(is) => Err(invalid(is)),
+    }
 }
 
 impl Plan {
