@@ -187,3 +187,27 @@ fn the_run_timeout_covers_the_setup() {
     // Stopped after the operators: well before the 1200 steps (≈ 100 s at this size).
     assert!(t0.elapsed() < Duration::from_secs(10), "{:?}", t0.elapsed());
 }
+
+#[test]
+fn an_interruption_stops_a_run_in_its_setup() {
+    // The scheduler's SIGTERM raises the cancel flag; a run still building its operators stops
+    // at the next setup checkpoint (before its first step) and is dropped, not written.
+    static CANCEL: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(true);
+    for text in [
+        "name = \"s\"\nscene = \"bar1d\"\n[fixed]\nelements = 1000000\ndt = 0.01\n",
+        "name = \"s\"\nscene = \"bar2d\"\n[fixed]\nh = 0.025\ndt = 0.0125\n",
+    ] {
+        let plan = expand(&SweepFile::parse("s.toml".as_ref(), text).unwrap()).unwrap();
+        let out = simulate(
+            &plan.runs[0].config,
+            &RunOptions {
+                series_every: 1,
+                timeout: None,
+                cancel: Some(&CANCEL),
+            },
+        );
+        assert_eq!(out.status, Status::Cancelled, "{text}");
+        assert_eq!(out.metrics.steps, 0);
+        assert!(out.series.is_empty());
+    }
+}
