@@ -191,10 +191,10 @@ fn random_file() -> impl Strategy<Value = String> {
             s += &fixed;
             s += "[grid]\n";
             s += &grid;
-            if let Some((k, list)) = huge {
-                if !grid.contains(&format!("{k} =")) {
-                    s += &format!("{k} = {list}\n");
-                }
+            if let Some((k, list)) = huge
+                && !grid.contains(&format!("{k} ="))
+            {
+                s += &format!("{k} = {list}\n");
             }
             s += "[zip]\n";
             s += &zip;
@@ -383,10 +383,10 @@ fn fuzzed_sweep_files_are_accepted_or_rejected_naming_a_key_quickly_and_never_pa
     let t0 = Instant::now();
     for _ in 0..cases {
         let text = strategy.new_tree(&mut runner).unwrap().current();
-        if let Err(why) = check(&text, &mut counts) {
-            if failures.len() < 5 {
-                failures.push((why, text));
-            }
+        if let Err(why) = check(&text, &mut counts)
+            && failures.len() < 5
+        {
+            failures.push((why, text));
         }
     }
     std::panic::set_hook(hook);
