@@ -6,9 +6,16 @@
 //! - `exec/…`: a 16-run plan on the serial loop and on the rayon pool (2 threads): the ratio is
 //!   the parallel speed-up measured in one process, both sides under the same machine load.
 //!
+//! - `thomas-ratio`: for m = 10², 10³, 10⁴, 10⁵, the cost of one CN step (mixed, mod3, errors
+//!   against the closed form included, series off) per node against one tridiagonal solve
+//!   with precomputed factors (Thomas, plus the copy of its right-hand side) per node — the floor a step cannot beat. Both are timed
+//!   in alternation, 9 rounds, medians; the table is printed (`per-step ÷ Thomas`).
+//!
 //! `cargo bench --bench bar1d`; compare medians, not single runs.
+//! `cargo bench --bench bar1d -- thomas-ratio` prints only the ratio table.
 
 use std::path::Path;
+use std::time::Instant;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
@@ -16,7 +23,7 @@ use contact_sweep::exec::{self, ExecOptions};
 use contact_sweep::run::bar1d::Bar1dConfig;
 use contact_sweep::run::{RunConfig, RunOptions, simulate};
 use contact_sweep::scene::BarParams;
-use contact_sweep::space::{ContactMethod, MassVariant};
+use contact_sweep::space::{Bar1dSpace, ContactMethod, MassVariant};
 use contact_sweep::sweep::{self, SweepFile};
 use contact_sweep::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
 
@@ -142,5 +149,93 @@ mass = ["mod3"]
     g.finish();
 }
 
-criterion_group!(benches, steps, executor);
+/// Median of a sample.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Per-step cost of a CN run against a bare Thomas solve, per node, for m = 10² … 10⁵.
+/// Not a criterion benchmark: the two sides are timed in alternation so that both see the same
+/// machine load, and their ratio is what is reported.
+fn thomas_ratio(c: &mut Criterion) {
+    // Honour criterion's name filter (`cargo bench --bench bar1d -- step` skips this).
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    if !filter.is_empty() && !filter.iter().any(|f| "thomas-ratio".contains(f.as_str())) {
+        return;
+    }
+    let _ = c;
+    println!(
+        "\nthomas-ratio: one CN step (mixed, mod3, errors included) per node against one Thomas solve per node"
+    );
+    println!(
+        "{:>8} {:>8} {:>14} {:>14} {:>8}",
+        "m", "steps", "step ns/node", "Thomas ns/node", "ratio"
+    );
+    for m in [100usize, 1_000, 10_000, 100_000] {
+        // About 3·10⁷ node-steps per sample: ≈ 0.25 s.
+        let steps = (30_000_000 / m).max(10);
+        let dt = 1.0 / m as f64; // ν = 1 on the unit bar (c₀ = 1)
+        let cfg = RunConfig::Bar1d(Bar1dConfig {
+            steps,
+            ..Bar1dConfig::new(
+                BarParams::default(),
+                m,
+                dt,
+                1.0,
+                ContactMethod::Mixed,
+                MassVariant::Mod3,
+                Scheme::Newmark(NewmarkParams::crank_nicolson()),
+            )
+        });
+        let no_series = RunOptions {
+            series_every: 0,
+            timeout: None,
+            cancel: None,
+        };
+        // The Thomas side: the same iteration matrix M + (τ²/4) K, factored once.
+        let sp = Bar1dSpace::new(
+            BarParams::default(),
+            m,
+            &MassVariant::Mod3,
+            ContactMethod::Mixed,
+        )
+        .expect("a valid space");
+        let lu = sp
+            .mass
+            .axpy(0.25 * dt * dt, &sp.stiffness_lin)
+            .factor()
+            .expect("M + cK is SPD");
+        let rhs: Vec<f64> = (0..m).map(|i| 1.0 + (i % 7) as f64).collect();
+        let mut x = rhs.clone();
+        let (mut run_ns, mut thomas_ns) = (Vec::new(), Vec::new());
+        for _ in 0..9 {
+            let t = Instant::now();
+            let out = simulate(&cfg, &no_series);
+            run_ns.push(t.elapsed().as_secs_f64() * 1e9 / (steps * m) as f64);
+            assert_eq!(out.metrics.steps as usize, steps);
+            let t = Instant::now();
+            for _ in 0..steps {
+                // A fresh right-hand side each time, as a step builds one (repeated solves of
+                // x ← A⁻¹x would grow like h⁻ⁿ and overflow): the copy is counted on this side.
+                x.copy_from_slice(&rhs);
+                lu.solve_in_place(&mut x);
+            }
+            std::hint::black_box(&x);
+            thomas_ns.push(t.elapsed().as_secs_f64() * 1e9 / (steps * m) as f64);
+        }
+        let (r, t) = (median(run_ns), median(thomas_ns));
+        println!("{m:>8} {steps:>8} {r:>14.2} {t:>14.2} {:>8.2}", r / t);
+    }
+}
+
+criterion_group!(benches, steps, executor, thomas_ratio);
 criterion_main!(benches);

@@ -9,7 +9,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
@@ -290,8 +290,9 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Run(args) => {
+            let start = Instant::now();
             let cfg = args.validate()?;
-            run(cfg)
+            run(cfg, start)
         }
         Command::Summarize { dir, errors } => {
             let opts = summarize_options(&dir, errors.as_deref())?;
@@ -336,7 +337,7 @@ fn summarize_options(dir: &Path, errors: Option<&[String]>) -> Result<summary::S
     Ok(opts)
 }
 
-fn run(cfg: RunConfig) -> Result<ExitCode> {
+fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     let plan = &cfg.plan;
     let dir = &cfg.out;
     let had_results = dir.join("runs").is_dir();
@@ -497,9 +498,10 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         }
     }
     let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+    let stats = sink.stats();
     manifest.finish(
         dir,
-        sink.written,
+        stats.written,
         interrupted || result.is_err() || flushed.is_err() || searched.is_err(),
     )?;
     result?;
@@ -508,18 +510,19 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
     if interrupted {
         eprintln!(
             "interrupted: {} finished runs committed to {}; the runs in flight were dropped — run the same command to resume",
-            sink.written,
+            stats.written,
             dir.display()
         );
         return Ok(ExitCode::from(130));
     }
     eprintln!(
         "{} runs written to {} ({} failed, {} diverged)",
-        sink.written,
+        stats.written,
         dir.display(),
         failed,
         diverged
     );
+    eprintln!("{}", cost_line(&stats, sweep_start.elapsed().as_secs_f64()));
     let mut ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
     let probes = searched_ids(dir, plan)?;
     ids.extend(probes.iter().map(String::as_str));
@@ -536,6 +539,25 @@ fn run(cfg: RunConfig) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Where the session's time and bytes went: the runs' own time (summed over workers) against
+/// the wall time since the command started, the writer thread's time, and the size of the
+/// time series per stored step.
+fn cost_line(stats: &crate::sink::SinkStats, wall_s: f64) -> String {
+    let mut s = format!(
+        "time: runs {:.3} s (summed), command {:.3} s wall so far, Parquet writer {:.3} s (own thread)",
+        stats.run_seconds, wall_s, stats.write_seconds
+    );
+    if stats.series_rows > 0 {
+        s.push_str(&format!(
+            "; series: {} stored steps, {:.1} MB, {:.2} bytes/step",
+            stats.series_rows,
+            stats.series_bytes as f64 / 1e6,
+            stats.series_bytes as f64 / stats.series_rows as f64
+        ));
+    }
+    s
 }
 
 fn slurm(args: SlurmArgs) -> Result<ExitCode> {

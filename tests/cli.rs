@@ -55,7 +55,8 @@ fn quickstart_runs_and_prints_errors_against_the_exact_solution() {
     assert!(out.join("manifest.json").exists());
 }
 
-/// Rows sorted by run_id, without the timing columns.
+/// Rows sorted by run_id, without the timing columns (wall_time_*, setup/stepping/observe
+/// `*_time_s`).
 fn rows_without_timing(dir: &Path, series: bool) -> DataFrame {
     let df = if series {
         read_series(dir)
@@ -67,7 +68,7 @@ fn rows_without_timing(dir: &Path, series: bool) -> DataFrame {
         .get_column_names()
         .into_iter()
         .map(|s| s.to_string())
-        .filter(|c| !c.starts_with("wall_time"))
+        .filter(|c| !c.starts_with("wall_time") && !c.ends_with("_time_s"))
         .collect();
     let by: Vec<&str> = if series {
         vec!["run_id", "step"]

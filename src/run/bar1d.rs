@@ -28,7 +28,7 @@
 
 use std::time::Instant;
 
-use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::{BarExact, BarParams};
@@ -599,6 +599,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     };
     let mut done = 0usize;
+    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
+    let loop_start = Instant::now();
+    let mut observe_timer = SampledTimer::default();
     let stop = (|| -> Result<(), Stop<ContactSolveError>> {
         rec.record(0, &st.u, &st.v, sigma0)
             .map_err(Stop::Diverged)?;
@@ -608,7 +611,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(n, e))?;
                     metrics.iterations += 1;
                     let sigma = eng.sigma(&st.u, phi);
-                    rec.record(n, &st.u, &st.v, sigma).map_err(Stop::Diverged)?;
+                    observe_timer
+                        .time(n, || rec.record(n, &st.u, &st.v, sigma))
+                        .map_err(Stop::Diverged)?;
                     done = n;
                     interrupted(n)?;
                 }
@@ -648,7 +653,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
                     for i in 0..m {
                         vn[i] = (wk.y[i] - prev[i]) / (2.0 * tau);
                     }
-                    rec.record(n, &st.u, &vn, lambda).map_err(Stop::Diverged)?;
+                    observe_timer
+                        .time(n, || rec.record(n, &st.u, &vn, lambda))
+                        .map_err(Stop::Diverged)?;
                     done = n;
                     std::mem::swap(&mut prev, &mut st.u);
                     std::mem::swap(&mut st.u, &mut wk.y);
@@ -659,6 +666,8 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     })();
     metrics.steps = done as i64;
+    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     rec.obs.finish(&mut metrics, status == Status::Ok);
     Outcome {

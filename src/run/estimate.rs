@@ -12,8 +12,8 @@
 //!   n = 19 440 → c = 12.5); 16 bytes per entry (value and row index). Besides: the step matrix,
 //!   K and M (3^d·d entries per row, 16 bytes each), the condensed contact columns Z = A⁻¹Bᵀ
 //!   (n × n_c dense), and 12 work vectors of n.
-//! - series: (steps / series_every + 2) rows of [`SeriesRow`] plus the run id each row is keyed
-//!   by in the sink's batch.
+//! - series: (steps / series_every + 2) rows of [`SeriesRow`] (the sink's batch keys a run's
+//!   rows by one id).
 //!
 //! Work = steps × unknowns (what the plan table prints and the Slurm shards balance).
 //! The estimates are within a factor of about 2 of what a run uses; they decide refusals only
@@ -25,9 +25,8 @@ use crate::time::Scheme;
 
 /// Bytes per bar1d element (measured, module header).
 const BAR1D_BYTES_PER_ELEMENT: f64 = 288.0;
-/// Bytes of one kept series row in the sink's batch: the row and its run id (a 16-hex-digit
-/// String: 24 bytes of header, 16 of heap).
-const SERIES_ROW_BYTES: f64 = (std::mem::size_of::<SeriesRow>() + 24 + 16) as f64;
+/// Bytes of one kept series row in the sink's batch.
+const SERIES_ROW_BYTES: f64 = std::mem::size_of::<SeriesRow>() as f64;
 
 /// A run's estimated cost.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -28,7 +28,7 @@
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
-use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
 use crate::contact::{Lcp, LcpError};
@@ -657,6 +657,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let mut done = 0usize;
     let mut iterations = 0i64;
+    let mut observe_timer = SampledTimer::default();
     let stop = (|| -> Result<(), Stop<LcpError>> {
         observe(0, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
@@ -697,7 +698,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             std::mem::swap(&mut a, &mut tmp);
             std::mem::swap(&mut ma, &mut pred);
             std::mem::swap(&mut u, &mut y);
-            observe(step, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            observe_timer
+                .time(step, || {
+                    observe(step, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err)
+                })
+                .map_err(Stop::Diverged)?;
             done = step;
             if step.is_multiple_of(CLOCK_EVERY) {
                 if opts.cancelled() {
@@ -713,6 +718,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.steps = done as i64;
     metrics.iterations = iterations;
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
     // The observer's pressure columns are the total force here; there is no midpoint pressure.

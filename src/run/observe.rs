@@ -52,6 +52,46 @@ pub struct Metrics {
     pub setup_time_s: Option<f64>,
     /// Time spent in the time loop (observables included).
     pub stepping_time_s: Option<f64>,
+    /// Part of the stepping time spent on observables and error norms (sampled estimate).
+    pub observe_time_s: Option<f64>,
+}
+
+/// One step in this many is timed by a [`SampledTimer`].
+pub const SAMPLE_EVERY: usize = 64;
+
+/// Times one part of a time loop on every [`SAMPLE_EVERY`]-th step only, and extrapolates to
+/// all steps. Reading the clock around every call would cost two clock reads (≈ 40 ns) per
+/// step — up to a quarter of a 1D step at m = 20 — while one step in 64 costs < 1 ns per step
+/// on average. The estimate is unbiased as long as the part's cost does not correlate with
+/// n mod 64 (contact phases last hundreds of steps and are not aligned with it).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SampledTimer {
+    sampled: std::time::Duration,
+    samples: u64,
+    calls: u64,
+}
+
+impl SampledTimer {
+    /// Run `f` for step `step`, timing it if the step is sampled.
+    #[inline]
+    pub fn time<R>(&mut self, step: usize, f: impl FnOnce() -> R) -> R {
+        self.calls += 1;
+        if step.is_multiple_of(SAMPLE_EVERY) {
+            let start = std::time::Instant::now();
+            let r = f();
+            self.sampled += start.elapsed();
+            self.samples += 1;
+            r
+        } else {
+            f()
+        }
+    }
+
+    /// Estimated total time over every call (None if no call was sampled).
+    pub fn estimate_s(&self) -> Option<f64> {
+        (self.samples > 0)
+            .then(|| self.sampled.as_secs_f64() * self.calls as f64 / self.samples as f64)
+    }
 }
 
 /// One row of the time series (SPEC §5).

@@ -14,6 +14,8 @@ pub enum ColumnData {
     F64(Vec<Option<f64>>),
     I64(Vec<Option<i64>>),
     Str(Vec<Option<String>>),
+    /// A string column given as runs of equal values (value, count): the run_id of a series.
+    StrRuns(Vec<(String, usize)>),
 }
 
 /// Rust types that can fill a column.
@@ -147,8 +149,9 @@ schema! {
         contact_dofs: Option<i64> => "", "unknowns the contact problem is condensed onto (2D/3D: vertical dofs of Γ_C)";
         contact_toggles: Option<i64> => "", "times the total contact force switched between zero and non-zero (2D/3D; 002's chatter)";
         factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D)";
-        setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set (2D/3D)";
-        stepping_time_s: Option<f64> => "s", "time loop, observables included (2D/3D)";
+        setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
+        stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
+        observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -202,19 +205,23 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
     ),
 ];
 
-/// The time series of a batch as typed columns.
-pub fn series_columns(rows: &[(String, SeriesRow)]) -> Vec<(&'static str, ColumnData)> {
+/// The time series of a batch (each run's id with its rows) as typed columns.
+pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, ColumnData)> {
     let f = |g: fn(&SeriesRow) -> Option<f64>| {
-        ColumnData::F64(rows.iter().map(|(_, r)| g(r)).collect())
+        ColumnData::F64(runs.iter().flat_map(|(_, s)| s.iter().map(g)).collect())
     };
     vec![
         (
             "run_id",
-            ColumnData::Str(rows.iter().map(|(id, _)| Some(id.clone())).collect()),
+            ColumnData::StrRuns(runs.iter().map(|(id, s)| (id.clone(), s.len())).collect()),
         ),
         (
             "step",
-            ColumnData::I64(rows.iter().map(|(_, r)| Some(r.step)).collect()),
+            ColumnData::I64(
+                runs.iter()
+                    .flat_map(|(_, s)| s.iter().map(|r| Some(r.step)))
+                    .collect(),
+            ),
         ),
         ("t", f(|r| Some(r.t))),
         ("u_contact", f(|r| Some(r.u_contact))),
@@ -325,6 +332,7 @@ impl RunRecord {
             factor_cache_hits: m.factor_cache_hits,
             setup_time_s: m.setup_time_s,
             stepping_time_s: m.stepping_time_s,
+            observe_time_s: m.observe_time_s,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

@@ -29,8 +29,10 @@
 
 use std::collections::HashSet;
 use std::fs::{self, File};
-use std::io::Write as _;
+use std::io::{BufWriter, Write as _};
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex, mpsc};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
 use polars::prelude::*;
@@ -78,6 +80,7 @@ pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame
         Some((_, ColumnData::F64(v))) => v.len(),
         Some((_, ColumnData::I64(v))) => v.len(),
         Some((_, ColumnData::Str(v))) => v.len(),
+        Some((_, ColumnData::StrRuns(v))) => v.iter().map(|(_, n)| n).sum(),
         None => 0,
     };
     let cols = columns
@@ -86,27 +89,51 @@ pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame
             ColumnData::F64(v) => Column::new(name.into(), &v),
             ColumnData::I64(v) => Column::new(name.into(), &v),
             ColumnData::Str(v) => Column::new(name.into(), &v),
+            ColumnData::StrRuns(v) => {
+                // Pushed as &str: no String per row (a series batch has ~10⁶ rows).
+                let mut b = StringChunkedBuilder::new(name.into(), height);
+                for (value, n) in &v {
+                    for _ in 0..*n {
+                        b.append_value(value);
+                    }
+                }
+                b.finish().into_column()
+            }
         })
         .collect();
     DataFrame::new(height, cols)
 }
 
-/// Write a DataFrame to `dir/name` atomically (temporary dot-file, fsync, rename).
-pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<(), SinkError> {
+/// Write a DataFrame to `dir/name` atomically (temporary dot-file, fsync, rename); returns the
+/// file's size in bytes.
+pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<u64, SinkError> {
     let tmp = dir.join(format!(".tmp-{name}"));
     let dst = dir.join(name);
     let file = File::create(&tmp).map_err(io(&tmp))?;
-    ParquetWriter::new(&file)
+    // zstd: the series' floats barely compress, but step, t and the closed-form columns do —
+    // 21.8 bytes per series row against 29.9 with lz4 and 59.7 uncompressed (measured on the
+    // benches/sweeps/overhead_1d.toml series). One row group per part (a part is a batch of
+    // runs, ≤ 10⁵–10⁶ rows): a reader prunes by part, and polars reads it in one go. Not
+    // parallel: the sink's writer thread is already off the workers' path, and polars' pool
+    // would compete with them for the cores.
+    // Buffered: polars writes a part page by page (≈ 40 000 write calls for the summary's
+    // tables and series parts of one sweep without the buffer).
+    let mut buf = BufWriter::with_capacity(1 << 20, &file);
+    ParquetWriter::new(&mut buf)
         .with_compression(ParquetCompression::Zstd(None))
+        .set_parallel(false)
         .finish(df)
         .map_err(|source| SinkError::Parquet {
             path: tmp.clone(),
             source,
         })?;
+    buf.flush().map_err(io(&tmp))?;
+    drop(buf);
     file.sync_all().map_err(io(&tmp))?;
+    let bytes = file.metadata().map_err(io(&tmp))?.len();
     drop(file);
     fs::rename(&tmp, &dst).map_err(io(&dst))?;
-    Ok(())
+    Ok(bytes)
 }
 
 fn sync_dir(dir: &Path) -> Result<(), SinkError> {
@@ -305,20 +332,65 @@ impl Default for BatchPolicy {
     }
 }
 
+/// What the session has committed so far.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SinkStats {
+    /// Runs committed (rows in runs parts).
+    pub written: usize,
+    /// Time-series rows (stored steps) committed.
+    pub series_rows: u64,
+    /// Bytes of the committed series parts.
+    pub series_bytes: u64,
+    /// Σ over committed runs of median wall time × repeats: the runs' own time.
+    pub run_seconds: f64,
+    /// Time the writer thread spent building frames and writing parts.
+    pub write_seconds: f64,
+}
+
+/// A batch on its way to the writer thread.
+enum Job {
+    Batch {
+        name: String,
+        rows: Vec<RunRecord>,
+        series: Vec<(String, Vec<SeriesRow>)>,
+    },
+    /// Answered once every job sent before has been handled.
+    Sync(mpsc::Sender<()>),
+}
+
+/// State shared with the writer thread.
+#[derive(Default)]
+struct Shared {
+    stats: SinkStats,
+    /// The first failure; the writer commits nothing after it.
+    error: Option<SinkError>,
+}
+
+/// Batches queued behind the one being written. One is enough to keep the workers busy while
+/// a part is written, and bounds the memory held by a slow disk (the producer then waits).
+const QUEUED_BATCHES: usize = 1;
+
 /// The writer of one session into DIR.
+///
+/// Batches are committed by a writer thread, so the thread collecting results (and, with
+/// `--threads 1`, the run loop itself) never waits for Parquet encoding or fsync. Commit order
+/// and atomicity are unchanged: batches are written one after another, each series part before
+/// its runs part. A write failure is reported by the next [`Sink::push`] or by
+/// [`Sink::flush`]; nothing is committed after it.
 pub struct Sink {
     runs_dir: PathBuf,
-    series_dir: PathBuf,
     rows: Vec<RunRecord>,
-    series: Vec<(String, SeriesRow)>,
+    series: Vec<(String, Vec<SeriesRow>)>,
     policy: BatchPolicy,
     last_flush: Instant,
     tag: String,
     seq: usize,
-    pub written: usize,
     /// Parts found unreadable when the folder was opened, now moved aside.
     pub damaged: Vec<Damaged>,
     shared_with_others: bool,
+    shared: Arc<Mutex<Shared>>,
+    jobs: Option<mpsc::SyncSender<Job>>,
+    writer: Option<JoinHandle<()>>,
     /// Shared lock on DIR/.lock, held while this session may write.
     _lock: File,
 }
@@ -355,19 +427,29 @@ impl Sink {
             .duration_since(SystemTime::UNIX_EPOCH)
             .unwrap_or_default()
             .as_millis();
+        let shared = Arc::new(Mutex::new(Shared::default()));
+        let (jobs, rx) = mpsc::sync_channel::<Job>(QUEUED_BATCHES);
+        let writer = {
+            let (runs_dir, shared) = (runs_dir.clone(), Arc::clone(&shared));
+            std::thread::Builder::new()
+                .name("parquet-writer".into())
+                .spawn(move || write_loop(&runs_dir, &series_dir, &rx, &shared))
+                .map_err(io(dir))?
+        };
         Ok((
             Sink {
                 runs_dir,
-                series_dir,
                 rows: Vec::new(),
                 series: Vec::new(),
                 policy,
                 last_flush: Instant::now(),
                 tag: format!("{stamp}-{}", std::process::id()),
                 seq: 0,
-                written: 0,
                 damaged,
                 shared_with_others: !alone,
+                shared,
+                jobs: Some(jobs),
+                writer: Some(writer),
                 _lock: lock,
             },
             done,
@@ -403,46 +485,160 @@ impl Sink {
         self.shared_with_others
     }
 
-    /// Add a finished run; flush if the batch is full or old.
+    /// What has been committed so far (batches still queued are not counted).
+    pub fn stats(&self) -> SinkStats {
+        self.lock().stats
+    }
+
+    /// Runs committed so far.
+    pub fn written(&self) -> usize {
+        self.stats().written
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Shared> {
+        // A poisoned lock means the writer panicked while holding it; its stats are still valid.
+        self.shared.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// The writer's failure, if any (taken: reported once).
+    fn take_error(&self) -> Result<(), SinkError> {
+        match self.lock().error.take() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    /// Add a finished run; hand the batch to the writer if it is full or old.
     pub fn push(&mut self, result: RunResult) -> Result<(), SinkError> {
-        let id = result.record.run_id.clone();
-        self.series
-            .extend(result.series.into_iter().map(|r| (id.clone(), r)));
+        self.take_error()?;
+        if !result.series.is_empty() {
+            self.series
+                .push((result.record.run_id.clone(), result.series));
+        }
         self.rows.push(result.record);
         if self.rows.len() >= self.policy.runs
             || self.last_flush.elapsed() >= Duration::from_secs_f64(self.policy.seconds)
         {
-            self.flush()?;
+            self.send_batch()?;
         }
         Ok(())
     }
 
-    /// Commit the pending batch (series first, then the runs part that commits it).
-    pub fn flush(&mut self) -> Result<(), SinkError> {
+    /// Queue the pending batch for the writer (waits only if a batch is already queued).
+    fn send_batch(&mut self) -> Result<(), SinkError> {
         self.last_flush = Instant::now();
         if self.rows.is_empty() {
             return Ok(());
         }
         let name = format!("part-{}-{:05}.parquet", self.tag, self.seq);
         self.seq += 1;
-        let mut sdf = frame(series_columns(&self.series)).map_err(|source| SinkError::Parquet {
-            path: self.series_dir.join(&name),
-            source,
-        })?;
-        write_parquet_atomic(&self.series_dir, &name, &mut sdf)?;
-        let mut rdf =
-            frame(RunRecord::to_columns(&self.rows)).map_err(|source| SinkError::Parquet {
-                path: self.runs_dir.join(&name),
-                source,
-            })?;
-        write_parquet_atomic(&self.runs_dir, &name, &mut rdf)?;
-        sync_dir(&self.series_dir)?;
-        sync_dir(&self.runs_dir)?;
-        self.written += self.rows.len();
-        self.rows.clear();
-        self.series.clear();
-        Ok(())
+        let job = Job::Batch {
+            name,
+            rows: std::mem::take(&mut self.rows),
+            series: std::mem::take(&mut self.series),
+        };
+        self.send(job)
     }
+
+    fn send(&self, job: Job) -> Result<(), SinkError> {
+        let sent = self.jobs.as_ref().is_some_and(|tx| tx.send(job).is_ok());
+        if sent {
+            Ok(())
+        } else {
+            self.take_error()?;
+            Err(io(&self.runs_dir)(std::io::Error::other(
+                "the Parquet writer thread stopped",
+            )))
+        }
+    }
+
+    /// Commit the pending batch and wait until every batch handed over is on disk.
+    pub fn flush(&mut self) -> Result<(), SinkError> {
+        self.send_batch()?;
+        let (ack, done) = mpsc::channel();
+        self.send(Job::Sync(ack))?;
+        if done.recv().is_err() {
+            self.take_error()?;
+            return Err(io(&self.runs_dir)(std::io::Error::other(
+                "the Parquet writer thread stopped",
+            )));
+        }
+        self.take_error()
+    }
+}
+
+impl Drop for Sink {
+    /// Batches already handed over are still committed (each is complete); then the writer
+    /// thread ends.
+    fn drop(&mut self) {
+        drop(self.jobs.take());
+        if let Some(w) = self.writer.take() {
+            let _ = w.join();
+        }
+    }
+}
+
+/// The writer thread: commit batches in order until the sink hangs up.
+fn write_loop(
+    runs_dir: &Path,
+    series_dir: &Path,
+    jobs: &mpsc::Receiver<Job>,
+    shared: &Mutex<Shared>,
+) {
+    let lock = || shared.lock().unwrap_or_else(|p| p.into_inner());
+    for job in jobs.iter() {
+        match job {
+            Job::Sync(ack) => {
+                let _ = ack.send(());
+            }
+            Job::Batch { name, rows, series } => {
+                if lock().error.is_some() {
+                    continue; // nothing is committed after a failure
+                }
+                let start = Instant::now();
+                let written = commit_batch(runs_dir, series_dir, &name, &rows, &series);
+                let mut sh = lock();
+                match written {
+                    Ok(series_bytes) => {
+                        let st = &mut sh.stats;
+                        st.written += rows.len();
+                        st.series_rows += series.iter().map(|(_, s)| s.len() as u64).sum::<u64>();
+                        st.series_bytes += series_bytes;
+                        st.run_seconds += rows
+                            .iter()
+                            .map(|r| r.wall_time_s * r.repeats as f64)
+                            .sum::<f64>();
+                        st.write_seconds += start.elapsed().as_secs_f64();
+                    }
+                    Err(e) => sh.error = Some(e),
+                }
+            }
+        }
+    }
+}
+
+/// Commit one batch (series first, then the runs part that commits it); returns the bytes of
+/// the series part.
+fn commit_batch(
+    runs_dir: &Path,
+    series_dir: &Path,
+    name: &str,
+    rows: &[RunRecord],
+    series: &[(String, Vec<SeriesRow>)],
+) -> Result<u64, SinkError> {
+    let mut sdf = frame(series_columns(series)).map_err(|source| SinkError::Parquet {
+        path: series_dir.join(name),
+        source,
+    })?;
+    let series_bytes = write_parquet_atomic(series_dir, name, &mut sdf)?;
+    let mut rdf = frame(RunRecord::to_columns(rows)).map_err(|source| SinkError::Parquet {
+        path: runs_dir.join(name),
+        source,
+    })?;
+    write_parquet_atomic(runs_dir, name, &mut rdf)?;
+    sync_dir(series_dir)?;
+    sync_dir(runs_dir)?;
+    Ok(series_bytes)
 }
 
 /// Read every committed runs part of DIR into one frame (diagonal concat tolerates parts

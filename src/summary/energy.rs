@@ -28,9 +28,6 @@
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 
-use anyhow::Context as _;
-use polars::prelude::*;
-
 use super::runs::{Run, Runs};
 use super::table::{self, Align, Kind, Table};
 
@@ -129,6 +126,26 @@ struct Series {
 }
 
 impl Series {
+    /// Order the rows by step and keep one row per step (the same run committed twice, by two
+    /// shards, repeats its rows: the first kept). A no-op for a series as the sink writes it.
+    fn normalize(&mut self) {
+        if self.step.windows(2).all(|w| w[0] < w[1]) {
+            return;
+        }
+        let mut order: Vec<usize> = (0..self.step.len()).collect();
+        order.sort_by_key(|&k| self.step[k]); // stable: the first of equal steps stays first
+        order.dedup_by_key(|k| self.step[*k]);
+        let pick = |v: &[Option<f64>]| order.iter().map(|&k| v[k]).collect::<Vec<_>>();
+        let (t, sigma, energy, theta) = (
+            pick(&self.t),
+            pick(&self.sigma),
+            pick(&self.energy),
+            pick(&self.theta),
+        );
+        self.step = order.iter().map(|&k| self.step[k]).collect();
+        (self.t, self.sigma, self.energy, self.theta) = (t, sigma, energy, theta);
+    }
+
     /// Largest gap between recorded steps: 1 for a complete series, k for `series_every = k`.
     fn stride(&self) -> i64 {
         self.step
@@ -208,14 +225,12 @@ fn read_series(
         return Ok(Err(format!("the series have no `{m}` column")));
     }
     let has_theta = raw.column("energy_theta").is_ok();
-    // Lazy: drop rows without a key, order by run and step.
-    let df = raw
-        .lazy()
-        .filter(col("run_id").is_not_null().and(col("step").is_not_null()))
-        .sort(["run_id", "step"], SortMultipleOptions::default())
-        .collect()
-        .map_err(anyhow::Error::new)
-        .with_context(|| format!("{}: reading the time series", dir.join("series").display()))?;
+    // No global sort by (run_id, step): a string sort of every row cost more than the rest of
+    // the summary. The sink writes each run's rows together and in step order, so rows are
+    // grouped by run as they come, and a run's rows are sorted by step only if they are not
+    // already (rows of another writer, or one run committed by two shards).
+    let mut df = raw;
+    df.rechunk_mut(); // one chunk: `get(i)` without a search over the parts
     let ids = df.column("run_id")?.str()?.clone();
     let steps = df.column("step")?.i64()?.clone();
     let ts = df.column("t")?.f64()?.clone();
@@ -226,24 +241,33 @@ fn read_series(
     } else {
         None
     };
+    // Blocks of consecutive rows of one run: the map is looked up once per block, not per row.
     let mut out: HashMap<String, Series> = HashMap::new();
-    for i in 0..df.height() {
-        let (Some(id), Some(step)) = (ids.get(i), steps.get(i)) else {
+    let mut i = 0;
+    while i < df.height() {
+        let Some(id) = ids.get(i) else {
+            i += 1;
             continue;
         };
-        if !wanted.contains_key(id) {
-            continue;
+        let mut end = i + 1;
+        while end < df.height() && ids.get(end) == Some(id) {
+            end += 1;
         }
-        let s = out.entry(id.to_string()).or_default();
-        // The same run committed twice (two shards) repeats its rows: keep the first.
-        if s.step.last() == Some(&step) {
-            continue;
+        if wanted.contains_key(id) {
+            let s = out.entry(id.to_string()).or_default();
+            for r in i..end {
+                let Some(step) = steps.get(r) else { continue };
+                s.step.push(step);
+                s.t.push(ts.get(r));
+                s.sigma.push(sig.get(r));
+                s.energy.push(en.get(r));
+                s.theta.push(th.as_ref().and_then(|c| c.get(r)));
+            }
         }
-        s.step.push(step);
-        s.t.push(ts.get(i));
-        s.sigma.push(sig.get(i));
-        s.energy.push(en.get(i));
-        s.theta.push(th.as_ref().and_then(|c| c.get(i)));
+        i = end;
+    }
+    for s in out.values_mut() {
+        s.normalize();
     }
     Ok(Ok(out))
 }

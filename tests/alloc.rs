@@ -1,0 +1,184 @@
+//! No heap allocation inside a time loop (issue 12, target 3) — a count, not a time.
+//!
+//! A counting global allocator (global only in this test binary) counts the allocations the
+//! current thread makes. A run with N steps and the same run with 2N steps (series off) do the
+//! same setup and the same finishing work; only the time loop runs N more steps. Equal counts
+//! mean the loop allocated nothing — not "little": a single allocation every 10⁴ steps shows
+//! as a difference. Each case is run once before it is measured, so that the FE engine's
+//! caches (geometry, factorisation) are filled and both measured runs take the same path.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::Path;
+
+use contact_sweep::run::{RunOptions, Status, simulate};
+use contact_sweep::sweep::{self, SweepFile};
+
+struct Counting;
+
+thread_local! {
+    /// Allocations made by this thread (a thread-local, so tests running in parallel in this
+    /// binary do not count each other's).
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+fn count() {
+    // try_with: the thread-local may already be gone while the thread is exiting.
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+// SAFETY: every call is forwarded unchanged to the system allocator; counting has no effect
+// on the memory returned.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        count();
+        unsafe { System.alloc_zeroed(layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        count();
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(Cell::get)
+}
+
+/// The plan of a sweep text with `T` substituted.
+fn plan(text: &str, t_final: f64) -> sweep::Plan {
+    let text = text.replace("T_FINAL", &format!("{t_final:?}"));
+    let sf = SweepFile::parse(Path::new("alloc.toml"), &text).expect("a valid sweep");
+    sweep::expand(&sf).expect("a valid plan")
+}
+
+/// For every run of the sweep: allocations of the run with T and with 2T must be equal.
+fn assert_loop_allocates_nothing(text: &str, t_final: f64) {
+    let (short, long) = (plan(text, t_final), plan(text, 2.0 * t_final));
+    assert_eq!(short.runs.len(), long.runs.len());
+    assert!(!short.runs.is_empty());
+    let opts = RunOptions {
+        series_every: 0,
+        ..RunOptions::default()
+    };
+    for (a, b) in short.runs.iter().zip(&long.runs) {
+        let out = simulate(&a.config, &opts); // warm the caches
+        assert_eq!(out.status, Status::Ok, "{}: {:?}", a.label, out.message);
+        let mut counts = [0u64; 2];
+        let mut steps = [0i64; 2];
+        for (k, spec) in [a, b].into_iter().enumerate() {
+            let before = allocations();
+            let out = simulate(&spec.config, &opts);
+            counts[k] = allocations() - before;
+            assert_eq!(out.status, Status::Ok, "{}: {:?}", spec.label, out.message);
+            steps[k] = out.metrics.steps;
+            drop(out);
+        }
+        assert_eq!(steps[1], 2 * steps[0], "{}: steps {steps:?}", a.label);
+        // The contact solve must have run in both states: the short run already switches
+        // between contact and release, so its loop took every branch the long one takes.
+        assert!(
+            out.metrics.contact_switches >= 2,
+            "{}: {} contact switches — the loop never left or entered contact",
+            a.label,
+            out.metrics.contact_switches
+        );
+        assert!(steps[0] >= 100, "{}: too few steps to show", a.label);
+        // Control: the counter sees this thread's allocations (a run's setup allocates).
+        assert!(counts[0] > 0, "{}: no allocation counted at all", a.label);
+        assert_eq!(
+            counts[0], counts[1],
+            "{}: {} allocations for {} steps, {} for {} steps — the time loop allocates",
+            a.label, counts[0], steps[0], counts[1], steps[1]
+        );
+    }
+}
+
+/// Every 1D scheme family with every contact treatment it runs with (and the massless
+/// quasi-static contact node, whose rows take their own path).
+#[test]
+fn bar1d_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-1d"
+scene = "bar1d"
+[fixed]
+T = T_FINAL
+elements = 40
+courant = 0.5
+[grid]
+method = [
+  { space = "mixed", mass = "mod3", scheme = "crank-nicolson" },
+  { space = "mixed", mass = "consistent", scheme = "crank-nicolson" },
+  { space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "crank-nicolson" },
+  { space = "penalty", penalty_gamma0 = 1e-3, scheme = "crank-nicolson" },
+  { space = "mixed", mass = "mod3", scheme = "newmark", newmark_beta = 0.3, newmark_gamma = 0.6 },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "newmark-dissipative" },
+  { space = "mixed", mass = "lumped", scheme = "central-difference" },
+  { space = "mixed", mass = "mod3", scheme = "backward-euler" },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "theta", theta_scheme = 0.7 },
+  { space = "penalty", penalty_gamma0 = 1e-3, scheme = "backward-euler" },
+  { space = "mixed", mass = "mod3", scheme = "paoli-schatzman" },
+  { space = "mixed", mass = "mod3", scheme = "hybrid" },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "hybrid" },
+  { space = "penalty", penalty_gamma0 = 1e-3, scheme = "hybrid" },
+]
+"#,
+        3.0,
+    );
+}
+
+/// The FE engine on bar2d: the modified mass with Crank–Nicolson, the consistent mass with
+/// backward Euler.
+#[test]
+fn bar2d_time_loop_allocates_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-fe"
+scene = "bar2d"
+[fixed]
+T = T_FINAL
+h = 0.1
+dt = 0.01
+[grid]
+method = [
+  { mass = "mod3", scheme = "crank-nicolson" },
+  { mass = "consistent", scheme = "backward-euler" },
+]
+"#,
+        1.0,
+    );
+}
+
+/// The FE engine on bar3d (a 3 × 3 × 21-node box at h = 0.1: the contact face has 9 nodes, so
+/// the LCP has several unknowns and switches), both masses and both schemes.
+#[test]
+fn bar3d_time_loop_allocates_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-3d"
+scene = "bar3d"
+[fixed]
+T = T_FINAL
+h = 0.1
+dt = 0.01
+[grid]
+method = [
+  { mass = "mod3", scheme = "crank-nicolson" },
+  { mass = "consistent", scheme = "crank-nicolson" },
+  { mass = "mod1", scheme = "backward-euler" },
+]
+"#,
+        1.0,
+    );
+}
