@@ -10,8 +10,9 @@
 //!   nested dissection, nnz(L) ≈ c·n·log₂n in 2D and c·n^{4/3} in 3D, with c calibrated on the
 //!   factors measured for the README (2D: 4.92 M entries at n = 83 200 → c = 3.63; 3D: 6.55 M at
 //!   n = 19 440 → c = 12.5); 16 bytes per entry (value and row index). Besides: the step matrix,
-//!   K and M (3^d·d entries per row, 16 bytes each), the condensed contact columns Z = A⁻¹Bᵀ
-//!   (n × n_c dense), and 12 work vectors of n.
+//!   K and M ((2p+1)^d·d entries per row for degree p, 16 bytes each), the condensed contact
+//!   columns Z = A⁻¹Bᵀ (n × n_c dense; the disc and ball: n_c ≈ n^((d−1)/d), a boundary's worth),
+//!   and 12 work vectors of n. The mapped disc/ball meshes are taken with the box's fill.
 //! - series: (steps / series_every + 2) rows of [`SeriesRow`] (the sink's batch keys a run's
 //!   rows by one id).
 //!
@@ -76,20 +77,45 @@ impl RunConfig {
                 (m, m * BAR1D_BYTES_PER_ELEMENT * engines)
             }
             RunConfig::Fe(c) => {
-                let FeGeometry::Box { cells, .. } = &c.setup.geometry;
-                let d = cells.len();
-                let nodes: f64 = cells.iter().map(|&k| k as f64 + 1.0).product();
-                let bottom: f64 = cells[..d - 1].iter().map(|&k| k as f64 + 1.0).product();
-                let n = (nodes - bottom) * d as f64;
+                // (unknowns, dimension, matrix entries per row, contact columns of Z), in f64.
+                let (n, d, per_row, contact) = match &c.setup.geometry {
+                    FeGeometry::Box { cells, .. } => {
+                        let d = cells.len();
+                        let nodes: f64 = cells.iter().map(|&k| k as f64 + 1.0).product();
+                        let bottom: f64 = cells[..d - 1].iter().map(|&k| k as f64 + 1.0).product();
+                        let n = (nodes - bottom) * d as f64;
+                        (n, d, 3f64.powi(d as i32) * d as f64, bottom)
+                    }
+                    FeGeometry::Ball {
+                        dim,
+                        degree,
+                        n_t,
+                        n_r,
+                        ..
+                    } => {
+                        // The node count of FeConfig::unknowns; Γ_C holds about a boundary's
+                        // worth of points, n^((d−1)/d).
+                        let (t, r) = ((n_t * degree) as f64, (n_r * degree) as f64);
+                        let nodes = if *dim == 2 {
+                            (t + 1.0).powi(2) + 4.0 * t * r
+                        } else {
+                            (t + 1.0).powi(3) + r * (6.0 * t * t + 2.0)
+                        };
+                        let n = nodes * *dim as f64;
+                        let per_row = ((2 * degree + 1) as f64).powi(*dim as i32) * *dim as f64;
+                        (n, *dim, per_row, n.powf((*dim as f64 - 1.0) / *dim as f64))
+                    }
+                };
                 let fill = if d == 2 {
                     3.63 * n * n.max(2.0).log2()
                 } else {
                     12.5 * n.powf(4.0 / 3.0)
                 };
-                let per_row = 3f64.powi(d as i32) * d as f64;
                 let matrices = 3.0 * per_row * n * 16.0;
-                let contact = n * bottom * 8.0;
-                (n, fill * 16.0 + matrices + contact + 12.0 * n * 8.0)
+                (
+                    n,
+                    fill * 16.0 + matrices + n * contact * 8.0 + 12.0 * n * 8.0,
+                )
             }
         };
         Estimate {

@@ -9,6 +9,7 @@
 pub mod bar1d;
 pub mod estimate;
 pub mod fe;
+mod fe_nitsche;
 pub mod observe;
 pub mod record;
 pub mod reference;

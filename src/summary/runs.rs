@@ -41,6 +41,7 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("lame_lambda", Kind::F64),
     ("lame_mu", Kind::F64),
     ("gravity", Kind::F64),
+    ("degree", Kind::I64),
     ("T", Kind::F64),
     ("ensemble_sample", Kind::I64),
     ("ensemble_perturbation", Kind::F64),
