@@ -70,9 +70,10 @@ impl FeConfig {
         match &self.setup.geometry {
             FeGeometry::Box { cells, .. } => {
                 let d = cells.len();
-                let nodes: usize = cells.iter().map(|c| c + 1).product();
-                let top: usize = cells[..d - 1].iter().map(|c| c + 1).product();
-                (nodes - top) * d
+                // Saturating: the planner sizes runs before refusing the huge ones.
+                let count = |cs: &[usize]| cs.iter().fold(1usize, |p, c| p.saturating_mul(c + 1));
+                let (nodes, top) = (count(cells), count(&cells[..d - 1]));
+                (nodes - top).saturating_mul(d)
             }
             FeGeometry::Ball {
                 dim,
@@ -781,6 +782,10 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         Ok(g) => g,
         Err(e) => return fail(Status::Invalid, e, metrics),
     };
+    // Checked outside the shared caches: an entry is never left half built.
+    if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
+        return fail(status, msg, metrics);
+    }
     let factor_key = format!(
         "{}|{:?}|{:?}|{:e}",
         geometry_key(&cfg.setup),
@@ -796,6 +801,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.factorizations = i64::from(!hit);
     metrics.factor_cache_hits = Some(i64::from(hit));
     metrics.mass_total = Some(fac.mass_total);
+    if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
+        return fail(status, msg, metrics);
+    }
     let refmap = match ctx.reference.as_ref().map(|r| ref_map(&geo, cfg, r)) {
         Some(Err(e)) => return fail(Status::Invalid, e, metrics),
         Some(Ok(m)) => Some(m),
@@ -934,6 +942,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         (slots, data)
     });
     let mut record = record;
+    if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
+        return fail(status, msg, metrics);
+    }
     metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
     let loop_start = Instant::now();
 
