@@ -189,8 +189,8 @@ method = [
     );
 }
 
-/// The FE engine on the disc under gravity (issue 8): mixed + CN (chatters), Nitsche + CN and
-/// Nitsche + hybrid (semismooth Newton, inactive before the impact at t ≈ 2, active after —
+/// The FE engine on the disc under gravity (issue 8): mixed + CN (chatters; also with the
+/// zero-contact mass), Nitsche + CN, Nitsche + hybrid and penalty + hybrid (semismooth Newton, inactive before the impact at t ≈ 2, active after —
 /// the disc then stays in contact, so one switch is all the short run can show).
 #[test]
 fn disc2d_time_loops_allocate_nothing() {
@@ -209,6 +209,8 @@ method = [
   { space = "mixed", scheme = "crank-nicolson" },
   { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "crank-nicolson" },
   { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" },
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "hybrid" },
+  { space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" },
 ]
 "#,
         15.0,

@@ -14,6 +14,16 @@ const CASES: &[(&str, &str, &str)] = &[
         "must be 1 or 2",
     ),
     (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 4.0\ndt = 0.1\nmass = \"zero-contact\"\nscheme = \"hybrid\"\n",
+        "fixed.scheme",
+        "reduced hybrid of mixed with a massless contact (000 §5) is 1D only",
+    ),
+    (
+        "name = \"x\"\nscene = \"sphere3d\"\n[fixed]\nh = 8.0\ndt = 0.1\nmass = \"singular-dynamic\"\n",
+        "fixed.mass",
+        "defined for the 1D bar only",
+    ),
+    (
         "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.1\ndegree = 2\n",
         "degree",
         "bar2d",

@@ -118,7 +118,12 @@ impl FeConfig {
                 Ok((p.theta * (1.0 - p.theta), p.theta * p.theta, p.theta))
             }
             // The hybrid scheme has its own loop with Crank–Nicolson's step matrix (c = ¼).
-            Scheme::Hybrid if matches!(self.method, ContactMethod::Nitsche { .. }) => {
+            Scheme::Hybrid
+                if matches!(
+                    self.method,
+                    ContactMethod::Nitsche { .. } | ContactMethod::Penalty { .. }
+                ) =>
+            {
                 Ok((0.25, 0.25, 0.5))
             }
             s => Err(format!(
@@ -454,18 +459,69 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
     })
 }
 
+/// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
+/// layer (mod2) and the weight of layer 1 (mod3).
+#[derive(Debug, Clone, Copy)]
+struct Redistribution {
+    mod2: f64,
+    mod3: f64,
+}
+
+impl Redistribution {
+    /// Layers of equal mass m/L (the bars' box: uniform elements, as many per layer):
+    /// mod2 = L/(L−1), mod3 = 2 — the 1D weights of 000 §3.
+    fn equal_layers(layers: usize) -> Redistribution {
+        Redistribution {
+            mod2: layers as f64 / (layers as f64 - 1.0),
+            mod3: 2.0,
+        }
+    }
+
+    /// From the measured masses: total m, layer 0 m₀, layer 1 m₁ (the disc/ball, whose layers
+    /// differ): mod2 = m/(m − m₀), mod3 = 1 + m₀/m₁, so the total mass is conserved.
+    fn measured(total: f64, m0: f64, m1: f64) -> Redistribution {
+        Redistribution {
+            mod2: total / (total - m0),
+            mod3: 1.0 + m0 / m1,
+        }
+    }
+}
+
 /// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (SPEC §2.2).
-fn layer_weight(mass: &MassVariant, layer: usize, layers: usize) -> f64 {
+fn layer_weight(mass: &MassVariant, layer: usize, r: Redistribution) -> f64 {
     match (mass, layer) {
         (
             MassVariant::Mod1 | MassVariant::Mod2 | MassVariant::Mod3 | MassVariant::Weights(_),
             0,
         ) => 0.0,
-        (MassVariant::Mod2, _) => layers as f64 / (layers as f64 - 1.0),
-        (MassVariant::Mod3, 1) => 2.0,
+        (MassVariant::Mod2, _) => r.mod2,
+        (MassVariant::Mod3, 1) => r.mod3,
         (MassVariant::Weights(w), k) => w[(k - 1).min(w.len() - 1)],
         _ => 1.0,
     }
+}
+
+/// 1ᵀM1 over one component of the mass assembled with the element weights `weight` on the full
+/// dof set (clamped nodes included), leaving out the entries `zeroed(i, j)` (dofs).
+fn component_total(
+    mesh: &dyn Mesh,
+    rho: f64,
+    weight: &dyn Fn(usize) -> f64,
+    zeroed: &dyn Fn(usize, usize) -> bool,
+) -> f64 {
+    let d = mesh.dim();
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let full_pattern = fe_pattern(mesh, &all);
+    let full = assemble(mesh, &all, &full_pattern, ElementOp::Mass { rho }, weight);
+    let mut total = 0.0;
+    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
+        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
+            if !zeroed(full_pattern.row_idx[k], j) {
+                total += full.values[k];
+            }
+        }
+    }
+    total
 }
 
 /// The run's mass matrix and 1ᵀM1 (per component: the total mass it represents).
@@ -479,7 +535,19 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     }
     let fm = &g.mesh;
     let mesh = fm.mesh();
-    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), layers);
+    let never = |_: usize, _: usize| false;
+    let redistribution = match fm {
+        FeMesh::Ball(_) if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) => {
+            let layer_mass = |l: usize| {
+                let w = |e: usize| f64::from(u8::from(fm.element_layer(e) == l));
+                component_total(mesh, s.density, &w, &never)
+            };
+            let total = component_total(mesh, s.density, &|_| 1.0, &never);
+            Redistribution::measured(total, layer_mass(0), layer_mass(1))
+        }
+        _ => Redistribution::equal_layers(layers),
+    };
+    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), redistribution);
     let rho = ElementOp::Mass { rho: s.density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
@@ -498,27 +566,31 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     }
     // 1ᵀM1 over one component, clamped nodes included: assembled on the full dof set.
     let d = mesh.dim();
-    let all = DofMap::all(mesh.num_nodes() * d);
-    let full_pattern = fe_pattern(mesh, &all);
-    let full = assemble(mesh, &all, &full_pattern, rho, &weight);
     let bottom_node = |dof: usize| g.contact_node[dof / d];
-    let mut total = 0.0;
-    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
-        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
-            let i = full_pattern.row_idx[k];
-            let zeroed =
-                matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j));
-            if !zeroed {
-                total += full.values[k];
-            }
-        }
-    }
+    let zeroed = |i: usize, j: usize| {
+        matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j))
+    };
+    let total = component_total(mesh, s.density, &weight, &zeroed);
     Ok((m, total))
 }
 
 fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
-    if let ContactMethod::Nitsche { theta, gamma0 } = cfg.method {
-        return factor_nitsche(g, cfg, c_tau2, theta, gamma0);
+    match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => {
+            return factor_nitsche(g, cfg, c_tau2, NitscheOps::new(&g.points, theta, gamma0));
+        }
+        ContactMethod::Penalty { gamma0 } => {
+            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (SPEC §2.4).
+            let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
+            let young = m * (3.0 * l + 2.0 * m) / (l + m);
+            return factor_nitsche(
+                g,
+                cfg,
+                c_tau2,
+                NitscheOps::penalty(&g.points, young, gamma0),
+            );
+        }
+        ContactMethod::Mixed => {}
     }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
@@ -556,24 +628,27 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
 }
 
 /// A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ) factored once, Z = A⁻¹C and W = P Z
-/// ([`super::fe_nitsche`]). Each s_q lives on one element's dofs, so the rank-one updates stay
-/// in the FE pattern.
+/// ([`super::fe_nitsche`]; the penalty is the case Θ = 0 with its own rows). Each s_q lives on
+/// one element's dofs, so the rank-one updates stay in the FE pattern.
 fn factor_nitsche(
     g: &Geometry,
     cfg: &FeConfig,
     c_tau2: f64,
-    theta: f64,
-    gamma0: f64,
+    ops: NitscheOps,
 ) -> Result<Factored, String> {
     if g.points.is_empty() {
         return Err(format!(
-            "space = nitsche is not available for scene {}",
+            "space = {} is not available for scene {}",
+            cfg.method.name(),
             cfg.setup.scene
         ));
     }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let mut a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
-    let ops = NitscheOps::new(&g.points, theta, gamma0);
+    let (theta, gamma0) = match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => (theta, gamma0),
+        _ => (0.0, 0.0),
+    };
     let (k, nq, n) = (ops.k, ops.len(), g.dofs.n_free());
     let red = |gd: usize| {
         g.dofs
@@ -696,17 +771,6 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: Vec::new(),
         reference: None,
     };
-    if matches!(cfg.method, ContactMethod::Penalty { .. }) {
-        return fail(
-            Status::Invalid,
-            format!(
-                "space = {} is not available for scene {}",
-                cfg.method.name(),
-                cfg.setup.scene
-            ),
-            metrics,
-        );
-    }
     let (c1, c, gamma) = match cfg.coefficients() {
         Ok(x) => x,
         Err(e) => return fail(Status::Invalid, e, metrics),
@@ -927,12 +991,13 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
      -> Result<(), Divergence> {
         let e = energy(u, v, mv, ma, lambda, tmp);
         // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
-        let (theta_term, force) = match nit {
+        // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
+        let (e, theta_term, force) = match nit {
             Some(ops) => {
-                let (t, f) = ops.theta_term_and_force(u);
-                (Some(t), f)
+                let (pot, t, f) = ops.energy_terms_and_force(u);
+                (e + pot, t, f)
             }
-            None => (None, lambda.iter().sum()),
+            None => (e, None, lambda.iter().sum()),
         };
         let uc = mean(u);
         if fall != 0.0 && !touched {

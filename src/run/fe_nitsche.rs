@@ -20,6 +20,10 @@
 //! Its step matrix is Crank–Nicolson's (c = ¼), and since P̃ⁿ is known, Φ = ½[P̃ⁿ⁺¹ − k]_+ with
 //! the kink k = −max(P̃ⁿ, 0) (H(0) = ½ gives the same value as P̃ⁿ < 0): the same Newton with
 //! per-step kinks g − max(P̃ⁿ, 0), the factor ½ absorbed by τ²/2·½ = cτ².
+//!
+//! The penalty (SPEC §2.4) is the same operator with P = P_Θγ = u_n (Θ = 0, no σ_n term) and
+//! 1/γ_q = κ_q = E·γ0/h_K: the force φ_q = w_q κ_q [u_n − g_q]_+, its potential
+//! ½Σ w κ [u_n − g]_+² added to E^h ([`NitscheOps::penalty`]).
 
 use crate::space::fe::nitsche::ContactPoint;
 
@@ -41,6 +45,9 @@ pub(crate) struct NitscheOps {
     pub gamma: Vec<f64>,
     pub gap: Vec<f64>,
     pub theta: f64,
+    /// Penalty (SPEC §2.4) instead of Nitsche: P = u_n, 1/γ_q = κ_q, and the penalty
+    /// potential ½Σ w κ [u_n − g]_+² belongs to E^h.
+    pub penalty: bool,
 }
 
 impl NitscheOps {
@@ -57,6 +64,7 @@ impl NitscheOps {
             gamma: Vec::with_capacity(points.len()),
             gap: Vec::with_capacity(points.len()),
             theta,
+            penalty: false,
         };
         for pt in points {
             let g = gamma0 * pt.gamma;
@@ -69,6 +77,21 @@ impl NitscheOps {
             o.w.push(pt.weight);
             o.gamma.push(g);
             o.gap.push(pt.gap);
+        }
+        o
+    }
+
+    /// The penalty of SPEC §2.4 as the same operators: κ_q = E·γ0/h_K with E Young's modulus
+    /// and h_K the point's element diameter (the h of Nitsche's γ_h = γ0·h_K), and P_q = t_q =
+    /// u_n, Θ = 0 — Nitsche's rows with γ = 0 — so φ_q(s) = w_q κ_q [s − g_q]_+ is the penalty
+    /// force and the Newton, the step matrix and the hybrid kinks are unchanged.
+    pub fn penalty(points: &[ContactPoint], young: f64, gamma0: f64) -> NitscheOps {
+        // γ = 0 in the rows: p = u_n, c = −u_n exactly.
+        let mut o = NitscheOps::new(points, 0.0, 0.0);
+        o.penalty = true;
+        for (g, pt) in o.gamma.iter_mut().zip(points) {
+            // 1/κ_q stored as γ_q (h_K is the points' γ with γ0 = 1).
+            *g = pt.gamma / (young * gamma0);
         }
         o
     }
@@ -90,18 +113,25 @@ impl NitscheOps {
             .sum()
     }
 
-    /// E_Θ − E^h = −(Θ/2)(Σ w γ σ_n² − Σ (w/γ)[P_γ − g]_+²) at u (SPEC §2.3), and the total
-    /// contact force Σ φ_q(P_γ,q(u)).
-    pub fn theta_term_and_force(&self, u: &[f64]) -> (f64, f64) {
+    /// The contact terms of the energies at u and the total contact force Σ φ_q(P_q(u)):
+    /// Nitsche: (0, E_Θ − E^h = −(Θ/2)(Σ w γ σ_n² − Σ (w/γ)[P_γ − g]_+²), force) (SPEC §2.3);
+    /// penalty: (½ Σ w κ [u_n − g]_+², the part of E^h, no E_Θ, force) (SPEC §2.4).
+    pub fn energy_terms_and_force(&self, u: &[f64]) -> (f64, Option<f64>, f64) {
         let (mut a, mut b, mut f) = (0.0, 0.0, 0.0);
         for q in 0..self.len() {
-            let sn = self.apply(&self.s, q, u);
+            if !self.penalty {
+                let sn = self.apply(&self.s, q, u);
+                a += self.w[q] * self.gamma[q] * sn * sn;
+            }
             let pg = (self.apply(&self.p, q, u) - self.gap[q]).max(0.0);
-            a += self.w[q] * self.gamma[q] * sn * sn;
             b += self.w[q] / self.gamma[q] * pg * pg;
             f += self.w[q] / self.gamma[q] * pg;
         }
-        (-0.5 * self.theta * (a - b), f)
+        if self.penalty {
+            (0.5 * b, None, f)
+        } else {
+            (0.0, Some(-0.5 * self.theta * (a - b)), f)
+        }
     }
 }
 
@@ -281,6 +311,7 @@ mod tests {
             gamma: vec![1.0],
             gap: vec![1.0],
             theta: 1.0,
+            penalty: false,
         };
         let mut work = NewtonWork::new(1);
         let mut phi = [0.0];

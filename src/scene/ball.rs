@@ -13,9 +13,21 @@
 //! reaching the plane in free fall (E⁰ = 0 here). There is no closed form and no reference
 //! run yet: the runs report energies and contact observables, not errors.
 //!
-//! Implemented so far (issue 8, in stages): `mixed` and `nitsche` contact with the consistent or
-//! lumped mass and the Newmark / θ schemes, and the hybrid scheme with `nitsche`. Penalty and
-//! the massless-contact masses are refused with that reason until they exist.
+//! Implemented so far (issue 8, in stages): `mixed`, `nitsche` and `penalty` (κ = E·γ0/h_K)
+//! contact with every mass variant of SPEC §2.2 but the 1D-only two (`singular-dynamic`,
+//! `node-neighbour`), the Newmark / θ schemes, and the hybrid scheme with `nitsche` or
+//! `penalty` (000 §5's reduced hybrid of `mixed` with a massless contact is 1D only).
+//!
+//! Mass variants on the disc/ball: layer 0 = the elements with a node on Γ_C, layer k + 1 their
+//! neighbours (by shared nodes); the layers' masses differ, so `mod2` scales every other
+//! element by m/(m − m₀) and `mod3` gives layer 1 the weight 1 + m₀/m₁ (total mass conserved);
+//! `zero-contact` zeroes the rows and columns of every dof of the Γ_C nodes (003 §4.1.2d, the
+//! paper's "modified mass"). Gravity is F = M_run·f e_d, the load of the run's own mass: the
+//! rigid fall u = ½ f t² e_d then solves M ü + K u = F for every variant (K·rigid = 0, and
+//! the massless rows read 0 = 0), so the free fall stays exact and E⁰ = 0; with `mod1` the
+//! removed mass carries no weight either (m = 1ᵀM1 is the run's `mass_total`). The massless
+//! nodes start at rest at u = 0, which is their quasi-static state (no contact at t = 0), so
+//! `contact_init` changes nothing here.
 
 use super::{ErrorSource, FeGeometry, FeSetup, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 use crate::space::fe::BallMesh;
@@ -92,29 +104,31 @@ impl Scene for BallScene {
         mass: &str,
         scheme: &str,
     ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "nitsche") {
+        if !matches!(space, "mixed" | "nitsche" | "penalty") {
             return Err((
                 "space",
                 format!(
-                    "space = {space} is not implemented for scene {} yet (issue 8 in progress: mixed and nitsche)",
+                    "space = {space} is not implemented for scene {} (mixed, nitsche, penalty)",
                     self.name()
                 ),
             ));
         }
-        if !matches!(mass, "consistent" | "lumped") {
+        if matches!(mass, "singular-dynamic" | "node-neighbour") {
             return Err((
                 "mass",
                 format!(
-                    "mass = {mass} is not implemented for scene {} yet (issue 8 in progress: consistent and lumped)",
+                    "mass = {mass} is defined for the 1D bar only (SPEC §2.2); scene {} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact",
                     self.name()
                 ),
             ));
         }
-        if !(matches!(scheme, "newmark" | "theta") || (scheme == "hybrid" && space == "nitsche")) {
+        if !(matches!(scheme, "newmark" | "theta")
+            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
+        {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes; hybrid with nitsche)",
+                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
                     self.name()
                 ),
             ));
@@ -167,8 +181,12 @@ mod tests {
         assert!(s.mesh_from_h(&physics(), 0.0).is_err());
         // P-wave speed √((λ+2μ)/ρ) = √60.
         assert!((s.wave_speed(&physics()) - 60f64.sqrt()).abs() < 1e-14);
-        assert!(s.supports("penalty", "consistent", "newmark").is_err());
-        assert!(s.supports("nitsche", "mod1", "newmark").is_err());
+        assert!(s.supports("penalty", "consistent", "hybrid").is_ok());
+        assert!(s.supports("mixed", "consistent", "hybrid").is_err());
+        assert!(s.supports("nitsche", "mod1", "newmark").is_ok());
+        assert!(s.supports("mixed", "zero-contact", "newmark").is_ok());
+        assert!(s.supports("mixed", "zero-contact", "hybrid").is_err());
+        assert!(s.supports("mixed", "singular-dynamic", "newmark").is_err());
         assert!(s.supports("mixed", "lumped", "theta").is_ok());
     }
 }
