@@ -49,7 +49,9 @@ fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
 /// The step matrix A = M + τ²/4 K of `config` (mod3 mass), assembled outside the engine, and
 /// the engine's choice of ordering and factor kind for it.
 fn step_matrix(cfg: &FeConfig) -> (SymMatrix, usize, CholeskyOptions) {
-    let contact_sweep::scene::FeGeometry::Box { extent, cells } = &cfg.setup.geometry;
+    let contact_sweep::scene::FeGeometry::Box { extent, cells } = &cfg.setup.geometry else {
+        panic!("the bench runs the bars");
+    };
     let mesh = BoxMesh::new(extent, cells);
     let d = mesh.dim;
     let dofs = DofMap::new(mesh.num_nodes() * d, |g| {

@@ -15,9 +15,10 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::exec::shard::ShardSpec;
 use crate::exec::{self, ExecOptions};
-use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS};
-use crate::sink::{BatchPolicy, Manifest, Sink, SinkError};
+use crate::run::{RunOptions, RunRecord, SERIES_COLUMNS, estimate};
+use crate::sink::{BatchPolicy, Manifest, ManifestState, Sink, SinkError};
 use crate::summary;
 use crate::sweep::{self, Plan, SweepError, SweepFile};
 
@@ -39,7 +40,12 @@ pub enum Command {
     #[command(
         after_help = "Examples:\n  contact-sweep plan sweeps/quickstart.toml\n  contact-sweep plan sweeps/quickstart.toml --set h=[0.1,0.05]   # h becomes an axis\n  contact-sweep plan --scene bar1d --set space=nitsche --set nitsche_gamma0=1e-6"
     )]
-    Plan(SweepArgs),
+    Plan {
+        #[command(flatten)]
+        source: SweepArgs,
+        #[command(flatten)]
+        limits: LimitArgs,
+    },
     /// Run a sweep: every run in parallel, results as Parquet under --out.
     #[command(
         after_help = "Examples:\n  contact-sweep run sweeps/quickstart.toml                       # → out/quickstart/\n  contact-sweep run sweeps/quickstart.toml --table runs           # every run, not one line per group\n  contact-sweep run sweeps/quickstart.toml --set T=3 --out out/qs-T3\n  contact-sweep run sweeps/quickstart.toml --set grid.h=[0.1,0.05]\n  contact-sweep run --scene bar1d --set h=0.01 --set courant=[0.5,1] --set scheme=hybrid\n  contact-sweep run sweeps/003_fig10_ladder.toml --threads 2 --shard 0/4   # one of four shards"
@@ -72,6 +78,18 @@ pub enum Command {
     /// Print the output schema (runs and series columns) as Markdown.
     #[command(after_help = "Examples:\n  contact-sweep schema\n  contact-sweep schema > schema.md")]
     Schema,
+    /// What a results folder holds: done, failed and missing runs per shard, damaged files,
+    /// sessions, and the command that completes only what is missing.
+    #[command(
+        after_help = "Examples:\n  contact-sweep status out/quickstart\n  contact-sweep status out/003-fig10 --sweep sweeps/003_fig10_ladder.toml"
+    )]
+    Status {
+        /// A folder written by `run` (or a Slurm array).
+        dir: PathBuf,
+        /// The sweep file (default: the one the folder's manifest records).
+        #[arg(long)]
+        sweep: Option<PathBuf>,
+    },
     /// Write (and with --submit, submit) a Slurm job array running the sweep in shards.
     #[command(
         after_help = "Examples:\n  contact-sweep slurm sweeps/003_fig10_ladder.toml --tasks 8            # writes the scripts, prints the sbatch commands\n  contact-sweep slurm sweeps/000_table1_bar2d.toml --tasks 4 --time 01:00:00 --submit"
@@ -79,13 +97,66 @@ pub enum Command {
     Slurm(SlurmArgs),
 }
 
+/// What the planner refuses before anything runs (shared by plan, run and slurm).
+#[derive(Debug, Args, Clone)]
+pub struct LimitArgs {
+    /// Refuse plans with more combinations than this (counted from the file before expanding).
+    #[arg(long, value_name = "N", default_value_t = sweep::plan::DEFAULT_MAX_RUNS)]
+    pub max_runs: u64,
+    /// Refuse runs whose estimated memory exceeds this (e.g. 4G, 512M; default: half of the
+    /// available memory, /proc/meminfo's MemAvailable).
+    #[arg(long, value_name = "SIZE")]
+    pub max_run_memory: Option<String>,
+}
+
+impl LimitArgs {
+    /// The planner's limits, for runs keeping every `series_every`-th step (None: the sweep's).
+    fn limits(&self, series_every: Option<usize>) -> Result<sweep::PlanLimits> {
+        let max_run_bytes = match &self.max_run_memory {
+            Some(text) => Some(estimate::parse_bytes(text).ok_or_else(|| {
+                UsageError(format!(
+                    "--max-run-memory must be a size such as 4G or 512M, got `{text}`"
+                ))
+            })?),
+            None => estimate::available_memory().map(|b| 0.5 * b),
+        };
+        if self.max_runs == 0 {
+            return Err(UsageError("--max-runs must be at least 1".into()).into());
+        }
+        Ok(sweep::PlanLimits {
+            max_runs: self.max_runs,
+            max_run_bytes,
+            series_every,
+            max_plan_bytes: estimate::available_memory().map(|b| 0.5 * b),
+        })
+    }
+}
+
 #[derive(Debug, Args)]
 pub struct SlurmArgs {
     /// The sweep file.
     pub sweep: PathBuf,
-    /// Number of array tasks (shards).
-    #[arg(long)]
-    pub tasks: usize,
+    /// Number of array tasks.
+    #[arg(long, conflicts_with_all = ["runs_per_task", "only_shards"])]
+    pub tasks: Option<usize>,
+    /// Size the array by runs instead: ⌈runs / R⌉ tasks.
+    #[arg(long, value_name = "R", conflicts_with = "only_shards")]
+    pub runs_per_task: Option<usize>,
+    /// Shards per task: the plan is cut into tasks × G shards of equal estimated work, task K
+    /// running shards K·G … K·G+G−1 (finer shards: a resubmission redoes less).
+    #[arg(long, value_name = "G", default_value_t = 1)]
+    pub shards_per_task: usize,
+    /// Submit only these shards of N (what `status DIR` prints to complete a folder), e.g.
+    /// `3,7-9/16`; each task takes --shards-per-task of them.
+    #[arg(long, value_name = "LIST/N")]
+    pub only_shards: Option<String>,
+    /// At most P tasks of each array at once (the array's %P throttle).
+    #[arg(long, value_name = "P")]
+    pub max_parallel: Option<usize>,
+    /// Split arrays at this many tasks (default: the cluster's MaxArraySize from `scontrol
+    /// show config`, 1001 if it does not answer).
+    #[arg(long, value_name = "M")]
+    pub max_array_size: Option<usize>,
     /// Output folder shared by all tasks (default: out/<sweep name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -98,9 +169,11 @@ pub struct SlurmArgs {
     /// Partition.
     #[arg(long)]
     pub partition: Option<String>,
-    /// Submit with sbatch (the summary job depends on the array).
+    /// Submit with sbatch (the summary job depends on the arrays).
     #[arg(long)]
     pub submit: bool,
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// Where a sweep comes from: a file, or `--scene` alone, with `--set` on top.
@@ -160,8 +233,9 @@ pub struct RunArgs {
     /// Do not write the summary tables at the end.
     #[arg(long)]
     pub no_summary: bool,
-    /// Run only shard K of N (runs whose plan index is K mod N), e.g. `--shard
-    /// $SLURM_ARRAY_TASK_ID/8` in a job array; all shards may write into one --out folder.
+    /// Run only shard K of N (the plan cut into N shards of equal estimated work), e.g.
+    /// `--shard $SLURM_ARRAY_TASK_ID/8` in a job array; several: `0-3/16`, `1,5/16`. All shards
+    /// may write into one --out folder.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<String>,
     /// Compute the sweep's reference runs into DIR/references and stop (the first job of a
@@ -172,6 +246,8 @@ pub struct RunArgs {
     /// group with its rates), `auto` (groups when the sweep has more than 30 runs).
     #[arg(long, value_enum, default_value_t = TableMode::Auto, value_name = "MODE")]
     pub table: TableMode,
+    #[command(flatten)]
+    pub limits: LimitArgs,
 }
 
 /// What the result table at the end of `run` shows.
@@ -205,6 +281,12 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         if let Some(SinkError::ForeignSweep { .. }) = cause.downcast_ref::<SinkError>() {
             return 2;
         }
+        if let Some(
+            exec::status::StatusError::Sweep(_) | exec::status::StatusError::NoSweep { .. },
+        ) = cause.downcast_ref::<exec::status::StatusError>()
+        {
+            return 2;
+        }
     }
     1
 }
@@ -216,7 +298,7 @@ static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 /// Validated `run` arguments.
 struct RunConfig {
     plan: Plan,
-    shard: Option<(usize, usize)>,
+    shard: Option<ShardSpec>,
     out: PathBuf,
     exec: ExecOptions,
     resume: bool,
@@ -229,7 +311,10 @@ struct RunConfig {
 impl RunArgs {
     fn validate(self) -> Result<RunConfig> {
         let sweep = self.source.load()?;
-        let plan = sweep::expand(&sweep)?;
+        let limits = self
+            .limits
+            .limits(Some(self.series_every.unwrap_or(sweep.series_every)))?;
+        let plan = sweep::expand_with(&sweep, &limits)?;
         if let Some(t) = self.run_timeout
             && !(t.is_finite() && t > 0.0)
         {
@@ -243,23 +328,7 @@ impl RunArgs {
         }
         let shard = match &self.shard {
             None => None,
-            Some(s) => {
-                let parsed = s.split_once('/').and_then(|(k, n)| {
-                    Some((
-                        k.trim().parse::<usize>().ok()?,
-                        n.trim().parse::<usize>().ok()?,
-                    ))
-                });
-                match parsed {
-                    Some((k, n)) if n > 0 && k < n => Some((k, n)),
-                    _ => {
-                        return Err(UsageError(format!(
-                            "--shard must be K/N with 0 ≤ K < N (e.g. 0/4), got `{s}`"
-                        ))
-                        .into());
-                    }
-                }
-            }
+            Some(s) => Some(ShardSpec::parse(s).map_err(UsageError)?),
         };
         let out = self
             .out
@@ -292,9 +361,9 @@ impl RunArgs {
 /// Run a subcommand.
 pub fn main(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Plan(source) => {
+        Command::Plan { source, limits } => {
             let sf = source.load()?;
-            let plan = sweep::expand(&sf)?;
+            let plan = sweep::expand_with(&sf, &limits.limits(None)?)?;
             print!("{}", plan.summary());
             println!();
             print!("{}", plan.table());
@@ -308,6 +377,9 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
         Command::Summarize { dir, errors } => {
             let opts = summarize_options(&dir, errors.as_deref())?;
             let s = summary::summarize_with(&dir, &opts)?;
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
             print!("{}", s.terminal);
             Ok(ExitCode::SUCCESS)
         }
@@ -329,6 +401,14 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Command::Slurm(args) => slurm(args),
+        Command::Status { dir, sweep } => {
+            if !dir.is_dir() {
+                return Err(UsageError(format!("{}: no such folder", dir.display())).into());
+            }
+            let st = exec::status::status(&dir, sweep.as_deref())?;
+            print!("{st}");
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 
@@ -353,8 +433,31 @@ fn summarize_options(dir: &Path, errors: Option<&[String]>) -> Result<summary::S
 fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     let plan = &cfg.plan;
     let dir = &cfg.out;
+    let had_results = dir.join("runs").is_dir();
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    if let Some(found) = Manifest::existing_sweep(dir)?
+    let found = match Manifest::inspect(dir)? {
+        ManifestState::Sweep(found) => found,
+        ManifestState::Missing => {
+            if had_results {
+                eprintln!(
+                    "warning: {} has no manifest.json: rebuilt from {}",
+                    dir.display(),
+                    plan.sweep.path.display()
+                );
+            }
+            None
+        }
+        ManifestState::MovedAside { to, reason } => {
+            eprintln!(
+                "warning: {} is damaged ({reason}): moved aside to {}, rebuilt from {}",
+                dir.join("manifest.json").display(),
+                to.display(),
+                plan.sweep.path.display()
+            );
+            None
+        }
+    };
+    if let Some(found) = found
         && found != plan.sweep.name
         && !cfg.resume
     {
@@ -376,15 +479,22 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let (mut sink, done) = Sink::open(dir, cfg.batch)?;
-    // Round-robin shards: neighbouring plan entries (levels of one ladder) have similar costs,
-    // so every shard gets a share of the expensive ones.
-    let mine: Vec<&sweep::RunSpec> = plan
-        .runs
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| cfg.shard.is_none_or(|(k, n)| i % n == k))
-        .map(|(_, r)| r)
-        .collect();
+    for d in &sink.damaged {
+        eprintln!("warning: {}", d.warning());
+    }
+    // Shards balanced by estimated work (exec::shard): every task computes the same split.
+    let mine: Vec<&sweep::RunSpec> = match &cfg.shard {
+        None => plan.runs.iter().collect(),
+        Some(spec) => {
+            let of = exec::shard::assign(&plan.runs, spec.of);
+            plan.runs
+                .iter()
+                .zip(of)
+                .filter(|(_, s)| spec.contains(*s))
+                .map(|(r, _)| r)
+                .collect()
+        }
+    };
     let todo: Vec<&sweep::RunSpec> = mine
         .iter()
         .copied()
@@ -404,11 +514,18 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     } else {
         cfg.exec.threads
     };
-    let mut manifest = Manifest::begin(dir, plan, mine.len(), skipped, threads, cfg.shard)?;
+    let mut manifest = Manifest::begin(
+        dir,
+        plan,
+        mine.len(),
+        skipped,
+        threads,
+        cfg.shard.as_ref().map(|s| s.to_string()),
+    )?;
     eprint!("{}", plan.summary());
-    if let Some((k, n)) = cfg.shard {
+    if let Some(spec) = &cfg.shard {
         eprintln!(
-            "shard {k}/{n}: {} of the {} runs",
+            "shard {spec}: {} of the {} runs",
             mine.len(),
             plan.runs.len()
         );
@@ -571,12 +688,56 @@ fn cost_line(stats: &crate::sink::SinkStats, wall_s: f64) -> String {
 }
 
 fn slurm(args: SlurmArgs) -> Result<ExitCode> {
-    use crate::exec::slurm::{SlurmOptions, submit, write_scripts};
-    if args.tasks == 0 || args.cpus_per_task == 0 {
-        return Err(UsageError("--tasks and --cpus-per-task must be at least 1".into()).into());
+    use crate::exec::slurm::{SlurmOptions, commands, max_array_size, submit, write_scripts};
+    let positive = |v: Option<usize>, flag: &str| -> Result<()> {
+        if v == Some(0) {
+            return Err(UsageError(format!("{flag} must be at least 1")).into());
+        }
+        Ok(())
+    };
+    positive(args.tasks, "--tasks")?;
+    positive(args.runs_per_task, "--runs-per-task")?;
+    positive(Some(args.shards_per_task), "--shards-per-task")?;
+    positive(Some(args.cpus_per_task), "--cpus-per-task")?;
+    positive(args.max_parallel, "--max-parallel")?;
+    positive(args.max_array_size, "--max-array-size")?;
+    let only = match &args.only_shards {
+        Some(text) => Some(
+            ShardSpec::parse(text)
+                .map_err(|e| UsageError(e.replace("--shard", "--only-shards")))?,
+        ),
+        None => None,
+    };
+    if only.is_none() && args.tasks.is_none() && args.runs_per_task.is_none() {
+        return Err(UsageError(
+            "give --tasks N or --runs-per-task R (or --only-shards LIST/N, as `status` prints)"
+                .into(),
+        )
+        .into());
     }
     let sf = SweepFile::load(&args.sweep)?;
-    let plan = sweep::expand(&sf)?;
+    let plan = sweep::expand_with(&sf, &args.limits.limits(None)?)?;
+    let g = args.shards_per_task;
+    let (shards, list): (usize, Vec<usize>) = match &only {
+        Some(spec) => (spec.of, spec.shards.clone()),
+        None => {
+            let tasks = args
+                .tasks
+                .unwrap_or_else(|| plan.runs.len().div_ceil(args.runs_per_task.unwrap_or(1)));
+            let n = tasks.saturating_mul(g);
+            (n, (0..n).collect())
+        }
+    };
+    let tasks: Vec<String> = list
+        .chunks(g)
+        .map(|c| {
+            ShardSpec {
+                shards: c.to_vec(),
+                of: shards,
+            }
+            .to_string()
+        })
+        .collect();
     let out = args
         .out
         .unwrap_or_else(|| Path::new("out").join(&plan.sweep.name));
@@ -585,6 +746,7 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
         .canonicalize()
         .with_context(|| format!("{}", out.display()))?;
     let exe = std::env::current_exe().context("locating the contact-sweep binary")?;
+    let max_array = args.max_array_size.or_else(max_array_size).unwrap_or(1001);
     let scripts = write_scripts(
         &exe,
         &plan.sweep.name,
@@ -592,37 +754,50 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
         !plan.references.is_empty(),
         &out,
         &SlurmOptions {
-            tasks: args.tasks,
+            tasks: tasks.clone(),
+            max_parallel: args.max_parallel,
+            max_array_size: max_array,
             cpus_per_task: args.cpus_per_task,
             time: args.time,
             partition: args.partition,
         },
     )?;
     eprint!("{}", plan.summary());
+    let assignment = exec::shard::assign(&plan.runs, shards);
+    let loads = exec::shard::loads(&plan.runs, &assignment, shards);
+    let chosen: Vec<u64> = list.iter().map(|&k| loads[k]).collect();
     eprintln!(
-        "{} runs in {} array tasks ({} to {} runs each)",
+        "{} of the {} runs in {} of {shards} shards (balanced by estimated work: {:.2e} to {:.2e} steps × unknowns each), {} array task(s) of {g} shard(s), {} array(s) of at most {max_array} (MaxArraySize){}",
+        list.iter()
+            .map(|&k| assignment.iter().filter(|&&s| s == k).count())
+            .sum::<usize>(),
         plan.runs.len(),
-        args.tasks,
-        plan.runs.len() / args.tasks,
-        plan.runs.len().div_ceil(args.tasks)
+        list.len(),
+        chosen.iter().min().copied().unwrap_or(0) as f64,
+        chosen.iter().max().copied().unwrap_or(0) as f64,
+        tasks.len(),
+        scripts.arrays.len(),
+        args.max_parallel
+            .map(|p| format!(", at most {p} at once"))
+            .unwrap_or_default()
     );
     if args.submit {
-        let (references, array, summary) = submit(&scripts)?;
-        if let Some(r) = references {
-            println!("submitted reference job {r}; the array depends on it (afterok:{r})");
+        let ids = submit(&scripts)?;
+        if let Some(r) = &ids.references {
+            println!("submitted reference job {r}; the arrays depend on it (afterok:{r})");
         }
-        println!("submitted array job {array} and summary job {summary} (afterok:{array})");
-        println!("results: {}", out.display());
-    } else {
-        if let Some(r) = &scripts.references {
-            println!("sbatch {}", r.display());
-            println!("(then the array with --dependency=afterok:<reference job id>)");
-        }
-        println!("sbatch {}", scripts.array.display());
         println!(
-            "sbatch --dependency=afterok:<array job id> {}",
-            scripts.summarize.display()
+            "submitted array job {} and summary job {} (afterok:{})",
+            ids.arrays.join(", "),
+            ids.summary,
+            ids.arrays.join(":")
         );
+        println!("results: {}", out.display());
+        println!("progress: contact-sweep status {}", out.display());
+    } else {
+        for c in commands(&scripts) {
+            println!("{c}");
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

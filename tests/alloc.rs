@@ -63,6 +63,12 @@ fn plan(text: &str, t_final: f64) -> sweep::Plan {
 
 /// For every run of the sweep: allocations of the run with T and with 2T must be equal.
 fn assert_loop_allocates_nothing(text: &str, t_final: f64) {
+    assert_loop_allocates_nothing_with(text, t_final, 2);
+}
+
+/// As [`assert_loop_allocates_nothing`], with the number of contact switches the short run
+/// must show (1: it enters contact and stays — the disc under gravity).
+fn assert_loop_allocates_nothing_with(text: &str, t_final: f64, min_switches: i64) {
     let (short, long) = (plan(text, t_final), plan(text, 2.0 * t_final));
     assert_eq!(short.runs.len(), long.runs.len());
     assert!(!short.runs.is_empty());
@@ -87,7 +93,7 @@ fn assert_loop_allocates_nothing(text: &str, t_final: f64) {
         // The contact solve must have run in both states: the short run already switches
         // between contact and release, so its loop took every branch the long one takes.
         assert!(
-            out.metrics.contact_switches >= 2,
+            out.metrics.contact_switches >= min_switches,
             "{}: {} contact switches — the loop never left or entered contact",
             a.label,
             out.metrics.contact_switches
@@ -180,5 +186,34 @@ method = [
 ]
 "#,
         1.0,
+    );
+}
+
+/// The FE engine on the disc under gravity (issue 8): mixed + CN (chatters; also with the
+/// zero-contact mass), Nitsche + CN, Nitsche + hybrid and penalty + hybrid (semismooth Newton, inactive before the impact at t ≈ 2, active after —
+/// the disc then stays in contact, so one switch is all the short run can show).
+#[test]
+fn disc2d_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing_with(
+        r#"
+name = "alloc-disc"
+scene = "disc2d"
+[fixed]
+T = T_FINAL
+h = 8.0
+dt = 0.1
+gap = 0.05
+degree = 1
+[grid]
+method = [
+  { space = "mixed", scheme = "crank-nicolson" },
+  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "crank-nicolson" },
+  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" },
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "hybrid" },
+  { space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" },
+]
+"#,
+        15.0,
+        1,
     );
 }

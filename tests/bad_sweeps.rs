@@ -9,6 +9,26 @@ use common::{cli, write};
 /// (file body, key the message must name, a phrase of the reason)
 const CASES: &[(&str, &str, &str)] = &[
     (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 4.0\ndt = 0.1\n[grid]\ndegree = [2, 3]\n",
+        "grid.degree[1]",
+        "must be 1 or 2",
+    ),
+    (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 4.0\ndt = 0.1\nmass = \"zero-contact\"\nscheme = \"hybrid\"\n",
+        "fixed.scheme",
+        "reduced hybrid of mixed with a massless contact (000 §5) is 1D only",
+    ),
+    (
+        "name = \"x\"\nscene = \"sphere3d\"\n[fixed]\nh = 8.0\ndt = 0.1\nmass = \"singular-dynamic\"\n",
+        "fixed.mass",
+        "defined for the 1D bar only",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.1\ndegree = 2\n",
+        "degree",
+        "bar2d",
+    ),
+    (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"mod3\"\n[grid]\ncontact_init = [\"consistent\", \"exact\"]\n",
         "grid.contact_init[1]",
         "unknown contact_init `exact` (expected consistent or interpolant",

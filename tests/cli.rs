@@ -537,7 +537,15 @@ fn table_flag_chooses_runs_or_groups() {
 
 #[test]
 fn every_subcommand_help_ends_with_examples() {
-    for sub in ["plan", "run", "summarize", "schema", "slurm", "report"] {
+    for sub in [
+        "plan",
+        "run",
+        "summarize",
+        "schema",
+        "slurm",
+        "report",
+        "status",
+    ] {
         let o = cli(repo(), &[sub, "--help"]);
         assert!(o.status.success(), "{sub}");
         let help = String::from_utf8_lossy(&o.stdout);

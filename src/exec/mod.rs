@@ -6,7 +6,9 @@
 //! 1-thread and N-thread outputs are identical except the timing columns (tested).
 
 pub mod references;
+pub mod shard;
 pub mod slurm;
+pub mod status;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, Ordering};

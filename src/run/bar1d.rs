@@ -533,6 +533,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Err(e) => return fail(Status::Invalid, e.to_string(), metrics),
     };
     metrics.mass_total = Some(sp.mass_total);
+    if let Some((status, msg)) = opts.setup_stop(start, "the operators") {
+        return fail(status, msg, metrics);
+    }
     let tau = cfg.dt;
     let (eng, starter) = match cfg.scheme {
         Scheme::PaoliSchatzman(ps) => {
@@ -554,6 +557,9 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         },
     };
     metrics.factorizations = eng.factorizations + starter.as_ref().map_or(0, |s| s.factorizations);
+    if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
+        return fail(status, msg, metrics);
+    }
     let m = sp.m;
     let mut wk = Work {
         b: vec![0.0; m],

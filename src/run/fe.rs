@@ -28,12 +28,16 @@
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
+use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
-use crate::contact::{Lcp, LcpError};
+use crate::contact::Lcp;
 use crate::scene::{FeGeometry, FeSetup};
-use crate::space::fe::{BoxMesh, DofMap, ElementOp, Pattern, SymMatrix, assemble, fe_pattern};
+use crate::space::fe::nitsche::{ContactPoint, contact_points};
+use crate::space::fe::{
+    BallMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+};
 use crate::space::linalg::{
     Cholesky, CholeskyOptions, FactorKind, Ordering, SolveWork, SymbolicCholesky,
 };
@@ -66,9 +70,27 @@ impl FeConfig {
         match &self.setup.geometry {
             FeGeometry::Box { cells, .. } => {
                 let d = cells.len();
-                let nodes: usize = cells.iter().map(|c| c + 1).product();
-                let top: usize = cells[..d - 1].iter().map(|c| c + 1).product();
-                (nodes - top) * d
+                // Saturating: the planner sizes runs before refusing the huge ones.
+                let count = |cs: &[usize]| cs.iter().fold(1usize, |p, c| p.saturating_mul(c + 1));
+                let (nodes, top) = (count(cells), count(&cells[..d - 1]));
+                (nodes - top).saturating_mul(d)
+            }
+            FeGeometry::Ball {
+                dim,
+                degree,
+                n_t,
+                n_r,
+                ..
+            } => {
+                // The central block's lattice, then n_r·p shells of the outer blocks: a shell is
+                // a square's perimeter (2D) or a cubed sphere's surface lattice (3D).
+                let (t, r) = (n_t * degree, n_r * degree);
+                let nodes = if *dim == 2 {
+                    (t + 1).pow(2) + 4 * t * r
+                } else {
+                    (t + 1).pow(3) + r * (6 * t * t + 2)
+                };
+                nodes * dim
             }
         }
     }
@@ -95,6 +117,15 @@ impl FeConfig {
             Scheme::Theta(p) if p.theta > 0.0 => {
                 Ok((p.theta * (1.0 - p.theta), p.theta * p.theta, p.theta))
             }
+            // The hybrid scheme has its own loop with Crank–Nicolson's step matrix (c = ¼).
+            Scheme::Hybrid
+                if matches!(
+                    self.method,
+                    ContactMethod::Nitsche { .. } | ContactMethod::Penalty { .. }
+                ) =>
+            {
+                Ok((0.25, 0.25, 0.5))
+            }
             s => Err(format!(
                 "scheme {} is not available for scene {}",
                 s.label(),
@@ -104,10 +135,49 @@ impl FeConfig {
     }
 }
 
+/// The mesh of a geometry: the bars' box or the mapped disc/ball.
+#[derive(Debug)]
+enum FeMesh {
+    Box(BoxMesh),
+    Ball(BallMesh),
+}
+
+impl FeMesh {
+    fn mesh(&self) -> &dyn Mesh {
+        match self {
+            FeMesh::Box(m) => m,
+            FeMesh::Ball(m) => m,
+        }
+    }
+    fn dim(&self) -> usize {
+        self.mesh().dim()
+    }
+    /// Mass layer of element e (SPEC §2.2; layer 0 touches Γ_C).
+    fn element_layer(&self, e: usize) -> usize {
+        match self {
+            FeMesh::Box(m) => m.element_layer(e),
+            FeMesh::Ball(m) => m.layers[e],
+        }
+    }
+    fn num_layers(&self) -> usize {
+        match self {
+            FeMesh::Box(m) => m.num_layers(),
+            FeMesh::Ball(m) => m.layers.iter().max().map_or(0, |l| l + 1),
+        }
+    }
+    /// The bars' box (reference lattices are defined on it only).
+    fn as_box(&self) -> Option<&BoxMesh> {
+        match self {
+            FeMesh::Box(m) => Some(m),
+            FeMesh::Ball(_) => None,
+        }
+    }
+}
+
 /// The operators of one geometry and material, shared by every run on it.
 #[derive(Debug)]
 struct Geometry {
-    mesh: BoxMesh,
+    mesh: FeMesh,
     dofs: DofMap,
     pattern: Arc<Pattern>,
     symbolic: Arc<SymbolicCholesky>,
@@ -117,6 +187,15 @@ struct Geometry {
     grad: SymMatrix,
     /// Reduced index of the vertical dof of each Γ_C node, and the node.
     contact: Vec<usize>,
+    /// Height x_d of each Γ_C node in the reference configuration, measured from the bottom
+    /// face (box: 0, the run's `gap` is added) or from the rigid plane (ball: the gap is in it).
+    contact_height: Vec<f64>,
+    /// Whether the gap is already in `contact_height` (ball) or is the run's `gap` (box).
+    gap_in_geometry: bool,
+    /// Whether each node is on Γ_C (all nodes, clamped ones included).
+    contact_node: Vec<bool>,
+    /// Nitsche's quadrature points of Γ_C with γ0 = 1 (their `gamma` is h_K); ball only.
+    points: Vec<ContactPoint>,
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     contact_weight: Vec<f64>,
     /// Reduced dofs that belong to a Γ_C node (all components).
@@ -133,8 +212,10 @@ struct Factored {
     chol: Cholesky,
     /// Z = A⁻¹Bᵀ, column-major (n × n_c).
     z: Vec<f64>,
-    /// H = cτ² B Z (n_c × n_c, row-major).
+    /// Mixed: H = cτ² B Z (n_c × n_c, row-major). Nitsche: W = P Z (Q × Q, row-major).
     h: Vec<f64>,
+    /// Nitsche's rows of the run (Θ, γ0 applied); Z's columns are then A⁻¹(−t_q).
+    nitsche: Option<NitscheOps>,
 }
 
 /// A process-wide cache: entries shared by concurrent runs (a second run waits for the first to
@@ -221,7 +302,100 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
 }
 
 fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
-    let FeGeometry::Box { extent, cells } = &s.geometry;
+    match &s.geometry {
+        FeGeometry::Box { extent, cells } => build_box(s, extent, cells),
+        FeGeometry::Ball {
+            dim,
+            degree,
+            radius,
+            centre_height,
+            n_t,
+            n_r,
+        } => {
+            let mut centre = [0.0; 3];
+            centre[dim - 1] = *centre_height;
+            let mesh = BallMesh::new(*dim, *degree, *radius, centre, *n_t, *n_r)
+                .map_err(|e| e.to_string())?;
+            build_ball(s, mesh)
+        }
+    }
+}
+
+/// The stiffness, Gram and grad-grad matrices of a mesh on its free dofs.
+fn operators(
+    s: &FeSetup,
+    mesh: &dyn Mesh,
+    dofs: &DofMap,
+    pattern: &Arc<Pattern>,
+) -> (SymMatrix, SymMatrix, SymMatrix) {
+    let one = |_: usize| 1.0;
+    let k = assemble(
+        mesh,
+        dofs,
+        pattern,
+        ElementOp::Stiffness {
+            lambda: s.lame_lambda,
+            mu: s.lame_mu,
+        },
+        &one,
+    );
+    let gram = assemble(mesh, dofs, pattern, ElementOp::Mass { rho: 1.0 }, &one);
+    let grad = assemble(mesh, dofs, pattern, ElementOp::GradGrad, &one);
+    (k, gram, grad)
+}
+
+/// The disc/ball: nothing clamped; contact on the vertical dofs of the Γ_C nodes, with gaps
+/// their heights above the plane (SPEC §1.3: g(x) = x_d, u_n = −u_d).
+fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
+    let d = mesh.dim;
+    let dofs = DofMap::all(mesh.coords.len() * d);
+    let pattern = fe_pattern(&mesh, &dofs);
+    // AMD: the mapped mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D (the
+    // bars' measurements, `cholesky_options`).
+    let opts = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if d == 2 {
+            FactorKind::Simplicial
+        } else {
+            FactorKind::Supernodal
+        },
+    };
+    let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
+    let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
+    let contact: Vec<usize> = mesh.contact_nodes.iter().map(|&n| n * d + d - 1).collect();
+    let contact_height = mesh
+        .contact_nodes
+        .iter()
+        .map(|&n| mesh.coords[n][d - 1])
+        .collect();
+    let contact_weight = mesh.contact_node_weights();
+    let points = contact_points(&mesh, s.lame_lambda, s.lame_mu, 1.0);
+    let mut contact_node = vec![false; mesh.coords.len()];
+    for &n in &mesh.contact_nodes {
+        contact_node[n] = true;
+    }
+    let on_contact_node = (0..dofs.n_free()).map(|r| contact_node[r / d]).collect();
+    let vertical = (0..dofs.n_free()).filter(|&r| r % d == d - 1).collect();
+    Ok(Geometry {
+        mesh: FeMesh::Ball(mesh),
+        dofs,
+        pattern,
+        symbolic,
+        k,
+        gram,
+        grad,
+        contact,
+        contact_height,
+        gap_in_geometry: true,
+        contact_node,
+        points,
+        contact_weight,
+        on_contact_node,
+        vertical,
+    })
+}
+
+fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, String> {
     let mesh = BoxMesh::try_new(extent, cells).map_err(|e| e.to_string())?;
     let d = mesh.dim;
     let top = cells[d - 1];
@@ -230,19 +404,7 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     let pattern = fe_pattern(&mesh, &dofs);
     let opts = cholesky_options(&mesh, &dofs);
     let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
-    let one = |_: usize| 1.0;
-    let k = assemble(
-        &mesh,
-        &dofs,
-        &pattern,
-        ElementOp::Stiffness {
-            lambda: s.lame_lambda,
-            mu: s.lame_mu,
-        },
-        &one,
-    );
-    let gram = assemble(&mesh, &dofs, &pattern, ElementOp::Mass { rho: 1.0 }, &one);
-    let grad = assemble(&mesh, &dofs, &pattern, ElementOp::GradGrad, &one);
+    let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let bottom = mesh.nodes_on_plane(d - 1, 0);
     let free = |g: usize| dofs.free_index(g).expect("Γ_C is not clamped");
     let contact: Vec<usize> = bottom.iter().map(|&n| free(n * d + d - 1)).collect();
@@ -273,8 +435,13 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     let vertical = (0..dofs.n_free())
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
+    let contact_height = vec![0.0; contact.len()];
+    let mut contact_node = vec![false; mesh.num_nodes()];
+    for &n in &bottom {
+        contact_node[n] = true;
+    }
     Ok(Geometry {
-        mesh,
+        mesh: FeMesh::Box(mesh),
         dofs,
         pattern,
         symbolic,
@@ -282,24 +449,79 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
         gram,
         grad,
         contact,
+        contact_height,
+        gap_in_geometry: false,
+        contact_node,
+        points: Vec::new(),
         contact_weight,
         on_contact_node,
         vertical,
     })
 }
 
+/// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
+/// layer (mod2) and the weight of layer 1 (mod3).
+#[derive(Debug, Clone, Copy)]
+struct Redistribution {
+    mod2: f64,
+    mod3: f64,
+}
+
+impl Redistribution {
+    /// Layers of equal mass m/L (the bars' box: uniform elements, as many per layer):
+    /// mod2 = L/(L−1), mod3 = 2 — the 1D weights of 000 §3.
+    fn equal_layers(layers: usize) -> Redistribution {
+        Redistribution {
+            mod2: layers as f64 / (layers as f64 - 1.0),
+            mod3: 2.0,
+        }
+    }
+
+    /// From the measured masses: total m, layer 0 m₀, layer 1 m₁ (the disc/ball, whose layers
+    /// differ): mod2 = m/(m − m₀), mod3 = 1 + m₀/m₁, so the total mass is conserved.
+    fn measured(total: f64, m0: f64, m1: f64) -> Redistribution {
+        Redistribution {
+            mod2: total / (total - m0),
+            mod3: 1.0 + m0 / m1,
+        }
+    }
+}
+
 /// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (SPEC §2.2).
-fn layer_weight(mass: &MassVariant, layer: usize, layers: usize) -> f64 {
+fn layer_weight(mass: &MassVariant, layer: usize, r: Redistribution) -> f64 {
     match (mass, layer) {
         (
             MassVariant::Mod1 | MassVariant::Mod2 | MassVariant::Mod3 | MassVariant::Weights(_),
             0,
         ) => 0.0,
-        (MassVariant::Mod2, _) => layers as f64 / (layers as f64 - 1.0),
-        (MassVariant::Mod3, 1) => 2.0,
+        (MassVariant::Mod2, _) => r.mod2,
+        (MassVariant::Mod3, 1) => r.mod3,
         (MassVariant::Weights(w), k) => w[(k - 1).min(w.len() - 1)],
         _ => 1.0,
     }
+}
+
+/// 1ᵀM1 over one component of the mass assembled with the element weights `weight` on the full
+/// dof set (clamped nodes included), leaving out the entries `zeroed(i, j)` (dofs).
+fn component_total(
+    mesh: &dyn Mesh,
+    rho: f64,
+    weight: &dyn Fn(usize) -> f64,
+    zeroed: &dyn Fn(usize, usize) -> bool,
+) -> f64 {
+    let d = mesh.dim();
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let full_pattern = fe_pattern(mesh, &all);
+    let full = assemble(mesh, &all, &full_pattern, ElementOp::Mass { rho }, weight);
+    let mut total = 0.0;
+    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
+        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
+            if !zeroed(full_pattern.row_idx[k], j) {
+                total += full.values[k];
+            }
+        }
+    }
+    total
 }
 
 /// The run's mass matrix and 1ᵀM1 (per component: the total mass it represents).
@@ -311,8 +533,21 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
             mass.name()
         ));
     }
-    let mesh = &g.mesh;
-    let weight = |e: usize| layer_weight(mass, mesh.element_layer(e), layers);
+    let fm = &g.mesh;
+    let mesh = fm.mesh();
+    let never = |_: usize, _: usize| false;
+    let redistribution = match fm {
+        FeMesh::Ball(_) if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) => {
+            let layer_mass = |l: usize| {
+                let w = |e: usize| f64::from(u8::from(fm.element_layer(e) == l));
+                component_total(mesh, s.density, &w, &never)
+            };
+            let total = component_total(mesh, s.density, &|_| 1.0, &never);
+            Redistribution::measured(total, layer_mass(0), layer_mass(1))
+        }
+        _ => Redistribution::equal_layers(layers),
+    };
+    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), redistribution);
     let rho = ElementOp::Mass { rho: s.density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
@@ -330,26 +565,33 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
         _ => {}
     }
     // 1ᵀM1 over one component, clamped nodes included: assembled on the full dof set.
-    let d = mesh.dim;
-    let all = DofMap::all(mesh.num_nodes() * d);
-    let full_pattern = fe_pattern(mesh, &all);
-    let full = assemble(mesh, &all, &full_pattern, rho, &weight);
-    let bottom_node = |dof: usize| mesh.node_index(dof / d)[d - 1] == 0;
-    let mut total = 0.0;
-    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
-        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
-            let i = full_pattern.row_idx[k];
-            let zeroed =
-                matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j));
-            if !zeroed {
-                total += full.values[k];
-            }
-        }
-    }
+    let d = mesh.dim();
+    let bottom_node = |dof: usize| g.contact_node[dof / d];
+    let zeroed = |i: usize, j: usize| {
+        matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j))
+    };
+    let total = component_total(mesh, s.density, &weight, &zeroed);
     Ok((m, total))
 }
 
 fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
+    match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => {
+            return factor_nitsche(g, cfg, c_tau2, NitscheOps::new(&g.points, theta, gamma0));
+        }
+        ContactMethod::Penalty { gamma0 } => {
+            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (SPEC §2.4).
+            let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
+            let young = m * (3.0 * l + 2.0 * m) / (l + m);
+            return factor_nitsche(
+                g,
+                cfg,
+                c_tau2,
+                NitscheOps::penalty(&g.points, young, gamma0),
+            );
+        }
+        ContactMethod::Mixed => {}
+    }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| e.to_string())?;
@@ -381,6 +623,80 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
         chol,
         z,
         h,
+        nitsche: None,
+    })
+}
+
+/// A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ) factored once, Z = A⁻¹C and W = P Z
+/// ([`super::fe_nitsche`]; the penalty is the case Θ = 0 with its own rows). Each s_q lives on
+/// one element's dofs, so the rank-one updates stay in the FE pattern.
+fn factor_nitsche(
+    g: &Geometry,
+    cfg: &FeConfig,
+    c_tau2: f64,
+    ops: NitscheOps,
+) -> Result<Factored, String> {
+    if g.points.is_empty() {
+        return Err(format!(
+            "space = {} is not available for scene {}",
+            cfg.method.name(),
+            cfg.setup.scene
+        ));
+    }
+    let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
+    let mut a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
+    let (theta, gamma0) = match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => (theta, gamma0),
+        _ => (0.0, 0.0),
+    };
+    let (k, nq, n) = (ops.k, ops.len(), g.dofs.n_free());
+    let red = |gd: usize| {
+        g.dofs
+            .free_index(gd)
+            .expect("the ball has no constrained dof")
+    };
+    if theta != 0.0 {
+        for q in 0..nq {
+            let f = c_tau2 * theta * ops.w[q] * ops.gamma[q];
+            let (d, sq) = (&ops.dofs[q * k..(q + 1) * k], &ops.s[q * k..(q + 1) * k]);
+            for (i, &gi) in d.iter().enumerate() {
+                for (j, &gj) in d.iter().enumerate() {
+                    let pos = a
+                        .pattern
+                        .position(red(gi), red(gj))
+                        .expect("element dofs are in the pattern");
+                    a.values[pos] -= f * sq[i] * sq[j];
+                }
+            }
+        }
+    }
+    let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| {
+        format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
+    })?;
+    let mut z = vec![0.0; n * nq];
+    for q in 0..nq {
+        for (&gd, &c) in ops.dofs[q * k..(q + 1) * k]
+            .iter()
+            .zip(&ops.c[q * k..(q + 1) * k])
+        {
+            z[q * n + red(gd)] += c;
+        }
+    }
+    let mut work = chol.work_for(nq);
+    chol.solve_many_in_place(&mut z, nq, &mut work);
+    let mut h = vec![0.0; nq * nq];
+    for q in 0..nq {
+        for r in 0..nq {
+            h[q * nq + r] = ops.apply(&ops.p, q, &z[r * n..(r + 1) * n]);
+        }
+    }
+    Ok(Factored {
+        m,
+        mass_total,
+        chol,
+        z,
+        h,
+        nitsche: Some(ops),
     })
 }
 
@@ -393,7 +709,11 @@ struct RefMap {
 }
 
 fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
-    let d = g.mesh.dim;
+    let mesh = g
+        .mesh
+        .as_box()
+        .ok_or_else(|| format!("scene {} has no reference runs", cfg.setup.scene))?;
+    let d = mesh.dim;
     let ratio = |coarse: f64, fine: f64, stride: usize, what: &str| {
         let q = coarse / fine;
         let r = q.round() as usize;
@@ -407,7 +727,7 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
     };
     let rs = ratio(cfg.setup.h, data.h, data.space_stride, "mesh size")?;
     let rt = ratio(cfg.dt, data.dt, data.time_stride, "time step")?;
-    if data.dim != d || (0..d).any(|a| g.mesh.cells[a] * rs + 1 != data.lattice[a]) {
+    if data.dim != d || (0..d).any(|a| mesh.cells[a] * rs + 1 != data.lattice[a]) {
         return Err("the reference's lattice does not cover the run's mesh".into());
     }
     if cfg.steps * rt >= data.times {
@@ -424,7 +744,7 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
         .free
         .iter()
         .map(|&gd| {
-            let idx = g.mesh.node_index(gd / d);
+            let idx = mesh.node_index(gd / d);
             let l = [idx[0] * rs, idx[1] * rs, idx[2] * rs];
             let node = l[0] + data.lattice[0] * (l[1] + data.lattice[1] * l[2]);
             node * d + gd % d
@@ -451,17 +771,6 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: Vec::new(),
         reference: None,
     };
-    if cfg.method != ContactMethod::Mixed {
-        return fail(
-            Status::Invalid,
-            format!(
-                "space = {} is not available for scene {}",
-                cfg.method.name(),
-                cfg.setup.scene
-            ),
-            metrics,
-        );
-    }
     let (c1, c, gamma) = match cfg.coefficients() {
         Ok(x) => x,
         Err(e) => return fail(Status::Invalid, e, metrics),
@@ -473,7 +782,17 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         Ok(g) => g,
         Err(e) => return fail(Status::Invalid, e, metrics),
     };
-    let factor_key = format!("{}|{:?}|{:e}", geometry_key(&cfg.setup), cfg.mass, c_tau2);
+    // Checked outside the shared caches: an entry is never left half built.
+    if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
+        return fail(status, msg, metrics);
+    }
+    let factor_key = format!(
+        "{}|{:?}|{:?}|{:e}",
+        geometry_key(&cfg.setup),
+        cfg.mass,
+        cfg.method,
+        c_tau2
+    );
     let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
     let fac = match fac {
         Ok(f) => f,
@@ -482,6 +801,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.factorizations = i64::from(!hit);
     metrics.factor_cache_hits = Some(i64::from(hit));
     metrics.mass_total = Some(fac.mass_total);
+    if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
+        return fail(status, msg, metrics);
+    }
     let refmap = match ctx.reference.as_ref().map(|r| ref_map(&geo, cfg, r)) {
         Some(Err(e)) => return fail(Status::Invalid, e, metrics),
         Some(Ok(m)) => Some(m),
@@ -490,15 +812,23 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
     let g = &*geo;
     let n = g.dofs.n_free();
-    let nc = g.contact.len();
-    let d = g.mesh.dim;
+    let nit = fac.nitsche.as_ref();
+    // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
+    let nc = nit.map_or(g.contact.len(), NitscheOps::len);
+    let d = g.mesh.dim();
     metrics.contact_dofs = Some(nc as i64);
-    let gap = cfg.setup.gap;
+    // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
+    let base_gap = if g.gap_in_geometry {
+        0.0
+    } else {
+        cfg.setup.gap
+    };
+    let gaps: Vec<f64> = g.contact_height.iter().map(|h| h + base_gap).collect();
 
     // Workspace: every vector of the time loop, allocated once. M u, M v and M a are carried
     // along the recursions of u, v, a, so a step costs one product with M (M a^{n+1}) besides
     // the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at all,
-    // uᵀKu = uᵀ(Bᵀλ − M a) by the equation at t^{n+1} (F = 0).
+    // uᵀKu = uᵀ(F + Bᵀλ − M a) by the equation at t^{n+1}.
     let mut u = vec![0.0; n];
     let mut v = vec![0.0; n];
     let mut a = vec![0.0; n];
@@ -511,7 +841,19 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let mut err = vec![0.0; n];
     let mut q = vec![0.0; nc];
     let mut lambda = vec![0.0; nc];
-    let mut lcp = Lcp::new(nc, fac.h.clone());
+    let mut lcp = Lcp::new(
+        g.contact.len(),
+        if nit.is_some() {
+            vec![0.0; g.contact.len().pow(2)]
+        } else {
+            fac.h.clone()
+        },
+    );
+    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+    // Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
+    let mut kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
+    let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
+    let mut newton_max = 0usize;
     let mut work: SolveWork = fac.chol.work();
     for &r in &g.vertical {
         v[r] = cfg.setup.v0;
@@ -523,20 +865,51 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         }
     }
     fac.m.matvec_into(&v, &mut mv);
-    // a⁰ = M⁻¹(F − Ku⁰) = 0: u⁰ = 0 and no volume load in the bars.
-    if cfg.setup.gravity != 0.0 {
+    // Gravity: F = M (f e_d) with the run's mass, f = −gravity — the load ∫ρ f·v of the
+    // consistent mass, whose row sums the lumped mass keeps. Then a⁰ = M⁻¹(F − Ku⁰) = f e_d
+    // exactly (u⁰ = 0): the rigid acceleration, and M a⁰ = F. The bars have no load (F = 0).
+    let fall = -cfg.setup.gravity;
+    let mut force_vec = vec![0.0; n];
+    if fall != 0.0 {
+        if g.mesh.as_box().is_some() {
+            return fail(
+                Status::Invalid,
+                format!(
+                    "scene {}: a volume load on the clamped bar is not supported",
+                    cfg.setup.scene
+                ),
+                metrics,
+            );
+        }
+        for &r in &g.vertical {
+            a[r] = fall;
+        }
+        fac.m.matvec_into(&a, &mut force_vec);
+        ma.copy_from_slice(&force_vec);
+    }
+    // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
+    let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
+    let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
+    if record_requested(ctx) && g.mesh.as_box().is_none() {
         return fail(
             Status::Invalid,
-            "a volume load is not supported by this engine yet".into(),
+            format!(
+                "scene {} cannot be recorded as a reference run",
+                cfg.setup.scene
+            ),
             metrics,
         );
     }
 
     // The reference lattice this run records, if it is one.
     let record = ctx.record_reference.map(|(space_stride, time_stride)| {
+        let bx = g
+            .mesh
+            .as_box()
+            .expect("checked above: references are boxes");
         let lattice = [0, 1, 2].map(|ax| {
             if ax < d {
-                g.mesh.cells[ax] / space_stride + 1
+                bx.cells[ax] / space_stride + 1
             } else {
                 1
             }
@@ -545,9 +918,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         for k in 0..lattice[2] {
             for j in 0..lattice[1] {
                 for i in 0..lattice[0] {
-                    let node =
-                        g.mesh
-                            .node_id([i * space_stride, j * space_stride, k * space_stride]);
+                    let node = bx.node_id([i * space_stride, j * space_stride, k * space_stride]);
                     for comp in 0..d {
                         slots.push(g.dofs.free_index(node * d + comp));
                     }
@@ -571,16 +942,30 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         (slots, data)
     });
     let mut record = record;
+    if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
+        return fail(status, msg, metrics);
+    }
     metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
     let loop_start = Instant::now();
 
     let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
-    // E = ½vᵀMv + ½uᵀKu with Mv carried and Ku = Bᵀλ − Ma (module header).
-    let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64]| {
+    if let Some(sc) = energy_scale {
+        obs = obs.with_energy_scale(sc);
+    }
+    // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
+    // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product with
+    // K (into the scratch `tmp`) instead.
+    let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64], tmp: &mut [f64]| {
         let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
-        let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
-        let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
-        0.5 * kinetic + 0.5 * (contact - uma)
+        let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
+        let uku = if nit.is_some() {
+            quad(&g.k, u, tmp)
+        } else {
+            let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
+            let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
+            fu + contact - uma
+        };
+        0.5 * kinetic + 0.5 * uku - fu
     };
     let mean = |x: &[f64]| -> f64 {
         g.contact
@@ -589,20 +974,41 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             .map(|(&c, w)| w * x[c])
             .sum()
     };
+    // Centre of mass against free fall until the first contact (scenes with gravity).
+    let mut fall_error = 0.0f64;
+    let mut touched = false;
     // Observe step n with state (u, v) and contact forces λ.
     #[allow(clippy::too_many_arguments)]
     let mut observe = |step: usize,
                        u: &[f64],
                        v: &[f64],
+                       mu: &[f64],
                        mv: &[f64],
                        ma: &[f64],
                        lambda: &[f64],
                        tmp: &mut [f64],
                        err: &mut [f64]|
      -> Result<(), Divergence> {
-        let e = energy(u, v, mv, ma, lambda);
-        let force: f64 = lambda.iter().sum();
+        let e = energy(u, v, mv, ma, lambda, tmp);
+        // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
+        // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
+        let (e, theta_term, force) = match nit {
+            Some(ops) => {
+                let (pot, t, f) = ops.energy_terms_and_force(u);
+                (e + pot, t, f)
+            }
+            None => (e, None, lambda.iter().sum()),
+        };
         let uc = mean(u);
+        if fall != 0.0 && !touched {
+            if force > 0.0 {
+                touched = true;
+            } else {
+                let t = step as f64 * tau;
+                let com: f64 = g.vertical.iter().map(|&r| mu[r]).sum::<f64>() / vertical_mass;
+                fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
+            }
+        }
         if let Some((slots, data)) = record.as_mut()
             && step.is_multiple_of(data.time_stride)
         {
@@ -638,7 +1044,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 sigma_contact: -force,
                 sigma_mid: None,
                 energy: e,
-                energy_theta: None,
+                energy_theta: theta_term.map(|t| e + t),
             },
             exact,
         )
@@ -647,24 +1053,79 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let mut done = 0usize;
     let mut iterations = 0i64;
     let mut observe_timer = SampledTimer::default();
-    let stop = (|| -> Result<(), Stop<LcpError>> {
-        observe(0, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+    let stop = (|| -> Result<(), Stop<String>> {
+        observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
         let (t1, ct2) = (tau, c1 * tau * tau);
         for step in 1..=cfg.steps {
-            // p^n and M p^n (the right-hand side) from the carried products.
-            for i in 0..n {
-                pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
-                y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
+            if hybrid {
+                // Midpoint rule: (M + τ²/4 K_Θ) u^{n+1} = M(u + τv) − τ²/4 K_Θ u + τ²/2 F − τ²/2 N_Φ
+                // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u).
+                g.k.matvec_into(&u, &mut tmp);
+                if let Some(ops) = nit
+                    && ops.theta != 0.0
+                {
+                    for k in 0..ops.len() {
+                        let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &u);
+                        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                            .iter()
+                            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+                        {
+                            tmp[gd] -= f * sk;
+                        }
+                    }
+                }
+                for i in 0..n {
+                    y[i] = mu[i] + tau * mv[i] - c_tau2 * tmp[i] + 2.0 * c_tau2 * force_vec[i];
+                }
+            } else {
+                // p^n and M p^n (the right-hand side) from the carried products.
+                for i in 0..n {
+                    pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
+                    y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
+                }
+                // M p^n is M u^{n+1} before the correction below; keep it. Then + cτ²F.
+                mu.copy_from_slice(&y);
+                if fall != 0.0 {
+                    for (yi, fi) in y.iter_mut().zip(&force_vec) {
+                        *yi += c_tau2 * fi;
+                    }
+                }
             }
-            // M p^n is M u^{n+1} before the correction below; keep it.
-            mu.copy_from_slice(&y);
             fac.chol.solve_in_place(&mut y, &mut work);
-            for (qi, &ci) in q.iter_mut().zip(&g.contact) {
-                *qi = y[ci] + gap;
+            if let Some(ops) = nit {
+                // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
+                for (k, qk) in q.iter_mut().enumerate() {
+                    *qk = ops.apply(&ops.p, k, &y);
+                }
+                if hybrid {
+                    // Kinks g − max(P̃ⁿ, 0) from u^n (fe_nitsche header).
+                    for (k, kk) in kink.iter_mut().enumerate() {
+                        let pn = ops.apply(&ops.p, k, &u) - ops.gap[k];
+                        *kk = ops.gap[k] - pn.max(0.0);
+                    }
+                }
+                let it = newton(
+                    ops,
+                    &fac.h,
+                    c_tau2,
+                    &q,
+                    &kink,
+                    &mut lambda,
+                    &mut newton_work,
+                )
+                .map_err(|e| Stop::Solver(step, e))?;
+                newton_max = newton_max.max(it);
+                iterations += it as i64;
+            } else {
+                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                    *qi = y[ci] + gi;
+                }
+                let it = lcp
+                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                newton_max = newton_max.max(it);
+                iterations += it as i64;
             }
-            iterations += lcp
-                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                .map_err(|e| Stop::Solver(step, e))? as i64;
             for (j, &l) in lambda.iter().enumerate() {
                 if l > 0.0 {
                     let zj = &fac.z[j * n..(j + 1) * n];
@@ -674,22 +1135,32 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                     }
                 }
             }
-            // y = u^{n+1}; tmp = a^{n+1} = (u^{n+1} − p^n)/(cτ²), then M a^{n+1} into pred.
-            for i in 0..n {
-                tmp[i] = (y[i] - pred[i]) / c_tau2;
+            if hybrid {
+                // v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n; M u and M v by products (a is not used).
+                for i in 0..n {
+                    v[i] = 2.0 * (y[i] - u[i]) / tau - v[i];
+                }
+                std::mem::swap(&mut u, &mut y);
+                fac.m.matvec_into(&u, &mut mu);
+                fac.m.matvec_into(&v, &mut mv);
+            } else {
+                // y = u^{n+1}; tmp = a^{n+1} = (u^{n+1} − p^n)/(cτ²), then M a^{n+1} into pred.
+                for i in 0..n {
+                    tmp[i] = (y[i] - pred[i]) / c_tau2;
+                }
+                fac.m.matvec_into(&tmp, &mut pred);
+                for i in 0..n {
+                    v[i] += tau * ((1.0 - gamma) * a[i] + gamma * tmp[i]);
+                    mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * pred[i]);
+                    mu[i] += c_tau2 * pred[i];
+                }
+                std::mem::swap(&mut a, &mut tmp);
+                std::mem::swap(&mut ma, &mut pred);
+                std::mem::swap(&mut u, &mut y);
             }
-            fac.m.matvec_into(&tmp, &mut pred);
-            for i in 0..n {
-                v[i] += tau * ((1.0 - gamma) * a[i] + gamma * tmp[i]);
-                mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * pred[i]);
-                mu[i] += c_tau2 * pred[i];
-            }
-            std::mem::swap(&mut a, &mut tmp);
-            std::mem::swap(&mut ma, &mut pred);
-            std::mem::swap(&mut u, &mut y);
             observe_timer
                 .time(step, || {
-                    observe(step, &u, &v, &mv, &ma, &lambda, &mut tmp, &mut err)
+                    observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
                 })
                 .map_err(Stop::Diverged)?;
             done = step;
@@ -706,15 +1177,19 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     })();
     metrics.steps = done as i64;
     metrics.iterations = iterations;
+    metrics.iterations_max_step = Some(newton_max as i64);
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
+    metrics.first_contact_time = obs.first_contact();
+    metrics.contact_phases = Some(obs.contact_phases());
+    metrics.free_fall_error = (fall != 0.0).then_some(fall_error);
     // The observer's pressure columns are the total force here; there is no midpoint pressure.
     metrics.err_force_l2 = metrics.err_sigma_l2.take();
     metrics.err_sigma_mid_l2 = None;
     metrics.contact_toggles = Some(metrics.contact_switches);
-    metrics.energy_scale = metrics.energy_initial;
+    metrics.energy_scale = energy_scale.or(metrics.energy_initial);
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
         _ => None,
@@ -726,6 +1201,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: std::mem::take(&mut obs.series),
         reference,
     }
+}
+
+/// Whether the run must record itself as a reference.
+fn record_requested(ctx: &RunContext) -> bool {
+    ctx.record_reference.is_some()
 }
 
 /// xᵀAx with `tmp` as scratch.

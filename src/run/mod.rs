@@ -7,7 +7,9 @@
 //! point is kept.
 
 pub mod bar1d;
+pub mod estimate;
 pub mod fe;
+mod fe_nitsche;
 pub mod observe;
 pub mod record;
 pub mod reference;
@@ -73,6 +75,30 @@ impl RunOptions {
     /// Whether the sweep was interrupted.
     pub fn cancelled(&self) -> bool {
         self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
+    /// A checkpoint of the setup (between its allocation-heavy phases: operators, factors,
+    /// workspace): the time budget covers the setup too, and an interruption (the scheduler's
+    /// SIGTERM) must not wait for the time loop. `phase` is what was just built.
+    pub(crate) fn setup_stop(
+        &self,
+        start: std::time::Instant,
+        phase: &str,
+    ) -> Option<(Status, String)> {
+        if self.cancelled() {
+            return Some((Status::Cancelled, "interrupted".into()));
+        }
+        self.timeout
+            .filter(|limit| start.elapsed() > *limit)
+            .map(|_| {
+                (
+                    Status::Timeout,
+                    format!(
+                        "run timeout after {:.3} s during setup (after {phase}, before the first step)",
+                        start.elapsed().as_secs_f64()
+                    ),
+                )
+            })
     }
 }
 
@@ -146,12 +172,13 @@ impl RunConfig {
         }
     }
 
-    /// Work estimate: steps × unknowns.
+    /// Work estimate: steps × unknowns (saturating: a refused run may exceed u64).
     pub fn work(&self) -> u64 {
-        match self {
-            RunConfig::Bar1d(c) => (c.steps * c.elements) as u64,
-            RunConfig::Fe(c) => (c.steps * c.unknowns()) as u64,
-        }
+        let (steps, unknowns) = match self {
+            RunConfig::Bar1d(c) => (c.steps, c.elements),
+            RunConfig::Fe(c) => (c.steps, c.unknowns()),
+        };
+        (steps as u64).saturating_mul(unknowns as u64)
     }
 }
 

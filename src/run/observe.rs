@@ -52,6 +52,14 @@ pub struct Metrics {
     pub setup_time_s: Option<f64>,
     /// Time spent in the time loop (observables included).
     pub stepping_time_s: Option<f64>,
+    /// First t^n with a non-zero contact force (FE scenes).
+    pub first_contact_time: Option<f64>,
+    /// Times the contact force switched on (FE scenes).
+    pub contact_phases: Option<i64>,
+    /// Centre of mass against free fall before the first contact (scenes with gravity).
+    pub free_fall_error: Option<f64>,
+    /// Most contact-solver iterations in one step (FE scenes).
+    pub iterations_max_step: Option<i64>,
     /// Part of the stepping time spent on observables and error norms (sampled estimate).
     pub observe_time_s: Option<f64>,
 }
@@ -166,6 +174,10 @@ pub struct Observer {
     sum_energy: f64,
     max_contact: f64,
     observed: usize,
+    /// The scene's energy scale when it is not E⁰ (disc/sphere: E⁰ = 0, SPEC §1.3).
+    scale: Option<f64>,
+    first_contact: Option<f64>,
+    phases: i64,
     pub series: Vec<SeriesRow>,
 }
 
@@ -200,8 +212,33 @@ impl Observer {
             sum_energy: 0.0,
             max_contact: 0.0,
             observed: 0,
+            scale: None,
+            first_contact: None,
+            phases: 0,
             series: Vec::with_capacity(cap),
         }
+    }
+
+    /// Measure relative energies (drift, deviations, increases, divergence) in `scale`
+    /// instead of E⁰ (SPEC §1.3: m·|f|·gap for the disc and the sphere, whose E⁰ is 0).
+    pub fn with_energy_scale(mut self, scale: f64) -> Self {
+        self.scale = Some(scale);
+        self
+    }
+
+    /// First observed time with a negative contact pressure (a non-zero contact force).
+    pub fn first_contact(&self) -> Option<f64> {
+        self.first_contact
+    }
+
+    /// Times the contact pressure switched on.
+    pub fn contact_phases(&self) -> i64 {
+        self.phases
+    }
+
+    /// The energy relative energies are measured in: the scene's scale, else E⁰.
+    fn energy_unit(&self) -> f64 {
+        self.scale.unwrap_or(self.e0)
     }
 
     /// Record one step. Returns the reason to stop if the run diverged.
@@ -239,6 +276,10 @@ impl Observer {
         if contact != self.in_contact {
             self.switches += 1;
             self.in_contact = contact;
+            if contact {
+                self.phases += 1;
+                self.first_contact.get_or_insert(v.t);
+            }
         }
         if let Some(x) = exact {
             self.has_exact = true;
@@ -271,11 +312,19 @@ impl Observer {
                 sigma_contact_exact: exact.map(|x| x.sigma_contact),
             });
         }
-        let scale = self.e0.abs().max(f64::MIN_POSITIVE);
+        let scale = self.energy_unit().abs().max(f64::MIN_POSITIVE);
         if v.energy > DIVERGENCE_FACTOR * scale {
             return Err(Divergence(format!(
-                "energy {:.3e} exceeded 1e6·E0 (E0 = {:.3e}) at step {} (t = {:.6})",
-                v.energy, self.e0, v.step, v.t
+                "energy {:.3e} exceeded 1e6·{} ({:.3e}) at step {} (t = {:.6})",
+                v.energy,
+                if self.scale.is_some() {
+                    "energy_scale"
+                } else {
+                    "E0"
+                },
+                scale,
+                v.step,
+                v.t
             )));
         }
         Ok(())
@@ -288,22 +337,25 @@ impl Observer {
             return;
         }
         let e0 = self.e0;
+        let unit = self.energy_unit();
         metrics.energy_initial = Some(e0);
         metrics.energy_final = Some(self.last_e);
-        metrics.energy_drift = Some((self.last_e - e0) / e0);
-        metrics.energy_max_dev = Some(self.max_dev / e0);
+        metrics.energy_drift = Some((self.last_e - e0) / unit);
+        metrics.energy_max_dev = Some(self.max_dev / unit);
         metrics.energy_theta_drift = self
             .last_et
             .zip(self.e0_theta)
-            .filter(|(_, e0t)| *e0t != 0.0)
-            .map(|(et, e0t)| (et - e0t) / e0t);
+            .map(|(et, e0t)| (et - e0t, self.scale.unwrap_or(e0t)))
+            .filter(|(_, unit)| *unit != 0.0)
+            .map(|(d, unit)| d / unit);
         if self.observed > 1 {
-            metrics.energy_max_increase = Some(self.max_inc / e0);
+            metrics.energy_max_increase = Some(self.max_inc / unit);
             metrics.energy_theta_max_increase = self
                 .max_inc_theta
                 .zip(self.e0_theta)
-                .map(|(m, e0t)| m / e0t);
+                .map(|(m, e0t)| m / self.scale.unwrap_or(e0t));
         }
+
         metrics.contact_switches = self.switches;
         if complete && self.has_exact {
             let t = self.tau;

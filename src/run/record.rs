@@ -116,6 +116,7 @@ schema! {
         lame_lambda: Option<f64> => "Pa", "Lamé λ (2D/3D scenes)";
         lame_mu: Option<f64> => "Pa", "Lamé μ (2D/3D scenes)";
         gravity: Option<f64> => "m/s²", "volume load (2D/3D scenes)";
+        degree: Option<i64> => "", "polynomial degree of the elements, 1 (Q1) or 2 (Q2) (disc2d, sphere3d)";
         ensemble_sample: Option<i64> => "", "ensemble member index (null outside ensembles)";
         ensemble_perturbation: Option<f64> => "", "relative amplitude of the perturbation of u⁰";
         search: Option<String> => "", "the [search] this run is a probe of (name, key, criterion, bracket, method index; null for grid runs)";
@@ -152,6 +153,10 @@ schema! {
         setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
         stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
         observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
+        first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
+        contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
+        free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
+        iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -297,6 +302,7 @@ impl RunRecord {
             lame_lambda: f(Key::LameLambda),
             lame_mu: f(Key::LameMu),
             gravity: f(Key::Gravity),
+            degree: f(Key::Degree).map(|x| x as i64),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
             search: spec.search.clone(),
@@ -333,6 +339,10 @@ impl RunRecord {
             setup_time_s: m.setup_time_s,
             stepping_time_s: m.stepping_time_s,
             observe_time_s: m.observe_time_s,
+            first_contact_time: m.first_contact_time,
+            contact_phases: m.contact_phases,
+            free_fall_error: m.free_fall_error,
+            iterations_max_step: m.iterations_max_step,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

@@ -19,6 +19,18 @@ pub enum FeGeometry {
     /// A box [0, extent_0] × … meshed by Q1 elements, `cells` per axis; the last axis is
     /// vertical, its top face clamped, its bottom face the contact boundary.
     Box { extent: Vec<f64>, cells: Vec<usize> },
+    /// The mapped disc (dim 2) or ball (dim 3) of radius `radius` centred at height
+    /// `centre_height` above the rigid plane x_d = 0 ([`crate::space::fe::BallMesh`]): Q1 or
+    /// Q2 (`degree`), `n_t` elements per side of the central block, `n_r` across the outer
+    /// blocks; nothing clamped, Γ_C the boundary below the centre.
+    Ball {
+        dim: usize,
+        degree: usize,
+        radius: f64,
+        centre_height: f64,
+        n_t: usize,
+        n_r: usize,
+    },
 }
 
 /// A finite-element scene as the sparse engine runs it.
@@ -33,7 +45,8 @@ pub struct FeSetup {
     pub density: f64,
     pub lame_lambda: f64,
     pub lame_mu: f64,
-    /// Distance from Γ_C to the rigid plane.
+    /// Distance from Γ_C to the rigid plane (the box's bottom face; the ball's lowest point,
+    /// already in its geometry).
     pub gap: f64,
     /// Volume load per unit mass towards the obstacle (−gravity e_d).
     pub gravity: f64,

@@ -11,9 +11,11 @@
 //! count, or a finite-element description ([`FeSetup`]: geometry, material, load, initial velocity,
 //! gap) which `space::fe` meshes and `run::fe` integrates, whatever the scene.
 
+pub mod ball;
 pub mod bar;
 pub mod bar1d;
 
+pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
 
@@ -103,11 +105,17 @@ pub enum SceneKind {
     Bar2d,
     /// The 3D bar dropped on an obstacle (SPEC §1.2).
     Bar3d,
+    /// The disc falling under gravity on a rigid plane (SPEC §1.3).
+    Disc2d,
+    /// The ball falling under gravity on a rigid plane (SPEC §1.3).
+    Sphere3d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
 static BAR2D: BarScene = BarScene { dim: 2 };
 static BAR3D: BarScene = BarScene { dim: 3 };
+static DISC2D: BallScene = BallScene { dim: 2 };
+static SPHERE3D: BallScene = BallScene { dim: 3 };
 
 impl SceneKind {
     /// Every scene name of SPEC §1, with whether this build implements it.
@@ -115,8 +123,8 @@ impl SceneKind {
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
-        ("disc2d", None),
-        ("sphere3d", None),
+        ("disc2d", Some(SceneKind::Disc2d)),
+        ("sphere3d", Some(SceneKind::Sphere3d)),
     ];
 
     /// The scene behind this name.
@@ -125,6 +133,8 @@ impl SceneKind {
             SceneKind::Bar1d => &BAR1D,
             SceneKind::Bar2d => &BAR2D,
             SceneKind::Bar3d => &BAR3D,
+            SceneKind::Disc2d => &DISC2D,
+            SceneKind::Sphere3d => &SPHERE3D,
         }
     }
 

@@ -34,7 +34,67 @@ pub struct Manifest {
     id: String,
 }
 
+/// What a run found of DIR's manifest before its session starts.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ManifestState {
+    /// No manifest (a new folder, or one whose manifest was lost).
+    Missing,
+    /// A readable manifest, recording this sweep name (if any).
+    Sweep(Option<String>),
+    /// Not valid JSON: moved aside to the given path, to be rebuilt by the session.
+    MovedAside {
+        to: std::path::PathBuf,
+        reason: String,
+    },
+}
+
 impl Manifest {
+    /// Inspect DIR's manifest before a session: a damaged one is moved aside to
+    /// `DIR/.damaged-manifest.json` (the session rebuilds it from its sweep file; the sessions
+    /// it recorded are lost, the results are not).
+    pub fn inspect(dir: &Path) -> Result<ManifestState, SinkError> {
+        let path = dir.join("manifest.json");
+        let lock_path = dir.join(".manifest.lock");
+        let _lock = super::lock_exclusive(&lock_path).map_err(|source| SinkError::Io {
+            path: lock_path.clone(),
+            source,
+        })?;
+        match Self::existing_sweep(dir) {
+            Ok(None) if !path.exists() => Ok(ManifestState::Missing),
+            Ok(name) => Ok(ManifestState::Sweep(name)),
+            Err(SinkError::Manifest { message, .. }) => {
+                let to = dir.join(".damaged-manifest.json");
+                std::fs::rename(&path, &to).map_err(|source| SinkError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+                Ok(ManifestState::MovedAside {
+                    to,
+                    reason: message,
+                })
+            }
+            Err(e) => Err(e),
+        }
+    }
+
+    /// DIR's manifest as JSON (`None` without one).
+    pub fn read(dir: &Path) -> Result<Option<Json>, SinkError> {
+        let path = dir.join("manifest.json");
+        if !path.exists() {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| SinkError::Manifest {
+                path,
+                message: e.to_string(),
+            })
+    }
+
     /// Read DIR's manifest if any: the sweep name it records.
     pub fn existing_sweep(dir: &Path) -> Result<Option<String>, SinkError> {
         let path = dir.join("manifest.json");
@@ -89,15 +149,15 @@ impl Manifest {
         }))
     }
 
-    /// Start a session: create or extend the manifest. `shard` is (k, n) for one shard of a
-    /// job array.
+    /// Start a session: create or extend the manifest. `shard` is the shards it runs (`K/N`,
+    /// `A-B/N`, … of a job array).
     pub fn begin(
         dir: &Path,
         plan: &Plan,
         planned: usize,
         skipped: usize,
         threads: usize,
-        shard: Option<(usize, usize)>,
+        shard: Option<String>,
     ) -> Result<Manifest, SinkError> {
         let path = dir.join("manifest.json");
         let id = format!(
@@ -117,7 +177,7 @@ impl Manifest {
             "git_commit": if commit.is_empty() { Json::Null } else { Json::from(commit) },
             "machine": machine(),
             "threads": threads,
-            "shard": shard.map(|(k, n)| format!("{k}/{n}")),
+            "shard": shard,
             "sweep_file": plan.sweep.path.display().to_string(),
             "sweep_text": plan.sweep.text,
             // `--set key=value` applied on top of sweep_text, in order.

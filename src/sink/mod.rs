@@ -18,6 +18,14 @@
 //! shared lock on `DIR/.lock` while it writes, and the clean-up above takes the exclusive lock
 //! — so it runs only when no other session is writing, and never removes a temporary or a
 //! series part that another session is about to commit.
+//!
+//! Damage from outside (a part truncated or overwritten by hand, a disk error): a runs part that
+//! cannot be read whole, or a series part whose footer cannot be read, is moved aside with its
+//! partner to `runs/.damaged-NAME` and `series/.damaged-NAME` ([`quarantine`], called by
+//! [`Sink::open`]); its runs are then missing and a resume computes them again, so every run is
+//! present exactly once. Renaming is safe while other shards write (their parts are complete
+//! files, never rewritten). Readers ([`read_runs`], the summaries) skip unreadable parts, with
+//! the same warning ([`Damaged::warning`]).
 
 use std::collections::HashSet;
 use std::fs::{self, File};
@@ -31,7 +39,7 @@ use polars::prelude::*;
 
 pub mod manifest;
 
-pub use manifest::Manifest;
+pub use manifest::{Manifest, ManifestState};
 
 use crate::exec::RunResult;
 use crate::run::record::{ColumnData, series_columns};
@@ -157,6 +165,116 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
     sync_dir(dir)
 }
 
+/// A part file that cannot be read.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Damaged {
+    pub path: PathBuf,
+    pub reason: String,
+    /// Where it was moved (None: left in place by a reader).
+    pub moved_to: Option<PathBuf>,
+}
+
+impl Damaged {
+    /// One line for the user: the file, why, and what was done about it.
+    pub fn warning(&self) -> String {
+        let what = match &self.moved_to {
+            Some(to) => format!(
+                "moved aside to {}; its runs are computed again",
+                to.display()
+            ),
+            None => "skipped (`contact-sweep run` on this folder moves it aside and computes its runs again)".into(),
+        };
+        format!(
+            "{} cannot be read ({}): {what}",
+            self.path.display(),
+            self.reason
+        )
+    }
+}
+
+/// Why a part cannot be read, if it cannot: a runs part is read whole (it is small, and a
+/// damaged page fails only when decoded); of a series part, which may be large, the footer.
+pub fn part_problem(path: &Path, whole: bool) -> Option<String> {
+    let file = match File::open(path) {
+        Ok(f) => f,
+        Err(e) => return Some(e.to_string()),
+    };
+    let mut reader = ParquetReader::new(file);
+    let r = if whole {
+        reader.finish().map(|_| ())
+    } else {
+        reader.num_rows().map(|_| ())
+    };
+    r.err().map(|e| {
+        let text = e.to_string();
+        // polars' messages can run over several lines: the first says what failed.
+        text.lines()
+            .next()
+            .unwrap_or("unreadable")
+            .trim()
+            .to_string()
+    })
+}
+
+/// The damaged-file name of a part: `.damaged-NAME` beside it (dot-named, so every glob and
+/// [`parquet_parts`] skip it).
+pub fn damaged_name(path: &Path) -> PathBuf {
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("part");
+    path.with_file_name(format!(".damaged-{name}"))
+}
+
+/// Unreadable parts of DIR, without touching them: runs parts read whole, series parts by
+/// their footer.
+pub fn unreadable_parts(dir: &Path) -> Result<Vec<Damaged>, SinkError> {
+    let mut out = Vec::new();
+    for (sub, whole) in [("runs", true), ("series", false)] {
+        for part in parquet_parts(&dir.join(sub))? {
+            if let Some(reason) = part_problem(&part, whole) {
+                out.push(Damaged {
+                    path: part,
+                    reason,
+                    moved_to: None,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Move every unreadable part of DIR aside, with its partner in the other folder (a batch is a
+/// runs part and a series part of one name: a batch with either damaged is computed again).
+pub fn quarantine(dir: &Path) -> Result<Vec<Damaged>, SinkError> {
+    let mut out = Vec::new();
+    for mut d in unreadable_parts(dir)? {
+        let name = d.path.file_name().expect("a part file").to_owned();
+        for sub in ["runs", "series"] {
+            let p = dir.join(sub).join(&name);
+            let to = damaged_name(&p);
+            match fs::rename(&p, &to) {
+                Ok(()) => {
+                    if p == d.path {
+                        d.moved_to = Some(to);
+                    }
+                }
+                // Another session moved it first, or the batch has no such partner.
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    if p == d.path {
+                        d.moved_to = Some(to);
+                    }
+                }
+                Err(e) => return Err(io(&p)(e)),
+            }
+        }
+        if !out
+            .iter()
+            .any(|o: &Damaged| o.path.file_name() == d.path.file_name())
+        {
+            out.push(d);
+        }
+    }
+    Ok(out)
+}
+
 /// Read the run_id column of every committed runs part.
 pub fn committed_run_ids(runs_dir: &Path) -> Result<HashSet<String>, SinkError> {
     let mut ids = HashSet::new();
@@ -267,6 +385,8 @@ pub struct Sink {
     last_flush: Instant,
     tag: String,
     seq: usize,
+    /// Parts found unreadable when the folder was opened, now moved aside.
+    pub damaged: Vec<Damaged>,
     shared_with_others: bool,
     shared: Arc<Mutex<Shared>>,
     jobs: Option<mpsc::SyncSender<Job>>,
@@ -301,6 +421,7 @@ impl Sink {
             lock.unlock().map_err(io(&lock_path))?;
         }
         lock.lock_shared().map_err(io(&lock_path))?;
+        let damaged = quarantine(dir)?;
         let done = committed_run_ids(&runs_dir)?;
         let stamp = SystemTime::now()
             .duration_since(SystemTime::UNIX_EPOCH)
@@ -324,6 +445,7 @@ impl Sink {
                 last_flush: Instant::now(),
                 tag: format!("{stamp}-{}", std::process::id()),
                 seq: 0,
+                damaged,
                 shared_with_others: !alone,
                 shared,
                 jobs: Some(jobs),
@@ -530,18 +652,15 @@ pub fn read_series(dir: &Path) -> Result<DataFrame, SinkError> {
     read_parts(&dir.join("series"))
 }
 
+/// Unreadable parts are skipped (see [`unreadable_parts`] for the warning).
 fn read_parts(dir: &Path) -> Result<DataFrame, SinkError> {
     let parts = parquet_parts(dir)?;
     let mut frames = Vec::with_capacity(parts.len());
     for p in &parts {
         let file = File::open(p).map_err(io(p))?;
-        let df = ParquetReader::new(file)
-            .finish()
-            .map_err(|source| SinkError::Parquet {
-                path: p.clone(),
-                source,
-            })?;
-        frames.push(df.lazy());
+        if let Ok(df) = ParquetReader::new(file).finish() {
+            frames.push(df.lazy());
+        }
     }
     if frames.is_empty() {
         return Ok(DataFrame::empty());

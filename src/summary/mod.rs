@@ -93,6 +93,8 @@ pub struct Summary {
     pub refinement_paths: usize,
     /// Columns of `DIR/runs` this version does not know (ignored).
     pub ignored_columns: Vec<String>,
+    /// Parts that could not be read and were skipped ([`crate::sink::Damaged::warning`]).
+    pub warnings: Vec<String>,
 }
 
 /// The column choice stored with DIR: the `[summary]` table of the sweep file of DIR's latest
@@ -101,7 +103,16 @@ pub struct Summary {
 /// Errors: an unreadable manifest, or a `[summary]` table this version refuses (a
 /// [`crate::sweep::SweepError`] naming the manifest, the key and the line in the stored text).
 pub fn stored_options(dir: &Path) -> anyhow::Result<SummaryOptions> {
-    match crate::sink::Manifest::latest_sweep(dir)? {
+    let stored = match crate::sink::Manifest::latest_sweep(dir) {
+        Ok(t) => t,
+        // A damaged manifest does not stop the summary: the default columns, and a warning.
+        Err(e @ crate::sink::SinkError::Manifest { .. }) => {
+            eprintln!("warning: {e}; the summary uses the default columns");
+            None
+        }
+        Err(e) => return Err(e.into()),
+    };
+    match stored {
         None => Ok(SummaryOptions::default()),
         Some((text, sets)) => {
             let name = PathBuf::from(format!(
@@ -125,6 +136,11 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
 /// Errors: DIR missing or without runs (the message names the folder), or an I/O failure.
 /// A folder without a refinement axis is not an error: the convergence section says so.
 pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summary> {
+    // Unreadable parts are skipped by the readers below; say which.
+    let warnings: Vec<String> = crate::sink::unreadable_parts(dir)?
+        .iter()
+        .map(|d| d.warning())
+        .collect();
     let runs = runs::load(dir)?;
     let out = dir.join("summary");
     std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
@@ -215,5 +231,6 @@ pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summa
         groups: runs.groups.len(),
         refinement_paths: runs.paths.len(),
         ignored_columns: runs.ignored,
+        warnings,
     })
 }

@@ -41,6 +41,7 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("lame_lambda", Kind::F64),
     ("lame_mu", Kind::F64),
     ("gravity", Kind::F64),
+    ("degree", Kind::I64),
     ("T", Kind::F64),
     ("ensemble_sample", Kind::I64),
     ("ensemble_perturbation", Kind::F64),
@@ -356,25 +357,22 @@ pub(crate) fn read_typed(
     let mut frames = Vec::new();
     for part in crate::sink::parquet_parts(folder)? {
         let file = std::fs::File::open(&part).with_context(|| format!("{}", part.display()))?;
-        let parquet_err =
-            |e: PolarsError| anyhow::Error::new(e).context(format!("{}: parquet", part.display()));
         let mut reader = ParquetReader::new(file);
-        let stored: Vec<String> = reader
-            .schema()
-            .map_err(parquet_err)?
-            .iter_names()
-            .map(|n| n.to_string())
-            .collect();
+        // An unreadable part is skipped: `summarize` warns about it (sink::unreadable_parts).
+        let Ok(schema) = reader.schema() else {
+            continue;
+        };
+        let stored: Vec<String> = schema.iter_names().map(|n| n.to_string()).collect();
         // Read only the known columns (a series part can be large; the rest is never loaded).
         let wanted: Vec<String> = stored
             .iter()
             .filter(|n| known.iter().any(|(k, _)| k == n))
             .cloned()
             .collect();
-        let raw = reader
-            .with_columns(Some(wanted))
-            .finish()
-            .map_err(parquet_err)?;
+        let raw = match reader.with_columns(Some(wanted)).finish() {
+            Ok(raw) => raw,
+            Err(_) => continue,
+        };
         let schema = raw.schema().clone();
         for name in &stored {
             let usable = schema.get(name).is_some_and(castable);

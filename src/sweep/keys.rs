@@ -29,8 +29,10 @@ pub enum Key {
     LameLambda,
     LameMu,
     Gravity,
-    /// Last: ids hash parameters in key order, so new keys go at the end.
+    /// Ids hash parameters in key order, so new keys go at the end.
     ContactInit,
+    /// Polynomial degree of the elements (disc2d/sphere3d: 1 or 2).
+    Degree,
 }
 
 /// What a key's value must look like.
@@ -116,7 +118,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 25] = [
+    pub const ALL: [Key; 26] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -142,6 +144,7 @@ impl Key {
         Key::LameMu,
         Key::Gravity,
         Key::ContactInit,
+        Key::Degree,
     ];
 
     pub fn name(self) -> &'static str {
@@ -171,6 +174,7 @@ impl Key {
             Key::LameMu => "lame_mu",
             Key::Gravity => "gravity",
             Key::ContactInit => "contact_init",
+            Key::Degree => "degree",
         }
     }
 
@@ -186,6 +190,7 @@ impl Key {
                 | Key::LameLambda
                 | Key::LameMu
                 | Key::Gravity
+                | Key::Degree
         )
     }
 
@@ -298,6 +303,13 @@ impl Key {
                 within(*x, 0.0, 1.0)
             }
             (Key::NitscheTheta | Key::Gravity, Value::Num(x)) => finite(*x).map(|_| ()),
+            (Key::Degree, Value::Num(x)) => {
+                if *x == 1.0 || *x == 2.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must be 1 or 2 (Q1 or Q2 elements), got {x}"))
+                }
+            }
             _ => Err("wrong type".into()),
         }
     }

@@ -19,7 +19,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 pub use keys::{Key, Value, ValueType};
-pub use plan::{Plan, RunSpec, expand};
+pub use plan::{Plan, PlanLimits, PlanSize, RunSpec, expand, expand_with};
 use tree::{Kind, Node};
 
 use crate::scene::SceneKind;

@@ -20,6 +20,7 @@ use sha2::{Digest, Sha256};
 use super::keys::canonical_number;
 use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::run::RunConfig;
+use crate::run::estimate::human_bytes;
 use crate::scene::{Physics, Scene, SceneKind};
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
@@ -71,6 +72,8 @@ pub struct ReferencePlan {
 #[derive(Debug, Clone)]
 pub struct Plan {
     pub sweep: SweepFile,
+    /// The limits it was expanded under (its search probes are checked against them too).
+    pub limits: PlanLimits,
     pub runs: Vec<RunSpec>,
     /// Number of raw combinations (before filters and merging).
     pub combinations: usize,
@@ -150,8 +153,14 @@ fn same(a: &Value, b: &Value) -> bool {
     a.canonical() == b.canonical()
 }
 
-/// Resolve one combination of entries for `scene`.
-fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> Outcome {
+/// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
+/// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
+fn resolve(
+    scene_kind: SceneKind,
+    entries: &[&Entry],
+    allow_unstable: bool,
+    limits: &PlanLimits,
+) -> Outcome {
     let scene = scene_kind.get();
     let mut issues = Vec::new();
     let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
@@ -443,6 +452,45 @@ fn resolve(scene_kind: SceneKind, entries: &[&Entry], allow_unstable: bool) -> O
         ContactInit::Consistent
     });
 
+    // Memory before anything is built (the CFL check below assembles the operators).
+    if let Some(budget) = limits.max_run_bytes {
+        let series_every = limits.series_every.unwrap_or(1);
+        let est = config.estimate(series_every);
+        if est.bytes() > budget {
+            let mesh_key = if user.contains_key(&Key::Elements) {
+                Key::Elements
+            } else {
+                Key::H
+            };
+            let (at, advice) = if est.state_bytes >= est.series_bytes {
+                (origin(mesh_key), format!("lower `{}`", mesh_key.name()))
+            } else {
+                (
+                    Origin {
+                        path: "series_every".into(),
+                        line: None,
+                    },
+                    format!(
+                        "raise `series_every` (now {series_every}) or `dt` ({} steps)",
+                        config.steps()
+                    ),
+                )
+            };
+            return Outcome::Invalid(vec![Issue::at(
+                &at,
+                format!(
+                    "the run needs an estimated {} ({:.3e} unknowns, {} steps: {} of operators and state, {} of kept series), above the per-run memory budget of {} (--max-run-memory): {advice}",
+                    human_bytes(est.bytes()),
+                    est.unknowns,
+                    config.steps(),
+                    human_bytes(est.state_bytes),
+                    human_bytes(est.series_bytes),
+                    human_bytes(budget),
+                ),
+            )]);
+        }
+    }
+
     // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
     match config.explicit_dt_limit() {
@@ -582,6 +630,7 @@ fn gcd(a: usize, b: usize) -> usize {
 /// reference must be nested: h_run/h_ref and dt_run/dt_ref whole numbers, and last as long.
 fn reference_of(
     sweep: &SweepFile,
+    limits: &PlanLimits,
     entries: &[&Entry],
     over: &[Entry],
     run: &Resolved,
@@ -608,7 +657,7 @@ fn reference_of(
                 line: None,
             })
     };
-    let r = match resolve(sweep.scene, &combined, false) {
+    let r = match resolve(sweep.scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
@@ -689,9 +738,149 @@ pub fn run_id(scene: SceneKind, canonical: &BTreeMap<Key, String>, extra: &str) 
     digest[..8].iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// Expand a checked sweep file into its plan. Errors found in any combination are reported
-/// together, once each, before anything runs.
+/// What the planner refuses before expanding or running anything.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanLimits {
+    /// Most combinations a plan may have (counted before filters and merging).
+    pub max_runs: u64,
+    /// Most bytes one run may need (its [`crate::run::estimate::Estimate`]); `None`: no check.
+    pub max_run_bytes: Option<f64>,
+    /// The series decimation the runs will use (the sweep's `series_every` unless overridden).
+    pub series_every: Option<usize>,
+    /// Most bytes the expanded plan may hold ([`PLAN_BYTES_PER_RUN`] per combination);
+    /// `None`: no check.
+    pub max_plan_bytes: Option<f64>,
+}
+
+/// Memory of a plan per combination: its spec, parameters, label and id, and the row of the
+/// printed plan table (measured: `plan` of 2·10⁵ runs peaks at 500 MB).
+pub const PLAN_BYTES_PER_RUN: f64 = 2560.0;
+
+/// The default plan-size limit: ten million runs (a plan holds about 1 KiB per run).
+pub const DEFAULT_MAX_RUNS: u64 = 10_000_000;
+
+impl Default for PlanLimits {
+    fn default() -> Self {
+        PlanLimits {
+            max_runs: DEFAULT_MAX_RUNS,
+            max_run_bytes: None,
+            series_every: None,
+            max_plan_bytes: None,
+        }
+    }
+}
+
+/// The size of a plan, computed from the parsed file without expanding it: the product of
+/// the axis lengths (zipped lists count once) times the ensemble samples. In u128, saturating:
+/// thirteen axes of 1000 values already exceed it, and the count only decides a refusal.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanSize {
+    pub combinations: u128,
+    /// (axis as written, its length), the zipped lists first.
+    pub axes: Vec<(String, usize)>,
+}
+
+impl PlanSize {
+    pub fn of(sweep: &SweepFile) -> PlanSize {
+        let mut axes: Vec<(String, usize)> = Vec::new();
+        if let Some(z) = &sweep.zip {
+            let names = z
+                .name
+                .split('+')
+                .map(|n| format!("zip.{n}"))
+                .collect::<Vec<_>>()
+                .join("+");
+            axes.push((names, z.items.len()));
+        }
+        axes.extend(
+            sweep
+                .grid
+                .iter()
+                .map(|a| (format!("grid.{}", a.name), a.items.len())),
+        );
+        if let Some(e) = sweep.ensemble {
+            axes.push(("ensemble.samples".into(), e.samples));
+        }
+        if sweep.search.is_some() {
+            // Every combination becomes the two bracket probes of a search.
+            axes.push(("search (2 probes)".into(), 2));
+        }
+        let combinations = axes
+            .iter()
+            .fold(1u128, |p, (_, n)| p.saturating_mul(*n as u128));
+        PlanSize { combinations, axes }
+    }
+
+    /// "grid.a (1000) × grid.b (1000)".
+    pub fn describe(&self) -> String {
+        self.axes
+            .iter()
+            .map(|(a, n)| format!("{a} ({n})"))
+            .collect::<Vec<_>>()
+            .join(" × ")
+    }
+}
+
+/// Expand a checked sweep file into its plan with the default limits (no memory check).
 pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
+    expand_with(sweep, &PlanLimits::default())
+}
+
+/// Expand a checked sweep file into its plan. The plan's size is checked first, from the file
+/// alone (a plan above `limits.max_runs` is refused before anything is allocated for it);
+/// errors found in any combination are reported together, once each, before anything runs.
+pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, SweepError> {
+    let limits = &PlanLimits {
+        series_every: Some(limits.series_every.unwrap_or(sweep.series_every)),
+        ..*limits
+    };
+    let size = PlanSize::of(sweep);
+    let plan_bytes = size.combinations as f64 * PLAN_BYTES_PER_RUN;
+    let too_big = limits.max_plan_bytes.is_some_and(|b| plan_bytes > b);
+    if size.combinations > limits.max_runs as u128 || too_big {
+        let count = if size.combinations == u128::MAX {
+            "more than 3.4e38".to_string()
+        } else {
+            format!("{} ({:.1e})", size.combinations, size.combinations as f64)
+        };
+        let (key, line) = sweep
+            .grid
+            .iter()
+            .chain(sweep.zip.iter())
+            .max_by_key(|a| a.items.len())
+            .map(|a| {
+                let line = a.items.iter().flatten().find_map(|e| e.origin.line);
+                let section = if sweep.zip.as_ref().is_some_and(|z| z.name == a.name) {
+                    "zip"
+                } else {
+                    "grid"
+                };
+                (format!("{section}.{}", a.name), line)
+            })
+            .unwrap_or(("ensemble.samples".into(), None));
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            sets: sweep.sets.clone(),
+            issues: vec![Issue {
+                line,
+                key,
+                reason: if size.combinations > limits.max_runs as u128 {
+                    format!(
+                        "the sweep has {count} combinations ({}), above the limit of {} runs; shorten the axes, or raise the limit with --max-runs N",
+                        size.describe(),
+                        limits.max_runs
+                    )
+                } else {
+                    format!(
+                        "the sweep has {count} combinations ({}): its plan would hold about {} in memory, more than the {} available to it; split the sweep into several files",
+                        size.describe(),
+                        human_bytes(plan_bytes),
+                        human_bytes(limits.max_plan_bytes.unwrap_or(0.0))
+                    )
+                },
+            }],
+        });
+    }
     let mut axes: Vec<&Axis> = Vec::new();
     if let Some(z) = &sweep.zip {
         axes.push(z);
@@ -740,6 +929,7 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
                         .iter()
                         .collect::<Vec<_>>(),
                     true,
+                    limits,
                 ) {
                     Outcome::Run(r) => r.label.clone(),
                     _ => String::new(),
@@ -760,7 +950,7 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
     let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
     for (owned, search) in &work {
         let entries: Vec<&Entry> = owned.iter().collect();
-        match resolve(sweep.scene, &entries, allow_unstable) {
+        match resolve(sweep.scene, &entries, allow_unstable, limits) {
             Outcome::Invalid(mut is) => issues.append(&mut is),
             Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
@@ -769,7 +959,7 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
                 } else {
                     let reference = match &sweep.reference {
                         None => None,
-                        Some(over) => match reference_of(sweep, &entries, over, &r) {
+                        Some(over) => match reference_of(sweep, limits, &entries, over, &r) {
                             Ok((spec, sx, st)) => {
                                 let id = spec.run_id.clone();
                                 match references.iter_mut().find(|p| p.spec.run_id == id) {
@@ -867,6 +1057,7 @@ pub fn expand(sweep: &SweepFile) -> Result<Plan, SweepError> {
     }
     Ok(Plan {
         sweep: sweep.clone(),
+        limits: *limits,
         runs,
         combinations,
         excluded_by_filter,
@@ -906,12 +1097,12 @@ pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, Swee
         issues,
         sets: sweep.sets.clone(),
     };
-    match resolve(sweep.scene, &entries, true) {
+    match resolve(sweep.scene, &entries, true, &plan.limits) {
         Outcome::Run(r) => {
             let reference = match &sweep.reference {
                 None => None,
                 Some(over) => Some(
-                    reference_of(sweep, &entries, over, &r)
+                    reference_of(sweep, &plan.limits, &entries, over, &r)
                         .map_err(invalid)?
                         .0
                         .run_id,

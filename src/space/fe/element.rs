@@ -1,7 +1,10 @@
-//! Element matrices of the vector Q1 element (bilinear squares, trilinear cubes), isoparametric.
+//! Element matrices of the vector tensor Lagrange elements, isoparametric: Q1 (bilinear squares,
+//! trilinear cubes) and Q2 (9-node quadrilaterals, 27-node hexahedra — the degree-2 elements of
+//! the disc and ball, SPEC §1.3).
 //!
-//! Reference element [−1, 1]^d with the 2^d nodes in tensor order (local node a sits at
-//! ξ_k = −1 if bit k of a is 0, +1 otherwise) and shape functions N_a(ξ) = Π_k (1 + s_ak ξ_k)/2.
+//! Reference element [−1, 1]^d with (p+1)^d nodes in tensor order (local node a has index
+//! i_k = ⌊a/(p+1)^k⌋ mod (p+1) along axis k, at ξ_k = −1 + 2 i_k/p; for Q1 this is bit k of a) and
+//! shape functions N_a(ξ) = Π_k L_{i_k}(ξ_k), the 1D Lagrange polynomials of degree p.
 //! At each quadrature point the Jacobian J = Σ_a x_a ⊗ ∇_ξ N_a maps the reference gradients to
 //! physical ones, ∇N_a = J⁻ᵀ ∇_ξ N_a, and dx = det J dξ — nothing assumes the box's constant
 //! Jacobian, so distorted (mapped) elements use the same code.
@@ -14,7 +17,12 @@
 //! - grad-grad   G_{ai,bj} = δ_ij ∫ ∇N_a·∇N_b (full vector gradient, for H1 error norms),
 //! - load        F_{ai} = ∫ ρ f_i N_a.
 //!
-//! Quadrature: Gauss–Legendre with 2 points per direction. It is exact for the Q1 mass and
+//! Quadrature (Q2): Gauss–Legendre with 3 points per direction (exact to degree 5): exact for
+//! the Q2 matrices on affine elements; on mapped Q2 elements it still integrates det J (degree
+//! ≤ 3 per variable in 2D, ≤ 5 in 3D) and cof(J)ᵀ∇_ξN_a (degree ≤ 3 / ≤ 5) exactly, so the
+//! total mass is the mapped mesh's measure and linear fields pass the patch test to round-off.
+//!
+//! Quadrature (Q1): Gauss–Legendre with 2 points per direction. It is exact for the Q1 mass and
 //! stiffness on squares, rectangles and boxes (integrands of degree ≤ 2 per variable, the rule is
 //! exact to degree 3) — the matrices of SPEC §1.2, never a reduced integration. On distorted
 //! elements the stiffness integrand is rational and the rule is the usual approximation; it still
@@ -23,7 +31,8 @@
 //!
 //! The kernels are generic over the dimension `D`, the node count `NN` and the dof count
 //! `ND = D·NN` (checked at compile time), so the 2D and 3D paths share one code; the concrete
-//! sizes are [`Q1Mat2`] (8×8) and [`Q1Mat3`] (24×24).
+//! sizes are [`Q1Mat2`] (8×8), [`Q1Mat3`] (24×24), [`Q2Mat2`] (18×18) and [`Q2Mat3`] (81×81).
+//! The `q1_*` names are historical: every kernel takes Q1 or Q2 by its node count NN.
 
 use nalgebra::{SMatrix, SVector};
 
@@ -31,6 +40,10 @@ use nalgebra::{SMatrix, SVector};
 pub type Q1Mat2 = SMatrix<f64, 8, 8>;
 /// The 3D Q1 element matrix (8 nodes × 3 components).
 pub type Q1Mat3 = SMatrix<f64, 24, 24>;
+/// The 2D Q2 element matrix (9 nodes × 2 components).
+pub type Q2Mat2 = SMatrix<f64, 18, 18>;
+/// The 3D Q2 element matrix (27 nodes × 3 components).
+pub type Q2Mat3 = SMatrix<f64, 81, 81>;
 
 /// Which element bilinear form to compute (see the module header).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,19 +62,88 @@ const GAUSS2: [(f64, f64); 2] = [
     (0.577_350_269_189_625_8, 1.0),
 ];
 
-/// Q1 shape functions and their reference gradients at ξ.
-fn q1_shape<const D: usize, const NN: usize>(xi: [f64; D]) -> ([f64; NN], [[f64; D]; NN]) {
-    const { assert!(NN == 1 << D) };
+/// Gauss–Legendre rule with `n` points on [−1, 1] (exact to degree 2n − 1), n = 1 … 6: 2 points
+/// for Q1, 3 for Q2 element matrices, 3 (order 5 ≥ 4, SPEC §1.3) on the faces of Γ_C, more for
+/// error norms and the tests' exact measures.
+///
+/// # Panics
+/// If n is 0 or > 6.
+pub fn gauss_legendre(n: usize) -> &'static [(f64, f64)] {
+    const G1: [(f64, f64); 1] = [(0.0, 2.0)];
+    const G3: [(f64, f64); 3] = [
+        (-0.774_596_669_241_483_4, 5.0 / 9.0),
+        (0.0, 8.0 / 9.0),
+        (0.774_596_669_241_483_4, 5.0 / 9.0),
+    ];
+    const G4: [(f64, f64); 4] = [
+        (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+        (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+        (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+    ];
+    const G5: [(f64, f64); 5] = [
+        (-0.906_179_845_938_664, 0.236_926_885_056_189_1),
+        (-0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+        (0.0, 0.568_888_888_888_888_9),
+        (0.538_469_310_105_683_1, 0.478_628_670_499_366_5),
+        (0.906_179_845_938_664, 0.236_926_885_056_189_1),
+    ];
+    const G6: [(f64, f64); 6] = [
+        (-0.932_469_514_203_152, 0.171_324_492_379_170_3),
+        (-0.661_209_386_466_264_5, 0.360_761_573_048_138_6),
+        (-0.238_619_186_083_196_9, 0.467_913_934_572_691_1),
+        (0.238_619_186_083_196_9, 0.467_913_934_572_691_1),
+        (0.661_209_386_466_264_5, 0.360_761_573_048_138_6),
+        (0.932_469_514_203_152, 0.171_324_492_379_170_3),
+    ];
+    match n {
+        1 => &G1,
+        2 => &GAUSS2,
+        3 => &G3,
+        4 => &G4,
+        5 => &G5,
+        6 => &G6,
+        _ => panic!("gauss_legendre: {n} points is not tabulated (1 … 6)"),
+    }
+}
+
+/// Nodes per axis of a tensor Lagrange element with NN nodes in dimension D: 2 (Q1) or 3 (Q2).
+pub const fn nodes_per_axis(d: usize, nn: usize) -> usize {
+    if nn == 1 << d {
+        2
+    } else if nn == 3usize.pow(d as u32) {
+        3
+    } else {
+        panic!("tensor Lagrange elements have 2^d (Q1) or 3^d (Q2) nodes")
+    }
+}
+
+/// One-dimensional Lagrange basis of degree n1 − 1 on the equispaced nodes of [−1, 1] and its
+/// derivative: (1 ∓ ξ)/2 for Q1; ξ(ξ−1)/2, 1 − ξ², ξ(ξ+1)/2 for Q2 (nodes −1, 0, 1).
+pub fn lagrange_1d(n1: usize, i: usize, xi: f64) -> (f64, f64) {
+    match (n1, i) {
+        (2, 0) => (0.5 * (1.0 - xi), -0.5),
+        (2, 1) => (0.5 * (1.0 + xi), 0.5),
+        (3, 0) => (0.5 * xi * (xi - 1.0), xi - 0.5),
+        (3, 1) => (1.0 - xi * xi, -2.0 * xi),
+        (3, 2) => (0.5 * xi * (xi + 1.0), xi + 0.5),
+        _ => panic!("lagrange_1d: node {i} of a {n1}-node basis"),
+    }
+}
+
+/// Tensor Lagrange shape functions (Q1 or Q2, by NN) and their reference gradients at ξ. Local
+/// node a has index i_k = ⌊a / n1^k⌋ mod n1 along axis k (x fastest); for Q1 that is bit k of a.
+pub fn shape<const D: usize, const NN: usize>(xi: [f64; D]) -> ([f64; NN], [[f64; D]; NN]) {
+    let n1 = const { nodes_per_axis(D, NN) };
     let mut n = [0.0; NN];
     let mut dn = [[0.0; D]; NN];
     for a in 0..NN {
-        // One-dimensional factors (1 ± ξ_k)/2 and their derivatives ±1/2.
         let mut f = [0.0; D];
         let mut df = [0.0; D];
+        let mut r = a;
         for k in 0..D {
-            let s = if (a >> k) & 1 == 1 { 1.0 } else { -1.0 };
-            f[k] = 0.5 * (1.0 + s * xi[k]);
-            df[k] = 0.5 * s;
+            (f[k], df[k]) = lagrange_1d(n1, r % n1, xi[k]);
+            r /= n1;
         }
         n[a] = f.iter().product();
         for j in 0..D {
@@ -98,7 +180,7 @@ fn det_inv<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
             }
             det
         }
-        _ => unreachable!("Q1 elements exist in 2D and 3D only"),
+        _ => unreachable!("elements exist in 2D and 3D only"),
     };
     (det, inv)
 }
@@ -109,11 +191,11 @@ fn det_inv<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
 /// # Panics
 /// If det J ≤ 0 (inverted or degenerate element: a mesh construction bug; the structured meshes
 /// never produce one).
-fn map_at<const D: usize, const NN: usize>(
+pub fn map_at<const D: usize, const NN: usize>(
     x: &[[f64; D]; NN],
     xi: [f64; D],
 ) -> ([f64; NN], [[f64; D]; NN], f64) {
-    let (n, dn) = q1_shape::<D, NN>(xi);
+    let (n, dn) = shape::<D, NN>(xi);
     let mut jac = [[0.0; D]; D];
     for a in 0..NN {
         for i in 0..D {
@@ -125,7 +207,7 @@ fn map_at<const D: usize, const NN: usize>(
     let (det, jinv) = det_inv(&jac);
     assert!(
         det > 0.0,
-        "Q1 element with det J = {det} ≤ 0 (inverted or degenerate element)"
+        "element with det J = {det} ≤ 0 (inverted or degenerate element)"
     );
     // ∇N_a = J⁻ᵀ ∇_ξ N_a, i.e. g_i = Σ_j (J⁻¹)_ji ∂_ξj N_a.
     let mut g = [[0.0; D]; NN];
@@ -137,19 +219,35 @@ fn map_at<const D: usize, const NN: usize>(
     (n, g, det)
 }
 
-/// Calls `f(N, ∇N, w·det J)` at each of the 2^D Gauss points of the element with node
-/// coordinates `x`.
+/// Calls `f(N, ∇N, w·det J)` at each Gauss point of the element with node coordinates `x`: the
+/// element's own rule, n1 points per direction (2 for Q1 — exact on boxes, SPEC §1.2 — and 3 for
+/// Q2, which integrates the Q2 mass and stiffness exactly on affine elements and, on mapped
+/// ones, ∫ det J and ∫ cof(J)ᵀ∇_ξN_a exactly: total mass and the patch test hold to round-off).
 fn for_each_point<const D: usize, const NN: usize>(
     x: &[[f64; D]; NN],
+    f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),
+) {
+    for_each_point_with(x, const { nodes_per_axis(D, NN) }, f)
+}
+
+/// Calls `f(N, ∇N, w·det J)` at each point of the tensor Gauss rule with `points` points per
+/// direction (error norms and exact measures use more points than the element matrices).
+pub fn for_each_point_with<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+    points: usize,
     mut f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),
 ) {
-    for q in 0..NN {
+    let rule = gauss_legendre(points);
+    let total = points.pow(D as u32);
+    for q in 0..total {
         let mut xi = [0.0; D];
         let mut w = 1.0;
-        for k in 0..D {
-            let (p, wk) = GAUSS2[(q >> k) & 1];
-            xi[k] = p;
+        let mut r = q;
+        for xk in xi.iter_mut() {
+            let (p, wk) = rule[r % points];
+            *xk = p;
             w *= wk;
+            r /= points;
         }
         let (n, g, det) = map_at(x, xi);
         f(&n, &g, w * det);
@@ -283,7 +381,7 @@ mod tests {
     fn shape_functions_partition_unity() {
         // Σ N_a = 1 and Σ ∇_ξ N_a = 0 at an arbitrary point: exact polynomial identities, so only
         // rounding (a few ulps) remains.
-        let (n, dn) = q1_shape::<3, 8>([0.3, -0.7, 0.1]);
+        let (n, dn) = shape::<3, 8>([0.3, -0.7, 0.1]);
         assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-15);
         for j in 0..3 {
             assert!(dn.iter().map(|d| d[j]).sum::<f64>().abs() < 1e-15);
@@ -299,6 +397,51 @@ mod tests {
         let m: Q1Mat2 = q1_mass(&x, 1.0);
         assert!((k - k.transpose()).amax() < 1e-14);
         assert!((m - m.transpose()).amax() < 1e-14);
+    }
+
+    #[test]
+    fn gauss_rules_are_exact_to_their_degree() {
+        // ∫_{−1}^{1} ξ^k = 2/(k+1) for even k, 0 for odd: exact for k ≤ 2n − 1 up to the rounding
+        // of the tabulated 16-digit nodes and weights (≤ 1e-15).
+        for n in 1..=6 {
+            for k in 0..2 * n {
+                let q: f64 = gauss_legendre(n)
+                    .iter()
+                    .map(|(x, w)| w * x.powi(k as i32))
+                    .sum();
+                let exact = if k % 2 == 0 {
+                    2.0 / (k as f64 + 1.0)
+                } else {
+                    0.0
+                };
+                assert!(
+                    (q - exact).abs() < 1e-15,
+                    "n = {n}, k = {k}: {q} vs {exact}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn q2_shape_functions_are_nodal() {
+        // N_a(ξ_b) = δ_ab at the 27 nodes, Σ N_a = 1 and Σ ∇N_a = 0 anywhere: polynomial
+        // identities with small integers and halves, exact up to a few ulps.
+        for b in 0..27 {
+            let xi = [
+                (b % 3) as f64 - 1.0,
+                ((b / 3) % 3) as f64 - 1.0,
+                (b / 9) as f64 - 1.0,
+            ];
+            let (n, _) = shape::<3, 27>(xi);
+            for (a, na) in n.iter().enumerate() {
+                assert_eq!(*na, if a == b { 1.0 } else { 0.0 });
+            }
+        }
+        let (n, dn) = shape::<2, 9>([0.3, -0.7]);
+        assert!((n.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        for j in 0..2 {
+            assert!(dn.iter().map(|d| d[j]).sum::<f64>().abs() < 1e-15);
+        }
     }
 
     #[test]

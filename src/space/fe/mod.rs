@@ -2,8 +2,13 @@
 //! matrices, and global sparse assembly with the pattern built once and refilled many times.
 //!
 //! - [`mesh`]: the structured box of Q1 squares/cubes (`bar2d`, `bar3d`) behind the [`Mesh`]
-//!   trait (elements = node ids + node coordinates), so mapped meshes plug in later;
-//! - [`element`]: isoparametric Q1 mass, elasticity stiffness, grad-grad and load with nalgebra
+//!   trait (elements = node ids + node coordinates);
+//! - [`ball`]: the block-structured mapped disc (five-block O-grid) and ball (seven-block cubed
+//!   sphere) of `disc2d`/`sphere3d`, Q1 or Q2, with the boundary faces of Γ_C and their
+//!   quadrature;
+//! - [`nitsche`]: the Γ_C quadrature points of the disc/ball with the linear functionals u_n and
+//!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
+//! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
 //!   element weights (the layer-weighted masses of SPEC §2.2) and the matrix operations of a
@@ -13,11 +18,14 @@
 //! (Dirichlet: clamped face, rollers) are dropped from the assembled matrices by [`DofMap`];
 //! the factorisation of the assembled matrices is [`crate::space::linalg`].
 
+pub mod ball;
 pub mod element;
 pub mod mesh;
+pub mod nitsche;
 pub mod sparse;
 
-pub use element::{ElementOp, Q1Mat2, Q1Mat3};
+pub use ball::{BallMesh, BoundaryFace, FacePoint};
+pub use element::{ElementOp, Q1Mat2, Q1Mat3, Q2Mat2, Q2Mat3};
 pub use mesh::{BoxMesh, Mesh};
 pub use sparse::{Pattern, SymMatrix, assemble, assemble_into, assemble_load, fe_pattern};
 

@@ -295,7 +295,7 @@ pub fn assemble<M: Mesh + ?Sized>(
 ///
 /// # Panics
 /// If the pattern does not fit the mesh and dofs (an entry of an element is missing), or the
-/// mesh is not made of 2D quadrilaterals / 3D hexahedra with 4 / 8 nodes.
+/// mesh is not made of Q1 or Q2 quadrilaterals / hexahedra (4, 9 / 8, 27 nodes).
 pub fn assemble_into<M: Mesh + ?Sized>(
     a: &mut SymMatrix,
     mesh: &M,
@@ -312,6 +312,8 @@ pub fn assemble_into<M: Mesh + ?Sized>(
     match (mesh.dim(), mesh.nodes_per_element()) {
         (2, 4) => assemble_generic::<M, 2, 4, 8>(a, mesh, dofs, op, weight),
         (3, 8) => assemble_generic::<M, 3, 8, 24>(a, mesh, dofs, op, weight),
+        (2, 9) => assemble_generic::<M, 2, 9, 18>(a, mesh, dofs, op, weight),
+        (3, 27) => assemble_generic::<M, 3, 27, 81>(a, mesh, dofs, op, weight),
         (d, k) => panic!("assemble: no element for dimension {d} with {k} nodes"),
     }
 }
@@ -381,6 +383,8 @@ pub fn assemble_load<M: Mesh + ?Sized>(
     match (mesh.dim(), mesh.nodes_per_element()) {
         (2, 4) => load_generic::<M, 2, 4, 8>(&mut r, mesh, dofs, rho, f, weight),
         (3, 8) => load_generic::<M, 3, 8, 24>(&mut r, mesh, dofs, rho, f, weight),
+        (2, 9) => load_generic::<M, 2, 9, 18>(&mut r, mesh, dofs, rho, f, weight),
+        (3, 27) => load_generic::<M, 3, 27, 81>(&mut r, mesh, dofs, rho, f, weight),
         (d, k) => panic!("assemble_load: no element for dimension {d} with {k} nodes"),
     }
     r

@@ -1,0 +1,192 @@
+//! Impacts of a disc (2D, plane strain) and a ball (3D) under gravity on a rigid plane
+//! (SPEC §1.3, paper 003 §4.2): `disc2d` and `sphere3d`.
+//!
+//! Diameter 40 (R = 20), λ = μ = 20, ρ = 1, volume load f = −0.1 e_d per unit mass, the lowest
+//! point 5 above the plane x_d = 0 (centre at height R + 5), at rest and unloaded at t = 0,
+//! T = 40. Nothing is clamped; Γ_C is the boundary below the centre. The mesh is the
+//! block-structured mapped disc/ball of [`crate::space::fe::BallMesh`] with elements of degree
+//! `degree` (1 or 2, default 2 — the paper's setting) and nominal size h (the paper: h = 4 in
+//! 2D, h ≈ 8 in 3D). `elements` is the number n_t of elements along a quarter of the boundary
+//! circle (even); h and n_t are linked by n_t = 2·round(πR/(4h)).
+//!
+//! Energies are measured in `energy_scale` = m·|f|·gap, the kinetic energy of the body
+//! reaching the plane in free fall (E⁰ = 0 here). There is no closed form and no reference
+//! run yet: the runs report energies and contact observables, not errors.
+//!
+//! Implemented so far (issue 8, in stages): `mixed`, `nitsche` and `penalty` (κ = E·γ0/h_K)
+//! contact with every mass variant of SPEC §2.2 but the 1D-only two (`singular-dynamic`,
+//! `node-neighbour`), the Newmark / θ schemes, and the hybrid scheme with `nitsche` or
+//! `penalty` (000 §5's reduced hybrid of `mixed` with a massless contact is 1D only).
+//!
+//! Mass variants on the disc/ball: layer 0 = the elements with a node on Γ_C, layer k + 1 their
+//! neighbours (by shared nodes); the layers' masses differ, so `mod2` scales every other
+//! element by m/(m − m₀) and `mod3` gives layer 1 the weight 1 + m₀/m₁ (total mass conserved);
+//! `zero-contact` zeroes the rows and columns of every dof of the Γ_C nodes (003 §4.1.2d, the
+//! paper's "modified mass"). Gravity is F = M_run·f e_d, the load of the run's own mass: the
+//! rigid fall u = ½ f t² e_d then solves M ü + K u = F for every variant (K·rigid = 0, and
+//! the massless rows read 0 = 0), so the free fall stays exact and E⁰ = 0; with `mod1` the
+//! removed mass carries no weight either (m = 1ᵀM1 is the run's `mass_total`). The massless
+//! nodes start at rest at u = 0, which is their quasi-static state (no contact at t = 0), so
+//! `contact_init` changes nothing here.
+
+use super::{ErrorSource, FeGeometry, FeSetup, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use crate::space::fe::BallMesh;
+
+/// Radius of the disc and the ball (diameter 40, SPEC §1.3).
+pub const RADIUS: f64 = 20.0;
+
+/// The scenes `disc2d` (dim 2) and `sphere3d` (dim 3).
+#[derive(Debug, Clone, Copy)]
+pub struct BallScene {
+    pub dim: usize,
+}
+
+const BALL_PHYSICS: [PhysicsKey; 6] = [
+    PhysicsKey {
+        name: "density",
+        default: 1.0,
+    },
+    PhysicsKey {
+        name: "lame_lambda",
+        default: 20.0,
+    },
+    PhysicsKey {
+        name: "lame_mu",
+        default: 20.0,
+    },
+    PhysicsKey {
+        name: "gap",
+        default: 5.0,
+    },
+    PhysicsKey {
+        name: "gravity",
+        default: 0.1,
+    },
+    PhysicsKey {
+        name: "degree",
+        default: 2.0,
+    },
+];
+
+impl Scene for BallScene {
+    fn name(&self) -> &'static str {
+        if self.dim == 2 { "disc2d" } else { "sphere3d" }
+    }
+    fn physics(&self) -> &'static [PhysicsKey] {
+        &BALL_PHYSICS
+    }
+    fn default_t(&self) -> f64 {
+        40.0
+    }
+    fn wave_speed(&self, p: &Physics) -> f64 {
+        ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()
+    }
+    fn mesh_from_h(&self, _p: &Physics, h: f64) -> Result<MeshChoice, String> {
+        if !(h.is_finite() && h > 0.0 && h <= RADIUS) {
+            return Err(format!(
+                "h = {h}: the element size must be in (0, R] with R = {RADIUS}"
+            ));
+        }
+        let (n_t, _) = BallMesh::counts_for_size(RADIUS, h);
+        Ok(MeshChoice { elements: n_t, h })
+    }
+    fn mesh_from_elements(&self, p: &Physics, elements: usize) -> Result<MeshChoice, String> {
+        if elements < 2 || !elements.is_multiple_of(2) {
+            return Err(format!(
+                "elements = {elements}: the number of elements along a quarter circle must be even and ≥ 2"
+            ));
+        }
+        self.mesh_from_h(p, std::f64::consts::PI * RADIUS / (2.0 * elements as f64))
+    }
+    fn supports(
+        &self,
+        space: &str,
+        mass: &str,
+        scheme: &str,
+    ) -> Result<(), (&'static str, String)> {
+        if !matches!(space, "mixed" | "nitsche" | "penalty") {
+            return Err((
+                "space",
+                format!(
+                    "space = {space} is not implemented for scene {} (mixed, nitsche, penalty)",
+                    self.name()
+                ),
+            ));
+        }
+        if matches!(mass, "singular-dynamic" | "node-neighbour") {
+            return Err((
+                "mass",
+                format!(
+                    "mass = {mass} is defined for the 1D bar only (SPEC §2.2); scene {} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact",
+                    self.name()
+                ),
+            ));
+        }
+        if !(matches!(scheme, "newmark" | "theta")
+            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
+        {
+            return Err((
+                "scheme",
+                format!(
+                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
+                    self.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+    fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
+        None
+    }
+    fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
+        let (n_t, n_r) = BallMesh::counts_for_size(RADIUS, mesh.h);
+        let gap = p.get("gap");
+        SceneSetup::Fe(FeSetup {
+            scene: self.name(),
+            dim: self.dim,
+            geometry: FeGeometry::Ball {
+                dim: self.dim,
+                degree: p.get("degree") as usize,
+                radius: RADIUS,
+                centre_height: RADIUS + gap,
+                n_t,
+                n_r,
+            },
+            h: mesh.h,
+            density: p.get("density"),
+            lame_lambda: p.get("lame_lambda"),
+            lame_mu: p.get("lame_mu"),
+            gap,
+            gravity: p.get("gravity"),
+            v0: 0.0,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn physics() -> Physics {
+        Physics(BALL_PHYSICS.iter().map(|k| (k.name, k.default)).collect())
+    }
+
+    #[test]
+    fn paper_meshes_and_wave_speed() {
+        let s = BallScene { dim: 2 };
+        // h = 4: 8 elements per quarter circle (module header of space::fe::ball).
+        assert_eq!(s.mesh_from_h(&physics(), 4.0).unwrap().elements, 8);
+        assert_eq!(s.mesh_from_elements(&physics(), 8).unwrap().elements, 8);
+        assert!(s.mesh_from_elements(&physics(), 7).is_err());
+        assert!(s.mesh_from_h(&physics(), 0.0).is_err());
+        // P-wave speed √((λ+2μ)/ρ) = √60.
+        assert!((s.wave_speed(&physics()) - 60f64.sqrt()).abs() < 1e-14);
+        assert!(s.supports("penalty", "consistent", "hybrid").is_ok());
+        assert!(s.supports("mixed", "consistent", "hybrid").is_err());
+        assert!(s.supports("nitsche", "mod1", "newmark").is_ok());
+        assert!(s.supports("mixed", "zero-contact", "newmark").is_ok());
+        assert!(s.supports("mixed", "zero-contact", "hybrid").is_err());
+        assert!(s.supports("mixed", "singular-dynamic", "newmark").is_err());
+        assert!(s.supports("mixed", "lumped", "theta").is_ok());
+    }
+}
