@@ -322,6 +322,25 @@ fn bar2d_runs_share_one_reference_stored_on_the_coarsest_common_lattice() {
     assert_ne!(ids(&p), ids(&q));
 }
 
+/// Regression: the FE scenes used to expand `contact_init` although both starts coincide there
+/// (the body starts at rest or in free flight), so a sweep over it ran every run twice.
+#[test]
+fn contact_init_over_an_fe_scene_makes_no_duplicate_runs() {
+    for scene in ["bar2d", "disc2d"] {
+        let h = if scene == "bar2d" { 0.05 } else { 4.0 };
+        let p = plan(&format!(
+            "name = \"b\"\nscene = \"{scene}\"\n[fixed]\nh = {h}\ndt = 0.025\nmass = \"mod3\"\n[grid]\ncontact_init = [\"consistent\", \"interpolant\"]\n"
+        ));
+        assert_eq!((p.combinations, p.runs.len()), (2, 1), "{scene}");
+        let reasons: Vec<&String> = p.collapsed.keys().collect();
+        assert!(
+            reasons.len() == 1 && reasons[0].contains("contact_init changes nothing in this scene"),
+            "{scene}: {reasons:?}"
+        );
+        assert!(!p.runs[0].params.contains_key(&Key::ContactInit));
+    }
+}
+
 #[test]
 fn bar2d_refuses_what_it_cannot_model_with_the_key_and_reason() {
     let base = "[fixed]\nh = 0.05\ndt = 0.025\n";

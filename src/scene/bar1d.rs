@@ -51,6 +51,10 @@ impl Bar1dScene {
 }
 
 impl Scene for Bar1dScene {
+    fn contact_init_matters(&self) -> bool {
+        true
+    }
+
     fn name(&self) -> &'static str {
         "bar1d"
     }

@@ -90,6 +90,13 @@ pub trait Scene: Send + Sync {
     /// at fault and the reason (a sweep error, not a silently dropped run).
     fn supports(&self, space: &str, mass: &str, scheme: &str)
     -> Result<(), (&'static str, String)>;
+    /// Whether the start of a massless contact node (`contact_init`) changes anything: only
+    /// where the quasi-static contact value differs from the interpolant of u0 (the 1D bar,
+    /// SPEC §1.1). The FE scenes start at rest or in free flight, where both starts coincide,
+    /// so the key is inapplicable there and a sweep over it makes no duplicate runs.
+    fn contact_init_matters(&self) -> bool {
+        false
+    }
     /// Where the errors come from.
     fn error_source(&self, physics: &Physics) -> Option<ErrorSource>;
     /// The description the engines run.

@@ -305,7 +305,7 @@ fn resolve(
             Key::ThetaScheme => matches!(scheme, Scheme::Theta(_)),
             Key::Restitution => matches!(scheme, Scheme::PaoliSchatzman(_)),
             Key::MassWeights => mass_name == "weights",
-            Key::ContactInit => mass.massless_contact(),
+            Key::ContactInit => mass.massless_contact() && scene.contact_init_matters(),
             _ => true,
         };
         if ok {
@@ -319,7 +319,11 @@ fn resolve(
             Key::ThetaScheme => "applies to the theta scheme only",
             Key::Restitution => "applies to paoli-schatzman only",
             Key::ContactInit => {
-                "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+                if scene.contact_init_matters() {
+                    "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+                } else {
+                    "changes nothing in this scene (its contact nodes start at rest or in free flight, where the quasi-static and interpolant starts coincide)"
+                }
             }
             _ => "applies to mass = weights only",
         })
@@ -446,7 +450,7 @@ fn resolve(
         dt,
         steps,
     )
-    .with_contact_init(if massless {
+    .with_contact_init(if massless && scene.contact_init_matters() {
         contact_init
     } else {
         ContactInit::Consistent
@@ -529,7 +533,7 @@ fn resolve(
     if let MassVariant::Weights(w) = &mass {
         put(Key::MassWeights, Value::List(w.clone()), true);
     }
-    if massless {
+    if massless && scene.contact_init_matters() {
         put(
             Key::ContactInit,
             Value::Str(contact_init.name().into()),
