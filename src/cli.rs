@@ -4,7 +4,7 @@
 //! Exit status: 0 done (failed runs are rows, not errors), 2 bad input (sweep file, flags,
 //! an output folder of another sweep), 1 a runtime failure (I/O).
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -26,7 +26,8 @@ use crate::sweep::{self, Plan, SweepError, SweepFile};
 #[command(
     name = "contact-sweep",
     version,
-    about = "Parameter sweeps of dynamic Signorini-contact simulations, to Parquet and convergence tables"
+    about = "Parameter sweeps of dynamic Signorini-contact simulations, to Parquet and convergence tables",
+    after_help = "Examples:\n  contact-sweep run sweeps/quickstart.toml            # 60 runs, tables and out/quickstart/report.html\n  contact-sweep run --scene bar1d --set h=[0.1,0.05] --set courant=1\n  contact-sweep plan sweeps/003_fig10_ladder.toml\n  contact-sweep report out/quickstart"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -36,15 +37,24 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Expand a sweep file and print its runs, without running anything.
+    #[command(
+        after_help = "Examples:\n  contact-sweep plan sweeps/quickstart.toml\n  contact-sweep plan sweeps/quickstart.toml --set h=[0.1,0.05]   # h becomes an axis\n  contact-sweep plan --scene bar1d --set space=nitsche --set nitsche_gamma0=1e-6"
+    )]
     Plan {
-        /// The sweep file (TOML, see README).
-        sweep: PathBuf,
+        #[command(flatten)]
+        source: SweepArgs,
         #[command(flatten)]
         limits: LimitArgs,
     },
     /// Run a sweep: every run in parallel, results as Parquet under --out.
+    #[command(
+        after_help = "Examples:\n  contact-sweep run sweeps/quickstart.toml                       # → out/quickstart/\n  contact-sweep run sweeps/quickstart.toml --table runs           # every run, not one line per group\n  contact-sweep run sweeps/quickstart.toml --set T=3 --out out/qs-T3\n  contact-sweep run sweeps/quickstart.toml --set grid.h=[0.1,0.05]\n  contact-sweep run --scene bar1d --set h=0.01 --set courant=[0.5,1] --set scheme=hybrid\n  contact-sweep run sweeps/003_fig10_ladder.toml --threads 2 --shard 0/4   # one of four shards"
+    )]
     Run(RunArgs),
     /// Write convergence, energy and speed-against-error tables for a results folder.
+    #[command(
+        after_help = "Examples:\n  contact-sweep summarize out/quickstart\n  contact-sweep summarize out/quickstart --errors err_u_l2h1,err_energy_l2\n  contact-sweep summarize out/quickstart --errors all"
+    )]
     Summarize {
         /// A folder written by `run`.
         dir: PathBuf,
@@ -54,10 +64,25 @@ pub enum Command {
         #[arg(long, value_name = "A,B,…", value_delimiter = ',')]
         errors: Option<Vec<String>>,
     },
+    /// Write one self-contained HTML report of a results folder (figures and tables).
+    #[command(
+        after_help = "Examples:\n  contact-sweep report out/quickstart                      # → out/quickstart/report.html\n  contact-sweep report out/003-fig10-ladder --out fig10.html"
+    )]
+    Report {
+        /// A folder written by `run`.
+        dir: PathBuf,
+        /// The HTML file to write (default: DIR/report.html).
+        #[arg(long, value_name = "FILE.html")]
+        out: Option<PathBuf>,
+    },
     /// Print the output schema (runs and series columns) as Markdown.
+    #[command(after_help = "Examples:\n  contact-sweep schema\n  contact-sweep schema > schema.md")]
     Schema,
     /// What a results folder holds: done, failed and missing runs per shard, damaged files,
     /// sessions, and the command that completes only what is missing.
+    #[command(
+        after_help = "Examples:\n  contact-sweep status out/quickstart\n  contact-sweep status out/003-fig10 --sweep sweeps/003_fig10_ladder.toml"
+    )]
     Status {
         /// A folder written by `run` (or a Slurm array).
         dir: PathBuf,
@@ -66,6 +91,9 @@ pub enum Command {
         sweep: Option<PathBuf>,
     },
     /// Write (and with --submit, submit) a Slurm job array running the sweep in shards.
+    #[command(
+        after_help = "Examples:\n  contact-sweep slurm sweeps/003_fig10_ladder.toml --tasks 8            # writes the scripts, prints the sbatch commands\n  contact-sweep slurm sweeps/000_table1_bar2d.toml --tasks 4 --time 01:00:00 --submit"
+    )]
     Slurm(SlurmArgs),
 }
 
@@ -148,10 +176,41 @@ pub struct SlurmArgs {
     pub limits: LimitArgs,
 }
 
+/// Where a sweep comes from: a file, or `--scene` alone, with `--set` on top.
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// The sweep file (TOML, see README); omit it to give everything with --scene and --set.
+    pub sweep: Option<PathBuf>,
+    /// Without a sweep file: the scene (bar1d, bar2d, bar3d); the sweep is named after it and
+    /// its parameters come from --set.
+    #[arg(long, value_name = "SCENE", conflicts_with = "sweep")]
+    pub scene: Option<String>,
+    /// Set a parameter, replacing the file's: `h=0.01` ([fixed]), `h=[0.01,0.005]` (an axis
+    /// of [grid]), `fixed.h=…`, `grid.h=…`, `zip.dt=…`, `summary.errors=[…]`, `name=…`;
+    /// repeatable, checked like the file. Bare words are strings (`scheme=hybrid`).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub sets: Vec<String>,
+}
+
+impl SweepArgs {
+    /// The checked sweep: the file with the overrides, or the scene with them.
+    pub fn load(&self) -> Result<SweepFile> {
+        match (&self.sweep, &self.scene) {
+            (Some(path), _) => Ok(SweepFile::load_with(path, &self.sets)?),
+            (None, Some(scene)) => Ok(SweepFile::from_flags(scene, &self.sets)?),
+            (None, None) => Err(UsageError(
+                "give a sweep file, or --scene NAME with --set key=value for a sweep without one"
+                    .into(),
+            )
+            .into()),
+        }
+    }
+}
+
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// The sweep file.
-    pub sweep: PathBuf,
+    #[command(flatten)]
+    pub source: SweepArgs,
     /// Output folder (default: out/<sweep name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -183,9 +242,28 @@ pub struct RunArgs {
     /// Slurm submission; the array depends on it).
     #[arg(long)]
     pub references_only: bool,
+    /// The result table at the end: `runs` (one line per run), `groups` (one line per method
+    /// group with its rates), `auto` (groups when the sweep has more than 30 runs).
+    #[arg(long, value_enum, default_value_t = TableMode::Auto, value_name = "MODE")]
+    pub table: TableMode,
     #[command(flatten)]
     pub limits: LimitArgs,
 }
+
+/// What the result table at the end of `run` shows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum TableMode {
+    /// groups when the sweep has more than [`COMPACT_ABOVE`] runs, else runs
+    Auto,
+    /// one line per run
+    Runs,
+    /// one line per method group with its convergence rates
+    Groups,
+}
+
+/// Above this many runs the result table is one line per method group: a screen holds about 50
+/// lines, and a ladder of 60 runs printed run by run pushes the rates off it.
+pub const COMPACT_ABOVE: usize = 30;
 
 /// Bad input detected by the CLI itself.
 #[derive(Debug, thiserror::Error)]
@@ -227,11 +305,12 @@ struct RunConfig {
     batch: BatchPolicy,
     summary: bool,
     references_only: bool,
+    table: TableMode,
 }
 
 impl RunArgs {
     fn validate(self) -> Result<RunConfig> {
-        let sweep = SweepFile::load(&self.sweep)?;
+        let sweep = self.source.load()?;
         let limits = self
             .limits
             .limits(Some(self.series_every.unwrap_or(sweep.series_every)))?;
@@ -274,6 +353,7 @@ impl RunArgs {
             },
             summary: !self.no_summary,
             references_only: self.references_only,
+            table: self.table,
         })
     }
 }
@@ -281,12 +361,12 @@ impl RunArgs {
 /// Run a subcommand.
 pub fn main(cli: Cli) -> Result<ExitCode> {
     match cli.command {
-        Command::Plan { sweep, limits } => {
-            let sf = SweepFile::load(&sweep)?;
+        Command::Plan { source, limits } => {
+            let sf = source.load()?;
             let plan = sweep::expand_with(&sf, &limits.limits(None)?)?;
             print!("{}", plan.summary());
             println!();
-            print!("{}", plan_table(&plan));
+            print!("{}", plan.table());
             Ok(ExitCode::SUCCESS)
         }
         Command::Run(args) => {
@@ -301,6 +381,19 @@ pub fn main(cli: Cli) -> Result<ExitCode> {
                 eprintln!("warning: {w}");
             }
             print!("{}", s.terminal);
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Report { dir, out } => {
+            let r = crate::report::write(&dir, out.as_deref())?;
+            println!(
+                "report: {} ({} KiB, {} figures)",
+                r.path.display(),
+                r.bytes.div_ceil(1024),
+                r.figures
+            );
+            for s in &r.skipped {
+                eprintln!("  not drawn: {s}");
+            }
             Ok(ExitCode::SUCCESS)
         }
         Command::Schema => {
@@ -444,15 +537,24 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             mine.len()
         );
     }
-    let bar = ProgressBar::new(todo.len() as u64);
+    // The bar advances by each run's estimated work (steps × unknowns × repeats, the plan's
+    // cost model), so its ETA is weighted: the last level of a ladder costs ~1000× the first,
+    // and an ETA counting runs would be wrong by that factor for most of the sweep.
+    let work_of = |r: &sweep::RunSpec| (r.config.work() * r.repeats as u64).max(1);
+    let works: HashMap<&str, u64> = todo
+        .iter()
+        .map(|r| (r.run_id.as_str(), work_of(r)))
+        .collect();
+    let bar = ProgressBar::new(works.values().sum());
     if std::io::stderr().is_terminal() {
         bar.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} runs  {msg}  ETA {eta}")
+            ProgressStyle::with_template("{bar:30} {percent:>3}% of the work  {msg}  ETA {eta}")
                 .expect("valid template"),
         );
     } else {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
+    let (total_runs, mut done_runs) = (todo.len(), 0usize);
     // A second signal is left to the default action: the user can still kill a stuck process.
     if let Err(e) = ctrlc::set_handler(|| {
         if INTERRUPTED.swap(true, Ordering::SeqCst) {
@@ -477,8 +579,11 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
                 "diverged" => diverged += 1,
                 _ => failed += 1,
             }
-            bar.set_message(format!("failed {failed}, diverged {diverged}"));
-            bar.inc(1);
+            done_runs += 1;
+            bar.set_message(format!(
+                "{done_runs}/{total_runs} runs, failed {failed}, diverged {diverged}"
+            ));
+            bar.inc(works.get(res.record.run_id.as_str()).copied().unwrap_or(1));
             sink.push(res)
         },
     );
@@ -526,7 +631,22 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     let mut ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
     let probes = searched_ids(dir, plan)?;
     ids.extend(probes.iter().map(String::as_str));
-    print!("{}", result_table(dir, plan, &ids)?);
+    let summarized = cfg.shard.is_none() && cfg.summary;
+    let per_run = match cfg.table {
+        TableMode::Runs => true,
+        TableMode::Groups => false,
+        TableMode::Auto => ids.len() <= COMPACT_ABOVE,
+    };
+    if per_run {
+        print!("{}", result_table(dir, plan, &ids)?);
+    } else if !summarized {
+        // The group lines come with the summary; without it, say where the results are.
+        println!(
+            "{} runs: `contact-sweep summarize {}` for the table by method group, or --table runs",
+            ids.len(),
+            dir.display()
+        );
+    }
     if cfg.shard.is_some() {
         eprintln!(
             "(a shard: run `contact-sweep summarize {}` once every shard is done)",
@@ -536,6 +656,13 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         match summary::summarize_with(dir, &plan.sweep.summary) {
             Ok(s) => print!("{}", s.terminal),
             Err(e) => eprintln!("summary not written: {e:#}"),
+        }
+        match crate::report::write(dir, None) {
+            Ok(r) => println!(
+                "report: {} — open it in a browser: figures and every table",
+                r.path.display()
+            ),
+            Err(e) => eprintln!("report not written: {e:#}"),
         }
     }
     Ok(ExitCode::SUCCESS)
@@ -676,73 +803,11 @@ fn slurm(args: SlurmArgs) -> Result<ExitCode> {
 }
 
 fn fmt_num(x: Option<f64>) -> String {
-    match x {
-        Some(v) if v.is_finite() => format!("{v:.4e}"),
-        Some(v) => format!("{v}"),
-        None => "—".into(),
-    }
+    x.map(summary::eng).unwrap_or_else(|| "—".into())
 }
 
-/// The plan as a table of the parameters that vary between runs.
-fn plan_table(plan: &Plan) -> String {
-    let keys = plan.varying_keys();
-    let mut header: Vec<String> = vec!["#".into(), "run_id".into(), "label".into()];
-    header.extend(keys.iter().map(|k| k.name().to_string()));
-    // steps × unknowns: what a run costs, to see where the time of a sweep goes before running it
-    header.push("work".into());
-    let mut total = 0u64;
-    let mut rows: Vec<Vec<String>> = plan
-        .runs
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let mut row = vec![i.to_string(), r.run_id.clone(), r.label.clone()];
-            row.extend(keys.iter().map(|k| {
-                r.params
-                    .get(k)
-                    .map(|v| v.to_string())
-                    .unwrap_or_else(|| "—".into())
-            }));
-            let work = r.config.work() * r.repeats as u64;
-            total += work;
-            row.push(format!("{work:.2e}", work = work as f64));
-            row
-        })
-        .collect();
-    let mut last = vec![String::new(); header.len()];
-    last[2] = "total".into();
-    *last.last_mut().expect("a column") = format!("{:.2e}", total as f64);
-    rows.push(last);
-    render(&header, &rows)
-}
-
-fn render(header: &[String], rows: &[Vec<String>]) -> String {
-    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
-    for r in rows {
-        for (w, c) in width.iter_mut().zip(r) {
-            *w = (*w).max(c.chars().count());
-        }
-    }
-    let line = |cells: &[String]| {
-        let mut s = String::new();
-        for (i, (c, w)) in cells.iter().zip(&width).enumerate() {
-            if i > 0 {
-                s.push_str("  ");
-            }
-            s.push_str(c);
-            s.push_str(&" ".repeat(w - c.chars().count()));
-        }
-        s.trim_end().to_string() + "\n"
-    };
-    let mut out = line(header);
-    out.push_str(&line(
-        &width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
-    ));
-    for r in rows {
-        out.push_str(&line(r));
-    }
-    out
-}
+/// The legend of the per-run result table: every abbreviated column.
+const RESULT_LEGEND: &str = "  E(T)/E0: final over initial discrete energy · l2(τ;L2), l2(τ;H1): displacement error in l2(0,T;L2), l2(0,T;H1) · σ½ l2(τ): contact pressure error at the midpoints t^(n+½), l2(0,T)\n";
 
 /// Per-run results of this sweep, in plan order, read back from the Parquet parts.
 fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> {
@@ -799,16 +864,18 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
             continue;
         };
         let ratio = e0[j].zip(ef[j]).map(|(a, b)| b / a);
-        let p = |k: sweep::Key| r.params.get(&k).map(|v| v.to_string()).unwrap_or_default();
+        let p = |k: sweep::Key| match r.params.get(&k) {
+            Some(sweep::Value::Num(x)) => summary::eng(*x),
+            Some(v) => v.to_string(),
+            None => String::new(),
+        };
         rows.push(vec![
             i.to_string(),
             r.label.clone(),
             p(sweep::Key::H),
             p(sweep::Key::Dt),
             status[j].clone().unwrap_or_default(),
-            ratio
-                .map(|x| format!("{x:.4}"))
-                .unwrap_or_else(|| "—".into()),
+            fmt_num(ratio),
             fmt_num(l2[j]),
             fmt_num(h1[j]),
             fmt_num(sig[j]),
@@ -817,7 +884,9 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
     if rows.is_empty() {
         bail!("no result rows found in {}", dir.display());
     }
-    Ok(render(&header, &rows))
+    let mut out = sweep::render_table(&header, &rows);
+    out.push_str(RESULT_LEGEND);
+    Ok(out)
 }
 
 /// The schema of DIR/runs and DIR/series as Markdown tables (the README's are generated here).

@@ -22,6 +22,8 @@
 //!   ([`exec::slurm`]).
 //! - [`sink`] — atomic Parquet parts, resume, manifest, several shards writing one folder.
 //! - [`summary`] — convergence rates, energy drift and speed-against-error tables.
+//! - [`report`] — one self-contained HTML file of a results folder: the summary's tables and
+//!   figures drawn in Rust (plotters, inline SVG).
 //! - [`cli`] — command-line flags and their validation into the types above.
 
 // Index loops mirror the formulas of the papers (x_i, M_{i,i+1}); iterator chains would hide them.
@@ -30,6 +32,7 @@
 pub mod cli;
 pub mod contact;
 pub mod exec;
+pub mod report;
 pub mod run;
 pub mod scene;
 pub mod sink;

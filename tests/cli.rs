@@ -34,6 +34,53 @@ fn quickstart_runs_and_prints_errors_against_the_exact_solution() {
         stdout.contains("l2(τ;L2)") && stdout.contains("l2(τ;H1)"),
         "{stdout}"
     );
+    // The terminal output fits one screen: 60 runs > 30, so one line per method group with its
+    // rates, a legend line for every abbreviated column, and what to look at.
+    let all = format!("{}{stdout}", String::from_utf8_lossy(&o.stderr));
+    let lines = all.lines().count();
+    assert!(lines <= 50, "{lines} lines:\n{all}");
+    let groups = [
+        "mixed · consistent · crank-nicolson",
+        "mixed · mod3 · crank-nicolson",
+        "mixed · mod3 · hybrid",
+        "mixed · zero-contact · crank-nicolson",
+        "nitsche(Θ=1, γ0=1e-6) · consistent · crank-nicolson",
+        "nitsche(Θ=1, γ0=1e-6) · consistent · hybrid",
+    ];
+    for (k, g) in groups.iter().enumerate() {
+        // the group's line: its number, title and path, then its rates
+        let line = stdout
+            .lines()
+            .find(|l| {
+                l.trim_start()
+                    .strip_prefix(&(k + 1).to_string())
+                    .is_some_and(|rest| rest.trim_start().starts_with(&format!("{g} ")))
+            })
+            .unwrap_or_else(|| panic!("no line for group {g}:\n{stdout}"));
+        assert!(line.contains("ν=0.5, h↓") && line.contains("5/5"), "{line}");
+    }
+    for legend in [
+        "l2(τ;L2): displacement error in l2(0,T;L2)",
+        "l2(τ;H1): displacement error in l2(0,T;H1)",
+        "σ½ l2(τ): contact pressure error at the midpoints",
+        "E l2(τ): energy error",
+        "E(T)/E⁰: final over initial discrete energy",
+        "rate letters: p pre-asymptotic",
+        "path: the value held fixed",
+    ] {
+        assert!(stdout.contains(legend), "no legend `{legend}`:\n{stdout}");
+    }
+    assert!(stdout.contains("look at:"), "{stdout}");
+    // zero-contact + CN converges fastest in l2(τ;H1) (README: rate ≈ 0.4 at ν = 0.5)
+    assert!(
+        stdout.contains("highest l2(τ;H1) rate: 0.42 (group 4"),
+        "{stdout}"
+    );
+    // One engineering format: no `e0` exponents, no five-digit mantissas.
+    assert!(
+        !stdout.contains("e0 ") && !stdout.contains("1.0025"),
+        "{stdout}"
+    );
     let df = read_runs(&out).unwrap();
     assert!(df.height() >= 50, "quickstart has {} runs", df.height());
     // Every run has its errors against the closed form, and its derived columns filled.
@@ -448,4 +495,71 @@ fn run_prints_the_columns_of_the_sweeps_summary_table() {
             && !md.contains("| flags |"),
         "{md}"
     );
+}
+
+#[test]
+fn table_flag_chooses_runs_or_groups() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"t\"\nscene = \"bar1d\"\n[fixed]\nT = 1.0\ncourant = 1.0\n[grid]\nh = [0.25, 0.125, 0.0625]\nmass = [\"consistent\", \"mod3\"]\n",
+    );
+    // 6 runs ≤ 30: every run by default, with the legend of its columns.
+    let o = cli(tmp.path(), &["run", "s.toml", "--out", "a"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let run_lines = out.lines().filter(|l| l.contains("  ok  ")).count();
+    assert_eq!(run_lines, 6, "{out}");
+    assert!(out.contains("σ½ l2(τ): contact pressure error"), "{out}");
+    // --table groups: no per-run line, one line per group.
+    let o = cli(
+        tmp.path(),
+        &["run", "s.toml", "--out", "b", "--table", "groups"],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert_eq!(
+        out.lines().filter(|l| l.contains("  ok  ")).count(),
+        0,
+        "{out}"
+    );
+    assert!(
+        out.contains("1  mixed · consistent · crank-nicolson"),
+        "{out}"
+    );
+    assert!(out.contains("2  mixed · mod3 · crank-nicolson"), "{out}");
+    // A bad mode is a usage error (clap: exit 2) naming the accepted values.
+    let o = cli(tmp.path(), &["run", "s.toml", "--table", "all"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("runs"));
+}
+
+#[test]
+fn every_subcommand_help_ends_with_examples() {
+    for sub in [
+        "plan",
+        "run",
+        "summarize",
+        "schema",
+        "slurm",
+        "report",
+        "status",
+    ] {
+        let o = cli(repo(), &[sub, "--help"]);
+        assert!(o.status.success(), "{sub}");
+        let help = String::from_utf8_lossy(&o.stdout);
+        let tail = help.trim_end();
+        let at = tail
+            .rfind("Examples:")
+            .unwrap_or_else(|| panic!("{sub}: {help}"));
+        // the examples are the last block, each line a command
+        assert!(
+            tail[at..]
+                .lines()
+                .skip(1)
+                .all(|l| l.trim_start().starts_with("contact-sweep ")),
+            "{sub}: {help}"
+        );
+    }
 }

@@ -366,6 +366,7 @@ fn check(text: &str, counts: &mut Counts) -> Result<(), String> {
             let msg = SweepError::Invalid {
                 file: "fuzz.toml".into(),
                 issues,
+                sets: Vec::new(),
             }
             .to_string();
             if !msg

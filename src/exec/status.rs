@@ -148,12 +148,21 @@ fn sweep_of(
                 Some((
                     x["sweep_text"].as_str()?.to_string(),
                     x["sweep_file"].as_str().map(PathBuf::from),
+                    // `--set key=value` applied on top of the text (issue 11)
+                    x["overrides"]
+                        .as_array()
+                        .map(|a| {
+                            a.iter()
+                                .filter_map(|v| v.as_str().map(String::from))
+                                .collect::<Vec<_>>()
+                        })
+                        .unwrap_or_default(),
                 ))
             })
         })
     });
     let frozen = dir.join("slurm/sweep.toml");
-    let Some((text, file)) = latest else {
+    let Some((text, file, sets)) = latest else {
         if frozen.exists() {
             return Ok(SweepFile::load(&frozen)?);
         }
@@ -173,7 +182,7 @@ fn sweep_of(
             copy
         }
     };
-    Ok(SweepFile::parse(&path, &text)?)
+    Ok(SweepFile::parse_with(&path, &text, &sets)?)
 }
 
 /// Tell the state of DIR.

@@ -115,6 +115,12 @@ impl Manifest {
     /// The sweep file's text of DIR's latest session that recorded one (`None` without a
     /// manifest or without such a session): where `summarize DIR` finds the `[summary]` table.
     pub fn latest_sweep_text(dir: &Path) -> Result<Option<String>, SinkError> {
+        Ok(Manifest::latest_sweep(dir)?.map(|(text, _)| text))
+    }
+
+    /// The sweep file's text of DIR's latest session that recorded one, with the `--set`
+    /// arguments that session applied on top of it (empty for sessions of older versions).
+    pub fn latest_sweep(dir: &Path) -> Result<Option<(String, Vec<String>)>, SinkError> {
         let path = dir.join("manifest.json");
         if !path.exists() {
             return Ok(None);
@@ -128,9 +134,18 @@ impl Manifest {
             message: e.to_string(),
         })?;
         Ok(doc["sessions"].as_array().and_then(|s| {
-            s.iter()
-                .rev()
-                .find_map(|x| x["sweep_text"].as_str().map(String::from))
+            s.iter().rev().find_map(|x| {
+                let text = x["sweep_text"].as_str()?.to_string();
+                let sets = x["overrides"]
+                    .as_array()
+                    .map(|a| {
+                        a.iter()
+                            .filter_map(|v| v.as_str().map(String::from))
+                            .collect()
+                    })
+                    .unwrap_or_default();
+                Some((text, sets))
+            })
         }))
     }
 
@@ -165,6 +180,8 @@ impl Manifest {
             "shard": shard,
             "sweep_file": plan.sweep.path.display().to_string(),
             "sweep_text": plan.sweep.text,
+            // `--set key=value` applied on top of sweep_text, in order.
+            "overrides": plan.sweep.sets,
             "runs_planned": planned,
             "runs_skipped_as_done": skipped,
             "runs_written": 0,

@@ -192,8 +192,8 @@ fn path_errors(runs: &Runs, p: &RefPath) -> Vec<usize> {
         .collect()
 }
 
-/// Errors printed on the terminal (the rest is in the files).
-const TERMINAL_ERRORS: &[&str] = &["err_u_l2l2", "err_u_l2h1", "err_sigma_mid_l2"];
+/// At most this many error columns on the terminal (the rest is in the files).
+const TERMINAL_ERRORS: usize = 4;
 
 /// The message when nothing can be fitted.
 pub const NO_REFINEMENT: &str = "no refinement axis: every group has a single (h, dt) level";
@@ -206,6 +206,10 @@ pub(crate) struct Section {
     pub latex: String,
     pub latex_doc: String,
     pub terminal: String,
+    /// One line per method group, with its legend and hints (terminal and report).
+    pub groups: GroupTable,
+    /// The error columns the text tables show (indices into [`Runs::errors`]).
+    pub display: Vec<usize>,
 }
 
 /// The error columns the text tables show: the chosen ones that have values in the folder
@@ -295,28 +299,270 @@ fn columns(runs: &Runs) -> Vec<(String, Kind)> {
     c
 }
 
-fn short_flags(f: &Fit) -> String {
-    let mut s = Vec::new();
-    if f.used < 2 {
-        s.push("no fit".to_string());
+/// A group's main refinement path: its index and the fits of its error columns.
+type MainPath = (usize, Vec<(usize, Fit)>);
+
+/// The flags of a fit as letters after its rate on the terminal (explained by the legend):
+/// p pre-asymptotic, s stagnating, r round-off floor, f failed levels, n no fit.
+fn flag_letters(f: &Fit) -> String {
+    let mut s = String::new();
+    for (on, c) in [
+        (f.used < 2, 'n'),
+        (f.pre_asymptotic, 'p'),
+        (f.stagnating, 's'),
+        (f.roundoff, 'r'),
+        (f.failed > 0, 'f'),
+    ] {
+        if on {
+            s.push(c);
+        }
     }
-    if f.pre_asymptotic {
-        s.push("pre-asym".into());
+    s
+}
+
+/// E(T)/E⁰ of a run (None without both energies).
+fn energy_ratio(r: &super::runs::Run) -> Option<f64> {
+    r.energy_initial
+        .zip(r.energy_final)
+        .map(|(a, b)| b / a)
+        .filter(|x| x.is_finite())
+}
+
+/// The terminal's view of the convergence section: one line per method group with the LSQ
+/// slopes of its longest refinement path (or, when no group is refined, its errors), a legend
+/// for every abbreviation, and the hints of "what to look at". `main[g]` is group g's main path
+/// and its fits; `hidden` the other paths; `single` the groups with one (h, dt) level.
+fn group_lines(
+    runs: &Runs,
+    display: &[usize],
+    main: &[Option<MainPath>],
+    hidden: usize,
+    single: usize,
+) -> GroupTable {
+    let mut out = String::new();
+    let mut hints = Vec::new();
+    let shown: Vec<usize> = display.iter().copied().take(TERMINAL_ERRORS).collect();
+    let main_paths: Vec<Option<usize>> = main.iter().map(|m| m.as_ref().map(|(p, _)| *p)).collect();
+    if runs.groups.is_empty() {
+        return GroupTable {
+            main_paths,
+            ..GroupTable::default()
+        };
     }
-    if f.stagnating {
-        s.push("stagnating".into());
-    }
-    if f.roundoff {
-        s.push("round-off".into());
-    }
-    if f.failed > 0 {
-        s.push(format!("{} failed", f.failed));
-    }
-    if s.is_empty() {
-        "-".into()
+    let refined = main.iter().any(Option::is_some);
+    let mut header: Vec<String> = vec!["#".into(), "method".into()];
+    let mut align = vec![Align::Right, Align::Left];
+    if refined {
+        header.extend(["path".into(), "levels".into()]);
+        align.extend([Align::Left, Align::Right]);
     } else {
-        s.join(", ")
+        header.push("runs".into());
+        align.push(Align::Right);
     }
+    for &e in &shown {
+        header.push(table::error_abbrev(runs.errors[e]).0.to_string());
+        align.push(Align::Right);
+    }
+    header.push("E(T)/E⁰".into());
+    align.push(Align::Right);
+    let mut rows = Vec::new();
+    // (group, rate) per shown column, and (group, E(T)/E⁰) — for the hints.
+    let mut best: Vec<Option<(usize, f64)>> = vec![None; shown.len()];
+    let mut stagnating: Vec<usize> = Vec::new();
+    let mut ratios: Vec<(usize, f64)> = Vec::new();
+    for (g, grp) in runs.groups.iter().enumerate() {
+        let mut row = vec![(g + 1).to_string(), grp.title.clone()];
+        let ratio;
+        match &main[g] {
+            Some((pi, fits)) => {
+                let p = &runs.paths[*pi];
+                let used = shown
+                    .iter()
+                    .find_map(|e| fits.iter().find(|(x, _)| x == e))
+                    .map(|(_, f)| f.used)
+                    .unwrap_or(0);
+                row.push(p.fixed.short());
+                row.push(format!("{used}/{}", p.levels.len()));
+                let mut stag = false;
+                for (k, e) in shown.iter().enumerate() {
+                    match fits.iter().find(|(x, _)| x == e) {
+                        Some((_, f)) => {
+                            let letters = flag_letters(f);
+                            stag |= f.stagnating;
+                            if let Some(r) = f.slope_all.filter(|r| r.is_finite())
+                                && best[k].is_none_or(|(_, b)| r > b)
+                            {
+                                best[k] = Some((g, r));
+                            }
+                            // Letters padded so that the rates stay right-aligned.
+                            row.push(format!("{} {letters:<2}", table::rate(f.slope_all)));
+                        }
+                        None => row.push("—".into()),
+                    }
+                }
+                if stag {
+                    stagnating.push(g);
+                }
+                ratio = p
+                    .levels
+                    .iter()
+                    .rev()
+                    .map(|&(_, i)| &runs.runs[i])
+                    .find(|r| r.ok())
+                    .and_then(energy_ratio);
+            }
+            None => {
+                // Not refined: the errors of the group's first ok run (a single level; several
+                // runs only as ensemble members or repeats).
+                let r = grp
+                    .runs
+                    .iter()
+                    .map(|&i| &runs.runs[i])
+                    .find(|r| r.ok())
+                    .unwrap_or(&runs.runs[grp.runs[0]]);
+                if refined {
+                    row.extend(["single level".into(), "1".into()]);
+                    row.extend(shown.iter().map(|_| "—".to_string()));
+                } else {
+                    row.push(format!(
+                        "{}/{}",
+                        grp.runs.iter().filter(|&&i| runs.runs[i].ok()).count(),
+                        grp.runs.len()
+                    ));
+                    row.extend(shown.iter().map(|&e| table::eng_opt(r.errors[e])));
+                }
+                ratio = if r.ok() { energy_ratio(r) } else { None };
+            }
+        }
+        if let Some(x) = ratio {
+            ratios.push((g, x));
+        }
+        row.push(table::eng_opt(ratio));
+        rows.push(row);
+    }
+    if refined {
+        let _ = writeln!(
+            out,
+            "convergence rates by method group (LSQ slope of log e against log h or dt over the group's longest refinement path):"
+        );
+    } else {
+        let _ = writeln!(out, "errors by method group (no refinement path):");
+    }
+    out.push_str(&table::plain(&header, &align, &rows));
+    // Legend: every abbreviation of the table, one per line for the error columns.
+    let mut legend: Vec<String> = Vec::new();
+    if refined {
+        legend.push(
+            "path: the value held fixed and the axis refined (ν Courant number, h↓ h refined); levels: usable/all".into(),
+        );
+        legend.push(format!(
+            "rate letters: p pre-asymptotic (pair rates spread > {PRE_ASYMPTOTIC_SPREAD}), s stagnating (finest-three slope < {STAGNATION_SLOPE}), r round-off floor, f failed levels, n no fit"
+        ));
+    }
+    // Two error columns per legend line: the legend must not push the table off the screen.
+    let entries: Vec<String> = shown
+        .iter()
+        .map(|&e| {
+            let (a, what) = table::error_abbrev(runs.errors[e]);
+            format!("{a}: {what} ({})", runs.errors[e])
+        })
+        .collect();
+    for pair in entries.chunks(2) {
+        legend.push(pair.join(" · "));
+    }
+    legend.push(if refined {
+        "E(T)/E⁰: final over initial discrete energy at the path's finest ok level".into()
+    } else {
+        "E(T)/E⁰: final over initial discrete energy".into()
+    });
+    for l in &legend {
+        let _ = writeln!(out, "  {l}");
+    }
+    if hidden > 0 || single > 0 {
+        let mut parts = Vec::new();
+        if hidden > 0 {
+            parts.push(format!(
+                "{hidden} other refinement path{} in convergence.md",
+                if hidden == 1 { "" } else { "s" }
+            ));
+        }
+        if single > 0 && refined {
+            parts.push(format!(
+                "{single} of {} groups with a single (h, dt) level",
+                runs.groups.len()
+            ));
+        }
+        if !parts.is_empty() {
+            let _ = writeln!(out, "  ({})", parts.join("; "));
+        }
+    }
+    // Hints: the best rate of the first two columns, the stagnating groups, the energy range.
+    for (k, b) in best.iter().enumerate().take(2) {
+        if let Some((g, r)) = b {
+            hints.push(format!(
+                "highest {} rate: {} (group {}, {})",
+                table::error_abbrev(runs.errors[shown[k]]).0,
+                table::rate(Some(*r)),
+                g + 1,
+                runs.groups[*g].title
+            ));
+        }
+    }
+    if !stagnating.is_empty() {
+        hints.push(format!(
+            "stagnating (s): group{} {} — refining does not reduce some error there",
+            if stagnating.len() == 1 { "" } else { "s" },
+            stagnating
+                .iter()
+                .map(|g| (g + 1).to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    let gained: Vec<String> = ratios
+        .iter()
+        .filter(|(_, x)| *x > 1.0 + 1e-3)
+        .map(|(g, _)| (g + 1).to_string())
+        .collect();
+    if !gained.is_empty() {
+        hints.push(format!(
+            "energy gained (E(T)/E⁰ > 1.001): group{} {}",
+            if gained.len() == 1 { "" } else { "s" },
+            gained.join(", ")
+        ));
+    }
+    GroupTable {
+        caption: if refined {
+            "convergence rates by method group (LSQ slope of log e against log h or dt over the group's longest refinement path)".into()
+        } else {
+            "errors by method group (no refinement path)".into()
+        },
+        header,
+        right: align.iter().map(|a| matches!(a, Align::Right)).collect(),
+        rows,
+        legend,
+        hints,
+        terminal: out,
+        main_paths,
+    }
+}
+
+/// The table of one line per method group (terminal and report), its legend and the hints.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct GroupTable {
+    pub caption: String,
+    pub header: Vec<String>,
+    /// Right-aligned columns.
+    pub right: Vec<bool>,
+    pub rows: Vec<Vec<String>>,
+    /// One line per abbreviation of the table.
+    pub legend: Vec<String>,
+    /// What to look at first, one sentence each.
+    pub hints: Vec<String>,
+    /// The table as the terminal prints it (caption, table, legend, notes).
+    pub terminal: String,
+    /// Per group: its main refinement path (index into [`Runs::paths`]), if refined.
+    pub main_paths: Vec<Option<usize>>,
 }
 
 /// Build the convergence section; `title` heads the stand-alone LaTeX document.
@@ -326,10 +572,9 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
     let mut tex_notes: Vec<String> = Vec::new();
     let mut tex_paths: Vec<latex::PathTex> = Vec::new();
     let (display, notes) = displayed(runs, opts);
-    let mut term_rows: Vec<Vec<String>> = Vec::new();
     let mut hidden = 0usize;
-    let mut last_group: Option<usize> = None;
-    let mut last_path: Option<usize> = None;
+    // Per group: its main refinement path (index) and the fits of its error columns.
+    let mut main: Vec<Option<MainPath>> = vec![None; runs.groups.len()];
 
     md.push_str("# Convergence\n\n");
     let _ = writeln!(
@@ -630,8 +875,8 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
             });
         }
 
-        // Terminal: the LSQ slopes of the main error columns, for the longest paths of each
-        // group only (a grid of h × dt also yields many two-level paths; they are in the files).
+        // Terminal: one line per group, from its longest refinement path (the first of equal
+        // length); a grid of h × dt also yields many two-level paths, they are in the files.
         let longest = runs
             .paths
             .iter()
@@ -639,89 +884,15 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
             .map(|q| q.levels.len())
             .max()
             .unwrap_or(0);
-        if p.levels.len() < longest {
+        if p.levels.len() < longest || main[g].is_some() {
             hidden += 1;
             continue;
         }
-        let mut on_terminal: Vec<&(usize, Fit)> = fits
-            .iter()
-            .filter(|(e, _)| TERMINAL_ERRORS.contains(&runs.errors[*e]))
-            .collect();
-        if on_terminal.is_empty() {
-            on_terminal = fits.iter().take(1).collect();
-        }
-        for (e, f) in on_terminal {
-            // The group's number and title once, on its first line.
-            let first_of_group = last_group != Some(g);
-            last_group = Some(g);
-            let first_of_path = last_path != Some(pi);
-            last_path = Some(pi);
-            term_rows.push(vec![
-                if first_of_group {
-                    (g + 1).to_string()
-                } else {
-                    String::new()
-                },
-                if first_of_group {
-                    runs.groups[g].title.clone()
-                } else {
-                    String::new()
-                },
-                if first_of_path {
-                    p.fixed.short()
-                } else {
-                    String::new()
-                },
-                format!("{}/{}", f.used, p.levels.len()),
-                runs.errors[*e].to_string(),
-                table::rate(f.slope_all),
-                table::rate(f.slope_fine3),
-                short_flags(f),
-            ]);
-        }
+        main[g] = Some((pi, fits));
     }
 
-    if !term_rows.is_empty() {
-        let _ = writeln!(
-            terminal,
-            "convergence: {} refinement path{} in {} group{} (LSQ slopes of log e vs log h or dt; every column in convergence.parquet)",
-            runs.paths.len(),
-            if runs.paths.len() == 1 { "" } else { "s" },
-            runs.groups.len(),
-            if runs.groups.len() == 1 { "" } else { "s" },
-        );
-        let header: Vec<String> = [
-            "#", "method", "path", "used", "error", "slope", "finest3", "flags",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let align = [
-            Align::Right,
-            Align::Left,
-            Align::Left,
-            Align::Right,
-            Align::Left,
-            Align::Right,
-            Align::Right,
-            Align::Left,
-        ];
-        terminal.push_str(&table::plain(&header, &align, &term_rows));
-        if hidden > 0 {
-            let _ = writeln!(
-                terminal,
-                " ({hidden} shorter refinement path{} not shown; all are in convergence.md)",
-                if hidden == 1 { "" } else { "s" }
-            );
-        }
-        if single > 0 {
-            let _ = writeln!(
-                terminal,
-                " ({single} of {} groups have a single (h, dt) level)",
-                runs.groups.len()
-            );
-        }
-    }
+    let groups = group_lines(runs, &display, &main, hidden, single);
+    terminal.push_str(&groups.terminal);
     let tex = latex::render(runs, opts, &display, &tex_paths, &tex_notes, title);
     Section {
         table: t,
@@ -729,5 +900,7 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
         latex: tex.fragment,
         latex_doc: tex.document,
         terminal,
+        groups,
+        display,
     }
 }

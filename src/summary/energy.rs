@@ -707,10 +707,10 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         let _ = writeln!(
             terminal,
             "  largest one-step gain {} E⁰: {} (h = {}, dt = {})",
-            table::sci(worst.energy_max_increase),
+            table::eng_opt(worst.energy_max_increase),
             worst.label,
-            table::sci(worst.h),
-            table::sci(worst.dt)
+            table::eng_opt(worst.h),
+            table::eng_opt(worst.dt)
         );
     }
     match &series {

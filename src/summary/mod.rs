@@ -65,14 +65,15 @@ pub mod energy;
 pub mod ensemble;
 mod latex;
 pub mod options;
-mod runs;
+pub(crate) mod runs;
 mod search;
 pub mod stability;
-mod table;
+pub(crate) mod table;
 pub mod work;
 
 pub use convergence::{NO_REFINEMENT, lsq_slope, observed_rate};
 pub use options::{DEFAULT_ERRORS, ERROR_COLUMNS, SummaryOptions, parse_errors};
+pub use table::eng;
 pub use work::{loglog_cost, pareto_front};
 
 /// What `summarize` produced.
@@ -102,7 +103,7 @@ pub struct Summary {
 /// Errors: an unreadable manifest, or a `[summary]` table this version refuses (a
 /// [`crate::sweep::SweepError`] naming the manifest, the key and the line in the stored text).
 pub fn stored_options(dir: &Path) -> anyhow::Result<SummaryOptions> {
-    let stored = match crate::sink::Manifest::latest_sweep_text(dir) {
+    let stored = match crate::sink::Manifest::latest_sweep(dir) {
         Ok(t) => t,
         // A damaged manifest does not stop the summary: the default columns, and a warning.
         Err(e @ crate::sink::SinkError::Manifest { .. }) => {
@@ -113,12 +114,12 @@ pub fn stored_options(dir: &Path) -> anyhow::Result<SummaryOptions> {
     };
     match stored {
         None => Ok(SummaryOptions::default()),
-        Some(text) => {
+        Some((text, sets)) => {
             let name = PathBuf::from(format!(
                 "{} (the sweep file stored in it)",
                 dir.join("manifest.json").display()
             ));
-            Ok(crate::sweep::summary_options(&name, &text)?)
+            Ok(crate::sweep::summary_options(&name, &text, &sets)?)
         }
     }
 }
@@ -216,6 +217,12 @@ pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summa
         "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
         out.display()
     ));
+    if !conv.groups.hints.is_empty() {
+        terminal.push_str("look at:\n");
+        for h in &conv.groups.hints {
+            terminal.push_str(&format!("  - {h}\n"));
+        }
+    }
     Ok(Summary {
         terminal,
         dir: out,

@@ -147,7 +147,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
          than δ = max(1, ν)·h/L (see energy.md).\n"
     );
     let mut maps = 0usize;
-    let mut terminal_lines = Vec::new();
+    let mut terminal_lines: Vec<(String, Vec<String>)> = Vec::new();
     for (m, idx) in &by_method {
         let distinct = |axis: &str| -> BTreeSet<String> {
             idx.iter()
@@ -277,7 +277,11 @@ pub(crate) fn section(runs: &Runs) -> Section {
                     .iter()
                     .filter_map(|s| counts.get(s).map(|n| format!("{n} {s}")))
                     .collect();
-                terminal_lines.push(format!("  {m}, {ya} × {xa}: {}", summary.join(", ")));
+                let key = format!("{ya} × {xa}: {}", summary.join(", "));
+                match terminal_lines.iter_mut().find(|(k, _)| *k == key) {
+                    Some((_, ms)) => ms.push(m.clone()),
+                    None => terminal_lines.push((key, vec![m.clone()])),
+                }
             }
         }
     }
@@ -286,9 +290,14 @@ pub(crate) fn section(runs: &Runs) -> Section {
         md.push_str("No method has two swept axes.\n");
     } else {
         let _ = writeln!(terminal, "stability maps ({maps}, cell states):");
-        for l in terminal_lines {
-            terminal.push_str(&l);
-            terminal.push('\n');
+        // Maps with the same axes and the same cell counts share a line.
+        for (key, ms) in terminal_lines {
+            let who = if ms.len() <= 2 {
+                ms.join("; ")
+            } else {
+                format!("{} methods", ms.len())
+            };
+            let _ = writeln!(terminal, "  {key} — {who}");
         }
     }
     Section {

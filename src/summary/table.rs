@@ -143,6 +143,11 @@ impl Table {
         }
     }
 
+    /// Rows closed so far.
+    pub(crate) fn height(&self) -> usize {
+        self.rows
+    }
+
     /// Close the current row: columns not set are null.
     pub(crate) fn end_row(&mut self) {
         for v in &mut self.values {
@@ -327,5 +332,76 @@ pub(crate) fn tex_rate(x: Option<f64>) -> String {
         Some(x) if x.is_finite() => format!("${x:.2}$"),
         Some(x) => tex(&format!("{x}")),
         None => String::new(),
+    }
+}
+
+/// Engineering format of the terminal: four significant digits, plain for 1e-2 ≤ |x| < 1e4
+/// (`1.003`, `0.3782`, `1235`), otherwise mantissa `e` exponent (`1.235e-5`, `2.5e4` is
+/// `2.500e4`); 0 prints as `0`. One format for every number of the terminal, so columns read
+/// alike and a reader never meets `1.0025e0`. The rounding is done once, by the exponent
+/// form, so the exponent that decides plain or not is the one of the rounded value (9.9996
+/// rounds to 10.00, not 9.9996 → "10.000").
+pub fn eng(x: f64) -> String {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    let s = format!("{x:.3e}");
+    let (mantissa, exp) = s.split_once('e').expect("exponent form");
+    let exp: i32 = exp.parse().expect("integer exponent");
+    if (-2..4).contains(&exp) {
+        let decimals = (3 - exp) as usize;
+        format!("{x:.decimals$}")
+    } else {
+        format!("{mantissa}e{exp}")
+    }
+}
+
+/// [`eng`] of an optional value; a missing one prints as `—`.
+pub(crate) fn eng_opt(x: Option<f64>) -> String {
+    x.map(eng).unwrap_or_else(|| "—".into())
+}
+
+/// The terminal's short name of an error column and its legend entry: columns are narrow, and
+/// every abbreviation is explained once under the table.
+pub(crate) fn error_abbrev(column: &str) -> (&'static str, &'static str) {
+    match column {
+        "err_u_l2l2" => ("l2(τ;L2)", "displacement error in l2(0,T;L2)"),
+        "err_u_l2h1" => ("l2(τ;H1)", "displacement error in l2(0,T;H1)"),
+        "err_u_linfl2" => ("l∞(τ;L2)", "displacement error in l∞(0,T;L2)"),
+        "err_sigma_l2" => (
+            "σ l2(τ)",
+            "contact pressure error at the time levels, l2(0,T)",
+        ),
+        "err_sigma_mid_l2" => (
+            "σ½ l2(τ)",
+            "contact pressure error at the midpoints t^(n+½), l2(0,T)",
+        ),
+        "err_energy_l2" => ("E l2(τ)", "energy error E^h − E, l2(0,T)"),
+        "err_u_contact_max" => ("u_C max", "max error of the contact displacement"),
+        _ => ("?", "unknown error column"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn engineering_format_is_four_significant_digits() {
+        assert_eq!(eng(1.0025), "1.002"); // 1.0025 is 1.00249999… in binary
+        assert_eq!(eng(0.37816), "0.3782");
+        assert_eq!(eng(0.012345), "0.01235");
+        assert_eq!(eng(0.0099996), "0.01000");
+        assert_eq!(eng(0.0012345), "1.234e-3");
+        assert_eq!(eng(1234.5), "1234");
+        assert_eq!(eng(9999.6), "1.000e4");
+        assert_eq!(eng(9.9996), "10.00");
+        assert_eq!(eng(-2.5e-7), "-2.500e-7");
+        assert_eq!(eng(0.0), "0");
+        assert_eq!(eng(f64::INFINITY), "inf");
+        assert_eq!(eng_opt(None), "—");
     }
 }

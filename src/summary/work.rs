@@ -526,23 +526,34 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 front.len(),
                 wall_pts.len()
             );
-            for &i in front.iter().take(8) {
+            // The cheapest and the most accurate ends of the front; the rest is in the files.
+            const SHOWN: usize = 4;
+            let ends: Vec<usize> = if front.len() <= SHOWN {
+                front.clone()
+            } else {
+                front[..SHOWN / 2]
+                    .iter()
+                    .chain(&front[front.len() - SHOWN / 2..])
+                    .copied()
+                    .collect()
+            };
+            for (k, &i) in ends.iter().enumerate() {
+                if k == SHOWN / 2 && front.len() > SHOWN {
+                    let _ = writeln!(
+                        terminal,
+                        "  … {} more in work_precision.md",
+                        front.len() - SHOWN
+                    );
+                }
                 let r = &runs.runs[i];
                 let _ = writeln!(
                     terminal,
-                    "  {:>10} s  e = {}  {} (h = {}, dt = {})",
-                    table::sci(r.wall_time_s),
-                    table::sci(r.errors[e]),
+                    "  {:>9} s  e = {:<9}  {} (h = {}, dt = {})",
+                    table::eng_opt(r.wall_time_s),
+                    table::eng_opt(r.errors[e]),
                     runs.groups[r.group].title,
-                    table::sci(r.h),
-                    table::sci(r.dt)
-                );
-            }
-            if front.len() > 8 {
-                let _ = writeln!(
-                    terminal,
-                    "  … {} more in work_precision.md",
-                    front.len() - 8
+                    table::eng_opt(r.h),
+                    table::eng_opt(r.dt)
                 );
             }
         }

@@ -11,6 +11,7 @@
 //! removed and the resulting duplicates merged, each run keyed by a stable [`plan::RunSpec::run_id`].
 
 pub mod keys;
+pub mod overrides;
 pub mod plan;
 pub mod tree;
 
@@ -57,21 +58,55 @@ pub enum SweepError {
         file: PathBuf,
         source: std::io::Error,
     },
-    #[error("{}", render_issues(file, issues))]
-    Invalid { file: PathBuf, issues: Vec<Issue> },
+    /// `sets`: the `--set` arguments applied on top of the file (issues on their lines name
+    /// the flag instead of the file).
+    #[error("{}", render_issues(file, issues, sets))]
+    Invalid {
+        file: PathBuf,
+        issues: Vec<Issue>,
+        sets: Vec<String>,
+    },
+    /// A `--set` argument that is not `key=value`.
+    #[error("{0}")]
+    BadSet(String),
 }
 
-fn render_issues(file: &Path, issues: &[Issue]) -> String {
+/// Where a line is: `file:line`, or the `--set` flag that wrote it.
+fn place(file: &Path, line: Option<usize>, sets: &[String]) -> String {
+    match line {
+        Some(l) if l >= overrides::SET_LINE => {
+            let arg = sets
+                .get(l - overrides::SET_LINE)
+                .map(String::as_str)
+                .unwrap_or("?");
+            format!("--set {arg}")
+        }
+        // A sweep without a file is named by its flag (`--scene bar1d`): the lines of its
+        // generated text mean nothing to the user.
+        Some(_) if file.to_string_lossy().starts_with("--") => file.display().to_string(),
+        Some(l) => format!("{}:{l}", file.display()),
+        None => file.display().to_string(),
+    }
+}
+
+/// A line inside a message: `line 6`, or `--set h=…`.
+fn line_ref(line: Option<usize>, sets: &[String]) -> String {
+    match line {
+        Some(l) if l >= overrides::SET_LINE => place(Path::new(""), line, sets),
+        Some(l) => format!("line {l}"),
+        None => "line 0".into(),
+    }
+}
+
+fn render_issues(file: &Path, issues: &[Issue], sets: &[String]) -> String {
     let mut out = String::new();
     for (i, is) in issues.iter().enumerate() {
         if i > 0 {
             out.push('\n');
         }
-        let line = is.line.map(|l| format!(":{l}")).unwrap_or_default();
         out.push_str(&format!(
-            "{}{}: key `{}`: {}",
-            file.display(),
-            line,
+            "{}: key `{}`: {}",
+            place(file, is.line, sets),
             is.key,
             is.reason
         ));
@@ -179,6 +214,9 @@ pub struct SweepFile {
     pub allow_unstable: bool,
     /// `[summary]`: what the convergence tables print.
     pub summary: SummaryOptions,
+    /// The `--set key=value` arguments applied on top of the file's text, in order (recorded
+    /// in the manifest; `text` stays the file's own).
+    pub sets: Vec<String>,
 }
 
 const TOP_KEYS: [&str; 14] = [
@@ -202,6 +240,7 @@ const TOP_KEYS: [&str; 14] = [
 struct Checker {
     scene: Option<SceneKind>,
     issues: Vec<Issue>,
+    sets: Vec<String>,
 }
 
 impl Checker {
@@ -479,20 +518,50 @@ impl SweepFile {
 
     /// Check a sweep file's text; `path` names it in messages.
     pub fn parse(path: &Path, text: &str) -> Result<SweepFile, SweepError> {
+        SweepFile::parse_with(path, text, &[])
+    }
+
+    /// Read a sweep file and apply `--set key=value` arguments on top of it
+    /// ([`overrides`]); the result is checked like a file.
+    pub fn load_with(path: &Path, sets: &[String]) -> Result<SweepFile, SweepError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SweepError::Read {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        SweepFile::parse_with(path, &text, sets)
+    }
+
+    /// A sweep without a file: scene `scene`, named after it, made of `--set` arguments only.
+    /// Messages name the flags (`--scene`, `--set`).
+    pub fn from_flags(scene: &str, sets: &[String]) -> Result<SweepFile, SweepError> {
+        // A TOML basic string of the scene name (its quotes and backslashes escaped); an
+        // unknown scene is then refused by the scene check like a file's.
+        let quoted = toml::Value::String(scene.to_string()).to_string();
+        let text = format!("name = {quoted}\nscene = {quoted}\n");
+        SweepFile::parse_with(Path::new(&format!("--scene {scene}")), &text, sets)
+    }
+
+    /// Check a sweep file's text with `--set` arguments applied on top of it; `path` names
+    /// the file in messages, the flag names an override.
+    pub fn parse_with(path: &Path, text: &str, sets: &[String]) -> Result<SweepFile, SweepError> {
         let invalid = |issues: Vec<Issue>| SweepError::Invalid {
             file: path.to_path_buf(),
             issues,
+            sets: sets.to_vec(),
         };
-        let top = tree::parse(text).map_err(|e| {
+        let parsed = overrides::parse(sets).map_err(SweepError::BadSet)?;
+        let mut top = tree::parse(text).map_err(|e| {
             invalid(vec![Issue {
                 line: e.line,
                 key: "(syntax)".into(),
                 reason: format!("invalid TOML: {}", e.message),
             }])
         })?;
+        overrides::apply(&mut top, &parsed);
         let mut ck = Checker {
             scene: None,
             issues: Vec::new(),
+            sets: sets.to_vec(),
         };
         let get = |name: &str| top.iter().find(|(k, _, _)| k == name);
         for (k, line, _) in &top {
@@ -854,10 +923,10 @@ impl SweepFile {
                     ck.issues.push(Issue::at(
                         &e.origin,
                         format!(
-                            "`{}` is also set by {} (line {}): two axes may not set one parameter",
+                            "`{}` is also set by {} ({}): two axes may not set one parameter",
                             e.key.name(),
                             o.path,
-                            o.line.unwrap_or(0)
+                            line_ref(o.line, &ck.sets)
                         ),
                     ));
                 } else if !sources.iter().any(|(k, _, s)| *k == e.key && *s == source) {
@@ -890,6 +959,7 @@ impl SweepFile {
                 search,
                 allow_unstable,
                 summary,
+                sets: sets.to_vec(),
             })
         } else {
             let mut issues = ck.issues;
@@ -900,25 +970,33 @@ impl SweepFile {
     }
 }
 
-/// Only the `[summary]` table of a sweep file's text (the rest is not checked): how
-/// `summarize DIR` reads the column choice back from the sweep file stored in
+/// Only the `[summary]` table of a sweep file's text with its `--set` arguments (the rest is
+/// not checked): how `summarize DIR` reads the column choice back from the sweep file stored in
 /// `DIR/manifest.json`, even when that file was written for another version. `path` names the
 /// text in messages.
-pub fn summary_options(path: &Path, text: &str) -> Result<SummaryOptions, SweepError> {
+pub fn summary_options(
+    path: &Path,
+    text: &str,
+    sets: &[String],
+) -> Result<SummaryOptions, SweepError> {
     let invalid = |issues: Vec<Issue>| SweepError::Invalid {
         file: path.to_path_buf(),
         issues,
+        sets: sets.to_vec(),
     };
-    let top = tree::parse(text).map_err(|e| {
+    let parsed = overrides::parse(sets).map_err(SweepError::BadSet)?;
+    let mut top = tree::parse(text).map_err(|e| {
         invalid(vec![Issue {
             line: e.line,
             key: "(syntax)".into(),
             reason: format!("invalid TOML: {}", e.message),
         }])
     })?;
+    overrides::apply(&mut top, &parsed);
     let mut ck = Checker {
         scene: None,
         issues: Vec::new(),
+        sets: sets.to_vec(),
     };
     let out = match top.iter().find(|(k, _, _)| k == "summary") {
         Some((_, line, node)) => ck.summary(*line, node),
@@ -938,6 +1016,36 @@ impl fmt::Display for Origin {
             None => write!(f, "{}", self.path),
         }
     }
+}
+
+/// A plain-text table: columns padded to their widest cell (counted in characters), a dashed
+/// rule under the header (the plan and the per-run result table).
+pub fn render_table(header: &[String], rows: &[Vec<String>]) -> String {
+    let mut width: Vec<usize> = header.iter().map(|h| h.chars().count()).collect();
+    for r in rows {
+        for (w, c) in width.iter_mut().zip(r) {
+            *w = (*w).max(c.chars().count());
+        }
+    }
+    let line = |cells: &[String]| {
+        let mut s = String::new();
+        for (i, (c, w)) in cells.iter().zip(&width).enumerate() {
+            if i > 0 {
+                s.push_str("  ");
+            }
+            s.push_str(c);
+            s.push_str(&" ".repeat(w - c.chars().count()));
+        }
+        s.trim_end().to_string() + "\n"
+    };
+    let mut out = line(header);
+    out.push_str(&line(
+        &width.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
+    ));
+    for r in rows {
+        out.push_str(&line(r));
+    }
+    out
 }
 
 fn line_of_search(top: &[(String, usize, Node)]) -> &usize {

@@ -864,6 +864,7 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
             .unwrap_or(("ensemble.samples".into(), None));
         return Err(SweepError::Invalid {
             file: sweep.path.clone(),
+            sets: sweep.sets.clone(),
             issues: vec![Issue {
                 line,
                 key,
@@ -1041,11 +1042,13 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
         return Err(SweepError::Invalid {
             file: sweep.path.clone(),
             issues,
+            sets: sweep.sets.clone(),
         });
     }
     if runs.is_empty() {
         return Err(SweepError::Invalid {
             file: sweep.path.clone(),
+            sets: sweep.sets.clone(),
             issues: vec![Issue {
                 line: None,
                 key: "grid".into(),
@@ -1096,6 +1099,7 @@ pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, Swee
     let invalid = |issues: Vec<Issue>| SweepError::Invalid {
         file: sweep.path.clone(),
         issues,
+        sets: sweep.sets.clone(),
     };
     match resolve(sweep.scene, &entries, true, &plan.limits) {
         Outcome::Run(r) => {
@@ -1148,6 +1152,40 @@ impl Plan {
             .collect()
     }
 
+    /// The plan as a table of the parameters that vary between runs.
+    pub fn table(&self) -> String {
+        let plan = self;
+        let keys = plan.varying_keys();
+        let mut header: Vec<String> = vec!["#".into(), "run_id".into(), "label".into()];
+        header.extend(keys.iter().map(|k| k.name().to_string()));
+        // steps × unknowns: what a run costs, to see where the time of a sweep goes before running it
+        header.push("work".into());
+        let mut total = 0u64;
+        let mut rows: Vec<Vec<String>> = plan
+            .runs
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                let mut row = vec![i.to_string(), r.run_id.clone(), r.label.clone()];
+                row.extend(keys.iter().map(|k| {
+                    r.params
+                        .get(k)
+                        .map(|v| v.to_string())
+                        .unwrap_or_else(|| "—".into())
+                }));
+                let work = r.config.work() * r.repeats as u64;
+                total += work;
+                row.push(format!("{work:.2e}", work = work as f64));
+                row
+            })
+            .collect();
+        let mut last = vec![String::new(); header.len()];
+        last[2] = "total".into();
+        *last.last_mut().expect("a column") = format!("{:.2e}", total as f64);
+        rows.push(last);
+        super::render_table(&header, &rows)
+    }
+
     /// Human summary: counts, merges and reasons.
     pub fn summary(&self) -> String {
         let mut s = format!(
@@ -1161,6 +1199,9 @@ impl Plan {
             s.push_str(" (ensemble members included)");
         }
         s.push('\n');
+        for set in &self.sweep.sets {
+            let _ = writeln!(s, "  --set {set}");
+        }
         for note in &self.sweep.overridden {
             let _ = writeln!(s, "  {note}");
         }
