@@ -213,3 +213,40 @@ fn bad_flags_exit_2_naming_the_flag_and_the_key() {
     // Nothing was written for a refused sweep.
     assert!(!tmp.path().join("out").exists());
 }
+
+/// Regression: the disc starts with E⁰ = 0 (at rest, potential measured from the start), and
+/// the result table printed E(T)/E⁰ as ±inf. It now prints 1 + energy_drift (drift relative to
+/// energy_scale = m·g·gap), which for CN's exact free fall is 1 to round-off.
+#[test]
+fn a_disc_run_prints_a_finite_energy_ratio() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = cli(
+        tmp.path(),
+        &[
+            "run",
+            "--scene",
+            "disc2d",
+            "--set",
+            "degree=1",
+            "--set",
+            "h=4",
+            "--set",
+            "T=2",
+            "--set",
+            "dt=0.1",
+            "--table",
+            "runs",
+            "--no-summary",
+            "--out",
+            "disc",
+        ],
+    );
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let row = out
+        .lines()
+        .find(|l| l.contains("disc") || l.contains(" ok "))
+        .unwrap_or_else(|| panic!("no run row in:\n{out}"));
+    assert!(!out.contains("inf"), "{out}");
+    assert!(row.contains("1.000"), "{row}\n{out}");
+}
