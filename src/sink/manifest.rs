@@ -97,19 +97,7 @@ impl Manifest {
 
     /// Read DIR's manifest if any: the sweep name it records.
     pub fn existing_sweep(dir: &Path) -> Result<Option<String>, SinkError> {
-        let path = dir.join("manifest.json");
-        if !path.exists() {
-            return Ok(None);
-        }
-        let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        let doc: Json = serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
-        Ok(doc["sweep"].as_str().map(String::from))
+        Ok(Manifest::read(dir)?.and_then(|doc| doc["sweep"].as_str().map(String::from)))
     }
 
     /// The sweep file's text of DIR's latest session that recorded one (`None` without a
@@ -121,18 +109,9 @@ impl Manifest {
     /// The sweep file's text of DIR's latest session that recorded one, with the `--set`
     /// arguments that session applied on top of it (empty for sessions of older versions).
     pub fn latest_sweep(dir: &Path) -> Result<Option<(String, Vec<String>)>, SinkError> {
-        let path = dir.join("manifest.json");
-        if !path.exists() {
+        let Some(doc) = Manifest::read(dir)? else {
             return Ok(None);
-        }
-        let text = std::fs::read_to_string(&path).map_err(|source| SinkError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        let doc: Json = serde_json::from_str(&text).map_err(|e| SinkError::Manifest {
-            path: path.clone(),
-            message: e.to_string(),
-        })?;
+        };
         Ok(doc["sessions"].as_array().and_then(|s| {
             s.iter().rev().find_map(|x| {
                 let text = x["sweep_text"].as_str()?.to_string();

@@ -544,25 +544,8 @@ impl SweepFile {
     /// Check a sweep file's text with `--set` arguments applied on top of it; `path` names
     /// the file in messages, the flag names an override.
     pub fn parse_with(path: &Path, text: &str, sets: &[String]) -> Result<SweepFile, SweepError> {
-        let invalid = |issues: Vec<Issue>| SweepError::Invalid {
-            file: path.to_path_buf(),
-            issues,
-            sets: sets.to_vec(),
-        };
-        let parsed = overrides::parse(sets).map_err(SweepError::BadSet)?;
-        let mut top = tree::parse(text).map_err(|e| {
-            invalid(vec![Issue {
-                line: e.line,
-                key: "(syntax)".into(),
-                reason: format!("invalid TOML: {}", e.message),
-            }])
-        })?;
-        overrides::apply(&mut top, &parsed);
-        let mut ck = Checker {
-            scene: None,
-            issues: Vec::new(),
-            sets: sets.to_vec(),
-        };
+        let invalid = |issues: Vec<Issue>| invalid_file(path, sets, issues);
+        let (top, mut ck) = overridden_tree(path, text, sets)?;
         let get = |name: &str| top.iter().find(|(k, _, _)| k == name);
         for (k, line, _) in &top {
             if !TOP_KEYS.contains(&k.as_str()) {
@@ -970,6 +953,46 @@ impl SweepFile {
     }
 }
 
+/// A sweep text's top-level entries: key, line, value.
+type TopLevel = Vec<(String, usize, tree::Node)>;
+
+/// The error of a sweep text with its `--set` arguments (`path` names the text in messages).
+fn invalid_file(path: &Path, sets: &[String], issues: Vec<Issue>) -> SweepError {
+    SweepError::Invalid {
+        file: path.to_path_buf(),
+        issues,
+        sets: sets.to_vec(),
+    }
+}
+
+/// A sweep text parsed into its top-level tree with the `--set` overrides applied, and the
+/// checker that collects its issues: what `SweepFile::parse_with` and `summary_options` share.
+fn overridden_tree(
+    path: &Path,
+    text: &str,
+    sets: &[String],
+) -> Result<(TopLevel, Checker), SweepError> {
+    let parsed = overrides::parse(sets).map_err(SweepError::BadSet)?;
+    let mut top = tree::parse(text).map_err(|e| {
+        invalid_file(
+            path,
+            sets,
+            vec![Issue {
+                line: e.line,
+                key: "(syntax)".into(),
+                reason: format!("invalid TOML: {}", e.message),
+            }],
+        )
+    })?;
+    overrides::apply(&mut top, &parsed);
+    let ck = Checker {
+        scene: None,
+        issues: Vec::new(),
+        sets: sets.to_vec(),
+    };
+    Ok((top, ck))
+}
+
 /// Only the `[summary]` table of a sweep file's text with its `--set` arguments (the rest is
 /// not checked): how `summarize DIR` reads the column choice back from the sweep file stored in
 /// `DIR/manifest.json`, even when that file was written for another version. `path` names the
@@ -979,25 +1002,7 @@ pub fn summary_options(
     text: &str,
     sets: &[String],
 ) -> Result<SummaryOptions, SweepError> {
-    let invalid = |issues: Vec<Issue>| SweepError::Invalid {
-        file: path.to_path_buf(),
-        issues,
-        sets: sets.to_vec(),
-    };
-    let parsed = overrides::parse(sets).map_err(SweepError::BadSet)?;
-    let mut top = tree::parse(text).map_err(|e| {
-        invalid(vec![Issue {
-            line: e.line,
-            key: "(syntax)".into(),
-            reason: format!("invalid TOML: {}", e.message),
-        }])
-    })?;
-    overrides::apply(&mut top, &parsed);
-    let mut ck = Checker {
-        scene: None,
-        issues: Vec::new(),
-        sets: sets.to_vec(),
-    };
+    let (top, mut ck) = overridden_tree(path, text, sets)?;
     let out = match top.iter().find(|(k, _, _)| k == "summary") {
         Some((_, line, node)) => ck.summary(*line, node),
         None => SummaryOptions::default(),
@@ -1005,7 +1010,7 @@ pub fn summary_options(
     if ck.issues.is_empty() {
         Ok(out)
     } else {
-        Err(invalid(ck.issues))
+        Err(invalid_file(path, sets, ck.issues))
     }
 }
 
