@@ -9,6 +9,7 @@
 pub mod bar1d;
 pub mod estimate;
 pub mod fe;
+pub mod impacts;
 mod fe_nitsche;
 pub mod observe;
 pub mod record;

@@ -62,6 +62,8 @@ pub struct Metrics {
     pub iterations_max_step: Option<i64>,
     /// Part of the stepping time spent on observables and error norms (sampled estimate).
     pub observe_time_s: Option<f64>,
+    /// Contact phases detected at every step ([`super::impacts`]); None if no step was observed.
+    pub impacts: Option<Vec<super::impacts::Phase>>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -178,6 +180,8 @@ pub struct Observer {
     scale: Option<f64>,
     first_contact: Option<f64>,
     phases: i64,
+    /// Contact phases at full resolution (issue 12), independent of `every`.
+    impacts: super::impacts::PhaseTracker,
     pub series: Vec<SeriesRow>,
 }
 
@@ -215,6 +219,7 @@ impl Observer {
             scale: None,
             first_contact: None,
             phases: 0,
+            impacts: super::impacts::PhaseTracker::new(),
             series: Vec::with_capacity(cap),
         }
     }
@@ -299,6 +304,8 @@ impl Observer {
             self.sum_energy += de * de;
             self.max_contact = self.max_contact.max((v.u_contact - x.u_contact).abs());
         }
+        self.impacts
+            .step(v.step, v.t, v.sigma_contact, v.energy, v.energy_theta);
         if self.every > 0 && (v.step.is_multiple_of(self.every) || v.step == self.last_step) {
             self.series.push(SeriesRow {
                 step: v.step as i64,
@@ -357,6 +364,7 @@ impl Observer {
         }
 
         metrics.contact_switches = self.switches;
+        metrics.impacts = Some(self.impacts.finish());
         if complete && self.has_exact {
             let t = self.tau;
             metrics.err_u_l2l2 = Some((t * self.sum_l2).sqrt());

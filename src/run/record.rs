@@ -16,6 +16,10 @@ pub enum ColumnData {
     Str(Vec<Option<String>>),
     /// A string column given as runs of equal values (value, count): the run_id of a series.
     StrRuns(Vec<(String, usize)>),
+    /// A List(Int64) column: one list per row (null: the row has none).
+    ListI64(Vec<Option<Vec<i64>>>),
+    /// A List(Float64) column whose elements may be null.
+    ListF64(Vec<Option<Vec<Option<f64>>>>),
 }
 
 /// Rust types that can fill a column.
@@ -51,6 +55,26 @@ impl ColumnValue for String {
 impl ColumnValue for Option<String> {
     fn column(v: Vec<Self>) -> ColumnData {
         ColumnData::Str(v)
+    }
+}
+
+impl ColumnValue for Option<Vec<i64>> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::ListI64(v)
+    }
+}
+impl ColumnValue for Option<Vec<f64>> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::ListF64(
+            v.into_iter()
+                .map(|l| l.map(|l| l.into_iter().map(Some).collect()))
+                .collect(),
+        )
+    }
+}
+impl ColumnValue for Option<Vec<Option<f64>>> {
+    fn column(v: Vec<Self>) -> ColumnData {
+        ColumnData::ListF64(v)
     }
 }
 
@@ -155,6 +179,14 @@ schema! {
         observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
         first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
         contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
+        impact_step_first: Option<Vec<i64>> => "", "contact phases found at every step (σ_C < 0; a one-step gap without pressure does not end a phase), one list element per phase: first contact step (null if no step ran; explode the impact_* lists together for one row per phase)";
+        impact_step_last: Option<Vec<i64>> => "", "per phase: last contact step";
+        impact_t_first: Option<Vec<f64>> => "s", "per phase: time of the first contact step";
+        impact_t_last: Option<Vec<f64>> => "s", "per phase: time of the last contact step";
+        impact_energy_before: Option<Vec<Option<f64>>> => "J", "per phase: E at the step before the phase (null for a phase open at step 0)";
+        impact_energy_after: Option<Vec<Option<f64>>> => "J", "per phase: E at the step after the phase (null for a phase open at the last step)";
+        impact_energy_theta_before: Option<Vec<Option<f64>>> => "J", "per phase: E_Θ at the step before the phase (Nitsche; else null)";
+        impact_energy_theta_after: Option<Vec<Option<f64>>> => "J", "per phase: E_Θ at the step after the phase (Nitsche; else null)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         tool_version: String => "", "contact-sweep version that computed the row";
@@ -341,11 +373,24 @@ impl RunRecord {
             observe_time_s: m.observe_time_s,
             first_contact_time: m.first_contact_time,
             contact_phases: m.contact_phases,
+            impact_step_first: phase_list(m, |p| p.step_first),
+            impact_step_last: phase_list(m, |p| p.step_last),
+            impact_t_first: phase_list(m, |p| p.t_first),
+            impact_t_last: phase_list(m, |p| p.t_last),
+            impact_energy_before: phase_list(m, |p| p.energy_before),
+            impact_energy_after: phase_list(m, |p| p.energy_after),
+            impact_energy_theta_before: phase_list(m, |p| p.energy_theta_before),
+            impact_energy_theta_after: phase_list(m, |p| p.energy_theta_after),
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }
+}
+
+/// One field of every contact phase of a run, as a list column value.
+fn phase_list<T>(m: &super::Metrics, f: impl Fn(&super::impacts::Phase) -> T) -> Option<Vec<T>> {
+    m.impacts.as_ref().map(|ps| ps.iter().map(f).collect())
 }
 
 #[cfg(test)]

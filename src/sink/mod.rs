@@ -81,6 +81,8 @@ pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame
         Some((_, ColumnData::I64(v))) => v.len(),
         Some((_, ColumnData::Str(v))) => v.len(),
         Some((_, ColumnData::StrRuns(v))) => v.iter().map(|(_, n)| n).sum(),
+        Some((_, ColumnData::ListI64(v))) => v.len(),
+        Some((_, ColumnData::ListF64(v))) => v.len(),
         None => 0,
     };
     let cols = columns
@@ -95,6 +97,37 @@ pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame
                 for (value, n) in &v {
                     for _ in 0..*n {
                         b.append_value(value);
+                    }
+                }
+                b.finish().into_column()
+            }
+            // Built with the inner type given, so a column of empty or null lists is still
+            // List(Int64)/List(Float64), not List(Null).
+            ColumnData::ListI64(v) => {
+                let values = v.iter().flatten().map(Vec::len).sum();
+                let mut b = ListPrimitiveChunkedBuilder::<Int64Type>::new(
+                    name.into(),
+                    v.len(),
+                    values,
+                    DataType::Int64,
+                );
+                for l in &v {
+                    b.append_opt_slice(l.as_deref());
+                }
+                b.finish().into_column()
+            }
+            ColumnData::ListF64(v) => {
+                let values = v.iter().flatten().map(Vec::len).sum();
+                let mut b = ListPrimitiveChunkedBuilder::<Float64Type>::new(
+                    name.into(),
+                    v.len(),
+                    values,
+                    DataType::Float64,
+                );
+                for l in &v {
+                    match l {
+                        Some(l) => b.append_iter(l.iter().copied()),
+                        None => b.append_null(),
                     }
                 }
                 b.finish().into_column()
