@@ -64,6 +64,8 @@ pub struct Metrics {
     pub observe_time_s: Option<f64>,
     /// Contact phases detected at every step ([`super::impacts`]); None if no step was observed.
     pub impacts: Option<Vec<super::impacts::Phase>>,
+    /// E_Θ⁰ (Nitsche): the unit of the impacts' E_Θ losses.
+    pub energy_theta_initial: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -365,6 +367,7 @@ impl Observer {
 
         metrics.contact_switches = self.switches;
         metrics.impacts = Some(self.impacts.finish());
+        metrics.energy_theta_initial = self.e0_theta;
         if complete && self.has_exact {
             let t = self.tau;
             metrics.err_u_l2l2 = Some((t * self.sum_l2).sqrt());

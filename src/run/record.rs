@@ -187,6 +187,7 @@ schema! {
         impact_energy_after: Option<Vec<Option<f64>>> => "J", "per phase: E at the step after the phase (null for a phase open at the last step)";
         impact_energy_theta_before: Option<Vec<Option<f64>>> => "J", "per phase: E_Θ at the step before the phase (Nitsche; else null)";
         impact_energy_theta_after: Option<Vec<Option<f64>>> => "J", "per phase: E_Θ at the step after the phase (Nitsche; else null)";
+        energy_theta_initial: Option<f64> => "J", "E_Θ⁰, the augmented energy of the initial state (Nitsche; the unit of the impacts' E_Θ losses)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         tool_version: String => "", "contact-sweep version that computed the row";
@@ -381,6 +382,7 @@ impl RunRecord {
             impact_energy_after: phase_list(m, |p| p.energy_after),
             impact_energy_theta_before: phase_list(m, |p| p.energy_theta_before),
             impact_energy_theta_after: phase_list(m, |p| p.energy_theta_after),
+            energy_theta_initial: m.energy_theta_initial,
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),

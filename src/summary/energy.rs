@@ -1,6 +1,8 @@
 //! Energy tables: per run and per group (drift, largest deviation, largest one-step increase,
-//! and the run's energy class), and for bar1d the energy lost at each impact, read from the
-//! time series.
+//! and the run's energy class), and the energy lost at each impact: from the contact phases
+//! each run found at every step (the runs table's `impact_*` lists, [`crate::run::impacts`]),
+//! or, for rows of older versions without them, from the time series (resolved to its
+//! recording stride; `series_decimated`/`series_stride` say so, stride 1 for online phases).
 //!
 //! # Energy classes
 //! Every run is classified by the energy functional F its scheme controls — E_Θ for Nitsche
@@ -25,7 +27,7 @@
 //! — a single step that raises F by more than [`ENERGY_TOL`]·F⁰ is growth as well: the proof
 //! forbids it, and rounding stays below 1e-12 (SPEC §6).
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
 
 use super::runs::{Run, Runs};
@@ -190,32 +192,42 @@ impl Series {
     }
 }
 
-/// Rows without pressure that do not end a contact phase (one: a pressure alternating
-/// step by step; two rows without pressure already count as a lift-off).
-const MERGE_GAP: usize = 1;
+/// Rows without pressure that do not end a contact phase: the online detector's rule.
+use crate::run::impacts::MERGE_GAP;
 
-/// The series of the runs, keyed by run_id; `Err(reason)` when there are none. Every scene
-/// stores σ_C < 0 while in contact (2D/3D: minus the total contact force), so the impacts are
-/// read the same way whatever the scene.
+/// The series of the runs `need` (those without online phases), keyed by run_id; `Err(reason)`
+/// when there are none. Only the series parts that hold them are read: the sink writes a
+/// batch's series under its runs part's name. Every scene stores σ_C < 0 while in contact
+/// (2D/3D: minus the total contact force), so the impacts are read the same way whatever the
+/// scene.
 fn read_series(
     dir: &std::path::Path,
-    runs: &Runs,
+    need: &[&Run],
 ) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
-    let wanted: HashMap<&str, ()> = runs.runs.iter().map(|r| (r.run_id.as_str(), ())).collect();
+    let wanted: HashMap<&str, ()> = need.iter().map(|r| (r.run_id.as_str(), ())).collect();
     if wanted.is_empty() {
         return Ok(Err("no runs".into()));
     }
+    // A row without its part's name (not read by `runs::load`) means: read every part.
+    let parts: Option<HashSet<String>> = need.iter().map(|r| r.part.clone()).collect();
+    let t = |k: Kind| match k {
+        Kind::I64 => polars::prelude::DataType::Int64,
+        Kind::Str => polars::prelude::DataType::String,
+        _ => polars::prelude::DataType::Float64,
+    };
     // Typed per part (another version may store a column with another type).
-    let (raw, _) = super::runs::read_typed(
+    let (raw, _) = super::runs::read_parts(
         &dir.join("series"),
         &[
-            ("run_id", Kind::Str),
-            ("step", Kind::I64),
-            ("t", Kind::F64),
-            ("sigma_contact", Kind::F64),
-            ("energy", Kind::F64),
-            ("energy_theta", Kind::F64),
+            ("run_id", t(Kind::Str)),
+            ("step", t(Kind::I64)),
+            ("t", t(Kind::F64)),
+            ("sigma_contact", t(Kind::F64)),
+            ("energy", t(Kind::F64)),
+            ("energy_theta", t(Kind::F64)),
         ],
+        &[],
+        parts.as_ref(),
     )?;
     if raw.height() == 0 {
         return Ok(Err("no time series in series/ (series_every = 0?)".into()));
@@ -272,6 +284,89 @@ fn read_series(
     Ok(Ok(out))
 }
 
+/// One contact phase as the impacts table lists it.
+#[derive(Debug, Clone, PartialEq)]
+struct PhaseRow {
+    step_first: i64,
+    step_last: i64,
+    t_first: Option<f64>,
+    t_last: Option<f64>,
+    step_before: Option<i64>,
+    step_after: Option<i64>,
+    energy_before: Option<f64>,
+    energy_after: Option<f64>,
+    theta_before: Option<f64>,
+    theta_after: Option<f64>,
+}
+
+/// A run's phases, the stride of the steps they were found on (1: every step) and the units
+/// E⁰, E_Θ⁰ of the losses.
+struct RunPhases {
+    list: Vec<PhaseRow>,
+    stride: i64,
+    e0: Option<f64>,
+    e0_theta: Option<f64>,
+}
+
+/// The phases of a run: the ones it recorded online (every step, stride 1) when its row has
+/// them, else those of its stored series (resolved to the series' stride); None when neither
+/// exists. Both paths read the same per-step values (the observer's E^n, E_Θ^n, t^n, copied
+/// unchanged into the row's lists or the series), so a complete series gives the same table.
+fn phases_of(r: &Run, series: &Result<HashMap<String, Series>, String>) -> Option<RunPhases> {
+    // E⁰: the run's initial energy (SPEC §5); E(t⁰) from the data when the row lacks it or
+    // it is 0 (a disc's E⁰ = 0: the losses are then not finite, as before).
+    let e0_row = r.energy_initial.filter(|e| e.is_finite() && *e != 0.0);
+    if let Some(online) = &r.impacts {
+        let list = online
+            .iter()
+            .map(|p| PhaseRow {
+                step_first: p.step_first,
+                step_last: p.step_last,
+                t_first: Some(p.t_first),
+                t_last: Some(p.t_last),
+                step_before: p.energy_before.map(|_| p.step_first - 1),
+                step_after: p.energy_after.map(|_| p.step_last + 1),
+                energy_before: p.energy_before,
+                energy_after: p.energy_after,
+                theta_before: p.energy_theta_before,
+                theta_after: p.energy_theta_after,
+            })
+            .collect();
+        return Some(RunPhases {
+            list,
+            stride: 1,
+            e0: e0_row.or(r.energy_initial),
+            e0_theta: r.energy_theta_initial,
+        });
+    }
+    let s = series.as_ref().ok()?.get(&r.run_id)?;
+    if s.step.is_empty() {
+        return None;
+    }
+    let list = s
+        .impacts()
+        .into_iter()
+        .map(|ph| PhaseRow {
+            step_first: s.step[ph.first],
+            step_last: s.step[ph.last],
+            t_first: s.t[ph.first],
+            t_last: s.t[ph.last],
+            step_before: ph.before.map(|i| s.step[i]),
+            step_after: ph.after.map(|i| s.step[i]),
+            energy_before: ph.before.and_then(|i| s.energy[i]),
+            energy_after: ph.after.and_then(|i| s.energy[i]),
+            theta_before: ph.before.and_then(|i| s.theta[i]),
+            theta_after: ph.after.and_then(|i| s.theta[i]),
+        })
+        .collect();
+    Some(RunPhases {
+        list,
+        stride: s.stride(),
+        e0: e0_row.or(s.energy[0]),
+        e0_theta: s.theta[0],
+    })
+}
+
 /// The energy section's outputs.
 pub(crate) struct Section {
     pub runs: Table,
@@ -307,7 +402,19 @@ fn range(lo: Option<f64>, hi: Option<f64>) -> String {
 
 /// Build the energy section.
 pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Section> {
-    let series = read_series(dir, runs)?;
+    // Runs of a version without the online phases fall back to their series.
+    let need: Vec<&Run> = runs.runs.iter().filter(|r| r.impacts.is_none()).collect();
+    let online = runs.runs.len() - need.len();
+    let series = if need.is_empty() {
+        Ok(HashMap::new())
+    } else {
+        match read_series(dir, &need)? {
+            // Some runs have online phases: the others' missing series is not the section's
+            // failure.
+            Err(_) if online > 0 => Ok(HashMap::new()),
+            other => other,
+        }
+    };
     let mut per_run = Table::new(&cols(
         &[
             ("group", Kind::I64),
@@ -378,29 +485,22 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     let mut run_impacts: Vec<Option<(usize, f64, bool, i64)>> = vec![None; runs.runs.len()];
 
     for (ri, r) in runs.runs.iter().enumerate() {
-        let Ok(map) = &series else { break };
-        let Some(s) = map.get(&r.run_id) else {
+        let Some(found) = phases_of(r, &series) else {
             continue;
         };
-        if s.step.is_empty() {
-            continue;
-        }
+        let RunPhases {
+            list,
+            stride,
+            e0,
+            e0_theta,
+        } = found;
         runs_with_series += 1;
-        let stride = s.stride();
         let decimated = stride > 1;
         decimated_runs += decimated as usize;
-        // E⁰: the run's initial energy (SPEC §5); the first recorded energy if the row lacks it.
-        let e0 = r
-            .energy_initial
-            .filter(|e| e.is_finite() && *e != 0.0)
-            .or(s.energy[0]);
-        let e0_theta = s.theta[0];
         let mut total = 0.0;
-        let list = s.impacts();
         for (k, ph) in list.iter().enumerate() {
-            let complete = ph.before.is_some() && ph.after.is_some();
-            let eb = ph.before.and_then(|i| s.energy[i]);
-            let ea = ph.after.and_then(|i| s.energy[i]);
+            let complete = ph.step_before.is_some() && ph.step_after.is_some();
+            let (eb, ea) = (ph.energy_before, ph.energy_after);
             let loss = match (eb, ea, e0) {
                 (Some(b), Some(a), Some(e0)) => Some((b - a) / e0),
                 _ => None,
@@ -408,8 +508,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             if let Some(l) = loss {
                 total += l;
             }
-            let tb = ph.before.and_then(|i| s.theta[i]);
-            let ta = ph.after.and_then(|i| s.theta[i]);
+            let (tb, ta) = (ph.theta_before, ph.theta_after);
             let tloss = match (tb, ta, e0_theta) {
                 (Some(b), Some(a), Some(e0)) if e0 != 0.0 => Some((b - a) / e0),
                 _ => None,
@@ -422,12 +521,12 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             impacts.f64("h", r.h);
             impacts.f64("dt", r.dt);
             impacts.i64("impact", Some(k as i64 + 1));
-            impacts.i64("step_first", Some(s.step[ph.first]));
-            impacts.i64("step_last", Some(s.step[ph.last]));
-            impacts.f64("t_first", s.t[ph.first]);
-            impacts.f64("t_last", s.t[ph.last]);
-            impacts.i64("step_before", ph.before.map(|i| s.step[i]));
-            impacts.i64("step_after", ph.after.map(|i| s.step[i]));
+            impacts.i64("step_first", Some(ph.step_first));
+            impacts.i64("step_last", Some(ph.step_last));
+            impacts.f64("t_first", ph.t_first);
+            impacts.f64("t_last", ph.t_last);
+            impacts.i64("step_before", ph.step_before);
+            impacts.i64("step_after", ph.step_after);
             impacts.f64("energy_e0", e0);
             impacts.f64("energy_before", eb);
             impacts.f64("energy_after", ea);
@@ -632,10 +731,11 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         Ok(_) => {
             let _ = writeln!(
                 md,
-                "Impacts: contact phases = maximal runs of recorded steps with σ_C < 0; \
-                 loss = (E just before − E just after)/E⁰ summed over complete phases; full list \
-                 in impacts.parquet. {impact_count} contact phases in {runs_with_series} runs with \
-                 series{}.\n",
+                "Impacts: contact phases = maximal runs of steps with σ_C < 0 (a one-step gap \
+                 without pressure does not end one), found by each run at every step (folders of \
+                 older versions: from the recorded series); loss = (E just before − E just \
+                 after)/E⁰ summed over complete phases; full list in impacts.parquet. \
+                 {impact_count} contact phases in {runs_with_series} runs{}.\n",
                 if decimated_runs > 0 {
                     format!(
                         "; {decimated_runs} series are decimated (phase ends resolved to the \
@@ -717,7 +817,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         Ok(_) => {
             let _ = writeln!(
                 terminal,
-                "  impacts: {impact_count} contact phases in {runs_with_series} runs with series{}",
+                "  impacts: {impact_count} contact phases in {runs_with_series} runs{}",
                 if decimated_runs > 0 {
                     format!(" ({decimated_runs} decimated)")
                 } else {

@@ -103,6 +103,7 @@ const MEASURED: &[(&str, Kind)] = &[
     ("energy_max_increase", Kind::F64),
     ("energy_theta_max_increase", Kind::F64),
     ("energy_theta_drift", Kind::F64),
+    ("energy_theta_initial", Kind::F64),
     ("search", Kind::Str),
 ];
 
@@ -171,10 +172,16 @@ pub(crate) struct Run {
     pub energy_max_increase: Option<f64>,
     pub energy_theta_max_increase: Option<f64>,
     pub energy_theta_drift: Option<f64>,
+    pub energy_theta_initial: Option<f64>,
     /// Ensemble member index (null outside ensembles).
     pub ensemble_sample: Option<i64>,
     /// The `[search]` whose probe this run is (null for grid runs).
     pub search: Option<String>,
+    /// The runs part the row was read from (`series/` holds the run's rows under the same name).
+    pub part: Option<String>,
+    /// The contact phases the run recorded online (the `impact_*` list columns); None for a
+    /// row of a version without them (the energy section then reads `series/`).
+    pub impacts: Option<Vec<crate::run::impacts::Phase>>,
     /// Index into [`Runs::groups`].
     pub group: usize,
 }
@@ -353,9 +360,33 @@ pub(crate) fn read_typed(
     folder: &Path,
     known: &[(&'static str, Kind)],
 ) -> anyhow::Result<(DataFrame, Vec<String>)> {
+    let known: Vec<(&'static str, DataType)> = known.iter().map(|(n, k)| (*n, dtype(*k))).collect();
+    read_parts(folder, &known, &[], None)
+}
+
+/// The column [`read_parts`] adds to name the part file each row came from.
+pub(crate) const PART_COLUMN: &str = "__part";
+
+/// [`read_typed`] with `lists` (list columns, read when the stored column is a list of
+/// numbers, cast to the given list type) and optionally only the parts named in `only`; every
+/// row carries the file name of its part in [`PART_COLUMN`]. The sink writes `runs/NAME` and
+/// `series/NAME` per batch, so a run's part names its series part too.
+pub(crate) fn read_parts(
+    folder: &Path,
+    known: &[(&'static str, DataType)],
+    lists: &[(&'static str, DataType)],
+    only: Option<&HashSet<String>>,
+) -> anyhow::Result<(DataFrame, Vec<String>)> {
     let mut ignored: Vec<String> = Vec::new();
     let mut frames = Vec::new();
     for part in crate::sink::parquet_parts(folder)? {
+        let name = part
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if only.is_some_and(|o| !o.contains(&name)) {
+            continue;
+        }
         let file = std::fs::File::open(&part).with_context(|| format!("{}", part.display()))?;
         let mut reader = ParquetReader::new(file);
         // An unreadable part is skipped: `summarize` warns about it (sink::unreadable_parts).
@@ -363,31 +394,42 @@ pub(crate) fn read_typed(
             continue;
         };
         let stored: Vec<String> = schema.iter_names().map(|n| n.to_string()).collect();
+        let is_known = |n: &str| known.iter().chain(lists).any(|(k, _)| *k == n);
         // Read only the known columns (a series part can be large; the rest is never loaded).
-        let wanted: Vec<String> = stored
-            .iter()
-            .filter(|n| known.iter().any(|(k, _)| k == n))
-            .cloned()
-            .collect();
+        let wanted: Vec<String> = stored.iter().filter(|n| is_known(n)).cloned().collect();
         let raw = match reader.with_columns(Some(wanted)).finish() {
             Ok(raw) => raw,
             Err(_) => continue,
         };
         let schema = raw.schema().clone();
+        let list_ok = |n: &str| {
+            lists.iter().any(|(k, _)| *k == n)
+                && schema.get(n).is_some_and(|t| match t {
+                    DataType::List(inner) => inner.is_primitive_numeric() || inner.is_null(),
+                    _ => false,
+                })
+        };
         for name in &stored {
-            let usable = schema.get(name).is_some_and(castable);
+            let usable = schema.get(name).is_some_and(castable) || list_ok(name);
             if !usable && !ignored.iter().any(|i| i == name) {
                 ignored.push(name.clone());
             }
         }
-        let exprs: Vec<Expr> = known
+        let mut exprs: Vec<Expr> = known
             .iter()
             .filter(|(n, _)| schema.get(n).is_some_and(castable))
-            .map(|(n, k)| col(*n).cast(dtype(*k)))
+            .map(|(n, t)| col(*n).cast(t.clone()))
             .collect();
+        exprs.extend(
+            lists
+                .iter()
+                .filter(|(n, _)| list_ok(n))
+                .map(|(n, t)| col(*n).cast(t.clone())),
+        );
         if exprs.is_empty() {
             continue;
         }
+        exprs.push(lit(name.as_str()).alias(PART_COLUMN));
         frames.push(raw.lazy().select(exprs));
     }
     if frames.is_empty() {
@@ -423,6 +465,82 @@ fn strs(df: &DataFrame, name: &str) -> anyhow::Result<Option<Vec<Option<String>>
     }
 }
 
+/// The runs table's list columns of the contact phases (issue 12), in [`Phase`] field order;
+/// `true`: Int64 elements.
+///
+/// [`Phase`]: crate::run::impacts::Phase
+const IMPACT_COLUMNS: &[(&str, bool)] = &[
+    ("impact_step_first", true),
+    ("impact_step_last", true),
+    ("impact_t_first", false),
+    ("impact_t_last", false),
+    ("impact_energy_before", false),
+    ("impact_energy_after", false),
+    ("impact_energy_theta_before", false),
+    ("impact_energy_theta_after", false),
+];
+
+/// Each row's contact phases, from the `impact_*` list columns: None for the whole frame
+/// when a column is missing, None for a row whose lists are null or of unequal lengths (a row
+/// this version did not write).
+#[allow(clippy::type_complexity)]
+fn impact_lists(
+    df: &DataFrame,
+) -> anyhow::Result<Option<Vec<Option<Vec<crate::run::impacts::Phase>>>>> {
+    if IMPACT_COLUMNS.iter().any(|(n, _)| df.column(n).is_err()) {
+        return Ok(None);
+    }
+    let ints = |n: &str| -> anyhow::Result<Vec<Option<Vec<i64>>>> {
+        let ca = df.column(n)?.list()?.clone();
+        Ok((0..ca.len())
+            .map(|i| {
+                let s = ca.get_as_series(i)?;
+                s.i64().ok().map(|c| c.iter().flatten().collect())
+            })
+            .collect())
+    };
+    let floats = |n: &str| -> anyhow::Result<Vec<Option<Vec<Option<f64>>>>> {
+        let ca = df.column(n)?.list()?.clone();
+        Ok((0..ca.len())
+            .map(|i| {
+                let s = ca.get_as_series(i)?;
+                s.f64().ok().map(|c| c.iter().collect())
+            })
+            .collect())
+    };
+    let (first, last) = (ints("impact_step_first")?, ints("impact_step_last")?);
+    let fl: Vec<_> = IMPACT_COLUMNS[2..]
+        .iter()
+        .map(|(n, _)| floats(n))
+        .collect::<anyhow::Result<_>>()?;
+    let out = (0..df.height())
+        .map(|i| {
+            let (f, l) = (first[i].as_ref()?, last[i].as_ref()?);
+            let cols: Vec<&Vec<Option<f64>>> =
+                fl.iter().map(|c| c[i].as_ref()).collect::<Option<_>>()?;
+            let n = f.len();
+            if l.len() != n || cols.iter().any(|c| c.len() != n) {
+                return None;
+            }
+            Some(
+                (0..n)
+                    .map(|k| crate::run::impacts::Phase {
+                        step_first: f[k],
+                        step_last: l[k],
+                        t_first: cols[0][k].unwrap_or(f64::NAN),
+                        t_last: cols[1][k].unwrap_or(f64::NAN),
+                        energy_before: cols[2][k],
+                        energy_after: cols[3][k],
+                        energy_theta_before: cols[4][k],
+                        energy_theta_after: cols[5][k],
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    Ok(Some(out))
+}
+
 /// Read and group the runs of `dir`.
 pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     if !dir.is_dir() {
@@ -438,7 +556,23 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         .copied()
         .chain(ERRORS.iter().map(|e| (*e, Kind::F64)))
         .collect();
-    let (df, mut ignored) = read_typed(&dir.join("runs"), &known)?;
+    let known: Vec<(&'static str, DataType)> =
+        known.iter().map(|(n, k)| (*n, dtype(*k))).collect();
+    let list = |t: DataType| DataType::List(Box::new(t));
+    let lists: Vec<(&'static str, DataType)> = IMPACT_COLUMNS
+        .iter()
+        .map(|&(n, int)| {
+            (
+                n,
+                list(if int {
+                    DataType::Int64
+                } else {
+                    DataType::Float64
+                }),
+            )
+        })
+        .collect();
+    let (df, mut ignored) = read_parts(&dir.join("runs"), &known, &lists, None)?;
     // Columns of this version's own schema that the summary does not need are not foreign.
     ignored.retain(|n| !crate::run::RunRecord::COLUMNS.iter().any(|c| c.0 == n));
     if df.height() == 0 {
@@ -503,6 +637,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     );
     let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
     let theta_drift = get_f("energy_theta_drift")?;
+    let theta_initial = get_f("energy_theta_initial")?;
     let sample = get_i("ensemble_sample")?;
     let search = strs(&df, "search")?;
     let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
@@ -514,6 +649,8 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         get_f("energy_theta_max_increase")?,
     );
     let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
+    let part = strs(&df, PART_COLUMN)?;
+    let impacts = impact_lists(&df)?;
 
     let mut seen: HashSet<String> = HashSet::new();
     let mut duplicates = 0;
@@ -588,8 +725,11 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             energy_max_increase: max_inc[i],
             energy_theta_max_increase: theta_inc[i],
             energy_theta_drift: theta_drift[i],
+            energy_theta_initial: theta_initial[i],
             ensemble_sample: sample[i],
             search: search.as_ref().and_then(|v| v[i].clone()),
+            part: part.as_ref().and_then(|v| v[i].clone()),
+            impacts: impacts.as_ref().and_then(|v| v[i].clone()),
             group: 0,
         });
     }
