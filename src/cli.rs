@@ -653,16 +653,24 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             dir.display()
         );
     } else if cfg.summary {
-        match summary::summarize_with(dir, &plan.sweep.summary) {
-            Ok(s) => print!("{}", s.terminal),
-            Err(e) => eprintln!("summary not written: {e:#}"),
-        }
-        match crate::report::write(dir, None) {
-            Ok(r) => println!(
-                "report: {} — open it in a browser: figures and every table",
-                r.path.display()
-            ),
-            Err(e) => eprintln!("report not written: {e:#}"),
+        // The sections are computed once for the tables and the report (the report alone,
+        // `contact-sweep report DIR`, reads the [summary] choice stored in the manifest: this
+        // session's, i.e. plan.sweep.summary).
+        match summary::Sections::compute(dir, &plan.sweep.summary) {
+            Ok(sections) => {
+                match sections.write(dir) {
+                    Ok(s) => print!("{}", s.terminal),
+                    Err(e) => eprintln!("summary not written: {e:#}"),
+                }
+                match crate::report::write_with(dir, None, &sections) {
+                    Ok(r) => println!(
+                        "report: {} — open it in a browser: figures and every table",
+                        r.path.display()
+                    ),
+                    Err(e) => eprintln!("report not written: {e:#}"),
+                }
+            }
+            Err(e) => eprintln!("summary and report not written: {e:#}"),
         }
     }
     Ok(ExitCode::SUCCESS)

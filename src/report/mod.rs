@@ -16,16 +16,16 @@
 
 pub mod figures;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
-use crate::summary::convergence::{self, lsq_slope};
+use crate::summary::Sections;
+use crate::summary::convergence::lsq_slope;
 use crate::summary::runs::{self, Runs};
-use crate::summary::table::{self as stable, Kind};
-use crate::summary::{energy, stability, work};
+use crate::summary::table as stable;
 use figures::Curve;
 
 /// What `report` wrote.
@@ -48,7 +48,19 @@ const SERIES_GROUPS: usize = 8;
 /// A figure that cannot be drawn (no positive errors, no series) is noted in the report, not an
 /// error.
 pub fn write(dir: &Path, out: Option<&Path>) -> anyhow::Result<Report> {
-    let html = render(dir)?;
+    let opts = crate::summary::stored_options(dir)?;
+    let sections = Sections::compute(dir, &opts)?;
+    write_with(dir, out, &sections)
+}
+
+/// [`write`] from sections already computed (`contact-sweep run` computes them once for the
+/// tables and the report).
+pub(crate) fn write_with(
+    dir: &Path,
+    out: Option<&Path>,
+    sections: &Sections,
+) -> anyhow::Result<Report> {
+    let html = render(dir, sections)?;
     let path = out
         .map(Path::to_path_buf)
         .unwrap_or_else(|| dir.join("report.html"));
@@ -317,41 +329,43 @@ struct RunSeries {
     sigma_exact: Vec<(f64, f64)>,
 }
 
-/// The series of the runs `ids`, in time order.
-fn read_series(dir: &Path, ids: &[&str]) -> anyhow::Result<HashMap<String, RunSeries>> {
+/// The series of the runs `chosen`, in time order. Only the series parts that hold them are
+/// read (the sink names a batch's series part like its runs part, which `runs::load` records
+/// per run), and only the columns drawn.
+fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<String, RunSeries>> {
     let mut out: HashMap<String, RunSeries> = HashMap::new();
     let folder = dir.join("series");
-    if !folder.exists() {
+    if !folder.exists() || chosen.is_empty() {
         return Ok(out);
     }
-    let (df, _) = runs::read_typed(
+    // A run without its part's name (not known to the loader) means: read every part.
+    let parts: Option<HashSet<String>> = chosen.iter().map(|r| r.part.clone()).collect();
+    let f64t = polars::prelude::DataType::Float64;
+    let (df, _) = runs::read_parts(
         &folder,
         &[
-            ("run_id", Kind::Str),
-            ("t", Kind::F64),
-            ("u_contact", Kind::F64),
-            ("sigma_contact", Kind::F64),
-            ("energy", Kind::F64),
-            ("u_contact_exact", Kind::F64),
-            ("sigma_contact_exact", Kind::F64),
+            ("run_id", polars::prelude::DataType::String),
+            ("t", f64t.clone()),
+            ("u_contact", f64t.clone()),
+            ("sigma_contact", f64t.clone()),
+            ("energy", f64t.clone()),
+            ("u_contact_exact", f64t.clone()),
+            ("sigma_contact_exact", f64t),
         ],
+        &[],
+        parts.as_ref(),
     )?;
     if df.height() == 0 || df.column("run_id").is_err() || df.column("t").is_err() {
         return Ok(out);
     }
-    let wanted: std::collections::HashSet<&str> = ids.iter().copied().collect();
+    let wanted: HashSet<&str> = chosen.iter().map(|r| r.run_id.as_str()).collect();
     let f = |name: &str| -> Vec<Option<f64>> {
         df.column(name)
             .ok()
             .and_then(|c| c.f64().ok().map(|c| c.iter().collect()))
             .unwrap_or_else(|| vec![None; df.height()])
     };
-    let ids_col: Vec<Option<String>> = df
-        .column("run_id")?
-        .str()?
-        .iter()
-        .map(|s| s.map(String::from))
-        .collect();
+    let ids_col = df.column("run_id")?.str()?;
     let (t, u, s, en, ue, se) = (
         f("t"),
         f("u_contact"),
@@ -360,14 +374,17 @@ fn read_series(dir: &Path, ids: &[&str]) -> anyhow::Result<HashMap<String, RunSe
         f("u_contact_exact"),
         f("sigma_contact_exact"),
     );
-    for k in 0..df.height() {
-        let (Some(id), Some(t)) = (&ids_col[k], t[k]) else {
+    for (k, id) in ids_col.iter().enumerate() {
+        let (Some(id), Some(t)) = (id, t[k]) else {
             continue;
         };
-        if !wanted.contains(id.as_str()) {
+        if !wanted.contains(id) {
             continue;
         }
-        let rs = out.entry(id.clone()).or_default();
+        let rs = match out.get_mut(id) {
+            Some(rs) => rs,
+            None => out.entry(id.to_string()).or_default(),
+        };
         let push = |v: &mut Vec<(f64, f64)>, y: Option<f64>| {
             if let Some(y) = y.filter(|y| y.is_finite()) {
                 v.push((t, y));
@@ -406,18 +423,16 @@ pre{background:#f7f7f7;padding:8px;overflow-x:auto;font-size:.85em}
 nav a{margin-right:1em}
 .legend{display:flex;flex-wrap:wrap;gap:4px 18px;font-size:.85em;margin:.4em 0}.legend i{display:inline-block;width:22px;height:4px;margin:0 6px 3px 0;vertical-align:middle}";
 
-fn render(dir: &Path) -> anyhow::Result<Html> {
-    let opts = crate::summary::stored_options(dir)?;
-    let runs = runs::load(dir)?;
-    let title = dir
-        .canonicalize()
-        .ok()
-        .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .unwrap_or_else(|| dir.display().to_string());
-    let conv = convergence::section(&runs, &opts, &title);
-    let en = energy::section(dir, &runs)?;
-    let wp = work::section(&runs);
-    let st = stability::section(&runs);
+fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
+    let Sections {
+        runs,
+        title,
+        conv,
+        en,
+        wp,
+        st,
+        ..
+    } = sections;
     let ses = session(dir)?;
     let name = ses.sweep.clone().unwrap_or_else(|| title.clone());
     let mut figures = 0usize;
@@ -593,11 +608,8 @@ fn render(dir: &Path) -> anyhow::Result<Html> {
         })
         .take(SERIES_GROUPS)
         .collect();
-    let ids: Vec<&str> = chosen
-        .iter()
-        .map(|&(_, i)| runs.runs[i].run_id.as_str())
-        .collect();
-    let series = read_series(dir, &ids)?;
+    let picked: Vec<&runs::Run> = chosen.iter().map(|&(_, i)| &runs.runs[i]).collect();
+    let series = read_series(dir, &picked)?;
     if series.is_empty() {
         body.push_str("<p class=\"note\">No time series in <code>series/</code> (series_every = 0?): nothing to plot.</p>\n");
     } else {

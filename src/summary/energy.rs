@@ -210,21 +210,17 @@ fn read_series(
     }
     // A row without its part's name (not read by `runs::load`) means: read every part.
     let parts: Option<HashSet<String>> = need.iter().map(|r| r.part.clone()).collect();
-    let t = |k: Kind| match k {
-        Kind::I64 => polars::prelude::DataType::Int64,
-        Kind::Str => polars::prelude::DataType::String,
-        _ => polars::prelude::DataType::Float64,
-    };
+    use polars::prelude::DataType;
     // Typed per part (another version may store a column with another type).
     let (raw, _) = super::runs::read_parts(
         &dir.join("series"),
         &[
-            ("run_id", t(Kind::Str)),
-            ("step", t(Kind::I64)),
-            ("t", t(Kind::F64)),
-            ("sigma_contact", t(Kind::F64)),
-            ("energy", t(Kind::F64)),
-            ("energy_theta", t(Kind::F64)),
+            ("run_id", DataType::String),
+            ("step", DataType::Int64),
+            ("t", DataType::Float64),
+            ("sigma_contact", DataType::Float64),
+            ("energy", DataType::Float64),
+            ("energy_theta", DataType::Float64),
         ],
         &[],
         parts.as_ref(),

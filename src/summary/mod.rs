@@ -130,107 +130,151 @@ pub fn summarize(dir: &Path) -> anyhow::Result<Summary> {
     summarize_with(dir, &opts)
 }
 
-/// Summarize DIR: read `DIR/runs` (and `DIR/series`), write the tables under `DIR/summary/`;
-/// `opts` chooses the error columns of the Markdown and LaTeX tables.
+/// Summarize DIR: read `DIR/runs` (and `DIR/series` for rows without online contact phases),
+/// write the tables under `DIR/summary/`; `opts` chooses the error columns of the Markdown and
+/// LaTeX tables.
 ///
 /// Errors: DIR missing or without runs (the message names the folder), or an I/O failure.
 /// A folder without a refinement axis is not an error: the convergence section says so.
 pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summary> {
-    // Unreadable parts are skipped by the readers below; say which.
-    let warnings: Vec<String> = crate::sink::unreadable_parts(dir)?
-        .iter()
-        .map(|d| d.warning())
-        .collect();
-    let runs = runs::load(dir)?;
-    let out = dir.join("summary");
-    std::fs::create_dir_all(&out).with_context(|| format!("{}: cannot create", out.display()))?;
-    let mut files = Vec::new();
+    let sections = Sections::compute(dir, opts)?;
+    sections.write(dir)
+}
 
-    // The folder's name heads the stand-alone LaTeX document.
-    let title = dir
-        .canonicalize()
-        .ok()
-        .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .unwrap_or_else(|| dir.display().to_string());
-    let conv = convergence::section(&runs, opts, &title);
-    files.extend(table::write_table(&out, "convergence", &conv.table)?);
-    files.push(table::write_text(&out, "convergence.md", &conv.markdown)?);
-    files.push(table::write_text(&out, "convergence.tex", &conv.latex)?);
-    files.push(table::write_text(
-        &out,
-        "convergence_doc.tex",
-        &conv.latex_doc,
-    )?);
+/// Every section of a folder's summary, computed once: [`Sections::write`] writes the tables,
+/// and the report draws from the same values (`contact-sweep run` computes them once for
+/// both, issue 12).
+pub(crate) struct Sections {
+    pub(crate) runs: runs::Runs,
+    pub(crate) title: String,
+    pub(crate) conv: convergence::Section,
+    pub(crate) en: energy::Section,
+    pub(crate) ens: ensemble::Section,
+    pub(crate) st: stability::Section,
+    pub(crate) se: search::Section,
+    pub(crate) wp: work::Section,
+    pub(crate) warnings: Vec<String>,
+}
 
-    let en = energy::section(dir, &runs)?;
-    files.extend(table::write_table(&out, "energy", &en.runs)?);
-    files.extend(table::write_table(&out, "energy_groups", &en.groups)?);
-    files.extend(table::write_table(&out, "impacts", &en.impacts)?);
-    files.push(table::write_text(&out, "energy.md", &en.markdown)?);
-
-    let ens = ensemble::section(&runs);
-    files.extend(table::write_table(&out, "ensemble", &ens.table)?);
-    files.push(table::write_text(&out, "ensemble.md", &ens.markdown)?);
-
-    let st = stability::section(&runs);
-    files.extend(table::write_table(&out, "stability_map", &st.table)?);
-    files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
-
-    let se = search::section(&runs);
-    files.extend(table::write_table(&out, "search", &se.table)?);
-    files.push(table::write_text(&out, "search.md", &se.markdown)?);
-
-    let wp = work::section(&runs);
-    files.extend(table::write_table(&out, "work_precision", &wp.table)?);
-    files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
-    files.push(table::write_text(&out, "work_precision.md", &wp.markdown)?);
-
-    let mut terminal = format!(
-        "{} runs ({} ok) in {} groups from {}\n",
-        runs.runs.len(),
-        runs.runs.iter().filter(|r| r.ok()).count(),
-        runs.groups.len(),
-        dir.display()
-    );
-    if runs.duplicates > 0 {
-        terminal.push_str(&format!(
-            "  ({} duplicate rows of the same run_id dropped)\n",
-            runs.duplicates
-        ));
+impl Sections {
+    /// Read DIR and compute every section (nothing is written).
+    pub(crate) fn compute(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Sections> {
+        // Unreadable parts are skipped by the readers below; say which.
+        let warnings: Vec<String> = crate::sink::unreadable_parts(dir)?
+            .iter()
+            .map(|d| d.warning())
+            .collect();
+        let runs = runs::load(dir)?;
+        // The folder's name heads the stand-alone LaTeX document.
+        let title = dir
+            .canonicalize()
+            .ok()
+            .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .unwrap_or_else(|| dir.display().to_string());
+        let conv = convergence::section(&runs, opts, &title);
+        let en = energy::section(dir, &runs)?;
+        let ens = ensemble::section(&runs);
+        let st = stability::section(&runs);
+        let se = search::section(&runs);
+        let wp = work::section(&runs);
+        Ok(Sections {
+            runs,
+            title,
+            conv,
+            en,
+            ens,
+            st,
+            se,
+            wp,
+            warnings,
+        })
     }
-    if !runs.ignored.is_empty() {
-        terminal.push_str(&format!(
-            "  (columns not known to this version, ignored: {})\n",
-            runs.ignored.join(", ")
-        ));
-    }
-    if runs.status_assumed {
-        terminal.push_str("  (no status column: every run counted as ok)\n");
-    }
-    terminal.push_str(&conv.terminal);
-    terminal.push_str(&en.terminal);
-    terminal.push_str(&ens.terminal);
-    terminal.push_str(&st.terminal);
-    terminal.push_str(&se.terminal);
-    terminal.push_str(&wp.terminal);
-    terminal.push_str(&format!(
-        "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
-        out.display()
-    ));
-    if !conv.groups.hints.is_empty() {
-        terminal.push_str("look at:\n");
-        for h in &conv.groups.hints {
-            terminal.push_str(&format!("  - {h}\n"));
+
+    /// Write the tables under `DIR/summary/` and compose the terminal report.
+    pub(crate) fn write(&self, dir: &Path) -> anyhow::Result<Summary> {
+        let Sections {
+            runs,
+            conv,
+            en,
+            ens,
+            st,
+            se,
+            wp,
+            ..
+        } = self;
+        let out = dir.join("summary");
+        std::fs::create_dir_all(&out)
+            .with_context(|| format!("{}: cannot create", out.display()))?;
+        let mut files = Vec::new();
+        files.extend(table::write_table(&out, "convergence", &conv.table)?);
+        files.push(table::write_text(&out, "convergence.md", &conv.markdown)?);
+        files.push(table::write_text(&out, "convergence.tex", &conv.latex)?);
+        files.push(table::write_text(
+            &out,
+            "convergence_doc.tex",
+            &conv.latex_doc,
+        )?);
+        files.extend(table::write_table(&out, "energy", &en.runs)?);
+        files.extend(table::write_table(&out, "energy_groups", &en.groups)?);
+        files.extend(table::write_table(&out, "impacts", &en.impacts)?);
+        files.push(table::write_text(&out, "energy.md", &en.markdown)?);
+        files.extend(table::write_table(&out, "ensemble", &ens.table)?);
+        files.push(table::write_text(&out, "ensemble.md", &ens.markdown)?);
+        files.extend(table::write_table(&out, "stability_map", &st.table)?);
+        files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
+        files.extend(table::write_table(&out, "search", &se.table)?);
+        files.push(table::write_text(&out, "search.md", &se.markdown)?);
+        files.extend(table::write_table(&out, "work_precision", &wp.table)?);
+        files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
+        files.push(table::write_text(&out, "work_precision.md", &wp.markdown)?);
+
+        let mut terminal = format!(
+            "{} runs ({} ok) in {} groups from {}\n",
+            runs.runs.len(),
+            runs.runs.iter().filter(|r| r.ok()).count(),
+            runs.groups.len(),
+            dir.display()
+        );
+        if runs.duplicates > 0 {
+            terminal.push_str(&format!(
+                "  ({} duplicate rows of the same run_id dropped)\n",
+                runs.duplicates
+            ));
         }
+        if !runs.ignored.is_empty() {
+            terminal.push_str(&format!(
+                "  (columns not known to this version, ignored: {})\n",
+                runs.ignored.join(", ")
+            ));
+        }
+        if runs.status_assumed {
+            terminal.push_str("  (no status column: every run counted as ok)\n");
+        }
+        terminal.push_str(&conv.terminal);
+        terminal.push_str(&en.terminal);
+        terminal.push_str(&ens.terminal);
+        terminal.push_str(&st.terminal);
+        terminal.push_str(&se.terminal);
+        terminal.push_str(&wp.terminal);
+        terminal.push_str(&format!(
+            "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
+            out.display()
+        ));
+        if !conv.groups.hints.is_empty() {
+            terminal.push_str("look at:\n");
+            for h in &conv.groups.hints {
+                terminal.push_str(&format!("  - {h}\n"));
+            }
+        }
+        Ok(Summary {
+            terminal,
+            dir: out,
+            files,
+            runs: runs.runs.len(),
+            groups: runs.groups.len(),
+            refinement_paths: runs.paths.len(),
+            ignored_columns: runs.ignored.clone(),
+            warnings: self.warnings.clone(),
+        })
     }
-    Ok(Summary {
-        terminal,
-        dir: out,
-        files,
-        runs: runs.runs.len(),
-        groups: runs.groups.len(),
-        refinement_paths: runs.paths.len(),
-        ignored_columns: runs.ignored,
-        warnings,
-    })
 }

@@ -348,29 +348,21 @@ fn castable(found: &DataType) -> bool {
     found.is_primitive_numeric() || found.is_bool() || found.is_string() || found.is_null()
 }
 
-/// Read every committed Parquet part of `folder`, keeping only the `known` columns, each cast
-/// to the type this version expects, and concatenate them diagonally (a column missing from a
-/// part is null there). Returns the frame and the columns that were not read.
+/// The column [`read_parts`] adds to name the part file each row came from.
+pub(crate) const PART_COLUMN: &str = "__part";
+
+/// Read the committed Parquet parts of `folder` (all, or those named in `only`), keeping only
+/// the `known` columns, each cast to the type this version expects, and the `lists` (list
+/// columns, read when the stored column is a list of numbers, cast to the given list type);
+/// concatenate them diagonally (a column missing from a part is null there). Every row carries
+/// the file name of its part in [`PART_COLUMN`]: the sink writes `runs/NAME` and `series/NAME`
+/// per batch, so a run's part names its series part too. Returns the frame and the columns
+/// that were not read.
 ///
 /// Why not `sink::read_runs`: it concatenates the parts as stored, which fails when two
 /// versions stored a column with different types (`repeats` as i32 and i64, `elements` as
 /// integer and float) or a foreign column differs between parts; casting each part first
 /// makes the union always well-typed.
-pub(crate) fn read_typed(
-    folder: &Path,
-    known: &[(&'static str, Kind)],
-) -> anyhow::Result<(DataFrame, Vec<String>)> {
-    let known: Vec<(&'static str, DataType)> = known.iter().map(|(n, k)| (*n, dtype(*k))).collect();
-    read_parts(folder, &known, &[], None)
-}
-
-/// The column [`read_parts`] adds to name the part file each row came from.
-pub(crate) const PART_COLUMN: &str = "__part";
-
-/// [`read_typed`] with `lists` (list columns, read when the stored column is a list of
-/// numbers, cast to the given list type) and optionally only the parts named in `only`; every
-/// row carries the file name of its part in [`PART_COLUMN`]. The sink writes `runs/NAME` and
-/// `series/NAME` per batch, so a run's part names its series part too.
 pub(crate) fn read_parts(
     folder: &Path,
     known: &[(&'static str, DataType)],
