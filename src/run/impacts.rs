@@ -130,10 +130,11 @@ impl PhaseTracker {
     }
 
     /// The phases of the run, the open one closed (its `after` is the step after its last
-    /// contact step if the run reached it, else None).
-    pub fn finish(&self) -> Vec<Phase> {
-        let mut out = self.phases.clone();
-        if let Some(mut ph) = self.open {
+    /// contact step if the run reached it, else None). Moves the list out (no copy, no
+    /// allocation within the reserve); the tracker is empty afterwards.
+    pub fn finish(&mut self) -> Vec<Phase> {
+        let mut out = std::mem::take(&mut self.phases);
+        if let Some(mut ph) = self.open.take() {
             if !self.after_seen {
                 ph.energy_after = None;
                 ph.energy_theta_after = None;

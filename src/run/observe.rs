@@ -341,7 +341,7 @@ impl Observer {
 
     /// Fill the metrics from what was observed. Error norms only for complete runs with a
     /// closed form (a partial sum is not the norm the column names).
-    pub fn finish(&self, metrics: &mut Metrics, complete: bool) {
+    pub fn finish(&mut self, metrics: &mut Metrics, complete: bool) {
         if self.observed == 0 {
             return;
         }

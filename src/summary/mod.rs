@@ -1,5 +1,6 @@
-//! Summaries of a results folder: `contact-sweep summarize DIR` turns `DIR/runs` (and, for the
-//! impacts, `DIR/series`) into the tables of a paper under `DIR/summary/` (SPEC §8, issue 4).
+//! Summaries of a results folder: `contact-sweep summarize DIR` turns `DIR/runs` into the
+//! tables of a paper under `DIR/summary/` (SPEC §8, issue 4). The impacts come from the runs'
+//! own contact-phase lists; `DIR/series` is read only for rows of older versions without them.
 //!
 //! # Groups and refinement paths
 //! Runs are grouped by every parameter column except the refinement axes (h/elements,
@@ -44,7 +45,7 @@
 //!
 //! # Energy, speed against error
 //! See [`energy`] (drift, the energy class of each run judged by its scheme's functional,
-//! energy lost per impact from the time series), [`ensemble`] (round-off spread) and [`work`] (Pareto front in (error, wall time) and (error,
+//! energy lost per impact from the runs' contact phases), [`ensemble`] (round-off spread) and [`work`] (Pareto front in (error, wall time) and (error,
 //! steps × dofs); cost to reach ε by log-log interpolation between consecutive levels, the
 //! same power-law model as the rates).
 //!
