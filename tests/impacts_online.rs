@@ -115,10 +115,7 @@ fn online_phases_equal_the_series_path_and_need_no_series() {
     // runs' lists or into the series — and compute the losses by the same expression with
     // the same E⁰, E_Θ⁰ (the row's energy_initial / energy_theta_initial are the step-0
     // values the series holds). No arithmetic differs, so no tolerance is needed.
-    assert!(
-        a.equals_missing(&b),
-        "online:\n{a}\nseries-based:\n{b}"
-    );
+    assert!(a.equals_missing(&b), "online:\n{a}\nseries-based:\n{b}");
     assert_eq!(
         i64s(&a, "series_stride"),
         vec![Some(1); a.height()],
@@ -147,7 +144,13 @@ fn decimated_series_no_longer_coarsen_the_phase_ends() {
     let d = impacts(&every10);
     // The same runs (series_every is not a parameter of a run): the phases found online do
     // not depend on what the series keeps — exact steps, equal to the full-series ones.
-    for c in ["run_id", "step_first", "step_last", "step_before", "step_after"] {
+    for c in [
+        "run_id",
+        "step_first",
+        "step_last",
+        "step_before",
+        "step_after",
+    ] {
         assert_eq!(
             a.column(c).unwrap(),
             d.column(c).unwrap(),
@@ -160,9 +163,7 @@ fn decimated_series_no_longer_coarsen_the_phase_ends() {
     strip_online_columns(&every10);
     let old = impacts(&every10);
     assert!(
-        i64s(&old, "series_stride")
-            .iter()
-            .all(|s| *s == Some(10)),
+        i64s(&old, "series_stride").iter().all(|s| *s == Some(10)),
         "stride of a series_every = 10 series"
     );
     // Every phase end the old path reports is a stored step: a multiple of 10, or the run's
@@ -188,7 +189,10 @@ fn decimated_series_no_longer_coarsen_the_phase_ends() {
     for c in ["step_first", "step_last"] {
         for (id, s) in ids.iter().zip(i64s(&old, c)) {
             let s = s.unwrap();
-            assert!(s % 10 == 0 || s == last[id], "{c} = {s} is not a stored step");
+            assert!(
+                s % 10 == 0 || s == last[id],
+                "{c} = {s} is not a stored step"
+            );
         }
     }
     let exact: Vec<i64> = ["step_first", "step_last"]

@@ -502,14 +502,14 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
             esc(&conv.groups.caption)
         );
         let gs: Vec<usize> = mains.iter().map(|&(g, _)| g).collect();
-        body.push_str(&legend(&runs, &gs, ""));
+        body.push_str(&legend(runs, &gs, ""));
         body.push_str("<div class=\"figs\">\n");
         for &e in &conv.display {
             let (abbr, what) = stable::error_abbrev(runs.errors[e]);
             let mut curves = Vec::new();
             let mut slopes = Vec::new();
             for &(g, p) in &mains {
-                let pts = path_points(&runs, p, e);
+                let pts = path_points(runs, p, e);
                 slopes.push(fit_line(&pts));
                 curves.push(Curve {
                     name: format!("{} · {}", runs.groups[g].title, runs.paths[p].fixed.short()),
@@ -574,7 +574,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
             let gs: Vec<usize> = (0..runs.groups.len())
                 .filter(|&g| !groups[g].points.is_empty())
                 .collect();
-            body.push_str(&legend(&runs, &gs, "○ black: Pareto front"));
+            body.push_str(&legend(runs, &gs, "○ black: Pareto front"));
             match figures::work_precision(&t, runs.errors[e], &groups, &front) {
                 Ok(svg) => {
                     let _ = writeln!(body, "<div class=\"fig\">{svg}</div>");
@@ -677,7 +677,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
             }
         }
         let gs: Vec<usize> = chosen.iter().map(|&(g, _)| g).collect();
-        body.push_str(&legend(&runs, &gs, "black dashes: exact"));
+        body.push_str(&legend(runs, &gs, "black dashes: exact"));
         body.push_str("<div class=\"figs\">\n");
         for (t, y, curves, exact) in [
             ("contact displacement u_C(t)", "u_C", &u, exact_u.as_ref()),

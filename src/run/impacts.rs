@@ -123,10 +123,7 @@ impl PhaseTracker {
                 }
             }
         }
-        self.prev = Some(Prev {
-            energy,
-            theta,
-        });
+        self.prev = Some(Prev { energy, theta });
     }
 
     /// The phases of the run, the open one closed (its `after` is the step after its last
@@ -154,7 +151,13 @@ mod tests {
     fn run(sigma: &[f64]) -> Vec<Phase> {
         let mut p = PhaseTracker::new();
         for (n, &s) in sigma.iter().enumerate() {
-            p.step(n, 0.5 * n as f64, s, 10.0 + n as f64, Some(100.0 + n as f64));
+            p.step(
+                n,
+                0.5 * n as f64,
+                s,
+                10.0 + n as f64,
+                Some(100.0 + n as f64),
+            );
         }
         p.finish()
     }

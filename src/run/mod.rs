@@ -9,8 +9,8 @@
 pub mod bar1d;
 pub mod estimate;
 pub mod fe;
-pub mod impacts;
 mod fe_nitsche;
+pub mod impacts;
 pub mod observe;
 pub mod record;
 pub mod reference;

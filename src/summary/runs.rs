@@ -548,8 +548,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
         .copied()
         .chain(ERRORS.iter().map(|e| (*e, Kind::F64)))
         .collect();
-    let known: Vec<(&'static str, DataType)> =
-        known.iter().map(|(n, k)| (*n, dtype(*k))).collect();
+    let known: Vec<(&'static str, DataType)> = known.iter().map(|(n, k)| (*n, dtype(*k))).collect();
     let list = |t: DataType| DataType::List(Box::new(t));
     let lists: Vec<(&'static str, DataType)> = IMPACT_COLUMNS
         .iter()
