@@ -15,7 +15,7 @@ BIN=${BIN:-target/release/contact-sweep}
 SWEEP=${SWEEP:-benches/sweeps/overhead_1d.toml}
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/overhead.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
-CONFIGS="t1:--threads=1 t1-nosum:--threads=1,--no-summary t2:--threads=2 t2-nosum:--threads=2,--no-summary t1-noseries:--threads=1,--no-summary,--series-every=0"
+CONFIGS="t1:--threads=1 t1-nosum:--threads=1,--no-summary t2:--threads=2 t2-nosum:--threads=2,--no-summary t1-noseries:--threads=1,--no-summary,--series-every=0 t2-noseries:--threads=2,--no-summary,--series-every=0"
 for round in $(seq "$ROUNDS"); do
   for c in $CONFIGS; do
     name=${c%%:*}
@@ -49,7 +49,7 @@ END {
   }
   printf "\noverhead, threads 1, series kept, no summary: %.1f %% of the runs Σ\n", 100 * (w["t1-nosum"] - r["t1-nosum"]) / r["t1-nosum"]
   printf "summary cost, threads 1: %.1f %% of the runs Σ\n", 100 * (w["t1"] - w["t1-nosum"]) / r["t1-nosum"]
-  printf "speed-up threads 2 / threads 1: %.2fx without summary, %.2fx with\n", w["t1-nosum"] / w["t2-nosum"], w["t1"] / w["t2"]
+  printf "speed-up threads 2 / threads 1: %.2fx without summary, %.2fx with, %.2fx without series and summary\n", w["t1-nosum"] / w["t2-nosum"], w["t1"] / w["t2"], w["t1-noseries"] / w["t2-noseries"]
   printf "runs Σ threads 2 / threads 1 (per-run slow-down when both cores work): %.2f\n", r["t2-nosum"] / r["t1-nosum"]
   # On 2 cores the writer thread takes its CPU from the two workers, and what is not a run
   # (planning, the summary) is serial: the best whole-command time with 2 threads is
