@@ -399,7 +399,7 @@ fn range(lo: Option<f64>, hi: Option<f64>) -> String {
 /// Build the energy section.
 pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Section> {
     // Runs of a version without the online phases fall back to their series.
-    let need: Vec<&Run> = runs.runs.iter().filter(|r| r.impacts.is_none()).collect();
+    let need: Vec<&Run> = runs.runs.iter().filter(|r| !r.impacts_stored).collect();
     let online = runs.runs.len() - need.len();
     let series = if need.is_empty() {
         Ok(HashMap::new())

@@ -180,8 +180,11 @@ pub(crate) struct Run {
     /// The runs part the row was read from (`series/` holds the run's rows under the same name).
     pub part: Option<String>,
     /// The contact phases the run recorded online (the `impact_*` list columns); None for a
-    /// row of a version without them (the energy section then reads `series/`).
+    /// row that observed no step.
     pub impacts: Option<Vec<crate::run::impacts::Phase>>,
+    /// The row's part stores the phase lists; false for a row of an older version (the energy
+    /// section then finds the phases in `series/`).
+    pub impacts_stored: bool,
     /// Index into [`Runs::groups`].
     pub group: usize,
 }
@@ -351,6 +354,10 @@ fn castable(found: &DataType) -> bool {
 /// The column [`read_parts`] adds to name the part file each row came from.
 pub(crate) const PART_COLUMN: &str = "__part";
 
+/// The column [`read_parts`] adds, when asked for list columns: whether the row's part stores
+/// every one of them (a part of this version, even if a row's lists are null).
+const LISTS_COLUMN: &str = "__lists";
+
 /// Read the committed Parquet parts of `folder` (all, or those named in `only`), keeping only
 /// the `known` columns, each cast to the type this version expects, and the `lists` (list
 /// columns, read when the stored column is a list of numbers, cast to the given list type);
@@ -422,6 +429,10 @@ pub(crate) fn read_parts(
             continue;
         }
         exprs.push(lit(name.as_str()).alias(PART_COLUMN));
+        if !lists.is_empty() {
+            let all = lists.iter().all(|(n, _)| list_ok(n));
+            exprs.push(lit(all).alias(LISTS_COLUMN));
+        }
         frames.push(raw.lazy().select(exprs));
     }
     if frames.is_empty() {
@@ -642,6 +653,11 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
     let part = strs(&df, PART_COLUMN)?;
     let impacts = impact_lists(&df)?;
+    let stored: Option<Vec<Option<bool>>> = df
+        .column(LISTS_COLUMN)
+        .ok()
+        .map(|c| c.bool().map(|b| b.iter().collect()))
+        .transpose()?;
 
     let mut seen: HashSet<String> = HashSet::new();
     let mut duplicates = 0;
@@ -721,6 +737,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             search: search.as_ref().and_then(|v| v[i].clone()),
             part: part.as_ref().and_then(|v| v[i].clone()),
             impacts: impacts.as_ref().and_then(|v| v[i].clone()),
+            impacts_stored: stored.as_ref().and_then(|v| v[i]).unwrap_or(false),
             group: 0,
         });
     }
