@@ -170,5 +170,8 @@ fn energy_impacts_figure_of_a_short_disc_sweep() {
         .unwrap();
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{stdout}");
-    assert!(stdout.trim_end().ends_with("1 passed, 0 failed"), "{stdout}");
+    assert!(
+        stdout.trim_end().ends_with("1 passed, 0 failed"),
+        "{stdout}"
+    );
 }
