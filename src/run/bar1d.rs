@@ -483,7 +483,7 @@ impl Recorder<'_> {
             _ => None,
         };
         let t = step as f64 * self.tau;
-        let (energy, energy_theta) = self.sp.energies(u, v);
+        let (energy, energy_theta, [kinetic, elastic]) = self.sp.energies(u, v);
         let exact = self.exact.map(|ex| {
             let (l2_sq, h1_semi_sq) = ex.error_sq(u, self.sp.h, t);
             ExactValues {
@@ -505,6 +505,12 @@ impl Recorder<'_> {
                 sigma_mid,
                 energy,
                 energy_theta,
+                energy_kinetic: Some(kinetic),
+                energy_elastic: Some(elastic),
+                energy_gravity: None,
+                u_lowest: None,
+                // u_n = −u₀ at the contact node, non-penetration u₀ ≥ −g (SPEC §1.1).
+                penetration: Some((-u[0] - self.sp.bar.gap).max(0.0)),
             },
             exact,
         )

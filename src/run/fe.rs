@@ -955,6 +955,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
     // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product with
     // K (into the scratch `tmp`) instead.
+    // Returns the parts (½vᵀMv, ½uᵀKu, −Fᵀu), whose sum is E^h.
     let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64], tmp: &mut [f64]| {
         let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
         let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
@@ -965,8 +966,20 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
             fu + contact - uma
         };
-        0.5 * kinetic + 0.5 * uku - fu
+        [0.5 * kinetic, 0.5 * uku, -fu]
     };
+    // The lowest point of the reference configuration (disc/ball): the Γ_C node nearest the
+    // plane, whose vertical dof gives `u_lowest`. The bars' bottom face is flat: none.
+    let lowest = g
+        .gap_in_geometry
+        .then(|| {
+            g.contact
+                .iter()
+                .zip(&g.contact_height)
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(&c, _)| c)
+        })
+        .flatten();
     let mean = |x: &[f64]| -> f64 {
         g.contact
             .iter()
@@ -989,7 +1002,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                        tmp: &mut [f64],
                        err: &mut [f64]|
      -> Result<(), Divergence> {
-        let e = energy(u, v, mv, ma, lambda, tmp);
+        let [kinetic, elastic, gravity] = energy(u, v, mv, ma, lambda, tmp);
+        let e = kinetic + elastic + gravity;
+        // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (SPEC §1.3 decisions): the
+        // points where the mixed method enforces the constraint, and where Nitsche/penalty
+        // are measured too (their quadrature points carry only a weak constraint).
+        let penetration = g
+            .contact
+            .iter()
+            .zip(&gaps)
+            .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
         // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
         // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
         let (e, theta_term, force) = match nit {
@@ -1045,6 +1067,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 sigma_mid: None,
                 energy: e,
                 energy_theta: theta_term.map(|t| e + t),
+                energy_kinetic: Some(kinetic),
+                energy_elastic: Some(elastic),
+                energy_gravity: (fall != 0.0).then_some(gravity),
+                u_lowest: lowest.map(|c| u[c]),
+                penetration: Some(penetration),
             },
             exact,
         )

@@ -157,6 +157,7 @@ schema! {
         contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
+        max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -208,6 +209,30 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "Pa",
         "closed-form (or reference-run) contact stress",
     ),
+    (
+        "energy_kinetic",
+        "Option<f64>",
+        "J",
+        "kinetic part ½vᵀMv of E^h",
+    ),
+    (
+        "energy_elastic",
+        "Option<f64>",
+        "J",
+        "elastic part ½uᵀKu of E^h",
+    ),
+    (
+        "energy_gravity",
+        "Option<f64>",
+        "J",
+        "gravity potential −Fᵀu of E^h, zero at the initial position (disc2d, sphere3d; null without a load). kinetic + elastic + gravity = energy (penalty: plus its potential)",
+    ),
+    (
+        "u_lowest",
+        "Option<f64>",
+        "m",
+        "vertical displacement u_d of the lowest point of the reference configuration (disc2d, sphere3d)",
+    ),
 ];
 
 /// The time series of a batch (each run's id with its rows) as typed columns.
@@ -236,6 +261,10 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
         ("energy_theta", f(|r| r.energy_theta)),
         ("u_contact_exact", f(|r| r.u_contact_exact)),
         ("sigma_contact_exact", f(|r| r.sigma_contact_exact)),
+        ("energy_kinetic", f(|r| r.energy_kinetic)),
+        ("energy_elastic", f(|r| r.energy_elastic)),
+        ("energy_gravity", f(|r| r.energy_gravity)),
+        ("u_lowest", f(|r| r.u_lowest)),
     ]
 }
 
@@ -343,6 +372,7 @@ impl RunRecord {
             contact_phases: m.contact_phases,
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
+            max_penetration: m.max_penetration,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }
