@@ -673,8 +673,14 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
 /// time series per stored step.
 fn cost_line(stats: &crate::sink::SinkStats, wall_s: f64) -> String {
     let mut s = format!(
-        "time: runs {:.3} s (summed), command {:.3} s wall so far, Parquet writer {:.3} s (own thread)",
-        stats.run_seconds, wall_s, stats.write_seconds
+        "time: runs {:.3} s (summed), command {:.3} s wall so far, Parquet writer {:.3} s (own thread{})",
+        stats.run_seconds,
+        wall_s,
+        stats.write_seconds,
+        stats
+            .write_cpu_seconds
+            .map(|c| format!(", {c:.3} s CPU"))
+            .unwrap_or_default()
     );
     if stats.series_rows > 0 {
         s.push_str(&format!(
