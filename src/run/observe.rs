@@ -62,6 +62,9 @@ pub struct Metrics {
     pub iterations_max_step: Option<i64>,
     /// Part of the stepping time spent on observables and error norms (sampled estimate).
     pub observe_time_s: Option<f64>,
+    /// max over the observed steps of the step's penetration (u_n − g)_+ (SPEC §1.3), where
+    /// the engine reports one ([`StepValues::penetration`]).
+    pub max_penetration: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -114,6 +117,10 @@ pub struct SeriesRow {
     pub energy_theta: Option<f64>,
     pub u_contact_exact: Option<f64>,
     pub sigma_contact_exact: Option<f64>,
+    pub energy_kinetic: Option<f64>,
+    pub energy_elastic: Option<f64>,
+    pub energy_gravity: Option<f64>,
+    pub u_lowest: Option<f64>,
 }
 
 /// The per-step values the observer needs.
@@ -128,6 +135,16 @@ pub struct StepValues {
     pub sigma_mid: Option<f64>,
     pub energy: f64,
     pub energy_theta: Option<f64>,
+    /// The parts of E^h, where the engine has them: ½vᵀMv, ½uᵀKu, −Fᵀu (SPEC §1.3).
+    pub energy_kinetic: Option<f64>,
+    pub energy_elastic: Option<f64>,
+    pub energy_gravity: Option<f64>,
+    /// Vertical displacement u_d of the lowest point of the reference configuration
+    /// (disc/ball).
+    pub u_lowest: Option<f64>,
+    /// max over the contact points the engine checks of (u_n − g)_+ at this step (SPEC §1.3);
+    /// the run's `max_penetration` is its maximum over the steps.
+    pub penetration: Option<f64>,
 }
 
 /// Exact values at a step, when the scene has a closed form.
@@ -178,6 +195,7 @@ pub struct Observer {
     scale: Option<f64>,
     first_contact: Option<f64>,
     phases: i64,
+    max_penetration: Option<f64>,
     pub series: Vec<SeriesRow>,
 }
 
@@ -215,6 +233,7 @@ impl Observer {
             scale: None,
             first_contact: None,
             phases: 0,
+            max_penetration: None,
             series: Vec::with_capacity(cap),
         }
     }
@@ -272,6 +291,9 @@ impl Observer {
         self.last_et = v.energy_theta;
         self.prev_sigma = v.sigma_contact;
         self.max_dev = self.max_dev.max((v.energy - self.e0).abs());
+        if let Some(p) = v.penetration {
+            self.max_penetration = Some(self.max_penetration.map_or(p, |m| m.max(p)));
+        }
         let contact = v.sigma_contact < 0.0;
         if contact != self.in_contact {
             self.switches += 1;
@@ -310,6 +332,10 @@ impl Observer {
                 energy_theta: v.energy_theta,
                 u_contact_exact: exact.map(|x| x.u_contact),
                 sigma_contact_exact: exact.map(|x| x.sigma_contact),
+                energy_kinetic: v.energy_kinetic,
+                energy_elastic: v.energy_elastic,
+                energy_gravity: v.energy_gravity,
+                u_lowest: v.u_lowest,
             });
         }
         let scale = self.energy_unit().abs().max(f64::MIN_POSITIVE);
@@ -357,6 +383,7 @@ impl Observer {
         }
 
         metrics.contact_switches = self.switches;
+        metrics.max_penetration = self.max_penetration;
         if complete && self.has_exact {
             let t = self.tau;
             metrics.err_u_l2l2 = Some((t * self.sum_l2).sqrt());
