@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Run every sweep of the papers (sweeps/000_*.toml, sweeps/003_*.toml) and draw their figures:
 # time series (displacement, pressure, energy with the exact solution), convergence with slope
-# triangles, work-precision with the Pareto front, stability maps. Then check that no figure is blank.
+# triangles, work-precision with the Pareto front, stability maps, and the energy of the disc and
+# ball impacts (003 Figs 11, 12). Then check that no figure is blank.
 #
 #   bash analysis/paper_figures.sh [OUT]      (default OUT = out)
 set -euo pipefail
@@ -19,5 +20,9 @@ for sweep in "$repo"/sweeps/000_*.toml "$repo"/sweeps/003_*.toml; do
   "$py" "$here/plot_convergence.py" "$dir" --out "$out/figures"
   "$py" "$here/plot_work_precision.py" "$dir" --out "$out/figures"
   "$py" "$here/plot_stability_map.py" "$dir" --out "$out/figures"
+  # 003 Figs 11, 12: energy against time of the four impact methods (disc, ball).
+  case "$(basename "$sweep")" in
+    003_fig11_*|003_fig12_*) "$py" "$here/plot_energy_impacts.py" "$dir" --out "$out/figures" ;;
+  esac
 done
 "$py" "$here/check_figures.py" "$out/figures"

@@ -4,8 +4,9 @@
     python3 analysis/plot_series.py DIR [--out FIGDIR] [--max-curves 8] [--include-failed]
 
 For every sweep in DIR one figure with three stacked panels against time t:
-u_contact, sigma_contact and energy / E0 (E0 = the run's first energy), one
-curve per run. Where the engine wrote a closed-form solution
+u_contact, sigma_contact and energy / E0 (E0 = the run's first energy; for a
+run starting at E0 = 0, the disc and ball under gravity, energy / energy_scale
+of the runs table), one curve per run. Where the engine wrote a closed-form solution
 (u_contact_exact, sigma_contact_exact) it is drawn dashed in black. The exact
 energy is known for the bar1d scene, E = young*amplitude^2/(2*length), and is
 conserved: it is drawn as the dashed line E/E0 = 1, and the mismatch of the
@@ -70,6 +71,16 @@ def exact_energy(row: dict) -> float | None:
     return None
 
 
+def zero_start_scale(row: dict, e: np.ndarray) -> float | None:
+    """The run's `energy_scale` when its initial energy is zero (disc2d/sphere3d: E⁰ = 0
+    under gravity, SPEC §1.3), else None. Dividing by the first non-zero value would divide
+    by the rounding of the first steps (~1e-17) there."""
+    scale = row.get("energy_scale")
+    if scale is None or not np.isfinite(scale) or scale <= 0 or e.size == 0 or not np.isfinite(e[0]):
+        return None
+    return float(scale) if abs(e[0]) <= 1e-12 * scale else None
+
+
 def first_value(x: np.ndarray) -> float | None:
     """First finite, non-zero value: the normalisation of a relative energy."""
     ok = np.isfinite(x) & (x != 0)
@@ -116,6 +127,7 @@ def plot_chunk(sweep: str, chunk: pl.DataFrame, series: dict[str, pl.DataFrame],
     ratios = []  # E0 / E_exact per run
     e_exact_any = False
     rel_max, rel_min = 0.0, np.inf  # range of E/E0, to switch to a log axis for blow-ups
+    any_scaled = False  # a run with E⁰ = 0 drawn as E / energy_scale
     for i, row in enumerate(chunk.iter_rows(named=True)):
         s = series.get(row["run_id"])
         if s is None:
@@ -133,18 +145,21 @@ def plot_chunk(sweep: str, chunk: pl.DataFrame, series: dict[str, pl.DataFrame],
                 line = ax.plot(t, y, **kw)[0]
         e = s["energy"].to_numpy()
         e0 = first_value(e)
-        if e0 is not None:
-            line = axes[2].plot(t, e / e0, **kw)[0]
-            rel = e[np.isfinite(e)] / e0
+        scale = zero_start_scale(row, e)
+        norm = scale if scale is not None else e0
+        any_scaled |= scale is not None
+        if norm is not None:
+            line = axes[2].plot(t, e / norm, **kw)[0]
+            rel = e[np.isfinite(e)] / norm
             if rel.size:
                 rel_max = max(rel_max, float(np.abs(rel).max()))
                 rel_min = min(rel_min, float(rel.min()))
             ex = exact_energy(row)
-            if ex:
+            if ex and e0 is not None:
                 e_exact_any = True
                 ratios.append(e0 / ex)
         et = s["energy_theta"].to_numpy()
-        et0 = first_value(et)
+        et0 = first_value(et) if scale is None else scale
         if et0 is not None:
             any_theta = True
             axes[2].plot(t, et / et0, color=st["color"], lw=1.0, ls=":")
@@ -166,11 +181,11 @@ def plot_chunk(sweep: str, chunk: pl.DataFrame, series: dict[str, pl.DataFrame],
         axes[2].set_title(f"E0/E_exact ∈ [{min(ratios):.6g}, {max(ratios):.6g}]", loc="right", fontsize="small")
     handles += exact_handles
     if any_theta:
-        handles.append((Line2D([], [], color="gray", ls=":"), "dotted: energy_theta / its first value (Nitsche)"))
+        handles.append((Line2D([], [], color="gray", ls=":"), "dotted: energy_theta / its first value (Nitsche)" + (" or energy_scale" if any_scaled else "")))
 
     axes[0].set_ylabel("contact displacement u")
     axes[1].set_ylabel("contact pressure σ")
-    axes[2].set_ylabel("energy E / E0")
+    axes[2].set_ylabel("energy E / E0" + (" (E⁰ = 0: E / energy_scale)" if any_scaled else ""))
     axes[2].set_xlabel("time t")
     for ax in axes:
         ax.grid(True, alpha=0.3)

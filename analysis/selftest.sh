@@ -15,4 +15,5 @@ py="${PYTHON:-python3}"
 "$py" "$here/plot_convergence.py" "$work/synthetic" --out "$work/figures"
 "$py" "$here/plot_work_precision.py" "$work/synthetic" --out "$work/figures"
 "$py" "$here/plot_work_precision.py" "$work/synthetic" --out "$work/figures" --error err_sigma_l2
+"$py" "$here/plot_energy_impacts.py" "$work/synthetic" --out "$work/figures"
 "$py" "$here/check_figures.py" "$work/figures"

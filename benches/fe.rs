@@ -8,7 +8,19 @@
 //! - `bar2d-82k/…`: the same for the h/32 reference of 000 Table 1 (65 × 641 nodes, 83 200
 //!   dofs, τ = h/2/32).
 //!
-//! `cargo bench --bench fe`; compare medians within one run.
+//! - `disc2d-q2-h4/…`, `sphere3d-q2-h8/…`: the paper's disc (Q2, h = 4: 1346 dofs) and ball
+//!   (Q2, h = 8: 4503 dofs) of 003 §4.2 with the engine's choices for them (AMD; simplicial in
+//!   2D, supernodal in 3D — `run::fe`'s `build_ball`): assembly of the pattern, K and M, the
+//!   symbolic analysis, the numeric factorisation of A = M + τ²/4 K (τ = 0.1, consistent mass:
+//!   mixed + CN; Nitsche's Θ-term adds rank-one updates inside the same pattern, so its factor
+//!   costs the same), the condensation Z = A⁻¹C onto the contact unknowns (one solve per
+//!   column: the Γ_C nodes for `mixed`, the Γ_C quadrature points for `nitsche`), and one solve.
+//!   A whole step (the solve, the contact Newton/LCP, the energy) is measured per run over the
+//!   paper's T = 40 by `sweeps/003_fig11_disc.toml` / `003_fig12_sphere.toml`
+//!   (`stepping_time_s / steps` of the runs table).
+//!
+//! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
+//! for one group).
 
 use std::time::Duration;
 
@@ -17,8 +29,13 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use contact_sweep::run::fe::{FeConfig, cholesky_options};
 use contact_sweep::run::{RunOptions, simulate};
 use contact_sweep::scene::{BarScene, MeshChoice, Physics, Scene, SceneSetup};
-use contact_sweep::space::fe::{BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern};
-use contact_sweep::space::linalg::{Cholesky, CholeskyOptions, SymbolicCholesky};
+use contact_sweep::space::fe::nitsche::contact_points;
+use contact_sweep::space::fe::{
+    BallMesh, BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern,
+};
+use contact_sweep::space::linalg::{
+    Cholesky, CholeskyOptions, FactorKind, Ordering, SymbolicCholesky,
+};
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
 
@@ -124,7 +141,85 @@ fn bench_bar(c: &mut Criterion, name: &str, dim: usize, h: f64) {
     g.finish();
 }
 
+/// The disc (dim 2) or ball (dim 3) of 003 §4.2 at degree 2 and nominal size h, as the engine
+/// builds it for a run (SPEC §1.3: R = 20, λ = μ = 20, ρ = 1, centre R + 5 above the plane).
+fn ball_operators(dim: usize, h: f64) -> (BallMesh, DofMap, SymMatrix, SymMatrix) {
+    let (radius, lame) = (20.0, 20.0);
+    let mut centre = [0.0; 3];
+    centre[dim - 1] = radius + 5.0;
+    let mesh = BallMesh::with_size(dim, 2, radius, centre, h).unwrap();
+    let dofs = DofMap::all(mesh.coords.len() * dim);
+    let p = fe_pattern(&mesh, &dofs);
+    let k = assemble(
+        &mesh,
+        &dofs,
+        &p,
+        ElementOp::Stiffness {
+            lambda: lame,
+            mu: lame,
+        },
+        &|_| 1.0,
+    );
+    let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
+    (mesh, dofs, k, m)
+}
+
+fn bench_ball(c: &mut Criterion, name: &str, dim: usize, h: f64) {
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    g.bench_function("assembly", |b| b.iter(|| ball_operators(dim, h)));
+    let (mesh, dofs, k, m) = ball_operators(dim, h);
+    let tau = 0.1;
+    let a = SymMatrix::lin_comb(1.0, &m, tau * tau / 4.0, &k);
+    let n = dofs.n_free();
+    // The engine's choice for the mapped meshes (`run::fe::build_ball`): no lattice to dissect.
+    let opts = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if dim == 2 {
+            FactorKind::Simplicial
+        } else {
+            FactorKind::Supernodal
+        },
+    };
+    g.bench_function("symbolic", |b| {
+        b.iter(|| SymbolicCholesky::with_options(&a.pattern, &opts).unwrap())
+    });
+    let sym = SymbolicCholesky::with_options(&a.pattern, &opts).unwrap();
+    g.bench_function("factorization", |b| {
+        b.iter(|| Cholesky::new(&sym, &a).unwrap())
+    });
+    let chol = Cholesky::new(&sym, &a).unwrap();
+    // Condensation: one column per contact unknown (mixed: the vertical dofs of the Γ_C nodes;
+    // nitsche: the Γ_C quadrature points), solved together as the engine does.
+    let mixed = mesh.contact_nodes.len();
+    let nitsche = contact_points(&mesh, 20.0, 20.0, 1.0).len();
+    for (what, nc) in [("condense-mixed", mixed), ("condense-nitsche", nitsche)] {
+        let z0: Vec<f64> = (0..n * nc).map(|i| ((i % 97) as f64).sin()).collect();
+        let mut z = z0.clone();
+        let mut work = chol.work_for(nc);
+        g.bench_function(format!("{what}-{nc}"), |b| {
+            b.iter(|| {
+                z.copy_from_slice(&z0);
+                chol.solve_many_in_place(&mut z, nc, &mut work)
+            })
+        });
+    }
+    let mut work = chol.work();
+    let mut x: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+    g.bench_function("solve", |b| {
+        b.iter(|| chol.solve_in_place(&mut x, &mut work))
+    });
+    println!(
+        "{name}: {n} dofs, nnz(A) {}, nnz(L) {}, contact unknowns mixed {mixed} / nitsche {nitsche}",
+        a.pattern.nnz(),
+        sym.factor_nnz()
+    );
+    g.finish();
+}
+
 fn fe(c: &mut Criterion) {
+    bench_ball(c, "disc2d-q2-h4", 2, 4.0);
+    bench_ball(c, "sphere3d-q2-h8", 3, 8.0);
     bench_bar(c, "bar3d-20k", 3, 0.0125);
     bench_bar(c, "bar2d-82k", 2, 0.05 / 32.0);
 }

@@ -78,3 +78,100 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
         assert!(figs.join(f).exists(), "{f} missing");
     }
 }
+
+/// 003 Figs 11/12: `plot_energy_impacts.py` on the disc sweep cut to T = 12 (the free fall and
+/// the first two time units of the impact: 120 steps of the 1346-dof Q2 disc, well under a
+/// second): the four methods are named as the paper names them (the runs joined to the series
+/// on run_id), the figure is drawn and not blank, and the deviation the script prints for each
+/// method is the engine's own `energy_max_dev` — both are max_n |E^n − E⁰|/energy_scale, so
+/// they agree to the script's printing (4 significant digits: relative 5e-4; bound 1e-3).
+#[test]
+fn energy_impacts_figure_of_a_short_disc_sweep() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("disc");
+    let o = cli(
+        repo,
+        &[
+            "run",
+            "sweeps/003_fig11_disc.toml",
+            "--set",
+            "T=12",
+            "--out",
+            out.to_str().unwrap(),
+            "--no-summary",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let figs = tmp.path().join("figures");
+    let o = Command::new("python3")
+        .arg(repo.join("analysis/plot_energy_impacts.py"))
+        .arg(&out)
+        .arg("--out")
+        .arg(&figs)
+        .arg("--stem")
+        .arg("disc_energy")
+        .output()
+        .expect("python3 runs (pip install -r analysis/requirements.txt)");
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "plot_energy_impacts.py failed — is analysis/requirements.txt installed?\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let runs = contact_sweep::sink::read_runs(&out).unwrap();
+    assert_eq!(runs.height(), 4);
+    let col = |name: &str| -> Vec<String> {
+        runs.column(name)
+            .unwrap()
+            .str()
+            .unwrap()
+            .iter()
+            .map(|s| s.unwrap_or("").to_string())
+            .collect()
+    };
+    let (space, mass, scheme) = (col("space"), col("mass"), col("scheme_label"));
+    let dev = runs.column("energy_max_dev").unwrap().f64().unwrap();
+    for i in 0..4 {
+        let name = match (space[i].as_str(), mass[i].as_str(), scheme[i].as_str()) {
+            ("mixed", "consistent", "crank-nicolson") => "mixed + CN:",
+            ("nitsche", "consistent", "crank-nicolson") => "Nitsche + CN (",
+            ("nitsche", "consistent", "hybrid") => "Nitsche-Hybrid (",
+            ("mixed", "zero-contact", "crank-nicolson") => "modified mass + CN:",
+            other => panic!("unexpected method {other:?} in sweeps/003_fig11_disc.toml"),
+        };
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with(&format!("003-fig11-disc {name}")))
+            .unwrap_or_else(|| panic!("no line for {name} in\n{stdout}"));
+        let printed: f64 = line
+            .split("max |E−E⁰| = ")
+            .nth(1)
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|v| v.parse().ok())
+            .unwrap_or_else(|| panic!("no deviation in {line}"));
+        let engine = dev.get(i).unwrap();
+        assert!(
+            (printed - engine).abs() <= 1e-3 * engine,
+            "{name} printed {printed:e}, runs table {engine:e}"
+        );
+        assert!(line.contains("(× energy_scale)"), "{line}");
+    }
+    let png = figs.join("disc_energy.png");
+    let size = std::fs::metadata(&png).expect("figure written").len();
+    // Measured 143 kB (two panels, four curves, two E_Θ curves, the legend); the same two
+    // panels with empty axes save to 30 kB: bound 60 kB.
+    assert!(size > 60_000, "{} is only {size} bytes", png.display());
+    let o = Command::new("python3")
+        .arg(repo.join("analysis/check_figures.py"))
+        .arg(&figs)
+        .args(["--expect", "disc_energy.png"])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout}");
+    assert!(
+        stdout.trim_end().ends_with("1 passed, 0 failed"),
+        "{stdout}"
+    );
+}

@@ -486,3 +486,262 @@ fn disc_mass_variants_conserve_mass_and_fall_freely() {
 fn ball_mass_variants_conserve_mass_and_fall_freely() {
     check_mass_variants("sphere3d", 8.0, "2");
 }
+
+/// Every run of a sweep given as text, simulated with its full time series (one row a step).
+fn outcomes(text: &str) -> Vec<(String, contact_sweep::run::Outcome)> {
+    use contact_sweep::run::{RunOptions, simulate};
+    use contact_sweep::sweep::{SweepFile, expand};
+    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
+    plan.runs
+        .iter()
+        .map(|spec| {
+            let o = simulate(
+                &spec.config,
+                &RunOptions {
+                    series_every: 1,
+                    ..RunOptions::default()
+                },
+            );
+            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
+            (spec.label.clone(), o)
+        })
+        .collect()
+}
+
+/// The energy parts and the lowest point in free fall (SPEC §1.3), Crank–Nicolson, both
+/// degrees, up to t = 9.9 (before the contact). With u⁰ = v⁰ = 0 and the load F = M f e_d the
+/// rigid fall u^n = ½ f t_n² e_d (f = −0.1) solves every Newmark step exactly (K kills
+/// translations, a = f is constant), so with m = e_dᵀ M e_d = `mass_total`:
+/// kinetic = ½ m (f t)² = m·0.005 t², elastic = 0, gravity = −Fᵀu = −m f·½ f t² = −m·0.005 t²,
+/// and u_lowest = ½ f t² = −0.05 t². What remains is rounding: the free-fall test bounds the
+/// centre of mass by 1e-10 of the gap; energies of size ≤ energy_scale carry ≤ 1e-10 of it.
+#[test]
+fn energy_parts_and_lowest_point_in_free_fall() {
+    let runs = outcomes(&format!(
+        r#"
+name = "parts"
+scene = "disc2d"
+[fixed]
+T = 9.9
+h = 4.0
+dt = {TAU}
+scheme = "crank-nicolson"
+[grid]
+degree = [1, 2]
+method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 }}]
+"#
+    ));
+    assert_eq!(runs.len(), 4);
+    for (label, o) in &runs {
+        let m = o.metrics.mass_total.unwrap();
+        let scale = o.metrics.energy_scale.unwrap();
+        assert_eq!(o.series.len(), 100);
+        let (mut worst_e, mut worst_u) = (0.0f64, 0.0f64);
+        for r in &o.series {
+            let (k, el, gr) = (
+                r.energy_kinetic.unwrap(),
+                r.energy_elastic.unwrap(),
+                r.energy_gravity.unwrap(),
+            );
+            let want = m * 0.5 * GRAVITY * GRAVITY * r.t * r.t;
+            worst_e = worst_e
+                .max((k - want).abs())
+                .max(el.abs())
+                .max((gr + want).abs());
+            worst_u = worst_u.max((r.u_lowest.unwrap() + 0.5 * GRAVITY * r.t * r.t).abs());
+            // The parts sum to E^h (Nitsche's E^h has no contact term; mixed none either).
+            assert!((k + el + gr - r.energy).abs() <= 1e-14 * scale, "{label}");
+        }
+        println!(
+            "{label}: free fall, largest error of the energy parts {:.2e} × energy_scale, of u_lowest {worst_u:.2e}, max penetration {:?}",
+            worst_e / scale,
+            o.metrics.max_penetration
+        );
+        assert!(worst_e < 1e-10 * scale, "{label}: {worst_e:e}");
+        assert!(worst_u < 1e-10 * GAP, "{label}: {worst_u:e}");
+        // No contact yet: the lowest point is 5 − 0.05·9.9² = 0.0995 above the plane.
+        assert_eq!(o.metrics.max_penetration, Some(0.0), "{label}");
+    }
+}
+
+/// The penetration of the paper's setting (Q2, h = 4, τ = 0.1, T = 40) and the energy parts
+/// through the impact. Mixed + CN enforces u_d + g ≥ 0 at the Γ_C nodes at the end of each
+/// step: the LCP stops when every violation is ≤ 1e-12·max|q| (q = y_c + g, |q| ≲ 10²
+/// here) and u^{n+1} = y + cτ²Zλ reproduces w = q + Hλ up to the rounding of that update, so
+/// the penetration is ≤ 1e-10 of the gap. Nitsche enforces the contact weakly: with
+/// γ0 = 1e-3 (1/γ_h = 250 on h = 4) the disc's weight and impact push the nodes in: measured
+/// 5.37e-2 (1.1 % of the gap, at the impact), bounded by 2 % of the gap.
+#[test]
+fn penetration_of_the_paper_setting() {
+    let runs = outcomes(&format!(
+        r#"
+name = "penetration"
+scene = "disc2d"
+[fixed]
+T = 40.0
+h = 4.0
+dt = {TAU}
+scheme = "crank-nicolson"
+[grid]
+method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 }}]
+"#
+    ));
+    assert_eq!(runs.len(), 2);
+    for (label, o) in &runs {
+        let scale = o.metrics.energy_scale.unwrap();
+        let p = o.metrics.max_penetration.unwrap();
+        let lowest_min = o
+            .series
+            .iter()
+            .map(|r| r.u_lowest.unwrap())
+            .fold(f64::INFINITY, f64::min);
+        println!(
+            "{label}: max penetration {p:.3e} (gap {GAP}), lowest point down to {lowest_min:.4}"
+        );
+        for r in &o.series {
+            let sum =
+                r.energy_kinetic.unwrap() + r.energy_elastic.unwrap() + r.energy_gravity.unwrap();
+            // Mixed: E^h is this sum; Nitsche's E^h has no contact term.
+            assert!(
+                (sum - r.energy).abs() <= 1e-14 * scale.max(r.energy.abs()),
+                "{label}"
+            );
+            // The lowest point is a Γ_C node: it penetrates at most max_penetration.
+            assert!(r.u_lowest.unwrap() >= -GAP - p - 1e-14 * GAP, "{label}");
+        }
+        // Both reach the plane: the lowest point goes down by the gap, to −5 within 2 %.
+        assert!(
+            (lowest_min + GAP).abs() < 0.02 * GAP,
+            "{label}: {lowest_min}"
+        );
+        if label.starts_with("mixed") {
+            assert!(p <= 1e-10 * GAP, "{label}: {p:e}");
+        } else {
+            assert!(p > 0.0 && p < 0.02 * GAP, "{label}: {p:e}");
+        }
+    }
+}
+
+/// `sweeps/003_disc_gamma0_theta.toml` in full (paper setting: Q2, h = 4, τ = 0.1, T = 40;
+/// 30 runs, ≈ 1 s on two threads — diverging runs stop early). The map of README "The disc's
+/// γ0 × Θ map": Θ = 1 loses the positivity of the step matrix M + τ²/4·K_Θ between γ0 = 1e-3
+/// and 1e-2 (K_Θ = K − Θ Σ w γ s sᵀ; the inverse trace constant of Q2 at h = 4 puts the limit
+/// near 3e-3, SPEC §6), which the factorisation reports before the first step; γ0 = 1e-4 is
+/// close to the ill-posed mixed method, so Crank–Nicolson chatters and gains tens of energy
+/// scales, while the hybrid scheme stays within 1 %; large γ0 with Θ ∈ {0, −1} lets the
+/// consistency term dominate and the energy passes 1e6 energy scales after the impact.
+#[test]
+fn disc_gamma0_theta_map() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/sweeps/003_disc_gamma0_theta.toml"
+    ))
+    .unwrap();
+    let rows = run_sweep_text(&text);
+    assert_eq!(rows.len(), 30);
+    let cell = |theta: f64, g0: f64, scheme: &str| {
+        rows.iter()
+            .find(|r| {
+                r.nitsche_theta == Some(theta)
+                    && r.nitsche_gamma0 == Some(g0)
+                    && r.scheme_label == scheme
+            })
+            .unwrap_or_else(|| panic!("no Θ = {theta}, γ0 = {g0}, {scheme} run"))
+    };
+    for scheme in ["crank-nicolson", "hybrid"] {
+        for g0 in [1e-2, 1e-1, 1.0] {
+            let r = cell(1.0, g0, scheme);
+            assert_eq!(r.status, "solver-failed", "Θ = 1, γ0 = {g0}, {scheme}");
+            assert!(
+                r.message
+                    .as_deref()
+                    .is_some_and(|m| m.contains("not positive definite")),
+                "{:?}",
+                r.message
+            );
+            assert_eq!(r.steps, 0);
+        }
+        for theta in [0.0, -1.0] {
+            let r = cell(theta, 1.0, scheme);
+            assert_eq!(r.status, "diverged", "Θ = {theta}, γ0 = 1, {scheme}");
+        }
+        // The paper's γ0 = 1e-3 is stable for every Θ (measured |drift| ≤ 0.18 energy scales,
+        // Θ = −1 with CN the largest); Θ = 1: within 1 % (measured CN −3.4e-5, hybrid
+        // −6.4e-4) and a penetration of 5.37e-2 (< 2 % of the gap) for both.
+        for theta in [1.0, 0.0, -1.0] {
+            let r = cell(theta, 1e-3, scheme);
+            assert_eq!(r.status, "ok", "Θ = {theta}, γ0 = 1e-3, {scheme}");
+            assert!(r.energy_drift.unwrap().abs() < 0.25);
+        }
+        let r = cell(1.0, 1e-3, scheme);
+        assert!(r.energy_drift.unwrap().abs() < 0.01, "{scheme}");
+        assert!(r.max_penetration.unwrap() < 0.02 * GAP, "{scheme}");
+    }
+    for theta in [1.0, 0.0, -1.0] {
+        // γ0 = 1e-4: CN gains 25–57 energy scales over 21–32 contact phases (measured), the
+        // hybrid keeps it within 1 % (measured −3.4e-3 … −3.5e-3) with ≤ 3 phases.
+        let cn = cell(theta, 1e-4, "crank-nicolson");
+        let hy = cell(theta, 1e-4, "hybrid");
+        assert_eq!((cn.status.as_str(), hy.status.as_str()), ("ok", "ok"));
+        assert!(cn.energy_drift.unwrap() > 10.0, "Θ = {theta}");
+        assert!(cn.contact_phases.unwrap() >= 10, "Θ = {theta}");
+        assert!(hy.energy_drift.unwrap().abs() < 0.01, "Θ = {theta}");
+        assert!(hy.contact_phases.unwrap() <= 3, "Θ = {theta}");
+    }
+    // Θ = 1 with the hybrid scheme: E_Θ never increases (003 Cor 3.8; rounding 1e-12).
+    for g0 in [1e-4, 1e-3] {
+        assert!(cell(1.0, g0, "hybrid").energy_theta_max_increase.unwrap() <= 1e-12);
+    }
+}
+
+/// The disc's reference runs (same mesh, finer step; `run::fe::ball_ref_map`): a run measured
+/// against itself (reference dt = its dt) has errors exactly 0 — the same deterministic
+/// computation read back dof for dof and step for step — and against a finer step (Q1,
+/// T = 12: the free fall and the first 2 time units of the impact) the errors fall as τ halves.
+#[test]
+fn disc_reference_runs_on_the_same_mesh() {
+    let self_ref = run_sweep_text(
+        r#"
+name = "self"
+scene = "disc2d"
+reference = { dt = 0.1 }
+[fixed]
+T = 12.0
+h = 4.0
+dt = 0.1
+degree = 1
+space = "nitsche"
+nitsche_theta = 1.0
+nitsche_gamma0 = 0.001
+"#,
+    );
+    let r = &self_ref[0];
+    assert_eq!(r.status, "ok", "{:?}", r.message);
+    for e in [r.err_u_l2l2, r.err_u_l2h1, r.err_force_l2, r.err_energy_l2] {
+        assert_eq!(e, Some(0.0));
+    }
+    let ladder = run_sweep_text(
+        r#"
+name = "ladder"
+scene = "disc2d"
+reference = { dt = 0.003125 }
+[fixed]
+T = 12.0
+h = 4.0
+degree = 1
+space = "nitsche"
+nitsche_theta = 1.0
+nitsche_gamma0 = 0.001
+scheme = "crank-nicolson"
+[grid]
+dt = [0.1, 0.05, 0.025]
+"#,
+    );
+    let errs: Vec<f64> = ladder.iter().map(|r| r.err_u_l2h1.unwrap()).collect();
+    println!("disc Q1 CN l2(τ;H1) against τ/32…τ/8: {errs:?}");
+    // Halving τ at least halves the error (a rate ≥ 1; measured 0.299, 0.106, 0.0276: rates
+    // 1.5, 1.9 — the impact keeps it below CN's 2 on longer runs, 0.9 over T = 40).
+    for w in errs.windows(2) {
+        assert!(w[1] < w[0] / 2.0, "{errs:?}");
+    }
+}

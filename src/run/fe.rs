@@ -23,7 +23,13 @@
 //!
 //! Errors against a reference run (nested mesh and step): e^n = u^n − I_h u_ref(t^n) at the
 //! coarse nodes, ‖e‖²_L2 = eᵀ G e with the unweighted Gram matrix, H1 = L2 + eᵀ D e with
-//! D = ∫∇e:∇e (SPEC §1.2). Nothing is allocated in the time loop.
+//! D = ∫∇e:∇e (SPEC §1.2). The disc/ball's references share the run's mesh (a finer step
+//! only; its mapped meshes of different sizes are not nested, [`ball_ref_map`]).
+//!
+//! Observables per step (SPEC §1.3): the parts ½vᵀMv, ½uᵀKu, −Fᵀu of E^h, the lowest Γ_C
+//! node's u_d (disc/ball), and the penetration max (u_n − g)_+ = max(−u_d − g)_+ over the Γ_C
+//! nodes (the run's `max_penetration` is its maximum over the steps; Nitsche and the penalty
+//! are measured at the same nodes). Nothing is allocated in the time loop.
 
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
@@ -709,10 +715,9 @@ struct RefMap {
 }
 
 fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
-    let mesh = g
-        .mesh
-        .as_box()
-        .ok_or_else(|| format!("scene {} has no reference runs", cfg.setup.scene))?;
+    let Some(mesh) = g.mesh.as_box() else {
+        return ball_ref_map(g, cfg, data);
+    };
     let d = mesh.dim;
     let ratio = |coarse: f64, fine: f64, stride: usize, what: &str| {
         let q = coarse / fine;
@@ -755,6 +760,82 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
         dof_offset,
         time_ratio: rt,
     })
+}
+
+/// The disc/ball against a reference on the same mesh (a finer step only): the mapped meshes
+/// of two sizes are not nested — n_t = 2·round(πR/(4h)) and n_r = round((R − a)/h) give
+/// (8, 3), (16, 5), (32, 10) at h = 4, 2, 1 — so a coarse node is not a reference node in
+/// general, and the reference stores every dof of its own mesh (`record_lattice`), read one to
+/// one.
+fn ball_ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
+    let (d, nodes) = (g.mesh.dim(), g.mesh.mesh().num_nodes());
+    if data.h != cfg.setup.h || data.space_stride != 1 || data.lattice != [nodes, 1, 1] {
+        return Err(format!(
+            "scene {}: the reference must be on the run's mesh (h = {}, got h = {}): the mapped meshes of different sizes are not nested, only a finer step is supported",
+            cfg.setup.scene, cfg.setup.h, data.h
+        ));
+    }
+    let q = cfg.dt / data.dt;
+    let r = q.round() as usize;
+    if r == 0 || (q - r as f64).abs() > 1e-9 * q || !r.is_multiple_of(data.time_stride) {
+        return Err(format!(
+            "the reference's time step ({}) is not nested in the run's ({}) on its stored times (stride {})",
+            data.dt, cfg.dt, data.time_stride
+        ));
+    }
+    let rt = r / data.time_stride;
+    if data.dim != d || cfg.steps * rt >= data.times {
+        return Err(format!(
+            "the reference holds {} stored times, the run needs {}",
+            data.times,
+            cfg.steps * rt + 1
+        ));
+    }
+    Ok(RefMap {
+        data: Arc::clone(data),
+        dof_offset: (0..g.dofs.n_free()).collect(),
+        time_ratio: rt,
+    })
+}
+
+/// The stored slots (a reduced dof or none, per lattice node and component) and the lattice of
+/// a reference run: every `space_stride`-th node of the bars' box, or every node of the
+/// disc/ball (stride 1 only: its meshes are not nested, [`ball_ref_map`]).
+fn record_lattice(
+    g: &Geometry,
+    cfg: &FeConfig,
+    space_stride: usize,
+) -> Result<(Vec<Option<usize>>, [usize; 3]), String> {
+    let d = g.mesh.dim();
+    let Some(bx) = g.mesh.as_box() else {
+        if space_stride != 1 {
+            return Err(format!(
+                "scene {}: a reference run must be on the runs' mesh (their h / its h = {space_stride}): the mapped meshes of different sizes are not nested",
+                cfg.setup.scene
+            ));
+        }
+        let n = g.dofs.n_free();
+        return Ok(((0..n).map(Some).collect(), [n / d, 1, 1]));
+    };
+    let lattice = [0, 1, 2].map(|ax| {
+        if ax < d {
+            bx.cells[ax] / space_stride + 1
+        } else {
+            1
+        }
+    });
+    let mut slots = Vec::with_capacity(lattice.iter().product::<usize>() * d);
+    for k in 0..lattice[2] {
+        for j in 0..lattice[1] {
+            for i in 0..lattice[0] {
+                let node = bx.node_id([i * space_stride, j * space_stride, k * space_stride]);
+                for comp in 0..d {
+                    slots.push(g.dofs.free_index(node * d + comp));
+                }
+            }
+        }
+    }
+    Ok((slots, lattice))
 }
 
 /// Run one finite-element simulation.
@@ -890,58 +971,30 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
     let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
     let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
-    if record_requested(ctx) && g.mesh.as_box().is_none() {
-        return fail(
-            Status::Invalid,
-            format!(
-                "scene {} cannot be recorded as a reference run",
-                cfg.setup.scene
-            ),
-            metrics,
-        );
-    }
-
     // The reference lattice this run records, if it is one.
-    let record = ctx.record_reference.map(|(space_stride, time_stride)| {
-        let bx = g
-            .mesh
-            .as_box()
-            .expect("checked above: references are boxes");
-        let lattice = [0, 1, 2].map(|ax| {
-            if ax < d {
-                bx.cells[ax] / space_stride + 1
-            } else {
-                1
+    let mut record = match ctx.record_reference {
+        None => None,
+        Some((space_stride, time_stride)) => match record_lattice(g, cfg, space_stride) {
+            Err(e) => return fail(Status::Invalid, e, metrics),
+            Ok((slots, lattice)) => {
+                let times = cfg.steps / time_stride + 1;
+                let data = ReferenceData {
+                    dim: d,
+                    h: cfg.setup.h,
+                    dt: tau,
+                    space_stride,
+                    time_stride,
+                    lattice,
+                    times,
+                    u: Vec::with_capacity(times * slots.len()),
+                    force: Vec::with_capacity(times),
+                    energy: Vec::with_capacity(times),
+                    u_contact: Vec::with_capacity(times),
+                };
+                Some((slots, data))
             }
-        });
-        let mut slots = Vec::with_capacity(lattice.iter().product::<usize>() * d);
-        for k in 0..lattice[2] {
-            for j in 0..lattice[1] {
-                for i in 0..lattice[0] {
-                    let node = bx.node_id([i * space_stride, j * space_stride, k * space_stride]);
-                    for comp in 0..d {
-                        slots.push(g.dofs.free_index(node * d + comp));
-                    }
-                }
-            }
-        }
-        let times = cfg.steps / time_stride + 1;
-        let data = ReferenceData {
-            dim: d,
-            h: cfg.setup.h,
-            dt: tau,
-            space_stride,
-            time_stride,
-            lattice,
-            times,
-            u: Vec::with_capacity(times * slots.len()),
-            force: Vec::with_capacity(times),
-            energy: Vec::with_capacity(times),
-            u_contact: Vec::with_capacity(times),
-        };
-        (slots, data)
-    });
-    let mut record = record;
+        },
+    };
     if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
         return fail(status, msg, metrics);
     }
@@ -955,6 +1008,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
     // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product with
     // K (into the scratch `tmp`) instead.
+    // Returns the parts (½vᵀMv, ½uᵀKu, −Fᵀu), whose sum is E^h.
     let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64], tmp: &mut [f64]| {
         let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
         let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
@@ -965,8 +1019,20 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
             fu + contact - uma
         };
-        0.5 * kinetic + 0.5 * uku - fu
+        [0.5 * kinetic, 0.5 * uku, -fu]
     };
+    // The lowest point of the reference configuration (disc/ball): the Γ_C node nearest the
+    // plane, whose vertical dof gives `u_lowest`. The bars' bottom face is flat: none.
+    let lowest = g
+        .gap_in_geometry
+        .then(|| {
+            g.contact
+                .iter()
+                .zip(&g.contact_height)
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(&c, _)| c)
+        })
+        .flatten();
     let mean = |x: &[f64]| -> f64 {
         g.contact
             .iter()
@@ -989,7 +1055,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                        tmp: &mut [f64],
                        err: &mut [f64]|
      -> Result<(), Divergence> {
-        let e = energy(u, v, mv, ma, lambda, tmp);
+        let [kinetic, elastic, gravity] = energy(u, v, mv, ma, lambda, tmp);
+        let e = kinetic + elastic + gravity;
+        // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (SPEC §1.3 decisions): the
+        // points where the mixed method enforces the constraint, and where Nitsche/penalty
+        // are measured too (their quadrature points carry only a weak constraint).
+        let penetration = g
+            .contact
+            .iter()
+            .zip(&gaps)
+            .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
         // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
         // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
         let (e, theta_term, force) = match nit {
@@ -1045,6 +1120,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 sigma_mid: None,
                 energy: e,
                 energy_theta: theta_term.map(|t| e + t),
+                energy_kinetic: Some(kinetic),
+                energy_elastic: Some(elastic),
+                energy_gravity: (fall != 0.0).then_some(gravity),
+                u_lowest: lowest.map(|c| u[c]),
+                penetration: Some(penetration),
             },
             exact,
         )
@@ -1201,11 +1281,6 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         series: std::mem::take(&mut obs.series),
         reference,
     }
-}
-
-/// Whether the run must record itself as a reference.
-fn record_requested(ctx: &RunContext) -> bool {
-    ctx.record_reference.is_some()
 }
 
 /// xᵀAx with `tmp` as scratch.

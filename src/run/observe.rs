@@ -66,6 +66,9 @@ pub struct Metrics {
     pub impacts: Option<Vec<super::impacts::Phase>>,
     /// E_Θ⁰ (Nitsche): the unit of the impacts' E_Θ losses.
     pub energy_theta_initial: Option<f64>,
+    /// max over the observed steps of the step's penetration (u_n − g)_+ (SPEC §1.3), where
+    /// the engine reports one ([`StepValues::penetration`]).
+    pub max_penetration: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -118,6 +121,10 @@ pub struct SeriesRow {
     pub energy_theta: Option<f64>,
     pub u_contact_exact: Option<f64>,
     pub sigma_contact_exact: Option<f64>,
+    pub energy_kinetic: Option<f64>,
+    pub energy_elastic: Option<f64>,
+    pub energy_gravity: Option<f64>,
+    pub u_lowest: Option<f64>,
 }
 
 /// The per-step values the observer needs.
@@ -132,6 +139,16 @@ pub struct StepValues {
     pub sigma_mid: Option<f64>,
     pub energy: f64,
     pub energy_theta: Option<f64>,
+    /// The parts of E^h, where the engine has them: ½vᵀMv, ½uᵀKu, −Fᵀu (SPEC §1.3).
+    pub energy_kinetic: Option<f64>,
+    pub energy_elastic: Option<f64>,
+    pub energy_gravity: Option<f64>,
+    /// Vertical displacement u_d of the lowest point of the reference configuration
+    /// (disc/ball).
+    pub u_lowest: Option<f64>,
+    /// max over the contact points the engine checks of (u_n − g)_+ at this step (SPEC §1.3);
+    /// the run's `max_penetration` is its maximum over the steps.
+    pub penetration: Option<f64>,
 }
 
 /// Exact values at a step, when the scene has a closed form.
@@ -184,6 +201,7 @@ pub struct Observer {
     phases: i64,
     /// Contact phases at full resolution (issue 12), independent of `every`.
     impacts: super::impacts::PhaseTracker,
+    max_penetration: Option<f64>,
     pub series: Vec<SeriesRow>,
 }
 
@@ -222,6 +240,7 @@ impl Observer {
             first_contact: None,
             phases: 0,
             impacts: super::impacts::PhaseTracker::new(),
+            max_penetration: None,
             series: Vec::with_capacity(cap),
         }
     }
@@ -279,6 +298,9 @@ impl Observer {
         self.last_et = v.energy_theta;
         self.prev_sigma = v.sigma_contact;
         self.max_dev = self.max_dev.max((v.energy - self.e0).abs());
+        if let Some(p) = v.penetration {
+            self.max_penetration = Some(self.max_penetration.map_or(p, |m| m.max(p)));
+        }
         let contact = v.sigma_contact < 0.0;
         if contact != self.in_contact {
             self.switches += 1;
@@ -319,6 +341,10 @@ impl Observer {
                 energy_theta: v.energy_theta,
                 u_contact_exact: exact.map(|x| x.u_contact),
                 sigma_contact_exact: exact.map(|x| x.sigma_contact),
+                energy_kinetic: v.energy_kinetic,
+                energy_elastic: v.energy_elastic,
+                energy_gravity: v.energy_gravity,
+                u_lowest: v.u_lowest,
             });
         }
         let scale = self.energy_unit().abs().max(f64::MIN_POSITIVE);
@@ -368,6 +394,7 @@ impl Observer {
         metrics.contact_switches = self.switches;
         metrics.impacts = Some(self.impacts.finish());
         metrics.energy_theta_initial = self.e0_theta;
+        metrics.max_penetration = self.max_penetration;
         if complete && self.has_exact {
             let t = self.tau;
             metrics.err_u_l2l2 = Some((t * self.sum_l2).sqrt());

@@ -197,6 +197,7 @@ schema! {
         energy_theta_initial: Option<f64> => "J", "E_Θ⁰, the augmented energy of the initial state (Nitsche; the unit of the impacts' E_Θ losses)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
+        max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -248,6 +249,30 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "Pa",
         "closed-form (or reference-run) contact stress",
     ),
+    (
+        "energy_kinetic",
+        "Option<f64>",
+        "J",
+        "kinetic part ½vᵀMv of E^h (2D/3D; null for bar1d)",
+    ),
+    (
+        "energy_elastic",
+        "Option<f64>",
+        "J",
+        "elastic part ½uᵀKu of E^h (2D/3D; null for bar1d)",
+    ),
+    (
+        "energy_gravity",
+        "Option<f64>",
+        "J",
+        "gravity potential −Fᵀu of E^h, zero at the initial position (disc2d, sphere3d; null without a load). kinetic + elastic + gravity = energy (penalty: plus its potential)",
+    ),
+    (
+        "u_lowest",
+        "Option<f64>",
+        "m",
+        "vertical displacement u_d of the lowest point of the reference configuration (disc2d, sphere3d)",
+    ),
 ];
 
 /// The time series of a batch (each run's id with its rows) as typed columns.
@@ -258,8 +283,8 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
     let rows: usize = runs.iter().map(|(_, s)| s.len()).sum();
     let mut step = Vec::with_capacity(rows);
     let mut dense: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(rows));
-    let mut optional: [Vec<Option<f64>>; 3] = std::array::from_fn(|_| Vec::with_capacity(rows));
-    let mut any = [false; 3];
+    let mut optional: [Vec<Option<f64>>; 7] = std::array::from_fn(|_| Vec::with_capacity(rows));
+    let mut any = [false; 7];
     for (_, s) in runs {
         for r in s {
             step.push(r.step);
@@ -274,6 +299,10 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
                 r.energy_theta,
                 r.u_contact_exact,
                 r.sigma_contact_exact,
+                r.energy_kinetic,
+                r.energy_elastic,
+                r.energy_gravity,
+                r.u_lowest,
             ]) {
                 *seen |= x.is_some();
                 col.push(x);
@@ -282,8 +311,16 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
     }
     let [t, u, v, sigma, energy] = dense;
     // A column none of whose rows has a value (E_Θ outside Nitsche, the exact solution
-    // outside the bar) is written as nulls.
-    let [theta, u_exact, sigma_exact] = {
+    // outside the bar, gravity outside the disc/ball) is written as nulls.
+    let [
+        theta,
+        u_exact,
+        sigma_exact,
+        kinetic,
+        elastic,
+        gravity,
+        lowest,
+    ] = {
         let mut it = optional.into_iter().zip(any).map(|(col, seen)| {
             if seen {
                 ColumnData::F64(col)
@@ -291,7 +328,7 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
                 ColumnData::Null(rows)
             }
         });
-        std::array::from_fn(|_| it.next().expect("three optional columns"))
+        std::array::from_fn(|_| it.next().expect("seven optional columns"))
     };
     vec![
         (
@@ -307,6 +344,10 @@ pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, C
         ("energy_theta", theta),
         ("u_contact_exact", u_exact),
         ("sigma_contact_exact", sigma_exact),
+        ("energy_kinetic", kinetic),
+        ("energy_elastic", elastic),
+        ("energy_gravity", gravity),
+        ("u_lowest", lowest),
     ]
 }
 
@@ -423,6 +464,7 @@ impl RunRecord {
             energy_theta_initial: m.energy_theta_initial,
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
+            max_penetration: m.max_penetration,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

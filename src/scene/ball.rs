@@ -135,8 +135,10 @@ impl Scene for BallScene {
         }
         Ok(())
     }
+    /// No closed form; a reference run on the same mesh with a finer step (the mapped meshes
+    /// of different sizes are not nested, `run::fe::ball_ref_map`).
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
-        None
+        Some(ErrorSource::ReferenceRun)
     }
     fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
         let (n_t, n_r) = BallMesh::counts_for_size(RADIUS, mesh.h);

@@ -770,6 +770,10 @@ mod tests {
             energy_theta: theta,
             u_contact_exact: exact,
             sigma_contact_exact: exact.map(|e| -e),
+            energy_kinetic: Some(0.5 + step as f64),
+            energy_elastic: Some(0.5 - step as f64),
+            energy_gravity: None,
+            u_lowest: theta.map(|t| -t),
         }
     }
 
@@ -811,6 +815,9 @@ mod tests {
             ("sigma_contact", |r| Some(r.sigma_contact)),
             ("energy", |r| Some(r.energy)),
             ("energy_theta", |r| r.energy_theta),
+            ("energy_kinetic", |r| r.energy_kinetic),
+            ("energy_elastic", |r| r.energy_elastic),
+            ("u_lowest", |r| r.u_lowest),
         ] {
             let want: Vec<Option<f64>> = rows.iter().map(|r| get(r)).collect();
             assert_eq!(f(name), want, "column {name}");
@@ -821,6 +828,7 @@ mod tests {
             &DataType::Float64
         );
         assert_eq!(back.column("u_contact_exact").unwrap().null_count(), 8);
+        assert_eq!(back.column("energy_gravity").unwrap().null_count(), 8);
         let steps: Vec<Option<i64>> = back.column("step").unwrap().i64().unwrap().iter().collect();
         assert_eq!(steps, [0, 1, 2, 3, 4, 0, 1, 2].map(Some));
     }
