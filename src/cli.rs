@@ -638,14 +638,14 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         TableMode::Auto => ids.len() <= COMPACT_ABOVE,
     };
     if per_run {
-        print!("{}", result_table(dir, plan, &ids)?);
+        say(&result_table(dir, plan, &ids)?);
     } else if !summarized {
         // The group lines come with the summary; without it, say where the results are.
-        println!(
-            "{} runs: `contact-sweep summarize {}` for the table by method group, or --table runs",
+        say(&format!(
+            "{} runs: `contact-sweep summarize {}` for the table by method group, or --table runs\n",
             ids.len(),
             dir.display()
-        );
+        ));
     }
     if cfg.shard.is_some() {
         eprintln!(
@@ -659,14 +659,14 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         match summary::Sections::compute(dir, &plan.sweep.summary) {
             Ok(sections) => {
                 match sections.write(dir) {
-                    Ok(s) => print!("{}", s.terminal),
+                    Ok(s) => say(&s.terminal),
                     Err(e) => eprintln!("summary not written: {e:#}"),
                 }
                 match crate::report::write_with(dir, None, &sections) {
-                    Ok(r) => println!(
-                        "report: {} — open it in a browser: figures and every table",
+                    Ok(r) => say(&format!(
+                        "report: {} — open it in a browser: figures and every table\n",
                         r.path.display()
-                    ),
+                    )),
                     Err(e) => eprintln!("report not written: {e:#}"),
                 }
             }
@@ -674,6 +674,14 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Print `run`'s results to stdout, ignoring a reader that went away (`run … | head`): the
+/// runs are committed by then, and the summary and report that follow must still be written
+/// (`print!` would panic on the broken pipe and skip them).
+fn say(text: &str) {
+    use std::io::Write as _;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
 }
 
 /// Where the session's time and bytes went: the runs' own time (summed over workers) against

@@ -563,3 +563,35 @@ fn every_subcommand_help_ends_with_examples() {
         );
     }
 }
+
+/// Regression (`contact-sweep plan … | head` panicked on the broken pipe): a reader that goes
+/// away ends `plan` quietly, and `run` still writes its summary and report after the runs (its
+/// results are committed before anything is printed).
+#[test]
+fn a_reader_that_goes_away_neither_panics_nor_loses_the_summary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("qs");
+    for args in [
+        vec!["plan", "sweeps/quickstart.toml"],
+        vec!["run", "sweeps/quickstart.toml", "--out", out.to_str().unwrap()],
+    ] {
+        let mut child = Command::new(bin())
+            .args(&args)
+            .current_dir(repo())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The read end is closed before the child prints anything (its output would fit in the
+        // pipe's buffer, so a reader that read one line first would never break the pipe).
+        drop(child.stdout.take());
+        let o = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        if args[0] == "run" {
+            assert!(o.status.success(), "{stderr}");
+            assert!(out.join("summary/energy.parquet").exists());
+            assert!(out.join("report.html").exists());
+        }
+    }
+}
