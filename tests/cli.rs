@@ -573,7 +573,12 @@ fn a_reader_that_goes_away_neither_panics_nor_loses_the_summary() {
     let out = tmp.path().join("qs");
     for args in [
         vec!["plan", "sweeps/quickstart.toml"],
-        vec!["run", "sweeps/quickstart.toml", "--out", out.to_str().unwrap()],
+        vec![
+            "run",
+            "sweeps/quickstart.toml",
+            "--out",
+            out.to_str().unwrap(),
+        ],
     ] {
         let mut child = Command::new(bin())
             .args(&args)

@@ -527,6 +527,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
     let start = Instant::now();
     let mut metrics = Metrics {
         dofs: cfg.elements as i64,
+        length_scale: Some(cfg.bar.length),
         ..Metrics::default()
     };
     let fail = |status, msg: String, metrics: Metrics| Outcome {

@@ -843,6 +843,8 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let start = Instant::now();
     let mut metrics = Metrics {
         dofs: cfg.unknowns() as i64,
+        // Known before anything can fail: a failed row still gets its energy tolerance.
+        length_scale: Some(cfg.setup.geometry.length_scale()),
         ..Metrics::default()
     };
     let fail = |status, msg: String, metrics: Metrics| Outcome {

@@ -40,6 +40,9 @@ pub struct Metrics {
     pub err_u_contact_max: Option<f64>,
     /// The scene's energy scale (E⁰ for the bars).
     pub energy_scale: Option<f64>,
+    /// The body's size L that mesh sizes are compared with (bar: its length; disc/ball: the
+    /// diameter): the energy classification's tolerance is max(1, ν)·h/L.
+    pub length_scale: Option<f64>,
     /// l2(τ) error of the total contact force against a reference run (FE scenes).
     pub err_force_l2: Option<f64>,
     /// Contact unknowns (the dofs the contact problem is condensed onto).

@@ -177,6 +177,7 @@ schema! {
         err_energy_l2: Option<f64> => "", "l2(τ) error of the energy";
         err_u_contact_max: Option<f64> => "m", "max_n |u^n(contact) − u(contact, t^n)| (2D/3D: mean u_d over Γ_C against the reference)";
         energy_scale: Option<f64> => "J", "the scene's energy scale relative energies are measured in (E⁰ for the bars)";
+        length_scale: Option<f64> => "m", "the body's size L mesh sizes are compared with (bar: its length; disc/ball: the diameter)";
         err_force_l2: Option<f64> => "N·s^½", "l2(τ) error of the total contact force against the reference run (2D/3D)";
         contact_dofs: Option<i64> => "", "unknowns the contact problem is condensed onto (2D/3D: vertical dofs of Γ_C)";
         contact_toggles: Option<i64> => "", "times the total contact force switched between zero and non-zero (2D/3D; 002's chatter)";
@@ -444,6 +445,7 @@ impl RunRecord {
             err_energy_l2: m.err_energy_l2,
             err_u_contact_max: m.err_u_contact_max,
             energy_scale: m.energy_scale,
+            length_scale: m.length_scale,
             err_force_l2: m.err_force_l2,
             contact_dofs: m.contact_dofs,
             contact_toggles: m.contact_toggles,

@@ -33,6 +33,17 @@ pub enum FeGeometry {
     },
 }
 
+impl FeGeometry {
+    /// The body's size that mesh sizes are compared with: the box's vertical extent (the
+    /// direction the impact travels), the disc's or ball's diameter.
+    pub fn length_scale(&self) -> f64 {
+        match self {
+            FeGeometry::Box { extent, .. } => extent.last().copied().unwrap_or(1.0),
+            FeGeometry::Ball { radius, .. } => 2.0 * radius,
+        }
+    }
+}
+
 /// A finite-element scene as the sparse engine runs it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeSetup {

@@ -15,7 +15,7 @@
 //!     δ = max(h, c0 τ) / L = max(1, ν) · h / L
 //! ```
 //!
-//! (L the bar length, 1 for scenes without one), a run is growing if d > δ, dissipative if
+//! (L the run's `length_scale`: the bar's length, the disc's or ball's diameter), a run is growing if d > δ, dissipative if
 //! d < −δ, conservative otherwise. δ is the consistency error of the contact discretisation:
 //! the contact node is resolved to one cell and one step, and the energy it exchanges over an
 //! impact is exact only up to O(max(h, c0τ)) — mod3 + CN, whose energy is conserved up to
@@ -77,10 +77,12 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
     let monotone = (hybrid && (space == "mixed" || nitsche_theta_one))
         || ((backward_euler || scheme == "theta" && theta_scheme == Some(1.0))
             && nitsche_theta_one);
-    let length = runs
-        .param_f64(r, "length")
-        .filter(|l| *l > 0.0)
-        .unwrap_or(1.0);
+    // The run's own length scale; folders of older versions: the bar's `length`, else 1.
+    let length = r.length_scale.unwrap_or_else(|| {
+        runs.param_f64(r, "length")
+            .filter(|l| *l > 0.0)
+            .unwrap_or(1.0)
+    });
     let tolerance = r.h.map(|h| r.courant.unwrap_or(1.0).max(1.0) * h / length);
     let class = match r.status.as_str() {
         "ok" => match (drift, tolerance) {

@@ -104,6 +104,7 @@ const MEASURED: &[(&str, Kind)] = &[
     ("energy_theta_max_increase", Kind::F64),
     ("energy_theta_drift", Kind::F64),
     ("energy_theta_initial", Kind::F64),
+    ("length_scale", Kind::F64),
     ("search", Kind::Str),
 ];
 
@@ -173,6 +174,8 @@ pub(crate) struct Run {
     pub energy_theta_max_increase: Option<f64>,
     pub energy_theta_drift: Option<f64>,
     pub energy_theta_initial: Option<f64>,
+    /// The body's size (runs column `length_scale`; None in folders of older versions).
+    pub length_scale: Option<f64>,
     /// Ensemble member index (null outside ensembles).
     pub ensemble_sample: Option<i64>,
     /// The `[search]` whose probe this run is (null for grid runs).
@@ -640,6 +643,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
     let theta_drift = get_f("energy_theta_drift")?;
     let theta_initial = get_f("energy_theta_initial")?;
+    let length_scale = get_f("length_scale")?;
     let sample = get_i("ensemble_sample")?;
     let search = strs(&df, "search")?;
     let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
@@ -733,6 +737,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             energy_theta_max_increase: theta_inc[i],
             energy_theta_drift: theta_drift[i],
             energy_theta_initial: theta_initial[i],
+            length_scale: finite(length_scale[i]).filter(|l| *l > 0.0),
             ensemble_sample: sample[i],
             search: search.as_ref().and_then(|v| v[i].clone()),
             part: part.as_ref().and_then(|v| v[i].clone()),
