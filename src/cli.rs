@@ -658,11 +658,19 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         // session's, i.e. plan.sweep.summary).
         match summary::Sections::compute(dir, &plan.sweep.summary) {
             Ok(sections) => {
-                match sections.write(dir) {
-                    Ok(s) => say(&s.terminal),
-                    Err(e) => eprintln!("summary not written: {e:#}"),
+                // Tables and report from the same sections, side by side: both only read them,
+                // and the sweep's workers are done, so the cores are free.
+                let (tables, report) = std::thread::scope(|scope| {
+                    let tables = scope.spawn(|| sections.write(dir));
+                    let report = crate::report::write_with(dir, None, &sections);
+                    (tables.join(), report)
+                });
+                match tables {
+                    Ok(Ok(s)) => say(&s.terminal),
+                    Ok(Err(e)) => eprintln!("summary not written: {e:#}"),
+                    Err(_) => eprintln!("summary not written: its writer panicked"),
                 }
-                match crate::report::write_with(dir, None, &sections) {
+                match report {
                     Ok(r) => say(&format!(
                         "report: {} — open it in a browser: figures and every table\n",
                         r.path.display()

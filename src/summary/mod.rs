@@ -142,6 +142,21 @@ pub fn summarize_with(dir: &Path, opts: &SummaryOptions) -> anyhow::Result<Summa
     sections.write(dir)
 }
 
+/// One file (or table: Parquet + CSV) of `DIR/summary/`.
+enum Output<'a> {
+    Table(&'static str, &'a table::Table),
+    Text(&'static str, &'a str),
+}
+
+impl Output<'_> {
+    fn write(self, out: &Path) -> anyhow::Result<Vec<PathBuf>> {
+        match self {
+            Output::Table(stem, t) => table::write_table(out, stem, t),
+            Output::Text(name, body) => Ok(vec![table::write_text(out, name, body)?]),
+        }
+    }
+}
+
 /// Every section of a folder's summary, computed once: [`Sections::write`] writes the tables,
 /// and the report draws from the same values (`contact-sweep run` computes them once for
 /// both, issue 12).
@@ -172,12 +187,23 @@ impl Sections {
             .ok()
             .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
             .unwrap_or_else(|| dir.display().to_string());
-        let conv = convergence::section(&runs, opts, &title);
-        let en = energy::section(dir, &runs)?;
-        let ens = ensemble::section(&runs);
-        let st = stability::section(&runs);
-        let se = search::section(&runs);
-        let wp = work::section(&runs);
+        // Two independent halves on two threads (each section only reads the runs).
+        let (conv, rest) = std::thread::scope(|scope| {
+            let rest = scope.spawn(|| {
+                (
+                    energy::section(dir, &runs),
+                    ensemble::section(&runs),
+                    stability::section(&runs),
+                    search::section(&runs),
+                    work::section(&runs),
+                )
+            });
+            let conv = convergence::section(&runs, opts, &title);
+            (conv, rest.join())
+        });
+        let (en, ens, st, se, wp) =
+            rest.map_err(|_| anyhow::anyhow!("a summary section panicked"))?;
+        let en = en?;
         Ok(Sections {
             runs,
             title,
@@ -206,28 +232,46 @@ impl Sections {
         let out = dir.join("summary");
         std::fs::create_dir_all(&out)
             .with_context(|| format!("{}: cannot create", out.display()))?;
+        // The tables are encoded concurrently (one scoped thread each; Parquet and CSV
+        // encoding is CPU-bound and the sweep's workers are done by now), the files listed in
+        // a fixed order whatever finishes first.
+        let jobs = [
+            Output::Table("convergence", &conv.table),
+            Output::Text("convergence.md", &conv.markdown),
+            Output::Text("convergence.tex", &conv.latex),
+            Output::Text("convergence_doc.tex", &conv.latex_doc),
+            Output::Table("energy", &en.runs),
+            Output::Table("energy_groups", &en.groups),
+            Output::Table("impacts", &en.impacts),
+            Output::Text("energy.md", &en.markdown),
+            Output::Table("ensemble", &ens.table),
+            Output::Text("ensemble.md", &ens.markdown),
+            Output::Table("stability_map", &st.table),
+            Output::Text("stability_map.md", &st.markdown),
+            Output::Table("search", &se.table),
+            Output::Text("search.md", &se.markdown),
+            Output::Table("work_precision", &wp.table),
+            Output::Table("cost_to_error", &wp.cost),
+            Output::Text("work_precision.md", &wp.markdown),
+        ];
+        let out_dir: &Path = &out;
+        let results: Vec<anyhow::Result<Vec<PathBuf>>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = jobs
+                .into_iter()
+                .map(|job| scope.spawn(move || job.write(out_dir)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(anyhow::anyhow!("a table writer panicked")))
+                })
+                .collect()
+        });
         let mut files = Vec::new();
-        files.extend(table::write_table(&out, "convergence", &conv.table)?);
-        files.push(table::write_text(&out, "convergence.md", &conv.markdown)?);
-        files.push(table::write_text(&out, "convergence.tex", &conv.latex)?);
-        files.push(table::write_text(
-            &out,
-            "convergence_doc.tex",
-            &conv.latex_doc,
-        )?);
-        files.extend(table::write_table(&out, "energy", &en.runs)?);
-        files.extend(table::write_table(&out, "energy_groups", &en.groups)?);
-        files.extend(table::write_table(&out, "impacts", &en.impacts)?);
-        files.push(table::write_text(&out, "energy.md", &en.markdown)?);
-        files.extend(table::write_table(&out, "ensemble", &ens.table)?);
-        files.push(table::write_text(&out, "ensemble.md", &ens.markdown)?);
-        files.extend(table::write_table(&out, "stability_map", &st.table)?);
-        files.push(table::write_text(&out, "stability_map.md", &st.markdown)?);
-        files.extend(table::write_table(&out, "search", &se.table)?);
-        files.push(table::write_text(&out, "search.md", &se.markdown)?);
-        files.extend(table::write_table(&out, "work_precision", &wp.table)?);
-        files.extend(table::write_table(&out, "cost_to_error", &wp.cost)?);
-        files.push(table::write_text(&out, "work_precision.md", &wp.markdown)?);
+        for r in results {
+            files.extend(r?);
+        }
 
         let mut terminal = format!(
             "{} runs ({} ok) in {} groups from {}\n",
