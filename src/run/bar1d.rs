@@ -483,7 +483,7 @@ impl Recorder<'_> {
             _ => None,
         };
         let t = step as f64 * self.tau;
-        let (energy, energy_theta, _parts) = self.sp.energies(u, v);
+        let (energy, energy_theta) = self.sp.energies(u, v);
         let exact = self.exact.map(|ex| {
             let (l2_sq, h1_semi_sq) = ex.error_sq(u, self.sp.h, t);
             ExactValues {

@@ -209,16 +209,9 @@ impl Bar1dSpace {
     }
 
     /// Mechanical energy E^h = ½vᵀMv + ½uᵀKu, plus the penalty potential κ/2 [s]₊² for the
-    /// penalty method (SPEC §2.4), the augmented Nitsche energy E_Θ (SPEC §2.3) if any, and the
-    /// parts (½vᵀMv, ½uᵀKu) E^h sums anyway (no extra work).
-    pub fn energies(&self, u: &[f64], v: &[f64]) -> (f64, Option<f64>, [f64; 2]) {
-        let parts = [0.5 * self.mass.quad(v), self.strain_energy(u)];
-        let (e, et) = self.energies_from(u, parts[0] + parts[1]);
-        (e, et, parts)
-    }
-
-    /// The contact terms added to E^h = `eh`.
-    fn energies_from(&self, u: &[f64], eh: f64) -> (f64, Option<f64>) {
+    /// penalty method (SPEC §2.4), and the augmented Nitsche energy E_Θ (SPEC §2.3) if any.
+    pub fn energies(&self, u: &[f64], v: &[f64]) -> (f64, Option<f64>) {
+        let eh = 0.5 * self.mass.quad(v) + self.strain_energy(u);
         let s = self.p.dot(u) + self.p0;
         match self.method {
             ContactMethod::Mixed => (eh, None),
