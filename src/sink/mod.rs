@@ -36,7 +36,10 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
 use polars::prelude::*;
-use polars_utils::compression::ZstdLevel;
+use polars_parquet::write::{
+    CompressionOptions, Encoding, FileWriter, StatisticsOptions, Version, WriteOptions, ZstdLevel,
+    get_dtype_encoding, row_group_iter, to_parquet_schema,
+};
 
 pub mod manifest;
 
@@ -148,36 +151,121 @@ pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame
 /// Write a DataFrame to `dir/name` atomically (temporary dot-file, fsync, rename); returns the
 /// file's size in bytes.
 pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<u64, SinkError> {
+    write_parquet_parts_atomic(dir, name, df, None, Durability::Synced)
+}
+
+/// Whether a file must survive a power cut once written. Results (runs and series parts, the
+/// manifest) are synced before they count as committed; what is derived from them (summary
+/// tables, the report) is only renamed into place — never seen half-written, and rebuilt by
+/// `contact-sweep summarize` if a power cut took it. fsync costs 5–10 ms a file here, and the
+/// summary writes ~20 files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Durability {
+    Synced,
+    Derived,
+}
+
+/// [`write_parquet_atomic`] with row groups of the given lengths (None: one per 512² rows) and
+/// the given durability.
+pub fn write_parquet_parts_atomic(
+    dir: &Path,
+    name: &str,
+    df: &mut DataFrame,
+    row_groups: Option<&[usize]>,
+    durability: Durability,
+) -> Result<u64, SinkError> {
     let tmp = dir.join(format!(".tmp-{name}"));
     let dst = dir.join(name);
     let file = File::create(&tmp).map_err(io(&tmp))?;
     // zstd: the series' floats barely compress, but step, t and the closed-form columns do —
     // 20.3 bytes per series row against 28.8 with lz4 and 59.7 uncompressed (measured on the
-    // benches/sweeps/overhead_1d.toml series). Level 1, not polars' default 3: 20.45 against
-    // 20.31 bytes per row for 27 % less compression time (197 against 269 ns per row of
-    // writer CPU, compression and encoding; the writer takes its CPU from the workers when
-    // every core runs one). One row group per part (a part is a batch of
-    // runs, ≤ 10⁵–10⁶ rows): a reader prunes by part, and polars reads it in one go. Not
-    // parallel: the sink's writer thread is already off the workers' path, and polars' pool
-    // would compete with them for the cores.
+    // benches/sweeps/overhead_1d.toml series with polars' encodings). Level 1, not polars'
+    // default 3: 20.45 against 20.31 bytes per row for 27 % less compression time (197 against
+    // 269 ns per row of writer CPU; the writer takes its CPU from the workers when every core
+    // runs one). Encodings per column type and row groups as the caller asks: see
+    // [`encode_parquet`]. Not parallel: the sink's writer thread is already off the workers'
+    // path, and a pool would compete with them for the cores.
     // Buffered: polars writes a part page by page (≈ 40 000 write calls for the summary's
     // tables and series parts of one sweep without the buffer).
     let mut buf = BufWriter::with_capacity(1 << 20, &file);
-    ParquetWriter::new(&mut buf)
-        .with_compression(ParquetCompression::Zstd(Some(zstd_level())))
-        .set_parallel(false)
-        .finish(df)
-        .map_err(|source| SinkError::Parquet {
-            path: tmp.clone(),
-            source,
-        })?;
+    encode_parquet(&mut buf, df, row_groups).map_err(|source| SinkError::Parquet {
+        path: tmp.clone(),
+        source,
+    })?;
     buf.flush().map_err(io(&tmp))?;
     drop(buf);
-    file.sync_all().map_err(io(&tmp))?;
+    if durability == Durability::Synced {
+        file.sync_all().map_err(io(&tmp))?;
+    }
     let bytes = file.metadata().map_err(io(&tmp))?.len();
     drop(file);
     fs::rename(&tmp, &dst).map_err(io(&dst))?;
     Ok(bytes)
+}
+
+/// Encode `df` as Parquet into `out`, with row groups of the lengths given (summing to the
+/// frame's height), else of 512² rows.
+///
+/// Polars' own `ParquetWriter` asks for a dictionary on every primitive column and, for a
+/// float column, first estimates its cardinality with a HyperLogLog pass, only to fall back to
+/// plain encoding: the values of a simulation are nearly all distinct. On the series that pass
+/// was 16 % of the writer's CPU. Here each column gets its encoding from its type:
+/// - Float64: plain (zstd then finds the repeats a dictionary would: the closed-form stress is
+///   piecewise constant);
+/// - Int64: delta (`step` is 0, 1, 2, …: a few bits a page, where plain was 8 bytes before
+///   compression);
+/// - everything else (run ids, strings, lists): polars' choice, a dictionary for strings.
+///
+/// Statistics as polars writes them (min/max/null count), so readers prune row groups.
+fn encode_parquet(
+    out: &mut impl std::io::Write,
+    df: &mut DataFrame,
+    row_groups: Option<&[usize]>,
+) -> PolarsResult<()> {
+    df.rechunk_mut();
+    let schema = df.schema().to_arrow(CompatLevel::newest());
+    let encodings: Vec<Vec<Encoding>> = schema
+        .iter_values()
+        .map(|field| match field.dtype() {
+            ArrowDataType::Float64 => vec![Encoding::Plain],
+            ArrowDataType::Int64 => vec![Encoding::DeltaBinaryPacked],
+            other => get_dtype_encoding(other),
+        })
+        .collect();
+    let options = WriteOptions {
+        statistics: StatisticsOptions::default(),
+        version: Version::V1,
+        compression: CompressionOptions::Zstd(Some(zstd_level())),
+        data_page_size: None,
+    };
+    let fields = to_parquet_schema(&schema)?.fields().to_vec();
+    let mut writer = FileWriter::try_new(out, schema, options)?;
+    let whole: Vec<usize>;
+    let lengths = match row_groups {
+        Some(l) => l,
+        None => {
+            const ROWS: usize = 512 * 512;
+            whole = (0..df.height().div_ceil(ROWS))
+                .map(|k| ROWS.min(df.height() - k * ROWS))
+                .collect();
+            &whole
+        }
+    };
+    let mut offset = 0;
+    for &rows in lengths.iter().filter(|&&n| n > 0) {
+        // A slice of a single-chunk frame is one record batch, without a copy.
+        let group = df.slice(offset as i64, rows);
+        offset += rows;
+        for batch in group.iter_chunks(CompatLevel::newest(), false) {
+            let n = batch.len() as u64;
+            writer.write(
+                n,
+                row_group_iter(batch, encodings.clone().into(), fields.clone(), options),
+            )?;
+        }
+    }
+    writer.end(None)?;
+    Ok(())
 }
 
 /// The writer's zstd level (see [`write_parquet_atomic`]).
@@ -203,15 +291,30 @@ pub fn lock_exclusive(path: &Path) -> std::io::Result<File> {
 
 /// Write bytes atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
+    write_text_atomic(path, bytes, Durability::Synced)
+}
+
+/// Write a derived file (a summary table, the report): atomically, without fsync
+/// (see [`Durability`]).
+pub fn write_derived(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
+    write_text_atomic(path, bytes, Durability::Derived)
+}
+
+fn write_text_atomic(path: &Path, bytes: &[u8], durability: Durability) -> Result<(), SinkError> {
     let dir = path.parent().unwrap_or(Path::new("."));
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
     let tmp = dir.join(format!(".tmp-{name}"));
     let mut f = File::create(&tmp).map_err(io(&tmp))?;
     f.write_all(bytes).map_err(io(&tmp))?;
-    f.sync_all().map_err(io(&tmp))?;
+    if durability == Durability::Synced {
+        f.sync_all().map_err(io(&tmp))?;
+    }
     drop(f);
     fs::rename(&tmp, path).map_err(io(path))?;
-    sync_dir(dir)
+    match durability {
+        Durability::Synced => sync_dir(dir),
+        Durability::Derived => Ok(()),
+    }
 }
 
 /// A part file that cannot be read.
@@ -275,9 +378,22 @@ pub fn damaged_name(path: &Path) -> PathBuf {
 /// Unreadable parts of DIR, without touching them: runs parts read whole, series parts by
 /// their footer.
 pub fn unreadable_parts(dir: &Path) -> Result<Vec<Damaged>, SinkError> {
+    unreadable_parts_except(dir, &HashSet::new())
+}
+
+/// [`unreadable_parts`], taking the runs parts named in `read` as readable: a reader that has
+/// just read them whole (the summary's loader) need not have them read a second time.
+pub fn unreadable_parts_except(
+    dir: &Path,
+    read: &HashSet<String>,
+) -> Result<Vec<Damaged>, SinkError> {
     let mut out = Vec::new();
     for (sub, whole) in [("runs", true), ("series", false)] {
         for part in parquet_parts(&dir.join(sub))? {
+            let name = part.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if whole && read.contains(name) {
+                continue;
+            }
             if let Some(reason) = part_problem(&part, whole) {
                 out.push(Damaged {
                     path: part,
@@ -705,7 +821,16 @@ fn commit_batch(
         path: series_dir.join(name),
         source,
     })?;
-    let series_bytes = write_parquet_atomic(series_dir, name, &mut sdf)?;
+    // A row group per run: a reader of one run's series (the report,
+    // `pl.scan_parquet(...).filter(pl.col("run_id") == id)`) decodes that run's pages only.
+    let lengths: Vec<usize> = series.iter().map(|(_, s)| s.len()).collect();
+    let series_bytes = write_parquet_parts_atomic(
+        series_dir,
+        name,
+        &mut sdf,
+        Some(&lengths),
+        Durability::Synced,
+    )?;
     let mut rdf = frame(RunRecord::to_columns(rows)).map_err(|source| SinkError::Parquet {
         path: runs_dir.join(name),
         source,
@@ -775,6 +900,56 @@ mod tests {
             energy_gravity: None,
             u_lowest: theta.map(|t| -t),
         }
+    }
+
+    /// A series part written with a row group per run: the footer names each group's run
+    /// (run_id statistics min = max), so a reader of one run decodes that run only; the rows
+    /// come back bit for bit through the typed encodings (delta `step`, plain floats).
+    #[test]
+    fn series_parts_have_a_row_group_per_run_with_typed_encodings() {
+        use polars_parquet::parquet::statistics::Statistics;
+        let a: Vec<SeriesRow> = (0..5).map(|n| row(n, None, Some(n as f64))).collect();
+        let b: Vec<SeriesRow> = (0..3).map(|n| row(n, None, Some(1.0))).collect();
+        let batch = vec![("run-a".to_string(), a), ("run-b".to_string(), b)];
+        let dir = tempfile::tempdir().unwrap();
+        let mut df = frame(series_columns(&batch)).unwrap();
+        let before = df.clone();
+        write_parquet_parts_atomic(
+            dir.path(),
+            "part-0.parquet",
+            &mut df,
+            Some(&[5, 3]),
+            Durability::Synced,
+        )
+        .unwrap();
+        let mut reader = ParquetReader::new(File::open(dir.path().join("part-0.parquet")).unwrap());
+        let md = reader.get_metadata().unwrap().clone();
+        let groups: Vec<(String, usize)> = md
+            .row_groups
+            .iter()
+            .map(|rg| {
+                let chunk = rg
+                    .columns_under_root_iter("run_id")
+                    .unwrap()
+                    .next()
+                    .unwrap();
+                let Statistics::Binary(st) = chunk.statistics(&md.footer_buf).unwrap().unwrap()
+                else {
+                    panic!("run_id statistics are binary")
+                };
+                assert_eq!(st.min_value, st.max_value);
+                (
+                    String::from_utf8(st.min_value.unwrap()).unwrap(),
+                    rg.num_rows(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            groups,
+            vec![("run-a".to_string(), 5), ("run-b".to_string(), 3)]
+        );
+        let back = reader.finish().unwrap();
+        assert!(back.equals_missing(&before));
     }
 
     /// The series columns are built in one pass (dense columns moved into the frame, the

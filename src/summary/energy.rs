@@ -380,6 +380,10 @@ fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
     c
 }
 
+fn cols_without_params(list: &[(&str, Kind)]) -> Vec<(String, Kind)> {
+    list.iter().map(|(n, k)| (n.to_string(), *k)).collect()
+}
+
 fn minmax(v: impl Iterator<Item = Option<f64>>) -> (Option<f64>, Option<f64>) {
     let mut lo: Option<f64> = None;
     let mut hi: Option<f64> = None;
@@ -444,35 +448,36 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         ],
         runs,
     ));
-    let mut impacts = Table::new(&cols(
-        &[
-            ("group", Kind::I64),
-            ("group_title", Kind::Str),
-            ("run_id", Kind::Str),
-            ("label", Kind::Str),
-            ("status", Kind::Str),
-            ("h", Kind::F64),
-            ("dt", Kind::F64),
-            ("impact", Kind::I64),
-            ("step_first", Kind::I64),
-            ("step_last", Kind::I64),
-            ("t_first", Kind::F64),
-            ("t_last", Kind::F64),
-            ("step_before", Kind::I64),
-            ("step_after", Kind::I64),
-            ("energy_e0", Kind::F64),
-            ("energy_before", Kind::F64),
-            ("energy_after", Kind::F64),
-            ("energy_loss_rel", Kind::F64),
-            ("energy_theta_before", Kind::F64),
-            ("energy_theta_after", Kind::F64),
-            ("energy_theta_loss_rel", Kind::F64),
-            ("phase_complete", Kind::Bool),
-            ("series_decimated", Kind::Bool),
-            ("series_stride", Kind::I64),
-        ],
-        runs,
-    ));
+    // One row per contact phase: tens of thousands of rows on a large sweep, so the run's
+    // parameters are not repeated on each (25 columns, half of impacts.csv's 7.9 MB and of its
+    // encoding time on issue 12's sweep); they are one join away, on `run_id`, in the energy
+    // table or `runs/`.
+    let mut impacts = Table::new(&cols_without_params(&[
+        ("group", Kind::I64),
+        ("group_title", Kind::Str),
+        ("run_id", Kind::Str),
+        ("label", Kind::Str),
+        ("status", Kind::Str),
+        ("h", Kind::F64),
+        ("dt", Kind::F64),
+        ("impact", Kind::I64),
+        ("step_first", Kind::I64),
+        ("step_last", Kind::I64),
+        ("t_first", Kind::F64),
+        ("t_last", Kind::F64),
+        ("step_before", Kind::I64),
+        ("step_after", Kind::I64),
+        ("energy_e0", Kind::F64),
+        ("energy_before", Kind::F64),
+        ("energy_after", Kind::F64),
+        ("energy_loss_rel", Kind::F64),
+        ("energy_theta_before", Kind::F64),
+        ("energy_theta_after", Kind::F64),
+        ("energy_theta_loss_rel", Kind::F64),
+        ("phase_complete", Kind::Bool),
+        ("series_decimated", Kind::Bool),
+        ("series_stride", Kind::I64),
+    ]));
 
     let mut run_rows_md: Vec<Vec<String>> = Vec::new();
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
@@ -535,9 +540,6 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             impacts.bool("phase_complete", Some(complete));
             impacts.bool("series_decimated", Some(decimated));
             impacts.i64("series_stride", Some(stride));
-            for ((n, _), c) in runs.params.iter().zip(&r.params) {
-                impacts.cell(n, c);
-            }
             impacts.end_row();
         }
         impact_count += list.len();

@@ -379,64 +379,81 @@ pub(crate) fn read_parts(
     lists: &[(&'static str, DataType)],
     only: Option<&HashSet<String>>,
 ) -> anyhow::Result<(DataFrame, Vec<String>)> {
+    use rayon::prelude::*;
+    // Parts are read on every core (a runs folder is many small parts: 25 for issue 12's
+    // 400-run sweep, each a few hundred columns of a few rows, where polars' per-file cost
+    // dominates), then stacked in file order.
+    let parts = crate::sink::parquet_parts(folder)?;
+    let read = parts
+        .par_iter()
+        .map(|part| -> anyhow::Result<Option<(LazyFrame, Vec<String>)>> {
+            let mut ignored: Vec<String> = Vec::new();
+            let name = part
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            if only.is_some_and(|o| !o.contains(&name)) {
+                return Ok(None);
+            }
+            let file = std::fs::File::open(part).with_context(|| format!("{}", part.display()))?;
+            let mut reader = ParquetReader::new(file);
+            // An unreadable part is skipped: `summarize` warns about it (sink::unreadable_parts).
+            let Ok(schema) = reader.schema() else {
+                return Ok(None);
+            };
+            let stored: Vec<String> = schema.iter_names().map(|n| n.to_string()).collect();
+            let is_known = |n: &str| known.iter().chain(lists).any(|(k, _)| *k == n);
+            // Read only the known columns (a series part can be large; the rest is never loaded).
+            let wanted: Vec<String> = stored.iter().filter(|n| is_known(n)).cloned().collect();
+            let raw = match reader.with_columns(Some(wanted)).finish() {
+                Ok(raw) => raw,
+                Err(_) => return Ok(None),
+            };
+            let schema = raw.schema().clone();
+            let list_ok = |n: &str| {
+                lists.iter().any(|(k, _)| *k == n)
+                    && schema.get(n).is_some_and(|t| match t {
+                        DataType::List(inner) => inner.is_primitive_numeric() || inner.is_null(),
+                        _ => false,
+                    })
+            };
+            for name in &stored {
+                let usable = schema.get(name).is_some_and(castable) || list_ok(name);
+                if !usable {
+                    ignored.push(name.clone());
+                }
+            }
+            let mut exprs: Vec<Expr> = known
+                .iter()
+                .filter(|(n, _)| schema.get(n).is_some_and(castable))
+                .map(|(n, t)| col(*n).cast(t.clone()))
+                .collect();
+            exprs.extend(
+                lists
+                    .iter()
+                    .filter(|(n, _)| list_ok(n))
+                    .map(|(n, t)| col(*n).cast(t.clone())),
+            );
+            if exprs.is_empty() {
+                return Ok(None);
+            }
+            exprs.push(lit(name.as_str()).alias(PART_COLUMN));
+            if !lists.is_empty() {
+                let all = lists.iter().all(|(n, _)| list_ok(n));
+                exprs.push(lit(all).alias(LISTS_COLUMN));
+            }
+            Ok(Some((raw.lazy().select(exprs), ignored)))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let mut ignored: Vec<String> = Vec::new();
     let mut frames = Vec::new();
-    for part in crate::sink::parquet_parts(folder)? {
-        let name = part
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        if only.is_some_and(|o| !o.contains(&name)) {
-            continue;
-        }
-        let file = std::fs::File::open(&part).with_context(|| format!("{}", part.display()))?;
-        let mut reader = ParquetReader::new(file);
-        // An unreadable part is skipped: `summarize` warns about it (sink::unreadable_parts).
-        let Ok(schema) = reader.schema() else {
-            continue;
-        };
-        let stored: Vec<String> = schema.iter_names().map(|n| n.to_string()).collect();
-        let is_known = |n: &str| known.iter().chain(lists).any(|(k, _)| *k == n);
-        // Read only the known columns (a series part can be large; the rest is never loaded).
-        let wanted: Vec<String> = stored.iter().filter(|n| is_known(n)).cloned().collect();
-        let raw = match reader.with_columns(Some(wanted)).finish() {
-            Ok(raw) => raw,
-            Err(_) => continue,
-        };
-        let schema = raw.schema().clone();
-        let list_ok = |n: &str| {
-            lists.iter().any(|(k, _)| *k == n)
-                && schema.get(n).is_some_and(|t| match t {
-                    DataType::List(inner) => inner.is_primitive_numeric() || inner.is_null(),
-                    _ => false,
-                })
-        };
-        for name in &stored {
-            let usable = schema.get(name).is_some_and(castable) || list_ok(name);
-            if !usable && !ignored.iter().any(|i| i == name) {
-                ignored.push(name.clone());
+    for (frame, names) in read.into_iter().flatten() {
+        for n in names {
+            if !ignored.contains(&n) {
+                ignored.push(n);
             }
         }
-        let mut exprs: Vec<Expr> = known
-            .iter()
-            .filter(|(n, _)| schema.get(n).is_some_and(castable))
-            .map(|(n, t)| col(*n).cast(t.clone()))
-            .collect();
-        exprs.extend(
-            lists
-                .iter()
-                .filter(|(n, _)| list_ok(n))
-                .map(|(n, t)| col(*n).cast(t.clone())),
-        );
-        if exprs.is_empty() {
-            continue;
-        }
-        exprs.push(lit(name.as_str()).alias(PART_COLUMN));
-        if !lists.is_empty() {
-            let all = lists.iter().all(|(n, _)| list_ok(n));
-            exprs.push(lit(all).alias(LISTS_COLUMN));
-        }
-        frames.push(raw.lazy().select(exprs));
+        frames.push(frame);
     }
     if frames.is_empty() {
         return Ok((DataFrame::empty(), ignored));

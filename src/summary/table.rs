@@ -222,7 +222,13 @@ pub(crate) fn write_table(dir: &Path, stem: &str, table: &Table) -> anyhow::Resu
         .map_err(anyhow::Error::new)
         .with_context(|| format!("building {stem} table"))?;
     let parquet = format!("{stem}.parquet");
-    crate::sink::write_parquet_atomic(dir, &parquet, &mut df)?;
+    crate::sink::write_parquet_parts_atomic(
+        dir,
+        &parquet,
+        &mut df,
+        None,
+        crate::sink::Durability::Derived,
+    )?;
     // Sized up front (≈ 12 bytes a cell): growing an 8 MB impacts.csv by doubling copied it
     // and faulted in fresh pages about as often as it was written. Capacity never written is
     // never touched.
@@ -232,14 +238,14 @@ pub(crate) fn write_table(dir: &Path, stem: &str, table: &Table) -> anyhow::Resu
         .map_err(anyhow::Error::new)
         .with_context(|| format!("{}: csv", dir.join(format!("{stem}.csv")).display()))?;
     let csv_path = dir.join(format!("{stem}.csv"));
-    crate::sink::write_atomic(&csv_path, &csv)?;
+    crate::sink::write_derived(&csv_path, &csv)?;
     Ok(vec![dir.join(parquet), csv_path])
 }
 
 /// Write text atomically; returns the path.
 pub(crate) fn write_text(dir: &Path, name: &str, text: &str) -> anyhow::Result<PathBuf> {
     let path = dir.join(name);
-    crate::sink::write_atomic(&path, text.as_bytes())?;
+    crate::sink::write_derived(&path, text.as_bytes())?;
     Ok(path)
 }
 
