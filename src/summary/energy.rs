@@ -375,7 +375,7 @@ pub(crate) struct Section {
 }
 
 fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
-    let mut c: Vec<(String, Kind)> = list.iter().map(|(n, k)| (n.to_string(), *k)).collect();
+    let mut c = cols_without_params(list);
     c.extend(runs.param_columns());
     c
 }
