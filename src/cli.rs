@@ -482,6 +482,12 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     for d in &sink.damaged {
         eprintln!("warning: {}", d.warning());
     }
+    for p in &sink.legacy_damaged {
+        eprintln!(
+            "note: moved {} (a damaged part set aside by an older version) out of the parts' folder",
+            p.display()
+        );
+    }
     // Shards balanced by estimated work (exec::shard): every task computes the same split.
     let mine: Vec<&sweep::RunSpec> = match &cfg.shard {
         None => plan.runs.iter().collect(),

@@ -22,14 +22,14 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 use crate::run::reference::ReferenceData;
-use crate::run::{self, Metrics, Outcome, RunContext, RunOptions, RunRecord, SeriesRow, Status};
+use crate::run::{self, Metrics, Outcome, RunContext, RunOptions, RunRecord, Series, Status};
 use crate::sweep::RunSpec;
 
 /// A finished run: its row and its (possibly decimated) time series.
 #[derive(Debug, Clone)]
 pub struct RunResult {
     pub record: RunRecord,
-    pub series: Vec<SeriesRow>,
+    pub series: Series,
 }
 
 /// How to execute.
@@ -53,7 +53,7 @@ fn guarded(f: impl FnOnce() -> Outcome) -> Outcome {
             status: Status::SolverFailed,
             message: Some(format!("internal error (panic): {what}")),
             metrics: Metrics::default(),
-            series: Vec::new(),
+            series: Series::default(),
             reference: None,
         }
     })

@@ -6,7 +6,8 @@
 //! *missing* otherwise. Shards are those of the folder's sessions (`--shard …/N` in the
 //! manifest; one shard without), cut as [`super::shard::assign`] cuts them, so "shard k misses
 //! runs" is exactly what `run --shard k/N` would compute. Damaged files are the parts that
-//! cannot be read and those already moved aside (`.damaged-*`). The report ends with the one
+//! cannot be read and those already moved aside (under `damaged/`, or `.damaged-*` beside the
+//! parts in folders written before `damaged/` existed). The report ends with the one
 //! command that completes only what is missing: locally `run` on the same folder (it skips what
 //! is done), on a cluster `slurm … --only-shards K,…/N --submit` (an array over the shards that
 //! miss runs).
@@ -269,19 +270,23 @@ pub fn status(dir: &Path, sweep: Option<&Path>) -> Result<FolderStatus, StatusEr
             }
         }
     }
+    // Moved aside: everything under damaged/, and the dot-files of the older layout.
     let mut moved_aside = Vec::new();
-    for sub in ["runs", "series", "references"] {
-        if let Ok(entries) = std::fs::read_dir(dir.join(sub)) {
+    let mut pending = vec![dir.join("damaged")];
+    while let Some(d) = pending.pop() {
+        if let Ok(entries) = std::fs::read_dir(&d) {
             for e in entries.flatten() {
                 let p = e.path();
-                if p.file_name()
-                    .and_then(|n| n.to_str())
-                    .is_some_and(|n| n.starts_with(".damaged-"))
-                {
+                if p.is_dir() {
+                    pending.push(p);
+                } else {
                     moved_aside.push(p);
                 }
             }
         }
+    }
+    for sub in ["runs", "series", "references"] {
+        moved_aside.extend(sink::legacy_damaged(&dir.join(sub))?);
     }
     let aside = dir.join(".damaged-manifest.json");
     if aside.exists() {

@@ -332,11 +332,10 @@ struct RunSeries {
 /// The series of the runs `chosen`, in time order. Only the series parts that hold them are
 /// read (the sink names a batch's series part like its runs part, which `runs::load` records
 /// per run); of a part, first its `run_id` column (dictionary-encoded: a few bytes a run), then
-/// only the rows of the chosen runs and only the columns drawn. The sink writes a row group per
-/// run, so those rows are whole row groups and nothing else is decoded: the report's series
-/// took 0.1 s when it read the four parts of its four runs whole (issue 12's 400-run sweep).
+/// only the rows of the chosen runs and only the columns drawn, the page index skipping the
+/// pages of the other runs (`sink::parquet::read_rows_f64`).
 fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<String, RunSeries>> {
-    use polars::prelude::{ParquetReader, SerReader as _};
+    use crate::sink::parquet as pq;
     let mut out: HashMap<String, RunSeries> = HashMap::new();
     let folder = dir.join("series");
     if !folder.exists() || chosen.is_empty() {
@@ -361,61 +360,37 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
         if parts.as_ref().is_some_and(|p| !p.contains(&name)) {
             continue;
         }
-        let open = || std::fs::File::open(&part).with_context(|| format!("{}", part.display()));
         // An unreadable part is skipped: `summarize` warns about it (sink::unreadable_parts).
-        let Some(ranges) = run_ranges(&part, &wanted) else {
+        let Ok(ranges) = pq::run_ranges(&part, &wanted) else {
             continue;
         };
         if ranges.is_empty() {
             continue;
         }
-        let mut reader = ParquetReader::new(open()?);
-        let Ok(schema) = reader.schema() else {
+        let rows: Vec<_> = ranges.iter().map(|(_, r)| r.clone()).collect();
+        let Ok(cols) = pq::read_rows_f64(&part, &rows, &DRAWN) else {
             continue;
         };
-        let columns: Vec<String> = DRAWN
-            .iter()
-            .filter(|c| schema.contains(c))
-            .map(|c| c.to_string())
-            .collect();
-        for (id, start, len) in ranges {
-            let Ok(df) = ParquetReader::new(open()?)
-                .with_columns(Some(columns.clone()))
-                .with_slice(Some((start, len)))
-                .finish()
-            else {
-                continue;
-            };
-            let f = |name: &str| -> Vec<Option<f64>> {
-                df.column(name)
-                    .ok()
-                    .and_then(|c| c.cast(&polars::prelude::DataType::Float64).ok())
-                    .and_then(|c| c.f64().ok().map(|c| c.iter().collect()))
-                    .unwrap_or_else(|| vec![None; df.height()])
-            };
-            let (t, u, s, en, ue, se) = (
-                f("t"),
-                f("u_contact"),
-                f("sigma_contact"),
-                f("energy"),
-                f("u_contact_exact"),
-                f("sigma_contact_exact"),
-            );
+        let [t, u, s, en, ue, se] = &cols[..] else {
+            unreachable!("one vector per drawn column")
+        };
+        let mut k = 0;
+        for (id, r) in ranges {
             let rs = out.entry(id).or_default();
-            for k in 0..df.height() {
-                let Some(t) = t[k] else {
-                    continue;
-                };
-                let push = |v: &mut Vec<(f64, f64)>, y: Option<f64>| {
-                    if let Some(y) = y.filter(|y| y.is_finite()) {
-                        v.push((t, y));
-                    }
-                };
-                push(&mut rs.u, u[k]);
-                push(&mut rs.sigma, s[k]);
-                push(&mut rs.energy, en[k]);
-                push(&mut rs.u_exact, ue[k]);
-                push(&mut rs.sigma_exact, se[k]);
+            for _ in r {
+                if let Some(t) = t[k] {
+                    let push = |v: &mut Vec<(f64, f64)>, y: Option<f64>| {
+                        if let Some(y) = y.filter(|y| y.is_finite()) {
+                            v.push((t, y));
+                        }
+                    };
+                    push(&mut rs.u, u[k]);
+                    push(&mut rs.sigma, s[k]);
+                    push(&mut rs.energy, en[k]);
+                    push(&mut rs.u_exact, ue[k]);
+                    push(&mut rs.sigma_exact, se[k]);
+                }
+                k += 1;
             }
         }
     }
@@ -435,60 +410,6 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
         }
     }
     Ok(out)
-}
-
-/// The contiguous row ranges (run id, first row, rows) of the `wanted` runs in a series part,
-/// or None if the part cannot be read. From the footer when every row group holds one run
-/// (its `run_id` statistics have min = max: parts written since row groups are per run);
-/// otherwise from the `run_id` column.
-fn run_ranges(part: &Path, wanted: &HashSet<&str>) -> Option<Vec<(String, usize, usize)>> {
-    use polars::prelude::{ParquetReader, SerReader as _};
-    let open = || std::fs::File::open(part).ok().map(ParquetReader::new);
-    use polars_parquet::parquet::statistics::Statistics;
-    let mut ranges: Vec<(String, usize, usize)> = Vec::new();
-    let mut push = |id: &str, row: usize, n: usize| {
-        if !wanted.contains(id) {
-            return;
-        }
-        match ranges.last_mut() {
-            Some((last, start, len)) if last == id && *start + *len == row => *len += n,
-            _ => ranges.push((id.to_string(), row, n)),
-        }
-    };
-    let md = open()?.get_metadata().ok()?.clone();
-    let from_footer: Option<Vec<(String, usize)>> = md
-        .row_groups
-        .iter()
-        .map(|rg| {
-            let chunk = rg.columns_under_root_iter("run_id")?.next()?;
-            match chunk.statistics(&md.footer_buf)?.ok()? {
-                Statistics::Binary(b) if b.min_value.is_some() && b.min_value == b.max_value => {
-                    let id = String::from_utf8(b.min_value?).ok()?;
-                    Some((id, rg.num_rows()))
-                }
-                _ => None,
-            }
-        })
-        .collect();
-    if let Some(groups) = from_footer {
-        let mut row = 0;
-        for (id, n) in groups {
-            push(&id, row, n);
-            row += n;
-        }
-        return Some(ranges);
-    }
-    let ids = open()?
-        .with_columns(Some(vec!["run_id".into()]))
-        .finish()
-        .ok()?;
-    let ids = ids.column("run_id").ok()?.str().ok()?.clone();
-    for (k, id) in ids.iter().enumerate() {
-        if let Some(id) = id {
-            push(id, k, 1);
-        }
-    }
-    Some(ranges)
 }
 
 const CSS: &str = "body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:0 auto;max-width:1560px;padding:16px 24px;color:#222;line-height:1.4}

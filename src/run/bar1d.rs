@@ -29,7 +29,7 @@
 use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
-use super::{Metrics, Outcome, RunOptions, Status, Stop};
+use super::{Metrics, Outcome, RunOptions, Series, Status, Stop};
 use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::{BarExact, BarParams};
 use crate::space::bar1d::Pair;
@@ -534,7 +534,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         status,
         message: Some(msg),
         metrics,
-        series: Vec::new(),
+        series: Series::default(),
         reference: None,
     };
     let sp = match Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method) {

@@ -37,7 +37,7 @@ use std::time::Instant;
 use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
-use super::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
+use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::contact::Lcp;
 use crate::scene::{FeGeometry, FeSetup};
 use crate::space::fe::nitsche::{ContactPoint, contact_points};
@@ -851,7 +851,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         status,
         message: Some(msg),
         metrics,
-        series: Vec::new(),
+        series: Series::default(),
         reference: None,
     };
     let (c1, c, gamma) = match cfg.coefficients() {

@@ -22,7 +22,7 @@ use crate::scene::SceneSetup;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
-pub use observe::{Metrics, SeriesRow};
+pub use observe::{Metrics, Series, SeriesRow};
 pub use record::{RunRecord, SERIES_COLUMNS};
 
 /// Final state of a run (the `status` column).
@@ -239,7 +239,7 @@ pub struct Outcome {
     pub status: Status,
     pub message: Option<String>,
     pub metrics: Metrics,
-    pub series: Vec<SeriesRow>,
+    pub series: Series,
     /// The recorded solution, when the context asked for it.
     pub reference: Option<reference::ReferenceData>,
 }

@@ -5,7 +5,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{Outcome, SeriesRow};
+use super::Outcome;
 use crate::sweep::{Key, RunSpec, Value};
 
 /// A typed column ready for the sink.
@@ -275,82 +275,6 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "vertical displacement u_d of the lowest point of the reference configuration (disc2d, sphere3d)",
     ),
 ];
-
-/// The time series of a batch (each run's id with its rows) as typed columns.
-pub fn series_columns(runs: &[(String, Vec<SeriesRow>)]) -> Vec<(&'static str, ColumnData)> {
-    // One pass over the rows, filling every column at once: a batch holds ~10⁶ rows of ~80
-    // bytes, and one pass per column made this memory-bound loop the writer's largest cost
-    // after compression.
-    let rows: usize = runs.iter().map(|(_, s)| s.len()).sum();
-    let mut step = Vec::with_capacity(rows);
-    let mut dense: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(rows));
-    let mut optional: [Vec<Option<f64>>; 7] = std::array::from_fn(|_| Vec::with_capacity(rows));
-    let mut any = [false; 7];
-    for (_, s) in runs {
-        for r in s {
-            step.push(r.step);
-            for (col, x) in
-                dense
-                    .iter_mut()
-                    .zip([r.t, r.u_contact, r.v_contact, r.sigma_contact, r.energy])
-            {
-                col.push(x);
-            }
-            for ((col, seen), x) in optional.iter_mut().zip(&mut any).zip([
-                r.energy_theta,
-                r.u_contact_exact,
-                r.sigma_contact_exact,
-                r.energy_kinetic,
-                r.energy_elastic,
-                r.energy_gravity,
-                r.u_lowest,
-            ]) {
-                *seen |= x.is_some();
-                col.push(x);
-            }
-        }
-    }
-    let [t, u, v, sigma, energy] = dense;
-    // A column none of whose rows has a value (E_Θ outside Nitsche, the exact solution
-    // outside the bar, gravity outside the disc/ball) is written as nulls.
-    let [
-        theta,
-        u_exact,
-        sigma_exact,
-        kinetic,
-        elastic,
-        gravity,
-        lowest,
-    ] = {
-        let mut it = optional.into_iter().zip(any).map(|(col, seen)| {
-            if seen {
-                ColumnData::F64(col)
-            } else {
-                ColumnData::Null(rows)
-            }
-        });
-        std::array::from_fn(|_| it.next().expect("seven optional columns"))
-    };
-    vec![
-        (
-            "run_id",
-            ColumnData::StrRuns(runs.iter().map(|(id, s)| (id.clone(), s.len())).collect()),
-        ),
-        ("step", ColumnData::I64Dense(step)),
-        ("t", ColumnData::F64Dense(t)),
-        ("u_contact", ColumnData::F64Dense(u)),
-        ("v_contact", ColumnData::F64Dense(v)),
-        ("sigma_contact", ColumnData::F64Dense(sigma)),
-        ("energy", ColumnData::F64Dense(energy)),
-        ("energy_theta", theta),
-        ("u_contact_exact", u_exact),
-        ("sigma_contact_exact", sigma_exact),
-        ("energy_kinetic", kinetic),
-        ("energy_elastic", elastic),
-        ("energy_gravity", gravity),
-        ("u_lowest", lowest),
-    ]
-}
 
 /// Timing of a run over its repeats.
 #[derive(Debug, Clone, Copy, PartialEq)]

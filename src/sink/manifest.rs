@@ -50,7 +50,7 @@ pub enum ManifestState {
 
 impl Manifest {
     /// Inspect DIR's manifest before a session: a damaged one is moved aside to
-    /// `DIR/.damaged-manifest.json` (the session rebuilds it from its sweep file; the sessions
+    /// `DIR/damaged/manifest.json` (the session rebuilds it from its sweep file; the sessions
     /// it recorded are lost, the results are not).
     pub fn inspect(dir: &Path) -> Result<ManifestState, SinkError> {
         let path = dir.join("manifest.json");
@@ -63,7 +63,13 @@ impl Manifest {
             Ok(None) if !path.exists() => Ok(ManifestState::Missing),
             Ok(name) => Ok(ManifestState::Sweep(name)),
             Err(SinkError::Manifest { message, .. }) => {
-                let to = dir.join(".damaged-manifest.json");
+                let to = super::damaged_dir(dir, "manifest.json");
+                if let Some(parent) = to.parent() {
+                    std::fs::create_dir_all(parent).map_err(|source| SinkError::Io {
+                        path: parent.to_path_buf(),
+                        source,
+                    })?;
+                }
                 std::fs::rename(&path, &to).map_err(|source| SinkError::Io {
                     path: path.clone(),
                     source,

@@ -3,16 +3,22 @@
 //! Layout of DIR:
 //! - `runs/part-*.parquet` — rows of [`RunRecord`], one file per batch;
 //! - `series/part-*.parquet` — the time series of the same batch, same file name;
-//! - `manifest.json` — the sweep file's text, tool version, git commit, machine, sessions.
+//! - `manifest.json` — the sweep file's text, tool version, git commit, machine, sessions;
+//! - `.tmp/` — parts being written (never a complete part);
+//! - `damaged/runs/`, `damaged/series/` — parts found unreadable, moved out of the way.
 //!
-//! A batch is committed by an atomic sequence: write `series/.tmp-NAME`, fsync, rename to
-//! `series/NAME`; then the same for `runs/NAME`; then fsync the folders. The runs part is the
-//! commit record: a run counts as done iff its row is in a runs part. After a SIGKILL at any
-//! moment the folder holds only complete Parquet files plus perhaps dot-named temporaries
-//! (ignored by polars' glob and by pyarrow's dataset) and a series part whose runs part never
-//! landed; [`Sink::open`] removes both, so `--resume` loses only the runs in flight and never
-//! duplicates a row. Batches are flushed every `batch_runs` runs or `batch_seconds`, whichever
-//! comes first, so a long sweep never holds much unsaved work.
+//! `runs/` and `series/` hold complete parts only, at every moment, so every reader's glob
+//! (`runs/*.parquet`, a directory read) sees committed data only: current polars expands
+//! `*.parquet` to dot-files too, so a temporary or a damaged part must not even sit beside the
+//! parts under another dot-name. A batch is committed by an atomic sequence: write
+//! `.tmp/NAME.series`, fsync, rename to `series/NAME`; then the same for `runs/NAME`; then
+//! fsync the folders (`.tmp/` is on the same file system, so the rename is atomic). The runs
+//! part is the commit record: a run counts as done iff its row is in a runs part. After a
+//! SIGKILL at any moment the folder holds only complete Parquet files plus perhaps temporaries
+//! in `.tmp/` and a series part whose runs part never landed; [`Sink::open`] removes both, so
+//! `--resume` loses only the runs in flight and never duplicates a row. Batches are flushed
+//! every `batch_runs` runs or `batch_seconds`, whichever comes first, so a long sweep never
+//! holds much unsaved work. The parts' encoding is [`parquet`]'s.
 //!
 //! Several sessions may write into one DIR at once (the shards of a job array): each holds a
 //! shared lock on `DIR/.lock` while it writes, and the clean-up above takes the exclusive lock
@@ -20,12 +26,14 @@
 //! series part that another session is about to commit.
 //!
 //! Damage from outside (a part truncated or overwritten by hand, a disk error): a runs part that
-//! cannot be read whole, or a series part whose footer cannot be read, is moved aside with its
-//! partner to `runs/.damaged-NAME` and `series/.damaged-NAME` ([`quarantine`], called by
+//! cannot be read whole, or a series part whose footer cannot be read, is moved with its
+//! partner to `damaged/runs/NAME` and `damaged/series/NAME` ([`quarantine`], called by
 //! [`Sink::open`]); its runs are then missing and a resume computes them again, so every run is
 //! present exactly once. Renaming is safe while other shards write (their parts are complete
-//! files, never rewritten). Readers ([`read_runs`], the summaries) skip unreadable parts, with
-//! the same warning ([`Damaged::warning`]).
+//! files, never rewritten). Folders written before this layout kept temporaries and damaged
+//! parts as dot-files beside the parts (`runs/.tmp-NAME`, `runs/.damaged-NAME`): the clean-up
+//! removes the former and moves the latter to `damaged/`. Readers ([`read_runs`], the
+//! summaries) skip unreadable parts, with the same warning ([`Damaged::warning`]).
 
 use std::collections::HashSet;
 use std::fs::{self, File};
@@ -36,18 +44,14 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
 use polars::prelude::*;
-use polars_parquet::write::{
-    CompressionOptions, Encoding, FileWriter, StatisticsOptions, Version, WriteOptions, ZstdLevel,
-    get_dtype_encoding, row_group_iter, to_parquet_schema,
-};
 
 pub mod manifest;
+pub mod parquet;
 
 pub use manifest::{Manifest, ManifestState};
 
 use crate::exec::RunResult;
-use crate::run::record::{ColumnData, series_columns};
-use crate::run::{RunRecord, SeriesRow};
+use crate::run::{RunRecord, Series};
 
 /// Failures of the output folder.
 #[derive(Debug, thiserror::Error)]
@@ -59,6 +63,11 @@ pub enum SinkError {
     },
     #[error("{path}: parquet")]
     Parquet { path: PathBuf, source: PolarsError },
+    #[error("{path}: parquet")]
+    Format {
+        path: PathBuf,
+        source: ::parquet::errors::ParquetError,
+    },
     #[error(
         "{path}: holds results of sweep `{found}`, not `{expected}`; choose another --out, or pass --resume to add this sweep's runs to it"
     )]
@@ -78,80 +87,11 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> SinkError + '_ {
     }
 }
 
-/// Build a DataFrame from typed columns.
-pub fn frame(columns: Vec<(&'static str, ColumnData)>) -> PolarsResult<DataFrame> {
-    let height = match columns.first() {
-        Some((_, ColumnData::F64(v))) => v.len(),
-        Some((_, ColumnData::I64(v))) => v.len(),
-        Some((_, ColumnData::Str(v))) => v.len(),
-        Some((_, ColumnData::StrRuns(v))) => v.iter().map(|(_, n)| n).sum(),
-        Some((_, ColumnData::ListI64(v))) => v.len(),
-        Some((_, ColumnData::ListF64(v))) => v.len(),
-        Some((_, ColumnData::F64Dense(v))) => v.len(),
-        Some((_, ColumnData::I64Dense(v))) => v.len(),
-        Some((_, ColumnData::Null(n))) => *n,
-        None => 0,
-    };
-    let cols = columns
-        .into_iter()
-        .map(|(name, data)| match data {
-            ColumnData::F64(v) => Column::new(name.into(), &v),
-            ColumnData::I64(v) => Column::new(name.into(), &v),
-            ColumnData::Str(v) => Column::new(name.into(), &v),
-            // Moved, not copied: a series batch has ~10⁶ rows.
-            ColumnData::F64Dense(v) => Float64Chunked::from_vec(name.into(), v).into_column(),
-            ColumnData::I64Dense(v) => Int64Chunked::from_vec(name.into(), v).into_column(),
-            ColumnData::Null(n) => Column::full_null(name.into(), n, &DataType::Float64),
-            ColumnData::StrRuns(v) => {
-                // One chunk per run, each value stored once: a series batch has ~10⁶ rows
-                // and a handful of runs.
-                let mut out = StringChunked::full_null(name.into(), 0);
-                for (value, n) in &v {
-                    out.append(&StringChunked::full(name.into(), value, *n))
-                        .expect("same name and type");
-                }
-                out.into_column()
-            }
-            // Built with the inner type given, so a column of empty or null lists is still
-            // List(Int64)/List(Float64), not List(Null).
-            ColumnData::ListI64(v) => {
-                let values = v.iter().flatten().map(Vec::len).sum();
-                let mut b = ListPrimitiveChunkedBuilder::<Int64Type>::new(
-                    name.into(),
-                    v.len(),
-                    values,
-                    DataType::Int64,
-                );
-                for l in &v {
-                    b.append_opt_slice(l.as_deref());
-                }
-                b.finish().into_column()
-            }
-            ColumnData::ListF64(v) => {
-                let values = v.iter().flatten().map(Vec::len).sum();
-                let mut b = ListPrimitiveChunkedBuilder::<Float64Type>::new(
-                    name.into(),
-                    v.len(),
-                    values,
-                    DataType::Float64,
-                );
-                for l in &v {
-                    match l {
-                        Some(l) => b.append_iter(l.iter().copied()),
-                        None => b.append_null(),
-                    }
-                }
-                b.finish().into_column()
-            }
-        })
-        .collect();
-    DataFrame::new(height, cols)
-}
-
-/// Write a DataFrame to `dir/name` atomically (temporary dot-file, fsync, rename); returns the
-/// file's size in bytes.
-pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<u64, SinkError> {
-    write_parquet_parts_atomic(dir, name, df, None, Durability::Synced)
+/// Where a file being written atomically in place of `dst` lives until it is complete: beside
+/// it, dot-named and with a suffix no reader's glob matches (`*.parquet`, `*.csv`).
+fn temp_beside(dst: &Path) -> PathBuf {
+    let name = dst.file_name().and_then(|n| n.to_str()).unwrap_or("file");
+    dst.with_file_name(format!(".tmp-{name}.partial"))
 }
 
 /// Whether a file must survive a power cut once written. Results (runs and series parts, the
@@ -165,112 +105,74 @@ pub enum Durability {
     Derived,
 }
 
-/// [`write_parquet_atomic`] with row groups of the given lengths (None: one per 512² rows) and
-/// the given durability.
-pub fn write_parquet_parts_atomic(
-    dir: &Path,
-    name: &str,
-    df: &mut DataFrame,
-    row_groups: Option<&[usize]>,
+/// Write `bytes` produced by `encode` to `tmp`, then rename it to `dst`; returns the size.
+fn write_then_rename(
+    tmp: &Path,
+    dst: &Path,
     durability: Durability,
+    encode: impl FnOnce(&mut BufWriter<&File>) -> Result<(), SinkError>,
 ) -> Result<u64, SinkError> {
-    let tmp = dir.join(format!(".tmp-{name}"));
-    let dst = dir.join(name);
-    let file = File::create(&tmp).map_err(io(&tmp))?;
-    // zstd: the series' floats barely compress, but step, t and the closed-form columns do —
-    // 20.3 bytes per series row against 28.8 with lz4 and 59.7 uncompressed (measured on the
-    // benches/sweeps/overhead_1d.toml series with polars' encodings). Level 1, not polars'
-    // default 3: 20.45 against 20.31 bytes per row for 27 % less compression time (197 against
-    // 269 ns per row of writer CPU; the writer takes its CPU from the workers when every core
-    // runs one). Encodings per column type and row groups as the caller asks: see
-    // [`encode_parquet`]. Not parallel: the sink's writer thread is already off the workers'
-    // path, and a pool would compete with them for the cores.
-    // Buffered: polars writes a part page by page (≈ 40 000 write calls for the summary's
-    // tables and series parts of one sweep without the buffer).
+    let file = File::create(tmp).map_err(io(tmp))?;
+    // Buffered: encoders write page by page (≈ 40 000 write calls for the summary's tables
+    // and series parts of one sweep without the buffer).
     let mut buf = BufWriter::with_capacity(1 << 20, &file);
-    encode_parquet(&mut buf, df, row_groups).map_err(|source| SinkError::Parquet {
-        path: tmp.clone(),
-        source,
-    })?;
-    buf.flush().map_err(io(&tmp))?;
+    encode(&mut buf)?;
+    buf.flush().map_err(io(tmp))?;
     drop(buf);
     if durability == Durability::Synced {
-        file.sync_all().map_err(io(&tmp))?;
+        file.sync_all().map_err(io(tmp))?;
     }
-    let bytes = file.metadata().map_err(io(&tmp))?.len();
+    let bytes = file.metadata().map_err(io(tmp))?.len();
     drop(file);
-    fs::rename(&tmp, &dst).map_err(io(&dst))?;
+    fs::rename(tmp, dst).map_err(io(dst))?;
     Ok(bytes)
 }
 
-/// Encode `df` as Parquet into `out`, with row groups of the lengths given (summing to the
-/// frame's height), else of 512² rows.
-///
-/// Polars' own `ParquetWriter` asks for a dictionary on every primitive column and, for a
-/// float column, first estimates its cardinality with a HyperLogLog pass, only to fall back to
-/// plain encoding: the values of a simulation are nearly all distinct. On the series that pass
-/// was 16 % of the writer's CPU. Here each column gets its encoding from its type:
-/// - Float64: plain (zstd then finds the repeats a dictionary would: the closed-form stress is
-///   piecewise constant);
-/// - Int64: delta (`step` is 0, 1, 2, …: a few bits a page, where plain was 8 bytes before
-///   compression);
-/// - everything else (run ids, strings, lists): polars' choice, a dictionary for strings.
-///
-/// Statistics as polars writes them (min/max/null count), so readers prune row groups.
-fn encode_parquet(
-    out: &mut impl std::io::Write,
-    df: &mut DataFrame,
-    row_groups: Option<&[usize]>,
-) -> PolarsResult<()> {
-    df.rechunk_mut();
-    let schema = df.schema().to_arrow(CompatLevel::newest());
-    let encodings: Vec<Vec<Encoding>> = schema
-        .iter_values()
-        .map(|field| match field.dtype() {
-            ArrowDataType::Float64 => vec![Encoding::Plain],
-            ArrowDataType::Int64 => vec![Encoding::DeltaBinaryPacked],
-            other => get_dtype_encoding(other),
-        })
-        .collect();
-    let options = WriteOptions {
-        statistics: StatisticsOptions::default(),
-        version: Version::V1,
-        compression: CompressionOptions::Zstd(Some(zstd_level())),
-        data_page_size: None,
-    };
-    let fields = to_parquet_schema(&schema)?.fields().to_vec();
-    let mut writer = FileWriter::try_new(out, schema, options)?;
-    let whole: Vec<usize>;
-    let lengths = match row_groups {
-        Some(l) => l,
-        None => {
-            const ROWS: usize = 512 * 512;
-            whole = (0..df.height().div_ceil(ROWS))
-                .map(|k| ROWS.min(df.height() - k * ROWS))
-                .collect();
-            &whole
-        }
-    };
-    let mut offset = 0;
-    for &rows in lengths.iter().filter(|&&n| n > 0) {
-        // A slice of a single-chunk frame is one record batch, without a copy.
-        let group = df.slice(offset as i64, rows);
-        offset += rows;
-        for batch in group.iter_chunks(CompatLevel::newest(), false) {
-            let n = batch.len() as u64;
-            writer.write(
-                n,
-                row_group_iter(batch, encodings.clone().into(), fields.clone(), options),
-            )?;
-        }
-    }
-    writer.end(None)?;
-    Ok(())
+/// Write a DataFrame to `dir/name` atomically and synced (see [`write_frame_atomic`]).
+pub fn write_parquet_atomic(dir: &Path, name: &str, df: &mut DataFrame) -> Result<u64, SinkError> {
+    write_frame_atomic(dir, name, df, Durability::Synced)
 }
 
-/// The writer's zstd level (see [`write_parquet_atomic`]).
-fn zstd_level() -> ZstdLevel {
-    ZstdLevel::try_new(1).expect("1 is a valid zstd level")
+/// Write a DataFrame (a summary table) to `dir/name` atomically with polars' own writer
+/// (zstd at its default level, statistics); returns the file's size in bytes.
+pub fn write_frame_atomic(
+    dir: &Path,
+    name: &str,
+    df: &mut DataFrame,
+    durability: Durability,
+) -> Result<u64, SinkError> {
+    let dst = dir.join(name);
+    let tmp = temp_beside(&dst);
+    write_then_rename(&tmp, &dst, durability, |out| {
+        ParquetWriter::new(out)
+            .with_compression(ParquetCompression::Zstd(None))
+            .with_statistics(StatisticsOptions::default())
+            .finish(df)
+            .map(|_| ())
+            .map_err(|source| SinkError::Parquet {
+                path: tmp.clone(),
+                source,
+            })
+    })
+}
+
+/// Write a sink part: encoded into `tmp_dir/NAME.SUFFIX` (outside the parts' folder), synced,
+/// renamed to `dir/NAME`. Returns the part's size in bytes.
+fn write_part_atomic(
+    tmp_dir: &Path,
+    dir: &Path,
+    name: &str,
+    suffix: &str,
+    encode: impl FnOnce(&mut BufWriter<&File>) -> Result<(), ::parquet::errors::ParquetError>,
+) -> Result<u64, SinkError> {
+    let dst = dir.join(name);
+    let tmp = tmp_dir.join(format!("{name}.{suffix}"));
+    write_then_rename(&tmp, &dst, Durability::Synced, |out| {
+        encode(out).map_err(|source| SinkError::Format {
+            path: tmp.clone(),
+            source,
+        })
+    })
 }
 
 fn sync_dir(dir: &Path) -> Result<(), SinkError> {
@@ -302,8 +204,7 @@ pub fn write_derived(path: &Path, bytes: &[u8]) -> Result<(), SinkError> {
 
 fn write_text_atomic(path: &Path, bytes: &[u8], durability: Durability) -> Result<(), SinkError> {
     let dir = path.parent().unwrap_or(Path::new("."));
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("file");
-    let tmp = dir.join(format!(".tmp-{name}"));
+    let tmp = temp_beside(path);
     let mut f = File::create(&tmp).map_err(io(&tmp))?;
     f.write_all(bytes).map_err(io(&tmp))?;
     if durability == Durability::Synced {
@@ -347,32 +248,13 @@ impl Damaged {
 /// Why a part cannot be read, if it cannot: a runs part is read whole (it is small, and a
 /// damaged page fails only when decoded); of a series part, which may be large, the footer.
 pub fn part_problem(path: &Path, whole: bool) -> Option<String> {
-    let file = match File::open(path) {
-        Ok(f) => f,
-        Err(e) => return Some(e.to_string()),
-    };
-    let mut reader = ParquetReader::new(file);
-    let r = if whole {
-        reader.finish().map(|_| ())
-    } else {
-        reader.num_rows().map(|_| ())
-    };
-    r.err().map(|e| {
-        let text = e.to_string();
-        // polars' messages can run over several lines: the first says what failed.
-        text.lines()
-            .next()
-            .unwrap_or("unreadable")
-            .trim()
-            .to_string()
-    })
+    parquet::problem(path, whole)
 }
 
-/// The damaged-file name of a part: `.damaged-NAME` beside it (dot-named, so every glob and
-/// [`parquet_parts`] skip it).
-pub fn damaged_name(path: &Path) -> PathBuf {
-    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("part");
-    path.with_file_name(format!(".damaged-{name}"))
+/// The folder damaged parts are moved to: `DIR/damaged/runs` or `DIR/damaged/series`, out of
+/// every reader's glob.
+pub fn damaged_dir(dir: &Path, sub: &str) -> PathBuf {
+    dir.join("damaged").join(sub)
 }
 
 /// Unreadable parts of DIR, without touching them: runs parts read whole, series parts by
@@ -406,28 +288,32 @@ pub fn unreadable_parts_except(
     Ok(out)
 }
 
-/// Move every unreadable part of DIR aside, with its partner in the other folder (a batch is a
-/// runs part and a series part of one name: a batch with either damaged is computed again).
+/// Move `from` to `to` (creating `to`'s folder); a `from` already gone (another session moved
+/// it first, or a batch without that partner) is not an error.
+fn move_aside(from: &Path, to: &Path) -> Result<bool, SinkError> {
+    if let Some(parent) = to.parent() {
+        fs::create_dir_all(parent).map_err(io(parent))?;
+    }
+    match fs::rename(from, to) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+        Err(e) => Err(io(from)(e)),
+    }
+}
+
+/// Move every unreadable part of DIR to `DIR/damaged/`, with its partner in the other folder
+/// (a batch is a runs part and a series part of one name: a batch with either damaged is
+/// computed again).
 pub fn quarantine(dir: &Path) -> Result<Vec<Damaged>, SinkError> {
     let mut out = Vec::new();
     for mut d in unreadable_parts(dir)? {
         let name = d.path.file_name().expect("a part file").to_owned();
         for sub in ["runs", "series"] {
             let p = dir.join(sub).join(&name);
-            let to = damaged_name(&p);
-            match fs::rename(&p, &to) {
-                Ok(()) => {
-                    if p == d.path {
-                        d.moved_to = Some(to);
-                    }
-                }
-                // Another session moved it first, or the batch has no such partner.
-                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                    if p == d.path {
-                        d.moved_to = Some(to);
-                    }
-                }
-                Err(e) => return Err(io(&p)(e)),
+            let to = damaged_dir(dir, sub).join(&name);
+            move_aside(&p, &to)?;
+            if p == d.path {
+                d.moved_to = Some(to);
             }
         }
         if !out
@@ -440,26 +326,51 @@ pub fn quarantine(dir: &Path) -> Result<Vec<Damaged>, SinkError> {
     Ok(out)
 }
 
+/// Move the damaged parts a folder written before `damaged/` existed keeps beside its parts
+/// (`runs/.damaged-NAME`, `series/.damaged-NAME`) to `damaged/`: polars' glob reads them.
+/// Returns where each went.
+pub fn migrate_legacy_damaged(dir: &Path) -> Result<Vec<PathBuf>, SinkError> {
+    let mut moved = Vec::new();
+    for sub in ["runs", "series"] {
+        for p in legacy_damaged(&dir.join(sub))? {
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let to = damaged_dir(dir, sub).join(name.trim_start_matches(".damaged-"));
+            if move_aside(&p, &to)? {
+                moved.push(to);
+            }
+        }
+    }
+    Ok(moved)
+}
+
+/// `.damaged-*` files of a folder (the layout before `damaged/`).
+pub fn legacy_damaged(folder: &Path) -> Result<Vec<PathBuf>, SinkError> {
+    let mut out = Vec::new();
+    if !folder.exists() {
+        return Ok(out);
+    }
+    for entry in fs::read_dir(folder).map_err(io(folder))? {
+        let p = entry.map_err(io(folder))?.path();
+        if p.file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.starts_with(".damaged-"))
+        {
+            out.push(p);
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
 /// Read the run_id column of every committed runs part.
 pub fn committed_run_ids(runs_dir: &Path) -> Result<HashSet<String>, SinkError> {
     let mut ids = HashSet::new();
     for part in parquet_parts(runs_dir)? {
-        let file = File::open(&part).map_err(io(&part))?;
-        let df = ParquetReader::new(file)
-            .with_columns(Some(vec!["run_id".into()]))
-            .finish()
-            .map_err(|source| SinkError::Parquet {
-                path: part.clone(),
-                source,
-            })?;
-        let col = df
-            .column("run_id")
-            .and_then(|c| c.str().cloned())
-            .map_err(|source| SinkError::Parquet {
-                path: part.clone(),
-                source,
-            })?;
-        ids.extend(col.iter().flatten().map(String::from));
+        let col = parquet::run_ids(&part).map_err(|source| SinkError::Format {
+            path: part.clone(),
+            source,
+        })?;
+        ids.extend(col.into_iter().flatten());
     }
     Ok(ids)
 }
@@ -539,7 +450,7 @@ enum Job {
     Batch {
         name: String,
         rows: Vec<RunRecord>,
-        series: Vec<(String, Vec<SeriesRow>)>,
+        series: Vec<(String, Series)>,
     },
     /// Answered once every job sent before has been handled.
     Sync(mpsc::Sender<()>),
@@ -567,13 +478,16 @@ const QUEUED_BATCHES: usize = 1;
 pub struct Sink {
     runs_dir: PathBuf,
     rows: Vec<RunRecord>,
-    series: Vec<(String, Vec<SeriesRow>)>,
+    series: Vec<(String, Series)>,
     policy: BatchPolicy,
     last_flush: Instant,
     tag: String,
     seq: usize,
     /// Parts found unreadable when the folder was opened, now moved aside.
     pub damaged: Vec<Damaged>,
+    /// Damaged parts of the layout before `damaged/` (dot-files beside the parts), moved to
+    /// `damaged/` when the folder was opened: where each went.
+    pub legacy_damaged: Vec<PathBuf>,
     shared_with_others: bool,
     shared: Arc<Mutex<Shared>>,
     jobs: Option<mpsc::SyncSender<Job>>,
@@ -603,11 +517,14 @@ impl Sink {
             Err(fs::TryLockError::WouldBlock) => false,
             Err(fs::TryLockError::Error(e)) => return Err(io(&lock_path)(e)),
         };
+        let tmp_dir = dir.join(".tmp");
         if alone {
-            Self::clean(&runs_dir, &series_dir)?;
+            Self::clean(&tmp_dir, &runs_dir, &series_dir)?;
             lock.unlock().map_err(io(&lock_path))?;
         }
+        fs::create_dir_all(&tmp_dir).map_err(io(&tmp_dir))?;
         lock.lock_shared().map_err(io(&lock_path))?;
+        let legacy_damaged = migrate_legacy_damaged(dir)?;
         let damaged = quarantine(dir)?;
         let done = committed_run_ids(&runs_dir)?;
         let stamp = SystemTime::now()
@@ -618,9 +535,14 @@ impl Sink {
         let (jobs, rx) = mpsc::sync_channel::<Job>(QUEUED_BATCHES);
         let writer = {
             let (runs_dir, shared) = (runs_dir.clone(), Arc::clone(&shared));
+            let dirs = PartDirs {
+                tmp: tmp_dir,
+                runs: runs_dir,
+                series: series_dir,
+            };
             std::thread::Builder::new()
                 .name("parquet-writer".into())
-                .spawn(move || write_loop(&runs_dir, &series_dir, &rx, &shared))
+                .spawn(move || write_loop(&dirs, &rx, &shared))
                 .map_err(io(dir))?
         };
         Ok((
@@ -633,6 +555,7 @@ impl Sink {
                 tag: format!("{stamp}-{}", std::process::id()),
                 seq: 0,
                 damaged,
+                legacy_damaged,
                 shared_with_others: !alone,
                 shared,
                 jobs: Some(jobs),
@@ -643,9 +566,16 @@ impl Sink {
         ))
     }
 
-    /// Remove what a killed session left: temporaries and series parts whose runs part never
+    /// Remove what a killed session left: temporaries (in `.tmp/`, and the dot-named ones
+    /// of the layout before it beside the parts) and series parts whose runs part never
     /// landed. Only called under the exclusive lock.
-    fn clean(runs_dir: &Path, series_dir: &Path) -> Result<(), SinkError> {
+    fn clean(tmp_dir: &Path, runs_dir: &Path, series_dir: &Path) -> Result<(), SinkError> {
+        if tmp_dir.exists() {
+            for entry in fs::read_dir(tmp_dir).map_err(io(tmp_dir))? {
+                let p = entry.map_err(io(tmp_dir))?.path();
+                fs::remove_file(&p).map_err(io(&p))?;
+            }
+        }
         for d in [runs_dir, series_dir] {
             for entry in fs::read_dir(d).map_err(io(d))? {
                 let p = entry.map_err(io(d))?.path();
@@ -766,12 +696,7 @@ impl Drop for Sink {
 }
 
 /// The writer thread: commit batches in order until the sink hangs up.
-fn write_loop(
-    runs_dir: &Path,
-    series_dir: &Path,
-    jobs: &mpsc::Receiver<Job>,
-    shared: &Mutex<Shared>,
-) {
+fn write_loop(dirs: &PartDirs, jobs: &mpsc::Receiver<Job>, shared: &Mutex<Shared>) {
     let lock = || shared.lock().unwrap_or_else(|p| p.into_inner());
     for job in jobs.iter() {
         match job {
@@ -784,13 +709,14 @@ fn write_loop(
                 }
                 let start = Instant::now();
                 let cpu_start = thread_cpu_seconds();
-                let written = commit_batch(runs_dir, series_dir, &name, &rows, &series);
+                let series_rows: u64 = series.iter().map(|(_, s)| s.len() as u64).sum();
+                let written = commit_batch(dirs, &name, &rows, series);
                 let mut sh = lock();
                 match written {
                     Ok(series_bytes) => {
                         let st = &mut sh.stats;
                         st.written += rows.len();
-                        st.series_rows += series.iter().map(|(_, s)| s.len() as u64).sum::<u64>();
+                        st.series_rows += series_rows;
                         st.series_bytes += series_bytes;
                         st.run_seconds += rows
                             .iter()
@@ -808,36 +734,30 @@ fn write_loop(
     }
 }
 
+/// The folders a session's writer thread commits into.
+struct PartDirs {
+    /// Parts being written (`DIR/.tmp`): outside the parts' folders, same file system.
+    tmp: PathBuf,
+    runs: PathBuf,
+    series: PathBuf,
+}
+
 /// Commit one batch (series first, then the runs part that commits it); returns the bytes of
 /// the series part.
 fn commit_batch(
-    runs_dir: &Path,
-    series_dir: &Path,
+    dirs: &PartDirs,
     name: &str,
     rows: &[RunRecord],
-    series: &[(String, Vec<SeriesRow>)],
+    series: Vec<(String, Series)>,
 ) -> Result<u64, SinkError> {
-    let mut sdf = frame(series_columns(series)).map_err(|source| SinkError::Parquet {
-        path: series_dir.join(name),
-        source,
+    let series_bytes = write_part_atomic(&dirs.tmp, &dirs.series, name, "series", |out| {
+        parquet::write_series(out, series)
     })?;
-    // A row group per run: a reader of one run's series (the report,
-    // `pl.scan_parquet(...).filter(pl.col("run_id") == id)`) decodes that run's pages only.
-    let lengths: Vec<usize> = series.iter().map(|(_, s)| s.len()).collect();
-    let series_bytes = write_parquet_parts_atomic(
-        series_dir,
-        name,
-        &mut sdf,
-        Some(&lengths),
-        Durability::Synced,
-    )?;
-    let mut rdf = frame(RunRecord::to_columns(rows)).map_err(|source| SinkError::Parquet {
-        path: runs_dir.join(name),
-        source,
+    write_part_atomic(&dirs.tmp, &dirs.runs, name, "runs", |out| {
+        parquet::write_runs(out, &parquet::record_batch(RunRecord::to_columns(rows))?)
     })?;
-    write_parquet_atomic(runs_dir, name, &mut rdf)?;
-    sync_dir(series_dir)?;
-    sync_dir(runs_dir)?;
+    sync_dir(&dirs.series)?;
+    sync_dir(&dirs.runs)?;
     Ok(series_bytes)
 }
 
@@ -883,6 +803,7 @@ fn read_parts(dir: &Path) -> Result<DataFrame, SinkError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::run::SeriesRow;
 
     fn row(step: i64, theta: Option<f64>, exact: Option<f64>) -> SeriesRow {
         SeriesRow {
@@ -902,57 +823,128 @@ mod tests {
         }
     }
 
-    /// A series part written with a row group per run: the footer names each group's run
-    /// (run_id statistics min = max), so a reader of one run decodes that run only; the rows
-    /// come back bit for bit through the typed encodings (delta `step`, plain floats).
-    #[test]
-    fn series_parts_have_a_row_group_per_run_with_typed_encodings() {
-        use polars_parquet::parquet::statistics::Statistics;
-        let a: Vec<SeriesRow> = (0..5).map(|n| row(n, None, Some(n as f64))).collect();
-        let b: Vec<SeriesRow> = (0..3).map(|n| row(n, None, Some(1.0))).collect();
-        let batch = vec![("run-a".to_string(), a), ("run-b".to_string(), b)];
-        let dir = tempfile::tempdir().unwrap();
-        let mut df = frame(series_columns(&batch)).unwrap();
-        let before = df.clone();
-        write_parquet_parts_atomic(
-            dir.path(),
-            "part-0.parquet",
-            &mut df,
-            Some(&[5, 3]),
-            Durability::Synced,
-        )
-        .unwrap();
-        let mut reader = ParquetReader::new(File::open(dir.path().join("part-0.parquet")).unwrap());
-        let md = reader.get_metadata().unwrap().clone();
-        let groups: Vec<(String, usize)> = md
-            .row_groups
+    /// Write a series batch as the sink does, into `dir/series/part-0.parquet`.
+    fn write_series(dir: &Path, batch: &[(String, Vec<SeriesRow>)]) -> PathBuf {
+        let runs: Vec<(String, Series)> = batch
             .iter()
-            .map(|rg| {
-                let chunk = rg
-                    .columns_under_root_iter("run_id")
-                    .unwrap()
-                    .next()
-                    .unwrap();
-                let Statistics::Binary(st) = chunk.statistics(&md.footer_buf).unwrap().unwrap()
-                else {
-                    panic!("run_id statistics are binary")
-                };
-                assert_eq!(st.min_value, st.max_value);
-                (
-                    String::from_utf8(st.min_value.unwrap()).unwrap(),
-                    rg.num_rows(),
-                )
-            })
+            .map(|(id, rows)| (id.clone(), rows.iter().cloned().collect()))
             .collect();
-        assert_eq!(
-            groups,
-            vec![("run-a".to_string(), 5), ("run-b".to_string(), 3)]
-        );
-        let back = reader.finish().unwrap();
-        assert!(back.equals_missing(&before));
+        let (tmp, series) = (dir.join(".tmp"), dir.join("series"));
+        fs::create_dir_all(&tmp).unwrap();
+        fs::create_dir_all(&series).unwrap();
+        write_part_atomic(&tmp, &series, "part-0.parquet", "series", |out| {
+            parquet::write_series(out, runs)
+        })
+        .unwrap();
+        // Nothing is left behind where the part is being written.
+        assert_eq!(fs::read_dir(&tmp).unwrap().count(), 0);
+        series.join("part-0.parquet")
     }
 
-    /// The series columns are built in one pass (dense columns moved into the frame, the
+    /// A series part is one row group whose columns carry the encodings chosen for their
+    /// type (BYTE_STREAM_SPLIT floats, delta integers, a dictionary for run_id), with page
+    /// statistics and the page index: the pages of run_id inside a run have min = max = its
+    /// id, so a reader of one run prunes the others' pages; and a reader of two of three runs
+    /// gets exactly their rows back, bit for bit.
+    #[test]
+    fn series_parts_are_typed_and_page_indexed() {
+        use ::parquet::basic::Encoding;
+        use ::parquet::file::page_index::column_index::ColumnIndexMetaData;
+        use ::parquet::file::reader::{FileReader, SerializedFileReader};
+        // 3 runs of 2.5 pages each: pages straddle runs, as they do in a real part.
+        let n = parquet::PAGE_ROWS * 5 / 2;
+        let batch: Vec<(String, Vec<SeriesRow>)> = ["run-a", "run-b", "run-c"]
+            .iter()
+            .enumerate()
+            .map(|(k, id)| {
+                let rows = (0..n as i64)
+                    .map(|s| row(s, None, Some((s + k as i64) as f64)))
+                    .collect();
+                (id.to_string(), rows)
+            })
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let part = write_series(dir.path(), &batch);
+        let options = ::parquet::file::serialized_reader::ReadOptionsBuilder::new()
+            .with_page_index()
+            .build();
+        let reader =
+            SerializedFileReader::new_with_options(File::open(&part).unwrap(), options).unwrap();
+        let md = reader.metadata();
+        assert_eq!(md.num_row_groups(), 1);
+        let rg = md.row_group(0);
+        let encodings = |name: &str| {
+            rg.columns()
+                .iter()
+                .find(|c| c.column_path().string() == name)
+                .unwrap()
+                .encodings()
+                .collect::<Vec<_>>()
+        };
+        assert!(encodings("t").contains(&Encoding::BYTE_STREAM_SPLIT));
+        assert!(encodings("energy").contains(&Encoding::BYTE_STREAM_SPLIT));
+        assert!(encodings("step").contains(&Encoding::DELTA_BINARY_PACKED));
+        assert!(encodings("run_id").contains(&Encoding::RLE_DICTIONARY));
+        let col = rg
+            .columns()
+            .iter()
+            .position(|c| c.column_path().string() == "run_id")
+            .unwrap();
+        let index = &md.column_index().expect("page index written")[0][col];
+        let ColumnIndexMetaData::BYTE_ARRAY(pages) = index else {
+            panic!("run_id's column index is of byte arrays")
+        };
+        let offsets = &md.offset_index().expect("offset index written")[0][col];
+        let first_rows: Vec<i64> = offsets
+            .page_locations()
+            .iter()
+            .map(|p| p.first_row_index)
+            .collect();
+        // The row limit holds: the writer checks it after each mini-batch, which for a column
+        // without nulls is PAGE_ROWS rows long (arrow-rs's writer), so a page ends once it holds
+        // PAGE_ROWS rows and holds fewer than 2·PAGE_ROWS.
+        let bounds: Vec<i64> = first_rows.iter().copied().chain([3 * n as i64]).collect();
+        for w in bounds.windows(2) {
+            assert!(w[1] - w[0] < 2 * parquet::PAGE_ROWS as i64, "{bounds:?}");
+        }
+        assert!(first_rows.len() >= (3 * n).div_ceil(2 * parquet::PAGE_ROWS));
+        // The pages wholly inside run-b say so.
+        let mut pure_b = 0;
+        for (k, first) in first_rows.iter().enumerate() {
+            let (lo, hi) = (pages.min_value(k).unwrap(), pages.max_value(k).unwrap());
+            let last = first_rows.get(k + 1).map_or(3 * n as i64, |&f| f) - 1;
+            if *first >= n as i64 && last < 2 * n as i64 {
+                assert_eq!(
+                    (lo.as_ref(), hi.as_ref()),
+                    (b"run-b".as_ref(), b"run-b".as_ref())
+                );
+                pure_b += 1;
+            }
+        }
+        assert!(pure_b >= 1);
+        // Two of the three runs, through the page index.
+        let wanted: HashSet<&str> = ["run-a", "run-c"].into();
+        let ranges = parquet::run_ranges(&part, &wanted).unwrap();
+        assert_eq!(
+            ranges,
+            vec![
+                ("run-a".to_string(), 0..n),
+                ("run-c".to_string(), 2 * n..3 * n)
+            ]
+        );
+        let r: Vec<_> = ranges.iter().map(|(_, r)| r.clone()).collect();
+        let cols = parquet::read_rows_f64(&part, &r, &["t", "u_contact_exact", "nope"]).unwrap();
+        let want_t: Vec<Option<f64>> = (0..2 * n).map(|k| Some((k % n) as f64 * 0.25)).collect();
+        assert_eq!(cols[0], want_t);
+        let want_exact: Vec<Option<f64>> = (0..n)
+            .map(|s| Some(s as f64))
+            .chain((0..n).map(|s| Some((s + 2) as f64)))
+            .collect();
+        assert_eq!(cols[1], want_exact);
+        assert_eq!(cols[2], vec![None; 2 * n]);
+    }
+
+    /// The series columns are stored by column (dense columns moved into the batch, the
     /// run_id as one chunk per run, all-null columns without a vector of Nones): what comes
     /// back from the Parquet part must be the rows that went in, bit for bit, with the nulls
     /// where a run has no value.
@@ -962,9 +954,9 @@ mod tests {
         let b: Vec<SeriesRow> = (0..3).map(|n| row(n, None, None)).collect();
         let batch = vec![("run-a".to_string(), a.clone()), ("run-b".to_string(), b)];
         let dir = tempfile::tempdir().unwrap();
-        let mut df = frame(series_columns(&batch)).unwrap();
-        write_parquet_atomic(dir.path(), "part-0.parquet", &mut df).unwrap();
-        let back = ParquetReader::new(File::open(dir.path().join("part-0.parquet")).unwrap())
+        let part = write_series(dir.path(), &batch);
+        // Read back by polars, the summaries' reader.
+        let back = ParquetReader::new(File::open(part).unwrap())
             .finish()
             .unwrap();
         assert_eq!(back.height(), 8);

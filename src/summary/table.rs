@@ -222,13 +222,7 @@ pub(crate) fn write_table(dir: &Path, stem: &str, table: &Table) -> anyhow::Resu
         .map_err(anyhow::Error::new)
         .with_context(|| format!("building {stem} table"))?;
     let parquet = format!("{stem}.parquet");
-    crate::sink::write_parquet_parts_atomic(
-        dir,
-        &parquet,
-        &mut df,
-        None,
-        crate::sink::Durability::Derived,
-    )?;
+    crate::sink::write_frame_atomic(dir, &parquet, &mut df, crate::sink::Durability::Derived)?;
     // Sized up front (≈ 12 bytes a cell): growing an 8 MB impacts.csv by doubling copied it
     // and faulted in fresh pages about as often as it was written. Capacity never written is
     // never touched.
