@@ -171,7 +171,7 @@ fn non_default_bar_scales_exactly_onto_the_default() {
             ) < 1e-9
         );
         // Contact displacement time series, step by step, against the exact solution.
-        for (rs, rd) in s.series.iter().zip(&d.series) {
+        for (rs, rd) in s.series.rows().zip(d.series.rows()) {
             assert!((rs.u_contact - 2.0 * a * rd.u_contact).abs() < 1e-12);
             assert!(
                 (rs.u_contact_exact.unwrap() - 2.0 * a * rd.u_contact_exact.unwrap()).abs() < 1e-14
@@ -197,7 +197,7 @@ fn non_default_bar_scales_exactly_onto_the_default() {
             1,
         ));
         o.series
-            .iter()
+            .rows()
             .map(|r| (r.u_contact - r.u_contact_exact.unwrap()).abs())
             .fold(0.0, f64::max)
             / p.amplitude

@@ -537,7 +537,7 @@ method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nits
         let scale = o.metrics.energy_scale.unwrap();
         assert_eq!(o.series.len(), 100);
         let (mut worst_e, mut worst_u) = (0.0f64, 0.0f64);
-        for r in &o.series {
+        for r in o.series.rows() {
             let (k, el, gr) = (
                 r.energy_kinetic.unwrap(),
                 r.energy_elastic.unwrap(),
@@ -592,13 +592,13 @@ method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nits
         let p = o.metrics.max_penetration.unwrap();
         let lowest_min = o
             .series
-            .iter()
+            .rows()
             .map(|r| r.u_lowest.unwrap())
             .fold(f64::INFINITY, f64::min);
         println!(
             "{label}: max penetration {p:.3e} (gap {GAP}), lowest point down to {lowest_min:.4}"
         );
-        for r in &o.series {
+        for r in o.series.rows() {
             let sum =
                 r.energy_kinetic.unwrap() + r.energy_elastic.unwrap() + r.energy_gravity.unwrap();
             // Mixed: E^h is this sum; Nitsche's E^h has no contact term.

@@ -41,7 +41,7 @@ fn massless_contact_variants_start_quasi_static_and_conserve_energy_with_cn() {
         let e0 = o.metrics.energy_initial.unwrap();
         // closed form of the discrete initial energy: round-off only.
         assert!((e0 - (1.0 - h) / 8.0).abs() < 1e-14, "{mass:?}: E0 = {e0}");
-        assert!((o.series[0].u_contact - (0.5 - h / 2.0)).abs() < 1e-15);
+        assert!((o.series.row(0).u_contact - (0.5 - h / 2.0)).abs() < 1e-15);
         // Well-posed semi-discretisation + CN: no energy blow-up; the measured drifts are
         // −0.4 … −0.9 %, so 1.5 % bounds them all while catching the ill-posed +100 % growth.
         let r = energy_ratio(&o);
@@ -66,7 +66,7 @@ fn penalty_penetration_scales_with_the_inverse_stiffness() {
             Scheme::Hybrid,
             1,
         ));
-        o.series.iter().map(|r| -r.u_contact).fold(0.0, f64::max)
+        o.series.rows().map(|r| -r.u_contact).fold(0.0, f64::max)
     };
     let (a, b, c) = (penetration(10.0), penetration(100.0), penetration(1000.0));
     for (p, g) in [(a, 10.0), (b, 100.0), (c, 1000.0)] {
@@ -160,15 +160,15 @@ fn interpolant_start_costs_energy_once_where_the_node_row_holds_at_the_new_time(
             1,
         ));
         // u₀(0) = a and E⁰ = 1/8, the exact energy (round-off only).
-        assert_eq!(o.series[0].u_contact, 0.5);
+        assert_eq!(o.series.row(0).u_contact, 0.5);
         assert!((o.metrics.energy_initial.unwrap() - 0.125).abs() < 1e-14);
         // σ_C⁰ is the multiplier of a node not in contact (u₀ = a > 0): zero, as the exact
         // contact stress — not the contact element's stress −aE of the non-equilibrium start.
-        assert_eq!(o.series[0].sigma_contact, 0.0);
+        assert_eq!(o.series.row(0).sigma_contact, 0.0);
         // The first step loses at least the contact element's excess strain energy h/8
         // (u₀ drops from a to about u₁); contact-free CN then conserves E^h to round-off
         // (linear system, ~1e-15 per step over 60 steps).
-        let e = |n: usize| o.series[n].energy;
+        let e = |n: usize| o.series.row(n).energy;
         assert!(e(0) - e(1) > h / 8.0, "{mass:?}: E0 − E1 = {}", e(0) - e(1));
         for n in 2..BEFORE_CONTACT {
             assert!((e(n) - e(1)).abs() < 1e-13, "{mass:?}: step {n}");
@@ -201,10 +201,10 @@ fn interpolant_start_persists_where_the_node_row_holds_at_the_midpoint() {
     let ah = 0.5 * 0.01;
     for n in 0..BEFORE_CONTACT {
         let sign = if n % 2 == 0 { 1.0 } else { -1.0 };
-        let d = i.series[n].u_contact - c.series[n].u_contact;
+        let d = i.series.row(n).u_contact - c.series.row(n).u_contact;
         assert!((d - sign * ah).abs() < 1e-12, "step {n}: δ = {d}");
         // The excess energy stays (no loss at the first step, unlike CN).
-        assert!((i.series[n].energy - 0.125).abs() < 1e-13, "step {n}");
+        assert!((i.series.row(n).energy - 0.125).abs() < 1e-13, "step {n}");
     }
     // Still energy-stable (003 Cor 3.8): E_Θ never increases beyond round-off.
     assert!(i.metrics.energy_theta_max_increase.unwrap() < 1e-12);

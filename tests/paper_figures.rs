@@ -134,10 +134,10 @@ fn gamma0_one_symmetric_is_unphysical_but_augmented_energy_holds() {
             "{scheme:?}: peak E/E0 = {peak}"
         );
         // …while E_Θ stays within 1 %.
-        let et0 = o.series[0].energy_theta.unwrap();
+        let et0 = o.series.row(0).energy_theta.unwrap();
         let dev = o
             .series
-            .iter()
+            .rows()
             .map(|r| (r.energy_theta.unwrap() - et0).abs() / et0)
             .fold(0.0, f64::max);
         assert!(dev < 0.01, "{scheme:?}: E_Θ deviates by {dev}");

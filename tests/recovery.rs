@@ -52,6 +52,19 @@ fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// runs/ and series/ hold nothing but committed `*.parquet` parts (no dot-file of any kind).
+fn assert_only_parts(out: &Path) {
+    for sub in ["runs", "series"] {
+        for e in std::fs::read_dir(out.join(sub)).unwrap() {
+            let name = e.unwrap().file_name().into_string().unwrap();
+            assert!(
+                !name.starts_with('.') && name.ends_with(".parquet"),
+                "{sub}/{name} is not a committed part"
+            );
+        }
+    }
+}
+
 fn folder_with_parts() -> (tempfile::TempDir, PathBuf, Vec<PathBuf>) {
     let tmp = tempfile::tempdir().unwrap();
     write(tmp.path(), "s.toml", SWEEP);
@@ -92,8 +105,11 @@ fn a_truncated_runs_part_is_moved_aside_and_its_runs_computed_again() {
         "{err}"
     );
     assert!(err.contains("20 of 24 runs already done"), "{err}");
-    assert!(out.join("runs").join(format!(".damaged-{name}")).exists());
-    assert!(out.join("series").join(format!(".damaged-{name}")).exists());
+    // Out of the parts' folders: every reader's glob of runs/ and series/ sees complete parts
+    // only (current polars expands `*.parquet` to dot-files too).
+    assert!(out.join("damaged/runs").join(&name).exists());
+    assert!(out.join("damaged/series").join(&name).exists());
+    assert_only_parts(&out);
     assert_complete(&out, 24);
 
     // A second resume finds nothing damaged and nothing to do.
@@ -126,7 +142,7 @@ fn a_corrupt_or_missing_manifest_is_rebuilt_with_a_warning() {
         err.contains("manifest.json is damaged") && err.contains("rebuilt from s.toml"),
         "{err}"
     );
-    assert!(out.join(".damaged-manifest.json").exists());
+    assert!(out.join("damaged/manifest.json").exists());
     let m: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(m["sweep"], "rec");
@@ -227,4 +243,36 @@ fn status_counts_done_failed_and_missing_per_shard_and_prints_what_completes_it(
     assert!(stderr(&o).contains("--sweep FILE"), "{}", stderr(&o));
     let o = cli(tmp.path(), &["status", "o", "--sweep", "s.toml"]);
     assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Regression (issue 23): current polars expands `runs/*.parquet` to dot-files, so the
+/// temporaries (`runs/.tmp-NAME`) and damaged parts (`runs/.damaged-NAME`) that older versions
+/// kept beside the parts broke every polars read of the folder. A folder of that layout is
+/// mended by the next `run`: temporaries removed, damaged parts moved to `damaged/` — and its
+/// runs stay done, each once.
+#[test]
+fn regression_dot_files_beside_the_parts_leave_on_the_next_run() {
+    let (tmp, out, parts) = folder_with_parts();
+    let name = parts[1].file_name().unwrap().to_str().unwrap().to_string();
+    // The old layout: a damaged pair moved aside as dot-files, and a temporary of a killed write.
+    for sub in ["runs", "series"] {
+        std::fs::rename(
+            out.join(sub).join(&name),
+            out.join(sub).join(format!(".damaged-{name}")),
+        )
+        .unwrap();
+    }
+    std::fs::write(out.join("runs/.tmp-part-x.parquet"), b"partial").unwrap();
+    let o = run(tmp.path(), &[]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("20 of 24 runs already done"), "{err}");
+    assert_only_parts(&out);
+    assert!(out.join("damaged/runs").join(&name).exists());
+    assert!(out.join("damaged/series").join(&name).exists());
+    assert_complete(&out, 24);
+    // status lists the moved pair among the files moved aside.
+    let o = cli(tmp.path(), &["status", "o"]);
+    let text = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(text.contains(&format!("damaged/runs/{name}")), "{text}");
 }
