@@ -914,10 +914,7 @@ mod tests {
             let (lo, hi) = (pages.min_value(k).unwrap(), pages.max_value(k).unwrap());
             let last = first_rows.get(k + 1).map_or(3 * n as i64, |&f| f) - 1;
             if *first >= n as i64 && last < 2 * n as i64 {
-                assert_eq!(
-                    (lo.as_ref(), hi.as_ref()),
-                    (b"run-b".as_ref(), b"run-b".as_ref())
-                );
+                assert_eq!((lo, hi), (b"run-b".as_ref(), b"run-b".as_ref()));
                 pure_b += 1;
             }
         }
