@@ -10,7 +10,13 @@ use contact_sweep::space::ContactMethod;
 use contact_sweep::time::{NewmarkParams, PaoliSchatzmanParams, Scheme};
 use std::f64::consts::PI;
 
-fn run(p: OscillatorParams, dt: f64, t_final: f64, method: ContactMethod, scheme: Scheme) -> Outcome {
+fn run(
+    p: OscillatorParams,
+    dt: f64,
+    t_final: f64,
+    method: ContactMethod,
+    scheme: Scheme,
+) -> Outcome {
     let o = simulate(
         &RunConfig::Oscillator(OscillatorConfig::new(p, dt, t_final, method, scheme)),
         &RunOptions {
@@ -79,7 +85,11 @@ fn zeno_accumulation_and_rest() {
     };
     let ex = p.exact(10.0);
     let t1 = (3.0 / (2.0 * 5f64.sqrt())).acos() - 0.5f64.atan();
-    assert!((ex.impacts()[0] - t1).abs() < 1e-14, "{} vs {t1}", ex.impacts()[0]);
+    assert!(
+        (ex.impacts()[0] - t1).abs() < 1e-14,
+        "{} vs {t1}",
+        ex.impacts()[0]
+    );
     let u1 = 2.75f64.sqrt();
     let mut t_rest = t1;
     let mut k = 0;

@@ -145,16 +145,14 @@ impl RunConfig {
                 perturbation: None,
             }),
             // The oscillator's one dof is its mass: no mass variant to keep.
-            SceneSetup::Oscillator(params) => {
-                RunConfig::Oscillator(oscillator::OscillatorConfig {
-                    params,
-                    method,
-                    scheme,
-                    dt,
-                    steps,
-                    perturbation: None,
-                })
-            }
+            SceneSetup::Oscillator(params) => RunConfig::Oscillator(oscillator::OscillatorConfig {
+                params,
+                method,
+                scheme,
+                dt,
+                steps,
+                perturbation: None,
+            }),
         }
     }
 

@@ -199,7 +199,12 @@ impl Osc {
 
     /// Solve A y = b, then the scalar contact problem with the argument's offset p0: returns
     /// (x, s, φ) with x = y + φ z.
-    fn solve(&self, b: f64, law: &ContactLaw, p0: f64) -> Result<(f64, f64, f64), ContactSolveError> {
+    fn solve(
+        &self,
+        b: f64,
+        law: &ContactLaw,
+        p0: f64,
+    ) -> Result<(f64, f64, f64), ContactSolveError> {
         let y = b / self.k.a;
         let sol = contact::solve(law, self.px * y + p0, self.w)?;
         Ok((y + sol.phi * self.z, sol.s, sol.phi))

@@ -217,11 +217,7 @@ impl OscillatorExact {
             rest: false,
         };
         let radius0 = ((p.x0 - xe).powi(2) + (p.v0 / w).powi(2)).sqrt();
-        let v_scale = if p.v0 != 0.0 {
-            p.v0.abs()
-        } else {
-            w * radius0
-        };
+        let v_scale = if p.v0 != 0.0 { p.v0.abs() } else { w * radius0 };
         let slow = 1e-14 * v_scale;
         // Net force on the mass resting at the obstacle: f − k(−g).
         let pushes_in = p.force + p.stiffness * g < 0.0;

@@ -142,9 +142,10 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::NewmarkGamma => Value::Num(0.5),
         Key::Restitution => Value::Num(1.0),
         Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
-        k if k.is_physics() => {
-            physics_value(k, scene.physics().iter().find(|p| p.name == k.name())?.default)
-        }
+        k if k.is_physics() => physics_value(
+            k,
+            scene.physics().iter().find(|p| p.name == k.name())?.default,
+        ),
         _ => return None,
     })
 }
