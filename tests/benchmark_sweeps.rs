@@ -2,6 +2,8 @@
 //! defaults leave every run id as it was, the word-valued `right_end` is validated and stored
 //! as a word, the oscillator needs no mesh, and the three benchmark sweep files plan.
 
+mod common;
+
 use std::path::Path;
 
 use contact_sweep::sweep::{self, Key, Plan, SweepFile, Value};
@@ -121,4 +123,33 @@ fn benchmark_sweep_files_plan() {
     assert_eq!(load("siconos_impacting_bar.toml").runs.len(), 12);
     // 7 steps × 3 laws × 8 methods.
     assert_eq!(load("oscillator.toml").runs.len(), 7 * 3 * 8);
+}
+
+/// The summary's convergence tables are per scheme and per exact law: runs with another
+/// `impact_law` are another group (the oscillator's rates in τ, issue 21).
+#[test]
+fn summary_groups_the_oscillator_per_impact_law() {
+    let dir = tempfile::tempdir().unwrap();
+    let sweep = common::write(
+        dir.path(),
+        "osc.toml",
+        "name = \"osc\"\nscene = \"oscillator\"\nseries_every = 0\n[fixed]\nT = 10.0\nscheme = \"paoli-schatzman\"\nrestitution = 1.0\n[grid]\nimpact_law = [1.0, 0.5]\ncourant = [0.02, 0.01, 0.005]\n",
+    );
+    let out = dir.path().join("out");
+    let o = common::cli(
+        dir.path(),
+        &[
+            "run",
+            sweep.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(out.join("summary/convergence.md")).unwrap();
+    assert_eq!(md.matches("\n## group").count(), 2, "{md}");
+    assert!(
+        md.contains("impact_law=1,") && md.contains("impact_law=0.5,"),
+        "{md}"
+    );
 }

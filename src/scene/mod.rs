@@ -8,8 +8,9 @@
 //! is new, a mesh in `space/fe`), never a change to `sweep/`, `exec/`, `sink/` or `summary/`.
 //!
 //! What a scene hands to the engines is a [`SceneSetup`]: the 1D bar's parameters and element
-//! count, or a finite-element description ([`FeSetup`]: geometry, material, load, initial velocity,
-//! gap) which `space::fe` meshes and `run::fe` integrates, whatever the scene.
+//! count, the oscillator's parameters, or a finite-element description ([`FeSetup`]:
+//! geometry, material, load, initial velocity, gap) which `space::fe` meshes and `run::fe`
+//! integrates, whatever the scene.
 
 pub mod ball;
 pub mod bar;
@@ -46,7 +47,7 @@ impl Physics {
 /// How a run's errors are measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorSource {
-    /// A closed-form solution (bar1d with zero gap).
+    /// A closed-form solution (bar1d: clamped with zero gap, or the flying bar; the oscillator).
     Exact,
     /// A reference run of the same scene on a finer nested mesh and step (SPEC §1.2).
     ReferenceRun,
@@ -112,7 +113,7 @@ pub trait Scene: Send + Sync {
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
 }
 
-/// The scenes the engine can run (the registry; SPEC §1 names five).
+/// The scenes the engine can run (the registry; SPEC §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SceneKind {
     /// The 1D impacting bar with its closed form (SPEC §1.1).
