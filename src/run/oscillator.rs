@@ -255,7 +255,9 @@ impl Osc {
                 st.s_prev = s;
                 (phi, st.x + dx)
             }
-            Scheme::PaoliSchatzman(_) => unreachable!("two-step scheme"),
+            // Paoli–Schatzman is two-step (its loop is in `simulate`); a family the scene does
+            // not list in `supports` never reaches the engine.
+            _ => unreachable!("not a one-step scheme of the oscillator"),
         };
         st.x = x_new;
         Ok((phi, phi != 0.0))
