@@ -3,8 +3,10 @@
 //! The modules form a pipeline and depend on each other in this order only:
 //!
 //! - [`scene`] — the physical problems behind one trait ([`scene::Scene`]): the 1D bar with its
-//!   closed form, the 2D/3D bars dropped on an obstacle; each declares its keys, defaults,
-//!   applicability and error source, and hands the engines a setup.
+//!   closed forms (clamped, and the flying bar with a free end), the 2D/3D bars dropped on an
+//!   obstacle, the disc and the ball, the impact oscillator with its exact solution event by
+//!   event; each declares its keys, defaults, applicability and error source, and hands the
+//!   engines a setup.
 //! - [`space`] — meshes, mass variants, stiffness, and how each contact method enters the
 //!   semi-discrete system; `space::fe` (Q1 elements, sparse assembly with the pattern built
 //!   once) and `space::linalg` (faer's sparse Cholesky: symbolic once, numeric per matrix).
@@ -13,8 +15,9 @@
 //!   solved exactly by branch enumeration (1D); a small dense LCP on the contact dofs solved
 //!   exactly by an active-set method (2D/3D).
 //! - [`run`] — one run: setup (factorisations once, shared between runs with the same matrix),
-//!   the allocation-free time loop of the tridiagonal and the sparse engine, observables
-//!   (energies, error norms against the closed form or a reference run), and the output schema
+//!   the allocation-free time loop of the tridiagonal, the sparse and the one-dof engine,
+//!   observables (energies, error norms against the closed form or a reference run), and the
+//!   output schema
 //!   ([`run::RunRecord`]).
 //! - [`sweep`] — sweep files: parsing with line numbers, validation, expansion, run ids.
 //! - [`exec`] — serial (reference) and rayon execution; failures become rows; reference runs

@@ -217,3 +217,28 @@ method = [
         1,
     );
 }
+
+/// The oscillator (SPEC §1.5): every scheme family it runs, with both contact treatments —
+/// the exact solution is built at setup and the contact starts go to a buffer sized there.
+#[test]
+fn oscillator_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-osc"
+scene = "oscillator"
+[fixed]
+T = T_FINAL
+courant = 0.02
+impact_law = 0.5
+[grid]
+method = [
+  { space = "mixed", scheme = "crank-nicolson" },
+  { space = "mixed", scheme = "backward-euler" },
+  { space = "mixed", scheme = "paoli-schatzman", restitution = 0.5 },
+  { space = "penalty", penalty_gamma0 = 100.0, scheme = "crank-nicolson" },
+  { space = "penalty", penalty_gamma0 = 100.0, scheme = "hybrid" },
+]
+"#,
+        5.0,
+    );
+}

@@ -52,6 +52,7 @@ fn exact_solution_conserves_energy_and_satisfies_the_wave_equation() {
         density: 0.25,
         amplitude: 0.3,
         gap: 0.0,
+        ..BarParams::default()
     };
     let ex = p.exact().unwrap();
     // ½∫ρu_t² + E u_x² by the midpoint rule on 2e5 cells: the integrand is piecewise constant,
@@ -120,6 +121,7 @@ fn non_default_bar_scales_exactly_onto_the_default() {
         density: 4.0,
         amplitude: 0.2,
         gap: 0.0,
+        ..BarParams::default()
     };
     let c0 = p.wave_speed();
     let mut rates = Vec::new();

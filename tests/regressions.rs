@@ -19,6 +19,7 @@ fn exact_stress_at_an_impact_instant_does_not_depend_on_rounding() {
         density: 4.0,
         amplitude: 0.2,
         gap: 0.0,
+        ..BarParams::default()
     };
     let ex = p.exact().unwrap();
     let tau = (p.length / p.wave_speed()) / 20.0;

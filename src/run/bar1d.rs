@@ -406,7 +406,8 @@ impl Engine {
     }
 }
 
-/// Build the initial state: interpolated u⁰ (perturbed for ensembles), v⁰ = 0, a massless
+/// Build the initial state: interpolated u⁰ (perturbed for ensembles), v⁰ the bar's uniform
+/// initial velocity (0 but for the flying bar, SPEC §1.4), a massless
 /// node at its quasi-static value (or left at the interpolant, `contact_init = interpolant`),
 /// a⁰ from the equation at t = 0 on the free nodes. Returns the state and σ_C⁰.
 fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), ContactSolveError> {
@@ -449,7 +450,9 @@ fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), Contac
     Ok((
         State {
             u,
-            v: vec![0.0; m],
+            v: (0..m)
+                .map(|i| sp.bar.initial_velocity(i as f64 * sp.h))
+                .collect(),
             a,
             s_prev,
         },
@@ -467,6 +470,8 @@ struct Recorder<'a> {
     exact: Option<BarExact>,
     tau: f64,
     obs: Observer,
+    /// The mean velocity of the last observed state (free end: the flying bar's exit speed).
+    exit_velocity: Option<f64>,
 }
 
 impl Recorder<'_> {
@@ -483,6 +488,9 @@ impl Recorder<'_> {
             _ => None,
         };
         let t = step as f64 * self.tau;
+        if self.sp.bar.free_end {
+            self.exit_velocity = Some(self.sp.mean_velocity(v));
+        }
         let (energy, energy_theta) = self.sp.energies(u, v);
         let exact = self.exact.map(|ex| {
             let (l2_sq, h1_semi_sq) = ex.error_sq(u, self.sp.h, t);
@@ -582,6 +590,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         exact: cfg.bar.exact(),
         tau,
         obs: Observer::new(tau, opts.series_every, cfg.steps),
+        exit_velocity: None,
     };
     let (mut st, sigma0) = match initial_state(&eng, cfg) {
         Ok(x) => x,
@@ -679,6 +688,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     rec.obs.finish(&mut metrics, status == Status::Ok);
+    metrics.exit_velocity = rec.exit_velocity;
     Outcome {
         status,
         message,

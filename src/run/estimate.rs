@@ -54,6 +54,7 @@ impl RunConfig {
         match self {
             RunConfig::Bar1d(c) => c.steps,
             RunConfig::Fe(c) => c.steps,
+            RunConfig::Oscillator(c) => c.steps,
         }
     }
 
@@ -76,6 +77,8 @@ impl RunConfig {
                 };
                 (m, m * BAR1D_BYTES_PER_ELEMENT * engines)
             }
+            // One dof: a few scalars and the exact solution's events (one per impact).
+            RunConfig::Oscillator(_) => (1.0, 4096.0),
             RunConfig::Fe(c) => {
                 // (unknowns, dimension, matrix entries per row, contact columns of Z), in f64.
                 let (n, d, per_row, contact) = match &c.setup.geometry {

@@ -12,6 +12,7 @@ pub mod fe;
 mod fe_nitsche;
 pub mod impacts;
 pub mod observe;
+pub mod oscillator;
 pub mod record;
 pub mod reference;
 
@@ -109,6 +110,7 @@ impl RunOptions {
 pub enum RunConfig {
     Bar1d(bar1d::Bar1dConfig),
     Fe(fe::FeConfig),
+    Oscillator(oscillator::OscillatorConfig),
 }
 
 impl RunConfig {
@@ -142,6 +144,15 @@ impl RunConfig {
                 steps,
                 perturbation: None,
             }),
+            // The oscillator's one dof is its mass: no mass variant to keep.
+            SceneSetup::Oscillator(params) => RunConfig::Oscillator(oscillator::OscillatorConfig {
+                params,
+                method,
+                scheme,
+                dt,
+                steps,
+                perturbation: None,
+            }),
         }
     }
 
@@ -160,6 +171,7 @@ impl RunConfig {
         match self {
             RunConfig::Bar1d(c) => c.perturbation = p,
             RunConfig::Fe(c) => c.perturbation = p,
+            RunConfig::Oscillator(c) => c.perturbation = p,
         }
     }
 
@@ -170,6 +182,7 @@ impl RunConfig {
         match self {
             RunConfig::Bar1d(c) => c.explicit_dt_limit(),
             RunConfig::Fe(c) => c.explicit_dt_limit(),
+            RunConfig::Oscillator(c) => c.explicit_dt_limit(),
         }
     }
 
@@ -178,6 +191,7 @@ impl RunConfig {
         let (steps, unknowns) = match self {
             RunConfig::Bar1d(c) => (c.steps, c.elements),
             RunConfig::Fe(c) => (c.steps, c.unknowns()),
+            RunConfig::Oscillator(c) => (c.steps, 1),
         };
         (steps as u64).saturating_mul(unknowns as u64)
     }
@@ -254,5 +268,6 @@ pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext)
     match config {
         RunConfig::Bar1d(c) => bar1d::simulate(c, options),
         RunConfig::Fe(c) => fe::simulate(c, options, ctx),
+        RunConfig::Oscillator(c) => oscillator::simulate(c, options),
     }
 }

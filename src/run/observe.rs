@@ -72,6 +72,13 @@ pub struct Metrics {
     /// max over the observed steps of the step's penetration (u_n − g)_+ (SPEC §1.3), where
     /// the engine reports one ([`StepValues::penetration`]).
     pub max_penetration: Option<f64>,
+    /// l2(τ) error of the velocity (oscillator, SPEC §1.5).
+    pub err_v_l2: Option<f64>,
+    /// Largest distance from an exact impact time to the nearest discrete contact start
+    /// (oscillator, SPEC §1.5).
+    pub err_impact_time: Option<f64>,
+    /// The bar's mean velocity 1ᵀMv/1ᵀM1 at the last step (bar1d with a free end).
+    pub exit_velocity: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -234,6 +241,11 @@ impl Series {
             energy_gravity: opt(5),
             u_lowest: opt(6),
         }
+    }
+
+    /// The last row, if any.
+    pub fn last(&self) -> Option<SeriesRow> {
+        self.len().checked_sub(1).map(|k| self.row(k))
     }
 
     /// The rows in order.

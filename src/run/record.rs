@@ -199,6 +199,15 @@ schema! {
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
+        right_end: Option<String> => "", "bar1d's end x = L: clamped (SPEC §1.1) or free (the flying bar, SPEC §1.4)";
+        velocity: Option<f64> => "m/s", "uniform initial velocity v0 (bar1d, oscillator; negative towards the obstacle)";
+        point_mass: Option<f64> => "kg", "oscillator mass m (SPEC §1.5)";
+        stiffness: Option<f64> => "N/m", "oscillator spring stiffness k";
+        force: Option<f64> => "N", "oscillator constant force f (negative towards the obstacle)";
+        impact_law: Option<f64> => "", "oscillator: Newton's restitution e_x of the exact solution the run is measured against";
+        err_v_l2: Option<f64> => "m·s^-½", "oscillator: (τ Σ_n |v^n − v(t^n)|²)^½ (velocities jump at impacts: the l2(τ) norm is the meaningful one)";
+        err_impact_time: Option<f64> => "s", "oscillator: max over the exact impacts in [0, T] of the distance to the nearest discrete contact start";
+        exit_velocity: Option<f64> => "m/s", "bar1d with a free end: the bar's mean velocity 1ᵀMv/1ᵀM1 at T (the flying bar leaves with −v0)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -391,6 +400,15 @@ impl RunRecord {
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
             max_penetration: m.max_penetration,
+            right_end: p.get(&Key::RightEnd).map(|v| v.to_string()),
+            velocity: f(Key::Velocity),
+            point_mass: f(Key::PointMass),
+            stiffness: f(Key::Stiffness),
+            force: f(Key::Force),
+            impact_law: f(Key::ImpactLaw),
+            err_v_l2: m.err_v_l2,
+            err_impact_time: m.err_impact_time,
+            exit_velocity: m.exit_velocity,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

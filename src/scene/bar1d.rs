@@ -8,6 +8,17 @@
 //! affine in (ξ, s); its kinks at a given time lie at ξ = f and ξ = 1 − f (f = s mod 1). Error
 //! norms are therefore integrated *exactly*: every element is split at those kinks and the
 //! difference between the P1 field and the exact field is affine on each piece.
+//!
+//! With `right_end = "free"`, no initial strain and a uniform velocity −V towards the obstacle
+//! (SPEC §1.4, the flying bar of Doyen–Ern–Piperno 2011 and Siconos' ImpactingBar) the solution
+//! is d'Alembert's: with c = √(E/ρ), t_c = g/V and s = t − t_c,
+//! u(x, t) = −g − V·min(x/c, s, 2L/c − s) for every t (before the impact the minimum is s, the
+//! rigid flight −Vt; after it 2L/c − s, the rigid rebound). The compression front x = c s
+//! leaves the wall at s = 0 and reaches the free end at s = L/c; the unloading front
+//! x = 2L − c s returns and reaches the wall at s = 2L/c, when the bar leaves with +V. The
+//! kinks at a time are those two fronts: error norms are integrated exactly by splitting the
+//! elements there, exactly as for the clamped bar. Every tolerance is relative to the bar's own
+//! scales (L, L/c, V), never to a unit bar.
 
 use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 
@@ -15,7 +26,7 @@ use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 #[derive(Debug, Clone, Copy)]
 pub struct Bar1dScene;
 
-const BAR1D_PHYSICS: [PhysicsKey; 5] = [
+const BAR1D_PHYSICS: [PhysicsKey; 7] = [
     PhysicsKey {
         name: "length",
         default: 1.0,
@@ -36,6 +47,15 @@ const BAR1D_PHYSICS: [PhysicsKey; 5] = [
         name: "gap",
         default: 0.0,
     },
+    // A choice key: the index into `Key::RightEnd.choices()`, 0 = clamped (SPEC §1.1's bar).
+    PhysicsKey {
+        name: "right_end",
+        default: 0.0,
+    },
+    PhysicsKey {
+        name: "velocity",
+        default: 0.0,
+    },
 ];
 
 impl Bar1dScene {
@@ -46,6 +66,8 @@ impl Bar1dScene {
             density: physics.get("density"),
             amplitude: physics.get("amplitude"),
             gap: physics.get("gap"),
+            free_end: physics.get("right_end") == 1.0,
+            velocity: physics.get("velocity"),
         }
     }
 }
@@ -106,7 +128,8 @@ impl Scene for Bar1dScene {
     }
 }
 
-/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0).
+/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0, clamped
+/// at x = L, at rest).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BarParams {
     pub length: f64,
@@ -114,6 +137,10 @@ pub struct BarParams {
     pub density: f64,
     pub amplitude: f64,
     pub gap: f64,
+    /// The end x = L is traction-free (SPEC §1.4) instead of clamped.
+    pub free_end: bool,
+    /// Uniform initial velocity v0 (negative towards the obstacle).
+    pub velocity: f64,
 }
 
 impl Default for BarParams {
@@ -124,6 +151,8 @@ impl Default for BarParams {
             density: 1.0,
             amplitude: 0.5,
             gap: 0.0,
+            free_end: false,
+            velocity: 0.0,
         }
     }
 }
@@ -139,9 +168,18 @@ impl BarParams {
         self.amplitude * (1.0 - x / self.length)
     }
 
-    /// The closed form exists for a zero gap only.
+    /// Initial velocity v0(x): uniform.
+    pub fn initial_velocity(&self, _x: f64) -> f64 {
+        self.velocity
+    }
+
+    /// The closed form: the clamped bar released at rest with a zero gap (SPEC §1.1), or the
+    /// flying bar — free end, no initial strain, moving towards the obstacle (SPEC §1.4).
+    /// Other combinations have none.
     pub fn exact(&self) -> Option<BarExact> {
-        (self.gap == 0.0).then_some(BarExact { p: *self })
+        let clamped = !self.free_end && self.gap == 0.0 && self.velocity == 0.0;
+        let flying = self.free_end && self.amplitude == 0.0 && self.velocity < 0.0;
+        (clamped || flying).then_some(BarExact { p: *self })
     }
 }
 
@@ -211,23 +249,89 @@ impl BarExact {
         reference(x / self.p.length, self.scaled_time(t))
     }
 
-    /// Period of the motion, 3L/c0.
+    /// Whether this is the flying bar (SPEC §1.4) rather than the clamped one.
+    pub fn is_flying(&self) -> bool {
+        self.p.free_end
+    }
+
+    /// The flying bar's s = t − t_c, snapped onto 0 and 2L/c (the contact's ends) within
+    /// 1e-12 of the time scale max(t, L/c): a step meant to land on an end must not fall on
+    /// either side of the pressure jump by round-off.
+    fn flight_time(&self, t: f64) -> f64 {
+        let c = self.p.wave_speed();
+        let v = -self.p.velocity;
+        let s = t - self.p.gap / v;
+        let tol = 1e-12 * t.abs().max(self.p.length / c);
+        let end = 2.0 * self.p.length / c;
+        if s.abs() <= tol {
+            0.0
+        } else if (s - end).abs() <= tol {
+            end
+        } else {
+            s
+        }
+    }
+
+    /// Flying bar: (u, u_x, u_t) at x for the flight time s, from
+    /// u = −g − V·min(x/c, s, 2L/c − s).
+    fn flying(&self, x: f64, s: f64) -> RefValue {
+        let c = self.p.wave_speed();
+        let v = -self.p.velocity;
+        let back = 2.0 * self.p.length / c - s;
+        let xc = x / c;
+        let rv = |psi: f64, u_xi, u_s| RefValue {
+            u: -self.p.gap - v * psi,
+            u_xi,
+            u_s,
+        };
+        if xc < s && xc < back {
+            // Behind the compression front and before the unloading one: at rest, strained.
+            rv(xc, -v / c, 0.0)
+        } else if s <= back {
+            // Ahead of the compression front (or before the impact): moving at −V.
+            rv(s, 0.0, -v)
+        } else {
+            // Behind the unloading front (or after the bar has left): moving at +V.
+            rv(back, 0.0, v)
+        }
+    }
+
+    /// Period of the motion, 3L/c0 (clamped bar; the flying bar has one impact and no period).
     pub fn period(&self) -> f64 {
         3.0 * self.p.length / self.p.wave_speed()
     }
 
+    /// The flying bar's first contact t_c = g/V and the contact's duration 2L/c (SPEC §1.4).
+    pub fn contact_interval(&self) -> Option<(f64, f64)> {
+        self.is_flying().then(|| {
+            (
+                self.p.gap / -self.p.velocity,
+                2.0 * self.p.length / self.p.wave_speed(),
+            )
+        })
+    }
+
     /// u(x, t).
     pub fn u(&self, x: f64, t: f64) -> f64 {
+        if self.is_flying() {
+            return self.flying(x, self.flight_time(t)).u;
+        }
         2.0 * self.p.amplitude * self.scaled(x, t).u
     }
 
     /// ∂u/∂x (x, t).
     pub fn u_x(&self, x: f64, t: f64) -> f64 {
+        if self.is_flying() {
+            return self.flying(x, self.flight_time(t)).u_xi;
+        }
         2.0 * self.p.amplitude / self.p.length * self.scaled(x, t).u_xi
     }
 
     /// ∂u/∂t (x, t).
     pub fn u_t(&self, x: f64, t: f64) -> f64 {
+        if self.is_flying() {
+            return self.flying(x, self.flight_time(t)).u_s;
+        }
         2.0 * self.p.amplitude * self.p.wave_speed() / self.p.length * self.scaled(x, t).u_s
     }
 
@@ -236,66 +340,93 @@ impl BarExact {
         self.p.young * self.u_x(0.0, t)
     }
 
-    /// Exact (conserved) energy E a² / (2L).
+    /// Exact (conserved) energy: E a² / (2L) for the clamped bar, ½ρLV² for the flying one.
     pub fn energy(&self) -> f64 {
+        if self.is_flying() {
+            let v = self.p.velocity;
+            return 0.5 * self.p.density * self.p.length * v * v;
+        }
         self.p.young * self.p.amplitude * self.p.amplitude / (2.0 * self.p.length)
     }
 
     /// Squared L2 norm and squared H1 seminorm of (u_h − u(·, t)) where u_h is the P1 field with
-    /// the nodal values `nodal` on the uniform mesh of spacing `h` (node `nodal.len()` is the
-    /// clamped end, value 0). Exact: elements are split at the kinks of u(·, t).
+    /// the nodal values `nodal` on the uniform mesh of spacing `h`: nodes 0 … m−1 with node m
+    /// clamped (value 0) for the clamped bar, nodes 0 … m for the free end. Exact: elements
+    /// are split at the kinks of u(·, t).
     pub fn error_sq(&self, nodal: &[f64], h: f64, t: f64) -> (f64, f64) {
+        if self.is_flying() {
+            let c = self.p.wave_speed();
+            let s = self.flight_time(t);
+            let (a, b) = (c * s, 2.0 * self.p.length - c * s);
+            let kinks = if a <= b { (a, b) } else { (b, a) };
+            let m = nodal.len() - 1;
+            return integrate_error(m, |i| nodal[i], h, kinks, |x| self.flying(x, s).u);
+        }
         let l = self.p.length;
         let inv_l = 1.0 / l;
         let (phase, f) = phase_of(self.scaled_time(t));
         let amp = 2.0 * self.p.amplitude;
         let exact = |x: f64| amp * reference_at(x * inv_l, phase, f).u;
-        let (k1, k2) = if f <= 0.5 {
+        let kinks = if f <= 0.5 {
             (f * l, (1.0 - f) * l)
         } else {
             ((1.0 - f) * l, f * l)
         };
-        let (h3, inv_h) = (h / 3.0, 1.0 / h);
         let m = nodal.len();
-        let (mut l2, mut h1) = (0.0, 0.0);
-        // The exact field is continuous, so its values at the piece ends determine the affine
-        // error on each piece; ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3.
-        // Exact value at the left node of the element, carried from the previous element.
-        let mut el = nodal[0] - exact(0.0);
-        for i in 0..m {
-            let xa = i as f64 * h;
-            let xb = (i + 1) as f64 * h;
-            let ua = nodal[i];
-            let ub = if i + 1 < m { nodal[i + 1] } else { 0.0 };
-            let er_node = ub - exact(xb);
-            if !((k1 > xa && k1 < xb) || (k2 > xa && k2 < xb)) {
-                // No kink inside (all elements but at most two): one affine piece.
-                l2 += h3 * (el * el + el * er_node + er_node * er_node);
-                let de = er_node - el;
-                h1 += de * de * inv_h;
-            } else {
-                let slope = (ub - ua) * inv_h;
-                let (mut xl, mut e_l) = (xa, el);
-                for (xr, er) in [k1, k2]
-                    .into_iter()
-                    .filter(|k| *k > xa && *k < xb)
-                    .map(|k| (k, ua + slope * (k - xa) - exact(k)))
-                    .chain(std::iter::once((xb, er_node)))
-                {
-                    let d = xr - xl;
-                    if d > 0.0 {
-                        l2 += d * (e_l * e_l + e_l * er + er * er) / 3.0;
-                        let de = er - e_l;
-                        h1 += de * de / d;
-                        xl = xr;
-                        e_l = er;
-                    }
+        let node = |i: usize| if i < m { nodal[i] } else { 0.0 };
+        integrate_error(m, node, h, kinks, exact)
+    }
+}
+
+/// ∫(u_h − u)² and ∫(u_h' − u')² over `elements` P1 elements of size h with nodal values
+/// `node(i)`, i = 0 … elements, against a continuous field `exact` that is affine between the
+/// kinks k1 ≤ k2 (only those inside an element matter). On each affine piece the error is
+/// affine, so its values at the piece ends determine both integrals: ∫ e² over a piece of
+/// length d is d (e_a² + e_a e_b + e_b²)/3, ∫ e'² is (e_b − e_a)²/d.
+fn integrate_error(
+    elements: usize,
+    node: impl Fn(usize) -> f64,
+    h: f64,
+    (k1, k2): (f64, f64),
+    exact: impl Fn(f64) -> f64,
+) -> (f64, f64) {
+    let (h3, inv_h) = (h / 3.0, 1.0 / h);
+    let (mut l2, mut h1) = (0.0, 0.0);
+    // Error at the left node of the element, carried from the previous element.
+    let mut el = node(0) - exact(0.0);
+    for i in 0..elements {
+        let xa = i as f64 * h;
+        let xb = (i + 1) as f64 * h;
+        let ua = node(i);
+        let ub = node(i + 1);
+        let er_node = ub - exact(xb);
+        if !((k1 > xa && k1 < xb) || (k2 > xa && k2 < xb)) {
+            // No kink inside (all elements but at most two): one affine piece.
+            l2 += h3 * (el * el + el * er_node + er_node * er_node);
+            let de = er_node - el;
+            h1 += de * de * inv_h;
+        } else {
+            let slope = (ub - ua) * inv_h;
+            let (mut xl, mut e_l) = (xa, el);
+            for (xr, er) in [k1, k2]
+                .into_iter()
+                .filter(|k| *k > xa && *k < xb)
+                .map(|k| (k, ua + slope * (k - xa) - exact(k)))
+                .chain(std::iter::once((xb, er_node)))
+            {
+                let d = xr - xl;
+                if d > 0.0 {
+                    l2 += d * (e_l * e_l + e_l * er + er * er) / 3.0;
+                    let de = er - e_l;
+                    h1 += de * de / d;
+                    xl = xr;
+                    e_l = er;
                 }
             }
-            el = er_node;
         }
-        (l2, h1)
+        el = er_node;
     }
+    (l2, h1)
 }
 
 #[cfg(test)]

@@ -8,16 +8,19 @@
 //! is new, a mesh in `space/fe`), never a change to `sweep/`, `exec/`, `sink/` or `summary/`.
 //!
 //! What a scene hands to the engines is a [`SceneSetup`]: the 1D bar's parameters and element
-//! count, or a finite-element description ([`FeSetup`]: geometry, material, load, initial velocity,
-//! gap) which `space::fe` meshes and `run::fe` integrates, whatever the scene.
+//! count, the oscillator's parameters, or a finite-element description ([`FeSetup`]:
+//! geometry, material, load, initial velocity, gap) which `space::fe` meshes and `run::fe`
+//! integrates, whatever the scene.
 
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod oscillator;
 
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
+pub use oscillator::{OscillatorExact, OscillatorParams, OscillatorScene};
 
 /// A physics parameter of a scene: its key name (SPEC §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,7 +47,7 @@ impl Physics {
 /// How a run's errors are measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ErrorSource {
-    /// A closed-form solution (bar1d with zero gap).
+    /// A closed-form solution (bar1d: clamped with zero gap, or the flying bar; the oscillator).
     Exact,
     /// A reference run of the same scene on a finer nested mesh and step (SPEC §1.2).
     ReferenceRun,
@@ -67,6 +70,8 @@ pub enum SceneSetup {
     Bar1d { bar: BarParams, elements: usize },
     /// A finite-element scene (sparse engine).
     Fe(FeSetup),
+    /// The impact oscillator: one mass, one spring, one obstacle (SPEC §1.5).
+    Oscillator(OscillatorParams),
 }
 
 /// A physical problem, as the planner sees it.
@@ -85,6 +90,11 @@ pub trait Scene: Send + Sync {
     fn mesh_from_h(&self, physics: &Physics, h: f64) -> Result<MeshChoice, String>;
     /// The mesh for a requested `elements` count, or why not.
     fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String>;
+    /// The mesh of a run that gives neither `h` nor `elements`: None (the default) makes them
+    /// required; a scene without a mesh (the oscillator) returns its one choice.
+    fn default_mesh(&self) -> Option<MeshChoice> {
+        None
+    }
     /// Whether the scene implements this combination of contact method (`space`), mass variant
     /// and scheme family (`newmark`, `theta`, `paoli-schatzman`, `hybrid`); `Err` names the key
     /// at fault and the reason (a sweep error, not a silently dropped run).
@@ -103,7 +113,7 @@ pub trait Scene: Send + Sync {
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
 }
 
-/// The scenes the engine can run (the registry; SPEC §1 names five).
+/// The scenes the engine can run (the registry; SPEC §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SceneKind {
     /// The 1D impacting bar with its closed form (SPEC §1.1).
@@ -116,6 +126,8 @@ pub enum SceneKind {
     Disc2d,
     /// The ball falling under gravity on a rigid plane (SPEC §1.3).
     Sphere3d,
+    /// One mass, one spring, one obstacle (SPEC §1.5).
+    Oscillator,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -123,15 +135,17 @@ static BAR2D: BarScene = BarScene { dim: 2 };
 static BAR3D: BarScene = BarScene { dim: 3 };
 static DISC2D: BallScene = BallScene { dim: 2 };
 static SPHERE3D: BallScene = BallScene { dim: 3 };
+static OSCILLATOR: OscillatorScene = OscillatorScene;
 
 impl SceneKind {
     /// Every scene name of SPEC §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 5] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 6] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
         ("disc2d", Some(SceneKind::Disc2d)),
         ("sphere3d", Some(SceneKind::Sphere3d)),
+        ("oscillator", Some(SceneKind::Oscillator)),
     ];
 
     /// The scene behind this name.
@@ -142,6 +156,7 @@ impl SceneKind {
             SceneKind::Bar3d => &BAR3D,
             SceneKind::Disc2d => &DISC2D,
             SceneKind::Sphere3d => &SPHERE3D,
+            SceneKind::Oscillator => &OSCILLATOR,
         }
     }
 

@@ -1,5 +1,7 @@
 //! P1 discretisation of the bar (0, L): nodes x_i = i h, i = 0 … m, node m clamped and
-//! eliminated, node 0 the contact node. All operators are tridiagonal.
+//! eliminated (m unknowns) or, with a free right end (SPEC §1.4), kept (m + 1 unknowns, a
+//! natural boundary condition: nothing else changes); node 0 the contact node. All operators
+//! are tridiagonal.
 //!
 //! Mass variants (SPEC §2.2): element k (nodes k, k+1) carries ρ h/6 [2 1; 1 2] times a weight
 //! w_k (element-weight family of 000 §3), or is lumped, or has the contact row modified.
@@ -32,7 +34,8 @@ impl Pair {
 #[derive(Debug, Clone)]
 pub struct Bar1dSpace {
     pub bar: BarParams,
-    /// Number of elements m (= number of unknowns, nodes 0 … m−1).
+    /// Number of unknowns: the elements m with the right end clamped (nodes 0 … m−1), m + 1
+    /// with it free (nodes 0 … m). The engines size their vectors with it.
     pub m: usize,
     pub h: f64,
     pub mass: Tridiag,
@@ -77,8 +80,11 @@ impl Bar1dSpace {
         let h = bar.length / m as f64;
         let rho = bar.density;
         let e = bar.young;
-        let mut k = Tridiag::zeros(m);
-        let mut mm = Tridiag::zeros(m);
+        // A free end keeps node m as an unknown: the last element's block is then assembled in
+        // full by `add_element` instead of losing its clamped row and column.
+        let unknowns = if bar.free_end { m + 1 } else { m };
+        let mut k = Tridiag::zeros(unknowns);
+        let mut mm = Tridiag::zeros(unknowns);
         let kel = e / h;
         let cons = |w: f64| {
             let a = w * rho * h / 6.0;
@@ -165,7 +171,7 @@ impl Bar1dSpace {
         };
         Ok(Self {
             bar,
-            m,
+            m: unknowns,
             h,
             mass: mm,
             stiffness: k,
@@ -190,6 +196,19 @@ impl Bar1dSpace {
         }
     }
 
+    /// The mean velocity 1ᵀMv/1ᵀM1 of the unknowns (the free bar's rigid velocity: its
+    /// momentum over its mass).
+    pub fn mean_velocity(&self, v: &[f64]) -> f64 {
+        let (mut p, mut mass) = (0.0, 0.0);
+        for i in 0..self.m {
+            let (l, d, u) = self.mass.row(i);
+            let row = l + d + u;
+            mass += row;
+            p += row * v[i];
+        }
+        p / mass
+    }
+
     pub fn penalty_stiffness(&self, gamma0: f64) -> f64 {
         self.bar.young * gamma0 / self.h
     }
@@ -198,8 +217,13 @@ impl Bar1dSpace {
     /// Σ K_ii u_i² + 2 Σ K_i,i+1 u_i u_{i+1} cancels terms of size E/h·u² down to O(1) and loses
     /// ~1e-12 relative accuracy, which energy-monotonicity checks at 1e-12 would see.
     pub fn strain_energy(&self, u: &[f64]) -> f64 {
-        // u_m = 0 (clamped): the last element's strain is −u_{m−1}/h.
-        let last = u[u.len() - 1];
+        // u_m = 0 (clamped): the last element's strain is −u_{m−1}/h; a free end's node m is
+        // in u, and the windows already hold every element.
+        let last = if self.bar.free_end {
+            0.0
+        } else {
+            u[u.len() - 1]
+        };
         let s: f64 = u
             .windows(2)
             .map(|w| (w[1] - w[0]) * (w[1] - w[0]))

@@ -57,6 +57,11 @@ const AXES: &[&str] = &[
     "lame_lambda",
     "lame_mu",
     "gravity",
+    "velocity",
+    "point_mass",
+    "stiffness",
+    "force",
+    "impact_law",
 ];
 
 fn state(runs: &Runs, r: &Run) -> &'static str {

@@ -33,6 +33,16 @@ pub enum Key {
     ContactInit,
     /// Polynomial degree of the elements (disc2d/sphere3d: 1 or 2).
     Degree,
+    /// bar1d's right end (SPEC §1.4): `clamped` (default) or `free`.
+    RightEnd,
+    /// Uniform initial velocity (bar1d, oscillator; negative towards the obstacle).
+    Velocity,
+    /// Oscillator (SPEC §1.5): mass m, spring stiffness k, constant force f, Newton's
+    /// restitution coefficient e_x of the exact solution.
+    PointMass,
+    Stiffness,
+    Force,
+    ImpactLaw,
 }
 
 /// What a key's value must look like.
@@ -118,7 +128,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 26] = [
+    pub const ALL: [Key; 32] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -145,6 +155,12 @@ impl Key {
         Key::Gravity,
         Key::ContactInit,
         Key::Degree,
+        Key::RightEnd,
+        Key::Velocity,
+        Key::PointMass,
+        Key::Stiffness,
+        Key::Force,
+        Key::ImpactLaw,
     ];
 
     pub fn name(self) -> &'static str {
@@ -175,6 +191,12 @@ impl Key {
             Key::Gravity => "gravity",
             Key::ContactInit => "contact_init",
             Key::Degree => "degree",
+            Key::RightEnd => "right_end",
+            Key::Velocity => "velocity",
+            Key::PointMass => "point_mass",
+            Key::Stiffness => "stiffness",
+            Key::Force => "force",
+            Key::ImpactLaw => "impact_law",
         }
     }
 
@@ -191,7 +213,23 @@ impl Key {
                 | Key::LameMu
                 | Key::Gravity
                 | Key::Degree
+                | Key::RightEnd
+                | Key::Velocity
+                | Key::PointMass
+                | Key::Stiffness
+                | Key::Force
+                | Key::ImpactLaw
         )
+    }
+
+    /// The named values of a physics key that takes one of a few words (`right_end`): a
+    /// scene holds the value as its index in this list (its [`crate::scene::PhysicsKey`]
+    /// default is an index too), the sweep file and the columns hold the word.
+    pub fn choices(self) -> Option<&'static [&'static str]> {
+        match self {
+            Key::RightEnd => Some(&["clamped", "free"]),
+            _ => None,
+        }
     }
 
     pub fn from_name(name: &str) -> Option<Key> {
@@ -201,7 +239,9 @@ impl Key {
     pub fn value_type(self) -> ValueType {
         match self {
             Key::Elements => ValueType::Int,
-            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit => ValueType::Str,
+            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit | Key::RightEnd => {
+                ValueType::Str
+            }
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -286,11 +326,19 @@ impl Key {
             }
             (Key::T | Key::H | Key::Dt | Key::Courant, Value::Num(x)) => positive(*x),
             (Key::NitscheGamma0 | Key::PenaltyGamma0, Value::Num(x)) => positive(*x),
-            (Key::Length | Key::Young | Key::Density | Key::Amplitude, Value::Num(x)) => {
-                positive(*x)
-            }
+            (Key::Length | Key::Young | Key::Density, Value::Num(x)) => positive(*x),
             (Key::LameLambda | Key::LameMu, Value::Num(x)) => positive(*x),
-            (Key::Gap, Value::Num(x)) => {
+            (Key::RightEnd, Value::Str(s)) => match s.as_str() {
+                "clamped" | "free" => Ok(()),
+                _ => Err(format!(
+                    "unknown right_end `{s}` (expected clamped or free: the bar's end x = L held at u = 0 or traction-free)"
+                )),
+            },
+            (Key::PointMass | Key::Stiffness, Value::Num(x)) => positive(*x),
+            (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),
+            (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
+            // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).
+            (Key::Gap | Key::Amplitude, Value::Num(x)) => {
                 finite(*x)?;
                 if *x >= 0.0 {
                     Ok(())

@@ -142,11 +142,21 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::NewmarkGamma => Value::Num(0.5),
         Key::Restitution => Value::Num(1.0),
         Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
-        k if k.is_physics() => {
-            Value::Num(scene.physics().iter().find(|p| p.name == k.name())?.default)
-        }
+        k if k.is_physics() => physics_value(
+            k,
+            scene.physics().iter().find(|p| p.name == k.name())?.default,
+        ),
         _ => return None,
     })
+}
+
+/// A scene's physics value as a parameter: a number, or the word a choice key's index names
+/// (`right_end`: 0 → clamped).
+fn physics_value(key: Key, x: f64) -> Value {
+    match key.choices() {
+        Some(words) => Value::Str(words[x as usize].into()),
+        None => Value::Num(x),
+    }
 }
 
 fn same(a: &Value, b: &Value) -> bool {
@@ -360,7 +370,16 @@ fn resolve(
             .iter()
             .map(|k| {
                 let key = Key::from_name(k.name).expect("scenes declare sweep keys");
-                (k.name, num(key).unwrap_or(k.default))
+                let word = |v: Value| {
+                    let w = key.choices()?.iter().position(|c| Some(*c) == v.as_str())?;
+                    Some(w as f64)
+                };
+                (
+                    k.name,
+                    num(key)
+                        .or_else(|| get(key).and_then(word))
+                        .unwrap_or(k.default),
+                )
             })
             .collect(),
     );
@@ -387,6 +406,7 @@ fn resolve(
             },
             _ => None,
         },
+        (None, None) if scene.default_mesh().is_some() => scene.default_mesh(),
         (None, None) => {
             issues.push(Issue {
                 line: None,
@@ -561,7 +581,8 @@ fn resolve(
         Scheme::Hybrid => {}
     }
     for (name, value) in &physics.0 {
-        put(Key::from_name(name).unwrap(), Value::Num(*value), false);
+        let key = Key::from_name(name).unwrap();
+        put(key, physics_value(key, *value), false);
     }
     // Derived columns, not part of the identity.
     params.insert(Key::H, Value::Num(h));

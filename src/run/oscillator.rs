@@ -1,0 +1,450 @@
+//! The oscillator's engine (SPEC §1.5): one mass m, one spring k, a constant force f and an
+//! obstacle x ≥ −g, integrated by the schemes of SPEC §3 that apply to one constrained dof.
+//!
+//! The conventions are the 1D bar's at its contact node (SPEC §2.1, §2.4), so the same contact
+//! solve serves: the contact force enters as φ·q with q = −1 (pushing the mass up for φ < 0);
+//! `mixed`: s = x + g, 0 ≤ s ⊥ φ ≤ 0 (φ the multiplier); `penalty`: s = −x − g,
+//! φ = −κ[s]₊ with κ = `penalty_gamma0`·k (SPEC §1.5). A step is the scalar version of the 1D
+//! engine's: A x = b + c·f + c_f φ q with A = m + c k, then the exact branch solve of
+//! s = s_free + w φ(s) ([`crate::contact::solve`]).
+//!
+//! Schemes (parameters as data, [`crate::time::Scheme`]):
+//! - Newmark(β, γ) and θ: equation at t^{n+1}, A = m + βτ²k (θ²τ²k), c = c_f = βτ² (θ²τ²);
+//! - hybrid (penalty only): the midpoint rule on Δx with 003's switched contact term;
+//! - Paoli–Schatzman(β, e): two-step, A = m + βτ²k, contact on (x^{n+1} + e x^{n−1})/(1+e) + g,
+//!   x¹ from Newmark(β, ½), v^n = (x^{n+1} − x^{n−1})/(2τ) (as the bar).
+//!
+//! Adding a scheme (the comparison methods of SPEC §3.2 on the `methods` branch): an arm in
+//! [`Coefficients::of`] (its A, c, c_f and contact argument) and one in [`Osc::step`]
+//! (predictor and update); a velocity-level scheme (`moreau-jean`) reports its impulse / τ as
+//! φ, and a scheme whose contact is decided by a predictor (`contact-stabilized-newmark`)
+//! returns `true` for `active` when its predictor is constrained — `err_impact_time` counts a
+//! contact start where a step is active after one that was not (SPEC §1.5). The observables,
+//! the exact solution and the error columns need nothing more.
+//!
+//! Errors against the exact solution (event by event, [`OscillatorExact`]): err_u_l2l2 =
+//! (τΣ|x^n − x(t^n)|²)^½, err_u_linfl2 = max|x^n − x(t^n)|, err_v_l2 = (τΣ|v^n − v(t^n)|²)^½,
+//! err_energy_l2 = (τΣ(E^n − E(t^n))²)^½ (E^n with the penalty potential), err_impact_time =
+//! max over the exact impacts in [0, T] of the distance to the nearest discrete contact start
+//! (T itself if no step was ever in contact). The bar's H1 and pressure columns do not apply
+//! (null): the exact contact force is an impulse.
+
+use std::time::Instant;
+
+use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::{Metrics, Outcome, RunOptions, Status, Stop};
+use crate::contact::{self, ContactLaw, ContactSolveError};
+use crate::scene::{OscillatorExact, OscillatorParams};
+use crate::space::ContactMethod;
+use crate::time::{NewmarkParams, Scheme};
+
+/// A validated oscillator run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OscillatorConfig {
+    pub params: OscillatorParams,
+    pub method: ContactMethod,
+    pub scheme: Scheme,
+    pub dt: f64,
+    pub steps: usize,
+    /// Ensemble member: relative amplitude of a perturbation of x⁰ and its seed.
+    pub perturbation: Option<(f64, u64)>,
+}
+
+impl OscillatorConfig {
+    /// A run with step `dt` up to `t_final` (rounded up to a whole number of steps).
+    pub fn new(
+        params: OscillatorParams,
+        dt: f64,
+        t_final: f64,
+        method: ContactMethod,
+        scheme: Scheme,
+    ) -> Self {
+        Self {
+            params,
+            method,
+            scheme,
+            dt,
+            steps: (t_final / dt - 1e-9).ceil() as usize,
+            perturbation: None,
+        }
+    }
+
+    /// Penalty stiffness κ = `penalty_gamma0`·k (0 for the mixed method).
+    fn kappa(&self) -> f64 {
+        match self.method {
+            ContactMethod::Penalty { gamma0 } => gamma0 * self.params.stiffness,
+            _ => 0.0,
+        }
+    }
+
+    /// The largest stable dt of an explicit scheme: τ·ω_max ≤ the scheme's bound with
+    /// ω_max² = (k + κ)/m, the penalty spring active.
+    pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
+        let Some(bound) = self.scheme.explicit_stability_limit() else {
+            return Ok(None);
+        };
+        if self.method == ContactMethod::Mixed {
+            return Err((
+                "scheme",
+                "an explicit scheme cannot enforce the multiplier constraint on the oscillator's mass (use space = penalty)".into(),
+            ));
+        }
+        let w2 = (self.params.stiffness + self.kappa()) / self.params.mass;
+        Ok(Some(bound / w2.sqrt()))
+    }
+}
+
+/// The step's constants: A = m + c k, the coefficient c of k and f, c_f of the contact force.
+#[derive(Debug, Clone, Copy)]
+struct Coefficients {
+    a: f64,
+    c: f64,
+    cf: f64,
+}
+
+impl Coefficients {
+    fn of(scheme: Scheme, p: &OscillatorParams, tau: f64) -> Self {
+        let (c, cf) = scheme.coefficients(tau);
+        // The load enters where the stiffness does: Newmark/θ at t^{n+1} (c = βτ², θ²τ²),
+        // Paoli–Schatzman with τ² (its equation at t^n), the hybrid's midpoint with τ²/2.
+        let c_load = match scheme {
+            Scheme::PaoliSchatzman(_) | Scheme::Hybrid => cf,
+            _ => c,
+        };
+        Self {
+            a: p.mass + c * p.stiffness,
+            c: c_load,
+            cf,
+        }
+    }
+}
+
+/// The run's constant part.
+struct Osc {
+    p: OscillatorParams,
+    scheme: Scheme,
+    tau: f64,
+    k: Coefficients,
+    /// Contact argument s = p_x·x + p0 of the state, and the state's contact law.
+    px: f64,
+    p0: f64,
+    law: ContactLaw,
+    kappa: f64,
+    /// z = c_f q / A and w = p_x z: the contact condensed (q = −1).
+    z: f64,
+    w: f64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct State {
+    x: f64,
+    v: f64,
+    a: f64,
+    s_prev: f64,
+}
+
+/// Direction of the contact force: up (q = −1 with φ ≤ 0).
+const Q: f64 = -1.0;
+
+impl Osc {
+    fn new(cfg: &OscillatorConfig, scheme: Scheme) -> Self {
+        let p = cfg.params;
+        let tau = cfg.dt;
+        let k = Coefficients::of(scheme, &p, tau);
+        let kappa = cfg.kappa();
+        let (px, p0, law) = match (cfg.method, scheme) {
+            (_, Scheme::PaoliSchatzman(ps)) => (
+                1.0 / (1.0 + ps.restitution),
+                p.gap,
+                ContactLaw::Complementarity,
+            ),
+            (ContactMethod::Penalty { .. }, _) => {
+                (-1.0, -p.gap, ContactLaw::PositivePart { k: -kappa })
+            }
+            _ => (1.0, p.gap, ContactLaw::Complementarity),
+        };
+        let z = k.cf * Q / k.a;
+        Self {
+            p,
+            scheme,
+            tau,
+            k,
+            px,
+            p0,
+            law,
+            kappa,
+            z,
+            w: px * z,
+        }
+    }
+
+    /// The state's contact force φ(x) (penalty), 0 for a multiplier not yet known.
+    fn state_force(&self, x: f64) -> f64 {
+        match self.law {
+            ContactLaw::PositivePart { k } => k * (self.px * x + self.p0).max(0.0),
+            _ => 0.0,
+        }
+    }
+
+    /// Acceleration from the equation at a state with contact force φ.
+    fn accel(&self, x: f64, phi: f64) -> f64 {
+        (self.p.force - self.p.stiffness * x + phi * Q) / self.p.mass
+    }
+
+    /// E^h = ½mv² + ½kx² − fx, plus the penalty potential κ/2[−x − g]₊².
+    fn energy(&self, x: f64, v: f64) -> f64 {
+        let pen = (-x - self.p.gap).max(0.0);
+        self.p.energy(x, v) + 0.5 * self.kappa * pen * pen
+    }
+
+    /// Solve A y = b, then the scalar contact problem with the argument's offset p0: returns
+    /// (x, s, φ) with x = y + φ z.
+    fn solve(
+        &self,
+        b: f64,
+        law: &ContactLaw,
+        p0: f64,
+    ) -> Result<(f64, f64, f64), ContactSolveError> {
+        let y = b / self.k.a;
+        let sol = contact::solve(law, self.px * y + p0, self.w)?;
+        Ok((y + sol.phi * self.z, sol.s, sol.phi))
+    }
+
+    /// One step of a one-step scheme; returns φ of the step and whether its contact is active.
+    fn step(&self, st: &mut State) -> Result<(f64, bool), ContactSolveError> {
+        let (tau, m, f) = (self.tau, self.p.mass, self.p.force);
+        let load = self.k.c * f;
+        let (phi, x_new) = match self.scheme {
+            Scheme::Newmark(NewmarkParams { beta, gamma }) => {
+                let pred = st.x + tau * st.v + tau * tau / 2.0 * (1.0 - 2.0 * beta) * st.a;
+                let (x, s, phi) = self.solve(m * pred + load, &self.law, self.p0)?;
+                let a = if beta > 0.0 {
+                    (x - pred) / (beta * tau * tau)
+                } else {
+                    self.accel(x, phi)
+                };
+                st.v += tau * ((1.0 - gamma) * st.a + gamma * a);
+                st.a = a;
+                st.s_prev = s;
+                (phi, x)
+            }
+            Scheme::Theta(th) => {
+                let t = th.theta;
+                let pred = st.x + tau * st.v + tau * tau * t * (1.0 - t) * st.a;
+                let (x, s, phi) = self.solve(m * pred + load, &self.law, self.p0)?;
+                let it = 1.0 / (tau * t);
+                let v = (x - st.x - tau * (1.0 - t) * st.v) * it;
+                st.a = (v - st.v - tau * (1.0 - t) * st.a) * it;
+                st.v = v;
+                st.s_prev = s;
+                (phi, x)
+            }
+            Scheme::Hybrid => {
+                // Δx from A Δx = τ m v − (τ²/2)(k x − f) + c_f φ q, the contact switched on the
+                // sign of the argument at t^n (003 (11)).
+                let ContactLaw::PositivePart { k } = self.law else {
+                    unreachable!("the planner gives the hybrid scheme the penalty method only")
+                };
+                let b = tau * m * st.v - tau * tau / 2.0 * self.p.stiffness * st.x + load;
+                let law = ContactLaw::HybridNitsche {
+                    k,
+                    s_prev: st.s_prev,
+                };
+                let (dx, s, phi) = self.solve(b, &law, self.p0 + self.px * st.x)?;
+                st.v = 2.0 * dx / tau - st.v;
+                st.s_prev = s;
+                (phi, st.x + dx)
+            }
+            // Paoli–Schatzman is two-step (its loop is in `simulate`); a family the scene does
+            // not list in `supports` never reaches the engine.
+            _ => unreachable!("not a one-step scheme of the oscillator"),
+        };
+        st.x = x_new;
+        Ok((phi, phi != 0.0))
+    }
+}
+
+/// Error sums against the exact solution, and the discrete contact starts.
+struct Errors<'a> {
+    exact: &'a OscillatorExact,
+    cursor: usize,
+    sum_v: f64,
+    was_active: bool,
+    /// Times of the steps whose contact is active after one that was not (capacity for
+    /// every step: no allocation in the loop).
+    starts: Vec<f64>,
+}
+
+/// How often the clock is read for the timeout.
+const CLOCK_EVERY: usize = 256;
+
+/// Run one oscillator simulation.
+pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
+    let start = Instant::now();
+    let p = cfg.params;
+    let tau = cfg.dt;
+    let t_final = cfg.steps as f64 * tau;
+    let mut metrics = Metrics {
+        dofs: 1,
+        factorizations: 0,
+        ..Metrics::default()
+    };
+    let exact = p.exact(t_final);
+    let eng = Osc::new(cfg, cfg.scheme);
+    let mut x0 = p.x0;
+    if let Some((delta, seed)) = cfg.perturbation {
+        let mut rng = fastrand::Rng::with_seed(seed);
+        x0 += delta * (2.0 * rng.f64() - 1.0) * x0.abs().max(p.gap);
+    }
+    let phi0 = eng.state_force(x0);
+    let mut st = State {
+        x: x0,
+        v: p.v0,
+        a: eng.accel(x0, phi0),
+        s_prev: eng.px * x0 + eng.p0,
+    };
+    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
+    let mut err = Errors {
+        exact: &exact,
+        cursor: 0,
+        sum_v: 0.0,
+        was_active: phi0 != 0.0,
+        starts: Vec::with_capacity(cfg.steps + 1),
+    };
+    let mut record = |n: usize, x: f64, v: f64, phi: f64, active: bool| -> Result<(), Divergence> {
+        let t = n as f64 * tau;
+        let (xe, ve) = err.exact.state(t, &mut err.cursor);
+        let dv = v - ve;
+        err.sum_v += dv * dv;
+        if active && !err.was_active && n > 0 {
+            err.starts.push(t);
+        }
+        err.was_active = active;
+        let dx = x - xe;
+        obs.observe(
+            StepValues {
+                step: n,
+                t,
+                u_contact: x,
+                v_contact: v,
+                sigma_contact: phi,
+                sigma_mid: None,
+                energy: eng.energy(x, v),
+                energy_theta: None,
+                energy_kinetic: None,
+                energy_elastic: None,
+                energy_gravity: None,
+                u_lowest: None,
+                penetration: Some((-x - p.gap).max(0.0)),
+            },
+            Some(ExactValues {
+                u_contact: xe,
+                // The exact contact force is an impulse at impacts; at rest on the obstacle it
+                // holds the net force, φ = f + k g (< 0).
+                sigma_contact: if xe == -p.gap && ve == 0.0 {
+                    (p.force + p.stiffness * p.gap).min(0.0)
+                } else {
+                    0.0
+                },
+                sigma_contact_mid: None,
+                energy: p.energy(xe, ve),
+                l2_sq: dx * dx,
+                h1_semi_sq: 0.0,
+            }),
+        )
+    };
+    let interrupted = |n: usize| -> Result<(), Stop<ContactSolveError>> {
+        if !n.is_multiple_of(CLOCK_EVERY) {
+            return Ok(());
+        }
+        if opts.cancelled() {
+            return Err(Stop::Cancelled);
+        }
+        if opts.timeout.is_some_and(|limit| start.elapsed() > limit) {
+            return Err(Stop::Timeout(n));
+        }
+        Ok(())
+    };
+    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
+    let loop_start = Instant::now();
+    let mut done = 0usize;
+    let stop = (|| -> Result<(), Stop<ContactSolveError>> {
+        match cfg.scheme {
+            Scheme::PaoliSchatzman(ps) => {
+                // x¹ from Newmark(β, ½); then x^{n+1} from (x^n, x^{n−1}), v^n centred: step n
+                // is recorded once x^{n+1} is known, with the multiplier λ^n of its equation.
+                let starter = Osc::new(
+                    cfg,
+                    Scheme::Newmark(NewmarkParams {
+                        beta: ps.beta,
+                        gamma: 0.5,
+                    }),
+                );
+                record(0, st.x, st.v, phi0, phi0 != 0.0).map_err(Stop::Diverged)?;
+                let mut prev = st.x;
+                starter.step(&mut st).map_err(|e| Stop::Solver(1, e))?;
+                metrics.iterations += 1;
+                let (e, beta) = (ps.restitution, ps.beta);
+                let (k, m) = (p.stiffness, p.mass);
+                for n in 1..=cfg.steps {
+                    let b = m * (2.0 * st.x - prev)
+                        - tau * tau * k * ((1.0 - 2.0 * beta) * st.x + beta * prev)
+                        + eng.k.c * p.force;
+                    let p0 = e * prev / (1.0 + e) + p.gap;
+                    let (next, _, lambda) = eng
+                        .solve(b, &ContactLaw::Complementarity, p0)
+                        .map_err(|err| Stop::Solver(n, err))?;
+                    metrics.iterations += 1;
+                    let v = (next - prev) / (2.0 * tau);
+                    record(n, st.x, v, lambda, lambda != 0.0).map_err(Stop::Diverged)?;
+                    done = n;
+                    prev = st.x;
+                    st.x = next;
+                    interrupted(n)?;
+                }
+            }
+            _ => {
+                record(0, st.x, st.v, phi0, phi0 != 0.0).map_err(Stop::Diverged)?;
+                for n in 1..=cfg.steps {
+                    let (phi, active) = eng.step(&mut st).map_err(|e| Stop::Solver(n, e))?;
+                    metrics.iterations += 1;
+                    record(n, st.x, st.v, phi, active).map_err(Stop::Diverged)?;
+                    done = n;
+                    interrupted(n)?;
+                }
+            }
+        }
+        Ok(())
+    })();
+    metrics.steps = done as i64;
+    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
+    let complete = status == Status::Ok;
+    obs.finish(&mut metrics, complete);
+    // The bar's H1 and pressure columns have no meaning for a point mass.
+    metrics.err_u_l2h1 = None;
+    metrics.err_sigma_l2 = None;
+    metrics.err_sigma_mid_l2 = None;
+    if complete {
+        metrics.err_v_l2 = Some((tau * err.sum_v).sqrt());
+        metrics.err_impact_time = (!exact.impacts().is_empty()).then(|| {
+            exact
+                .impacts()
+                .iter()
+                .map(|ti| {
+                    err.starts
+                        .iter()
+                        .map(|s| (s - ti).abs())
+                        .fold(t_final, f64::min)
+                })
+                .fold(0.0, f64::max)
+        });
+    }
+    Outcome {
+        status,
+        message,
+        metrics,
+        series: std::mem::take(&mut obs.series),
+        reference: None,
+    }
+}
