@@ -16,13 +16,15 @@
 //! Row groups are per part (a batch), not per run: zstd's throughput falls three-fold on the
 //! 2 000-row groups a run gives. A reader of one run prunes *pages* instead: statistics are
 //! kept per page and the page index (column and offset index) is written, and a run's rows
-//! are contiguous, so the pages of `run_id` inside a run have min = max = its id. Pages hold
-//! at most [`PAGE_ROWS`] rows.
+//! are contiguous, so the pages of `run_id` inside a run have min = max = its id. Page size:
+//! [`PAGE_ROWS`].
 //!
 //! The arrow schema is not embedded (`ARROW:schema`): every column's type is then the Parquet
-//! logical type alone (String, Int64, Float64, List), which every reader maps to the same type
-//! whichever writer made the part — parts written by polars' encoder (before this module) and
-//! by this one read back as one table.
+//! logical type alone (String, Int64, Float64, List), which every reader maps to its own
+//! default type for it. Parts written by polars' encoder (before this module) embedded
+//! `string_view` and `large_list`: polars and pandas read both kinds with the same types
+//! (`tests/readers.rs` checks it), pyarrow's arrow-level types differ (string against
+//! string_view, list against large_list) and its dataset casts between them.
 
 use std::collections::HashSet;
 use std::fs::File;
