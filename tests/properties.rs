@@ -185,3 +185,183 @@ fn hybrid_schemes_stay_stable_over_a_hundred_impacts_at_large_courant_numbers() 
         }
     }
 }
+
+// ---- Methods of the comparison literature (SPEC §3.2) ----
+
+/// kane (trapezoidal rule, contact force fully implicit): the force λ^{n+1} does the work
+/// λ·(u₀^{n+1} − u₀ⁿ) ≤ 0 (it acts only with u₀^{n+1} = −g ≤ u₀ⁿ), so E^h never increases —
+/// for masses with inertia on the contact node (a quasi-static massless node takes its row at
+/// t^{n+1}, not at the midpoint the identity needs). Same round-off tolerance as above.
+#[test]
+fn kane_energy_never_increases() {
+    assert_never_increases(11, 24, Energy::Mechanical, |i, _| {
+        let mass = [MassVariant::Consistent, MassVariant::Lumped][i % 2].clone();
+        (ContactMethod::Mixed, mass, Scheme::Kane)
+    });
+}
+
+/// contact-stabilized Newmark: the M-projection of the predictor does not increase ‖·‖_M, and
+/// the kane step from it does not increase E^h (Deuflhard–Krause–Ertel 2008, Thm 3.2).
+#[test]
+fn contact_stabilized_newmark_energy_never_increases() {
+    assert_never_increases(12, 24, Energy::Mechanical, |i, _| {
+        let mass = [MassVariant::Consistent, MassVariant::Lumped][i % 2].clone();
+        (ContactMethod::Mixed, mass, Scheme::ContactStabilizedNewmark)
+    });
+}
+
+/// Moreau–Jean with θ = ½: the impulse p ≥ 0 does the work p·B v^{n+½} = ½p(1 − e)·B vⁿ ≤ 0
+/// on an approaching contact row, for every restitution e ∈ [0, 1] (drawn at random here).
+#[test]
+fn moreau_jean_midpoint_energy_never_increases() {
+    use contact_sweep::time::MoreauJeanParams;
+    assert_never_increases(13, 24, Energy::Mechanical, |i, d| {
+        let mass = [MassVariant::Consistent, MassVariant::Lumped][i % 2].clone();
+        // e from the draw's γ0 (log-uniform on [1e-8, 1e-2]) mapped to [0, 1].
+        let e = (d.gamma0.log10() + 8.0) / 6.0;
+        (
+            ContactMethod::Mixed,
+            mass,
+            Scheme::MoreauJean(MoreauJeanParams {
+                theta: 0.5,
+                restitution: e,
+            }),
+        )
+    });
+}
+
+/// The discrete gradient conserves E^h + Φ (penalty, the energy the run reports) and E_Θ
+/// (Nitsche, Θ = 1) exactly: the step-to-step change, in both directions, is round-off
+/// (tolerance 1e-12·E⁰ as above: O(1) energies differenced after ≤ 1e5 steps).
+#[test]
+fn discrete_gradient_conserves_its_energy_every_step() {
+    for (i, d) in draws(14, 24).iter().enumerate() {
+        let (method, augmented) = if i % 2 == 0 {
+            // κh/E = 1/γ0 ∈ [1e2, 1e8]: from soft to very stiff penalties.
+            (
+                ContactMethod::Penalty {
+                    gamma0: 1.0 / d.gamma0,
+                },
+                false,
+            )
+        } else {
+            (
+                ContactMethod::Nitsche {
+                    theta: 1.0,
+                    gamma0: d.gamma0,
+                },
+                true,
+            )
+        };
+        let o = ok(bar1d(
+            BarParams::default(),
+            d.elements,
+            d.dt,
+            6.0,
+            method,
+            MassVariant::Consistent,
+            Scheme::DiscreteGradient,
+            1,
+        ));
+        let e0 = o.metrics.energy_initial.unwrap();
+        let energy = |r: &contact_sweep::run::SeriesRow| {
+            if augmented {
+                r.energy_theta.unwrap()
+            } else {
+                r.energy
+            }
+        };
+        let worst = o
+            .series
+            .windows(2)
+            .map(|w| (energy(&w[1]) - energy(&w[0])).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst <= TOL * e0,
+            "{method:?} m={} dt={}: the conserved energy moved by {:e}·E0 in one step",
+            d.elements,
+            d.dt,
+            worst / e0
+        );
+        // The run did meet the obstacle (else conservation would be the trivial linear case).
+        assert!(o.metrics.contact_switches >= 1, "{method:?}: no contact");
+    }
+}
+
+/// generalized-α with ρ∞ = 1 (α_m = α_f = ½, β = ¼, γ = ½) averages the equations at tⁿ and
+/// t^{n+1}; with a⁰ from the equation at t = 0 every average of two equations that hold is
+/// Crank–Nicolson's equation at t^{n+1} — the same step up to round-off. Through the first
+/// impact (T = 2: contact during t ∈ [1, 2]) u(0, t) and E^h agree to 1e-9 (round-off amplified
+/// by the ill-posed mixed + consistent-mass contact, well below it before chaos sets in after
+/// the impact, SPEC §6). hht with α = 0 is Crank–Nicolson's Newmark(¼, ½) itself.
+#[test]
+fn generalized_alpha_with_rho_one_is_crank_nicolson_through_the_first_impact() {
+    use contact_sweep::time::{GeneralizedAlphaParams, NewmarkParams};
+    let cn = Scheme::Newmark(NewmarkParams::crank_nicolson());
+    for (i, d) in draws(15, 12).iter().enumerate() {
+        let ga = if i % 2 == 0 {
+            GeneralizedAlphaParams::from_rho_inf(1.0)
+        } else {
+            GeneralizedAlphaParams::hht(0.0)
+        };
+        let run = |scheme| {
+            ok(bar1d(
+                BarParams::default(),
+                d.elements,
+                d.dt,
+                2.0,
+                ContactMethod::Mixed,
+                MassVariant::Consistent,
+                scheme,
+                1,
+            ))
+        };
+        let (a, b) = (run(Scheme::GeneralizedAlpha(ga)), run(cn));
+        assert_eq!(a.series.len(), b.series.len());
+        let du = a
+            .series
+            .iter()
+            .zip(&b.series)
+            .map(|(x, y)| {
+                (x.u_contact - y.u_contact)
+                    .abs()
+                    .max((x.energy - y.energy).abs())
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            du <= 1e-9,
+            "{ga:?} m={} dt={}: differs from crank-nicolson by {du:e}",
+            d.elements,
+            d.dt
+        );
+    }
+}
+
+/// Kinematic contact (central difference, `mixed`, lumped mass) puts a penetrating node back
+/// on the obstacle at every step: max_penetration is exactly 0, for every h and every τ below
+/// the CFL limit h/c (lumped mass: ω_max = 2c/h, bound τω ≤ 2).
+#[test]
+fn kinematic_contact_never_penetrates() {
+    use contact_sweep::time::NewmarkParams;
+    let mut rng = fastrand::Rng::with_seed(16);
+    for _ in 0..24 {
+        let elements = rng.usize(4..=400);
+        let h = 1.0 / elements as f64;
+        let dt = h * (0.1 + 0.9 * rng.f64());
+        let o = ok(bar1d(
+            BarParams::default(),
+            elements,
+            dt,
+            6.0,
+            ContactMethod::Mixed,
+            MassVariant::Lumped,
+            Scheme::Newmark(NewmarkParams::central_difference()),
+            0,
+        ));
+        assert_eq!(o.metrics.max_penetration, Some(0.0), "m={elements} dt={dt}");
+        assert!(
+            o.metrics.contact_switches >= 2,
+            "m={elements} dt={dt}: no impact"
+        );
+    }
+}

@@ -72,6 +72,8 @@ pub struct Metrics {
     /// max over the observed steps of the step's penetration (u_n − g)_+ (SPEC §1.3), where
     /// the engine reports one ([`StepValues::penetration`]).
     pub max_penetration: Option<f64>,
+    /// max over the contact phases of TV(σ_C)/(2·max|σ_C|) (SPEC §3.2), from the phases.
+    pub pressure_oscillation: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -396,6 +398,7 @@ impl Observer {
 
         metrics.contact_switches = self.switches;
         metrics.impacts = Some(self.impacts.finish());
+        metrics.pressure_oscillation = self.impacts.pressure_oscillation();
         metrics.energy_theta_initial = self.e0_theta;
         metrics.max_penetration = self.max_penetration;
         if complete && self.has_exact {

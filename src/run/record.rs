@@ -130,7 +130,7 @@ schema! {
         mass: String => "", "mass variant (SPEC §2.2)";
         mass_weights: Option<String> => "", "user element weights w1,w2,… (mass = weights)";
         contact_init: Option<String> => "", "start of a massless contact node: consistent (its quasi-static value) or interpolant (u0(0)); null when the contact node has mass";
-        scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid";
+        scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid | kane | contact-stabilized-newmark | generalized-alpha | hht | moreau-jean | discrete-gradient";
         scheme_label: String => "", "preset name when the parameters are a preset's (crank-nicolson, backward-euler, …)";
         nitsche_theta: Option<f64> => "", "Nitsche Θ";
         nitsche_gamma0: Option<f64> => "", "Nitsche γ0 (γ_h = γ0 h)";
@@ -139,6 +139,8 @@ schema! {
         newmark_gamma: Option<f64> => "", "Newmark γ";
         theta_scheme: Option<f64> => "", "θ of the θ-scheme";
         restitution: Option<f64> => "", "Paoli–Schatzman restitution e";
+        rho_inf: Option<f64> => "", "generalized-α spectral radius at infinity ρ∞ (SPEC §3.2)";
+        hht_alpha: Option<f64> => "", "HHT α (scheme = hht, SPEC §3.2)";
         length: Option<f64> => "m", "bar length L";
         young: Option<f64> => "Pa", "Young modulus E";
         density: Option<f64> => "kg/m", "density ρ";
@@ -199,6 +201,7 @@ schema! {
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
         max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
+        pressure_oscillation: Option<f64> => "", "max over the contact phases (impact_*) of TV/(2·max|σ_C|), TV the total variation of σ_C (1D) or of the total contact force (2D/3D) over the phase's steps, rise from and fall to zero included: 1 for a pressure that rises once and falls once, larger when it chatters (SPEC §3.2); null without contact";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -407,6 +410,8 @@ impl RunRecord {
             newmark_gamma: f(Key::NewmarkGamma),
             theta_scheme: f(Key::ThetaScheme),
             restitution: f(Key::Restitution),
+            rho_inf: f(Key::RhoInf),
+            hht_alpha: f(Key::HhtAlpha),
             length: f(Key::Length),
             young: f(Key::Young),
             density: f(Key::Density),
@@ -467,6 +472,7 @@ impl RunRecord {
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
             max_penetration: m.max_penetration,
+            pressure_oscillation: m.pressure_oscillation,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

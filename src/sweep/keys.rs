@@ -33,6 +33,10 @@ pub enum Key {
     ContactInit,
     /// Polynomial degree of the elements (disc2d/sphere3d: 1 or 2).
     Degree,
+    /// Generalized-α spectral radius at infinity ρ∞ (SPEC §3.2).
+    RhoInf,
+    /// HHT α (SPEC §3.2, preset `hht` of generalized-α).
+    HhtAlpha,
 }
 
 /// What a key's value must look like.
@@ -118,7 +122,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 26] = [
+    pub const ALL: [Key; 28] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -145,6 +149,8 @@ impl Key {
         Key::Gravity,
         Key::ContactInit,
         Key::Degree,
+        Key::RhoInf,
+        Key::HhtAlpha,
     ];
 
     pub fn name(self) -> &'static str {
@@ -175,6 +181,8 @@ impl Key {
             Key::Gravity => "gravity",
             Key::ContactInit => "contact_init",
             Key::Degree => "degree",
+            Key::RhoInf => "rho_inf",
+            Key::HhtAlpha => "hht_alpha",
         }
     }
 
@@ -302,6 +310,8 @@ impl Key {
             (Key::NewmarkGamma | Key::ThetaScheme | Key::Restitution, Value::Num(x)) => {
                 within(*x, 0.0, 1.0)
             }
+            (Key::RhoInf, Value::Num(x)) => within(*x, 0.0, 1.0),
+            (Key::HhtAlpha, Value::Num(x)) => within(*x, 0.0, 1.0 / 3.0),
             (Key::NitscheTheta | Key::Gravity, Value::Num(x)) => finite(*x).map(|_| ()),
             (Key::Degree, Value::Num(x)) => {
                 if *x == 1.0 || *x == 2.0 {
@@ -316,7 +326,7 @@ impl Key {
 }
 
 /// Scheme names and aliases accepted in sweep files (SPEC §3).
-pub const SCHEME_NAMES: [&str; 8] = [
+pub const SCHEME_NAMES: [&str; 14] = [
     "newmark",
     "crank-nicolson",
     "newmark-dissipative",
@@ -325,4 +335,10 @@ pub const SCHEME_NAMES: [&str; 8] = [
     "backward-euler",
     "paoli-schatzman",
     "hybrid",
+    "kane",
+    "contact-stabilized-newmark",
+    "generalized-alpha",
+    "hht",
+    "moreau-jean",
+    "discrete-gradient",
 ];
