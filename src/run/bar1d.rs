@@ -155,6 +155,9 @@ struct Engine {
     wm: f64,
     /// Central difference with `mixed` and a diagonal mass: kinematic contact.
     kinematic: bool,
+    /// Contact-solver iterations beyond one per step (the discrete gradient's Newton
+    /// iterations, the contact-stabilized predictor's second solve), for `iterations`.
+    extra_iterations: std::cell::Cell<i64>,
 }
 
 /// Vectors reused by every step.
@@ -276,6 +279,7 @@ impl Engine {
             zm,
             wm,
             kinematic,
+            extra_iterations: std::cell::Cell::new(0),
         })
     }
 
@@ -534,6 +538,8 @@ impl Engine {
                 std::mem::swap(&mut wk.b, &mut wk.y);
                 let s_free = self.p.dot(&wk.y) + s_n;
                 let sol = gradient::solve(self.potential_stiffness(), s_n, s_free, self.w)?;
+                self.extra_iterations
+                    .set(self.extra_iterations.get() + sol.iterations as i64 - 1);
                 // The force −D p enters as φ q̃ with q = p (penalty; Nitsche with Θ = 1).
                 let phi = -sol.d;
                 if phi != 0.0 {
@@ -551,6 +557,7 @@ impl Engine {
                 }
                 let s_free = self.p.dot(&wk.pred) + self.p0;
                 let pred = contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?;
+                self.extra_iterations.set(self.extra_iterations.get() + 1);
                 if pred.phi != 0.0 {
                     for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
                         *x += pred.phi * z;
@@ -922,6 +929,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     })();
     metrics.steps = done as i64;
+    metrics.iterations += eng.extra_iterations.get();
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);

@@ -159,7 +159,7 @@ schema! {
         repeats: i64 => "", "timing repeats (results are identical across repeats)";
         steps: i64 => "", "time steps completed";
         dofs: i64 => "", "unknowns of the space discretisation";
-        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step)";
+        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step; two with contact-stabilized-newmark; the Newton iterations of discrete-gradient)";
         factorizations: i64 => "", "matrix factorisations performed";
         solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
         contact_switches: i64 => "", "times the contact pressure switched on or off";

@@ -33,6 +33,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("newmark_gamma", Kind::F64),
     ("theta_scheme", Kind::F64),
     ("restitution", Kind::F64),
+    ("rho_inf", Kind::F64),
+    ("hht_alpha", Kind::F64),
     ("length", Kind::F64),
     ("young", Kind::F64),
     ("density", Kind::F64),
@@ -63,6 +65,8 @@ const IN_LABEL: &[&str] = &[
     "newmark_gamma",
     "theta_scheme",
     "restitution",
+    "rho_inf",
+    "hht_alpha",
 ];
 
 /// The refinement axes: `h` (or `elements`), `dt` (or `courant`).
