@@ -453,3 +453,19 @@ fn comparison_methods_are_left_out_where_they_do_not_apply() {
     let labels: Vec<&str> = p.runs.iter().map(|r| r.label.as_str()).collect();
     assert_eq!(labels, ["mixed · lumped · central-difference"]);
 }
+
+/// `sweeps/comparison_bar1d.toml` plans every method of SPEC §3.2 applicable to the bar on the
+/// h = τ ladder and at ν = 1.5: 14 methods × 6 levels, nothing collapsed or left out, and its
+/// CN run at the 003 setting is the frozen run of `run_ids_are_canonical_and_stable`.
+#[test]
+fn comparison_sweep_plans_every_method_on_its_ladder() {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/sweeps/comparison_bar1d.toml"
+    ));
+    let sf = SweepFile::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let p = sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(p.runs.len(), 84);
+    assert!(p.inapplicable.is_empty() && p.collapsed.is_empty());
+    assert!(ids(&p).contains(&"35050bcfa8862a8f".to_string()));
+}
