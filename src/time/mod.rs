@@ -25,7 +25,7 @@
 //! - `moreau-jean` (Jean 1999): velocity-level θ-scheme with impulses, on the contact rows
 //!   whose predicted gap closes ([`MoreauJeanParams`]);
 //! - `discrete-gradient` (Gonzalez 1996): the midpoint rule with the contact force the
-//!   difference quotient of the contact potential ([`crate::contact::discrete_gradient`]), so
+//!   difference quotient of the contact potential ([`crate::contact::gradient`]), so
 //!   E^h + Φ (penalty) and E_Θ (Nitsche, Θ = 1) are conserved exactly.
 //!
 //! Every per-step formula acts on the contact rows through a scalar (1D: the contact node;
