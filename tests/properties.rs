@@ -309,6 +309,12 @@ fn discrete_gradient_conserves_its_energy_every_step() {
         );
         // The run did meet the obstacle (else conservation would be the trivial linear case).
         assert!(o.metrics.contact_switches >= 1, "{method:?}: no contact");
+        // Newton iterations are counted: at least one per step, at most 100 (SPEC §4).
+        let (it, steps) = (o.metrics.iterations, o.metrics.steps);
+        assert!(
+            it >= steps && it <= 100 * steps,
+            "{it} iterations, {steps} steps"
+        );
     }
 }
 

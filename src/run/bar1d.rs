@@ -539,7 +539,7 @@ impl Engine {
                 let s_free = self.p.dot(&wk.y) + s_n;
                 let sol = gradient::solve(self.potential_stiffness(), s_n, s_free, self.w)?;
                 self.extra_iterations
-                    .set(self.extra_iterations.get() + sol.iterations as i64 - 1);
+                    .set(self.extra_iterations.get() + sol.iterations.max(1) as i64 - 1);
                 // The force −D p enters as φ q̃ with q = p (penalty; Nitsche with Θ = 1).
                 let phi = -sol.d;
                 if phi != 0.0 {
