@@ -11,6 +11,11 @@
 //!   with precomputed factors (Thomas, plus the copy of its right-hand side) per node — the floor a step cannot beat. Both are timed
 //!   in alternation, 9 rounds, medians; the table is printed (`per-step ÷ Thomas`).
 //!
+//! - `scheme-ratio`: for m = 10³, 10⁴, 10⁵, the cost of a run (errors included, series off) of
+//!   each method of SPEC §3.2 against Crank–Nicolson on the same mesh and step (mixed +
+//!   consistent mass; the discrete gradient with the penalty, central difference with the
+//!   lumped mass at ν = 0.9), timed in alternation, 5 rounds, medians; target ≤ 1.3×.
+//!
 //! `cargo bench --bench bar1d`; compare medians, not single runs.
 //! `cargo bench --bench bar1d -- thomas-ratio` prints only the ratio table.
 
@@ -237,5 +242,98 @@ fn thomas_ratio(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, steps, executor, thomas_ratio);
+/// Per-step cost of each SPEC §3.2 method against Crank–Nicolson, m = 10³ … 10⁵ (module header).
+fn scheme_ratio(c: &mut Criterion) {
+    use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams};
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    if !filter.is_empty() && !filter.iter().any(|f| "scheme-ratio".contains(f.as_str())) {
+        return;
+    }
+    let _ = c;
+    let mixed = ContactMethod::Mixed;
+    let cn = Scheme::Newmark(NewmarkParams::crank_nicolson());
+    let methods = [
+        ("kane", mixed, MassVariant::Consistent, Scheme::Kane),
+        (
+            "contact-stabilized-newmark",
+            mixed,
+            MassVariant::Consistent,
+            Scheme::ContactStabilizedNewmark,
+        ),
+        (
+            "generalized-alpha",
+            mixed,
+            MassVariant::Consistent,
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams::from_rho_inf(0.5)),
+        ),
+        (
+            "moreau-jean",
+            mixed,
+            MassVariant::Consistent,
+            Scheme::MoreauJean(MoreauJeanParams::midpoint()),
+        ),
+        (
+            "discrete-gradient",
+            ContactMethod::Penalty { gamma0: 1.0 },
+            MassVariant::Consistent,
+            Scheme::DiscreteGradient,
+        ),
+        (
+            "central-difference",
+            mixed,
+            MassVariant::Lumped,
+            Scheme::Newmark(NewmarkParams::central_difference()),
+        ),
+    ];
+    println!(
+        "\nscheme-ratio: a run of each SPEC §3.2 method against Crank–Nicolson (ns per node-step)"
+    );
+    println!(
+        "{:>8} {:>28} {:>10} {:>10} {:>8}",
+        "m", "method", "method", "CN", "ratio"
+    );
+    let no_series = RunOptions {
+        series_every: 0,
+        timeout: None,
+        cancel: None,
+    };
+    for m in [1_000usize, 10_000, 100_000] {
+        // About 2·10⁷ node-steps per sample, through the first impact (t ≥ 1.5 at ν ≤ 1).
+        let steps = (20_000_000 / m).max(10);
+        for (name, method, mass, scheme) in &methods {
+            let nu = if name == &"central-difference" {
+                0.9
+            } else {
+                1.0
+            };
+            let dt = nu / m as f64;
+            let cfg = |method, mass, scheme| {
+                RunConfig::Bar1d(Bar1dConfig {
+                    steps,
+                    ..Bar1dConfig::new(BarParams::default(), m, dt, 1.0, method, mass, scheme)
+                })
+            };
+            let (a, b) = (
+                cfg(*method, mass.clone(), *scheme),
+                cfg(*method, mass.clone(), cn),
+            );
+            let (mut ta, mut tb) = (Vec::new(), Vec::new());
+            for _ in 0..5 {
+                for (cfg, out) in [(&a, &mut ta), (&b, &mut tb)] {
+                    let t = Instant::now();
+                    let o = simulate(cfg, &no_series);
+                    out.push(t.elapsed().as_secs_f64() * 1e9 / (steps * m) as f64);
+                    assert_eq!(o.metrics.steps as usize, steps, "{name}: {:?}", o.message);
+                }
+            }
+            let (x, y) = (median(ta), median(tb));
+            println!("{m:>8} {name:>28} {x:>10.2} {y:>10.2} {:>8.2}", x / y);
+        }
+    }
+}
+
+criterion_group!(benches, steps, executor, thomas_ratio, scheme_ratio);
 criterion_main!(benches);

@@ -10,10 +10,13 @@
 //! - [`space`] — meshes, mass variants, stiffness, and how each contact method enters the
 //!   semi-discrete system; `space::fe` (Q1 elements, sparse assembly with the pattern built
 //!   once) and `space::linalg` (faer's sparse Cholesky: symbolic once, numeric per matrix).
-//! - [`time`] — the time schemes as data with named presets.
+//! - [`time`] — the time schemes as data with named presets, the methods of the comparison
+//!   literature (SPEC §3.2: kane, contact-stabilized Newmark, generalized-α/HHT, Moreau–Jean,
+//!   discrete gradient, kinematic central difference) among them.
 //! - [`contact`] — the condensed contact solve: one scalar piecewise-linear equation per step,
 //!   solved exactly by branch enumeration (1D); a small dense LCP on the contact dofs solved
-//!   exactly by an active-set method (2D/3D).
+//!   exactly by an active-set method (2D/3D); the discrete gradient's scalar equation by a
+//!   safeguarded semismooth Newton iteration ([`contact::gradient`]).
 //! - [`run`] — one run: setup (factorisations once, shared between runs with the same matrix),
 //!   the allocation-free time loop of the tridiagonal, the sparse and the one-dof engine,
 //!   observables (energies, error norms against the closed form or a reference run), and the
@@ -24,7 +27,8 @@
 //!   computed once per output folder ([`exec::references`]); Slurm job arrays of shards
 //!   ([`exec::slurm`]).
 //! - [`sink`] — atomic Parquet parts, resume, manifest, several shards writing one folder.
-//! - [`summary`] — convergence rates, energy drift and speed-against-error tables.
+//! - [`summary`] — convergence rates, energy drift, speed-against-error and method-class
+//!   tables.
 //! - [`report`] — one self-contained HTML file of a results folder: the summary's tables and
 //!   figures drawn in Rust (plotters, inline SVG).
 //! - [`cli`] — command-line flags and their validation into the types above.

@@ -110,7 +110,9 @@ fn assert_loop_allocates_nothing_with(text: &str, t_final: f64, min_switches: i6
 }
 
 /// Every 1D scheme family with every contact treatment it runs with (and the massless
-/// quasi-static contact node, whose rows take their own path).
+/// quasi-static contact node, whose rows take their own path), the methods of SPEC §3.2
+/// included (kane, contact-stabilized Newmark's two solves, generalized-α/hht, Moreau–Jean, the
+/// discrete gradient's Newton iteration, kinematic central difference with the lumped mass).
 #[test]
 fn bar1d_time_loops_allocate_nothing() {
     assert_loop_allocates_nothing(
@@ -138,6 +140,14 @@ method = [
   { space = "mixed", mass = "mod3", scheme = "hybrid" },
   { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "hybrid" },
   { space = "penalty", penalty_gamma0 = 1e-3, scheme = "hybrid" },
+  { space = "mixed", scheme = "kane" },
+  { space = "mixed", mass = "mod3", scheme = "kane" },
+  { space = "mixed", scheme = "contact-stabilized-newmark" },
+  { space = "mixed", scheme = "generalized-alpha", rho_inf = 0.5 },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "hht", hht_alpha = 0.1 },
+  { space = "mixed", scheme = "moreau-jean", restitution = 0.5 },
+  { space = "penalty", penalty_gamma0 = 1.0, scheme = "discrete-gradient" },
+  { space = "nitsche", nitsche_gamma0 = 1e-6, scheme = "discrete-gradient" },
 ]
 "#,
         3.0,

@@ -390,3 +390,82 @@ fn bar2d_refuses_what_it_cannot_model_with_the_key_and_reason() {
         "{e}"
     );
 }
+
+/// SPEC §3.2's keys (`rho_inf`, `hht_alpha`, and `theta_scheme`/`restitution` now also read by
+/// moreau-jean) do not apply to the existing schemes: crossing the 003 CN run with them
+/// collapses to that run, with its frozen id; the new schemes drop what does not apply to them.
+#[test]
+fn comparison_method_keys_collapse_and_keep_existing_ids() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n[grid]\nmass = [\"consistent\"]\nrho_inf = [0.5, 1.0]\nhht_alpha = [0.1, 0.2]\n"
+    ));
+    assert_eq!(p.runs.len(), 1);
+    assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
+    assert!(
+        p.collapsed
+            .keys()
+            .any(|k| k.contains("rho_inf applies to generalized-alpha only")),
+        "{:?}",
+        p.collapsed
+    );
+    // The methods with their parameters: distinct runs, distinct ids; ρ∞ applies to
+    // generalized-alpha, α to hht, θ and e to moreau-jean.
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\n[grid]\nmethod = [\n  {{ scheme = \"kane\" }},\n  {{ scheme = \"contact-stabilized-newmark\" }},\n  {{ scheme = \"generalized-alpha\", rho_inf = 0.5 }},\n  {{ scheme = \"hht\", hht_alpha = 0.1 }},\n  {{ scheme = \"moreau-jean\", restitution = 1.0 }},\n  {{ scheme = \"moreau-jean\" }},\n  {{ scheme = \"discrete-gradient\", space = \"penalty\", penalty_gamma0 = 1.0 }},\n]\n"
+    ));
+    assert_eq!(p.runs.len(), 7);
+    let mut all = ids(&p);
+    all.sort();
+    all.dedup();
+    assert_eq!(all.len(), 7);
+    assert_eq!(p.runs[2].params[&Key::RhoInf].as_f64(), Some(0.5));
+    assert_eq!(p.runs[3].params[&Key::HhtAlpha].as_f64(), Some(0.1));
+    assert!(!p.runs[3].params.contains_key(&Key::RhoInf));
+    // Moreau–Jean's own defaults: θ = ½, e = 0.
+    assert_eq!(p.runs[5].params[&Key::ThetaScheme].as_f64(), Some(0.5));
+    assert_eq!(p.runs[5].params[&Key::Restitution].as_f64(), Some(0.0));
+}
+
+/// Where the methods of SPEC §3.2 do not apply, the planner leaves the run out with its reason.
+#[test]
+fn comparison_methods_are_left_out_where_they_do_not_apply() {
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\nnitsche_gamma0 = 1e-6\npenalty_gamma0 = 1.0\n[grid]\nspace = [\"mixed\", \"nitsche\", \"penalty\"]\nmass = [\"consistent\", \"lumped\", \"mod3\"]\nscheme = [\"kane\", \"contact-stabilized-newmark\", \"generalized-alpha\", \"moreau-jean\", \"discrete-gradient\"]\n"
+    ));
+    let reasons: Vec<&String> = p.inapplicable.keys().collect();
+    let has = |s: &str| reasons.iter().any(|k| k.contains(s));
+    assert!(has("kane is defined for space = mixed only"), "{reasons:?}");
+    assert!(has("moreau-jean is defined for space = mixed only"));
+    assert!(has(
+        "contact-stabilized-newmark needs inertia on the contact dof"
+    ));
+    assert!(has("generalized-alpha needs inertia on the contact dof"));
+    assert!(has("discrete-gradient needs a contact potential"));
+    // kane: mixed × 3 masses; CSN, MJ: mixed × 2 masses with inertia; GA: 3 spaces × 2; DG:
+    // nitsche, penalty × 3 masses — 3 + 2 + 2 + 6 + 6 = 19 of 45.
+    assert_eq!(p.runs.len(), 19);
+    let labels: Vec<&str> = p.runs.iter().map(|r| r.label.as_str()).collect();
+    assert!(labels.contains(&"mixed · mod3 · kane"), "{labels:?}");
+    // Central difference with the mixed method: kinematic contact with the lumped mass only.
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.009\nscheme = \"central-difference\"\n[grid]\nmass = [\"consistent\", \"lumped\"]\n"
+    ));
+    let labels: Vec<&str> = p.runs.iter().map(|r| r.label.as_str()).collect();
+    assert_eq!(labels, ["mixed · lumped · central-difference"]);
+}
+
+/// `sweeps/comparison_bar1d.toml` plans every method of SPEC §3.2 applicable to the bar on the
+/// h = τ ladder and at ν = 1.5: 14 methods × 6 levels, nothing collapsed or left out, and its
+/// CN run at the 003 setting is the frozen run of `run_ids_are_canonical_and_stable`.
+#[test]
+fn comparison_sweep_plans_every_method_on_its_ladder() {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/sweeps/comparison_bar1d.toml"
+    ));
+    let sf = SweepFile::load(path).unwrap_or_else(|e| panic!("{e}"));
+    let p = sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(p.runs.len(), 84);
+    assert!(p.inapplicable.is_empty() && p.collapsed.is_empty());
+    assert!(ids(&p).contains(&"35050bcfa8862a8f".to_string()));
+}

@@ -940,3 +940,74 @@ fn pareto_front_and_cost_to_reach_an_error() {
         "{md}"
     );
 }
+
+/// The method-class table (`summary/methods.*`): one row per method group, its words computed
+/// from the runs — the worst energy class, the largest pressure_oscillation against the
+/// smooth threshold (5), the largest max_penetration against 1e-12·L, and the LSQ slopes of
+/// err_u_l2l2 and err_u_l2h1 along the τ ∝ h path. Errors are exact power laws of h here
+/// (0.1h and h^½; h² and h), so the slopes are 1, ½, 2, 1 to the rounding of the logarithms
+/// ([`TOL`]).
+#[test]
+fn method_class_table_is_computed_from_the_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let hs: [f64; 3] = [0.25, 0.125, 0.0625];
+    let mut rows = Vec::new();
+    for &h in &hs {
+        let e = [Some(0.1 * h), Some(h.sqrt()), None, None];
+        rows.push(run("mixed · consistent · kane", "kane", h, h, e));
+    }
+    for (k, &h) in hs.iter().enumerate() {
+        let e = [Some(h * h), Some(h), None, None];
+        let mut r = run("mixed · consistent · moreau-jean", "moreau-jean", h, h, e);
+        if k == 1 {
+            // E gained 50 % > δ = h: the method can grow energy.
+            r.drift = Some(0.5);
+        }
+        rows.push(r);
+    }
+    let mut df = runs_frame(&rows);
+    let osc = [1.0, 3.0, 4.9, 2.0, 11.3, 3.0];
+    let pen = [0.0, 1e-18, 0.0, 1e-3, 5e-4, 2.5e-4];
+    df.with_column(Column::new("pressure_oscillation".into(), osc.to_vec()))
+        .unwrap();
+    df.with_column(Column::new("max_penetration".into(), pen.to_vec()))
+        .unwrap();
+    write_runs(dir.path(), "part-0.parquet", &mut df);
+    summary::summarize(dir.path()).unwrap();
+    let t = read(&dir.path().join("summary/methods.parquet"));
+    let methods = strs(&t, "method");
+    let row = |label: &str| {
+        methods
+            .iter()
+            .position(|m| m.as_deref() == Some(label))
+            .unwrap_or_else(|| panic!("{label} not in {methods:?}"))
+    };
+    let (a, b) = (
+        row("mixed · consistent · kane"),
+        row("mixed · consistent · moreau-jean"),
+    );
+    let (energy, pressure, penetration) = (
+        strs(&t, "energy"),
+        strs(&t, "pressure"),
+        strs(&t, "penetration"),
+    );
+    assert_eq!(energy[a].as_deref(), Some("conserving"));
+    assert_eq!(energy[b].as_deref(), Some("growing"));
+    assert_eq!(pressure[a].as_deref(), Some("smooth"));
+    assert_eq!(pressure[b].as_deref(), Some("oscillating"));
+    assert_eq!(penetration[a].as_deref(), Some("none"));
+    assert_eq!(penetration[b].as_deref(), Some("O(τ)"));
+    assert_eq!(f64s(&t, "pressure_oscillation_max")[b], Some(11.3));
+    let (l2, h1) = (f64s(&t, "rate_l2"), f64s(&t, "rate_h1"));
+    close(l2[a].unwrap(), 1.0, "kane L2 rate");
+    close(h1[a].unwrap(), 0.5, "kane H1 rate");
+    close(l2[b].unwrap(), 2.0, "moreau-jean L2 rate");
+    close(h1[b].unwrap(), 1.0, "moreau-jean H1 rate");
+    let md = std::fs::read_to_string(dir.path().join("summary/methods.md")).unwrap();
+    assert!(
+        md.contains("smooth if max pressure_oscillation ≤ 5"),
+        "{md}"
+    );
+    assert!(dir.path().join("summary/methods.tex").is_file());
+    assert!(dir.path().join("summary/methods.csv").is_file());
+}

@@ -13,8 +13,11 @@
 //! is reported, never silently resolved.
 //!
 //! The finite-element scenes condense onto several contact dofs: [`lcp`] solves the resulting
-//! small dense complementarity problem exactly by an active-set method.
+//! small dense complementarity problem exactly by an active-set method. The discrete-gradient
+//! scheme's contact force is a difference quotient, not a piecewise-linear law: [`gradient`]
+//! solves its scalar equation by a safeguarded semismooth Newton iteration.
 
+pub mod gradient;
 pub mod lcp;
 
 pub use lcp::{Lcp, LcpError};
@@ -104,6 +107,8 @@ pub enum ContactSolveError {
         "the condensed contact operator is not positive (w = {w:.3e}); the multiplier is undetermined"
     )]
     NonPositive { w: f64 },
+    #[error(transparent)]
+    Gradient(#[from] gradient::GradientSolveError),
 }
 
 /// Solution of the scalar problem: the contact argument s and the force factor φ.

@@ -25,16 +25,26 @@
 //! eliminated (u₀ = max(−g, u₁)), the contact element's energy (E/2h)[−(u₁+g)]₊² is split into
 //! its quadratic part (kept in K*, node 0 clamped at −g) and −(E/2h)[u₁+g]₊², whose force
 //! (E/h)[u₁+g]₊ e₁ is switched between midpoint and Crank–Nicolson on the sign of u₁^n + g.
+//!
+//! The methods of SPEC §3.2 ([`Engine::step_comparison`]) use the same constant matrix and the
+//! same condensation: `kane`, `discrete-gradient` step the increment Δu with S = M + τ²/4 K
+//! (one scalar solve; the discrete gradient's is a Newton iteration on the contact point's
+//! difference quotient, [`crate::contact::gradient`]); `contact-stabilized-newmark` adds the
+//! M-projection of the free flight (a second scalar solve, with M⁻¹q computed at setup);
+//! `generalized-alpha`/`hht` step u^{n+1} with M + cK, c = (1−α_f)βτ²/(1−α_m), carrying the
+//! previous contact force φⁿ; `moreau-jean` steps Δv with M + θ²τ²K and an impulse on the
+//! contact node when its predicted gap closes. `central-difference` with `mixed` and the lumped
+//! mass enforces contact kinematically ([`crate::time::kinematic_impulse`]): no solve at all.
 
 use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Series, Status, Stop};
-use crate::contact::{self, ContactLaw, ContactSolveError};
+use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{BarExact, BarParams};
 use crate::space::bar1d::Pair;
 use crate::space::{Bar1dSpace, ContactInit, ContactMethod, MassVariant, Tridiag, TridiagLu};
-use crate::time::{NewmarkParams, Scheme};
+use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
 
 /// A validated bar1d run.
 #[derive(Debug, Clone, PartialEq)]
@@ -140,6 +150,14 @@ struct Engine {
     p: Pair,
     p0: f64,
     factorizations: i64,
+    /// Contact-stabilized Newmark's predictor: z_M = M⁻¹q and w_M = pᵀz_M (empty otherwise).
+    zm: Vec<f64>,
+    wm: f64,
+    /// Central difference with `mixed` and a diagonal mass: kinematic contact.
+    kinematic: bool,
+    /// Contact-solver iterations beyond one per step (the discrete gradient's Newton
+    /// iterations, the contact-stabilized predictor's second solve), for `iterations`.
+    extra_iterations: std::cell::Cell<i64>,
 }
 
 /// Vectors reused by every step.
@@ -155,6 +173,8 @@ struct State {
     a: Vec<f64>,
     /// Contact argument at t^n (hybrid switches).
     s_prev: f64,
+    /// Contact force factor φⁿ of the last step (generalized-α carries α_f φⁿ).
+    phi_prev: f64,
 }
 
 impl Engine {
@@ -174,7 +194,12 @@ impl Engine {
         }
         let mut a = sp.mass.axpy(c, &klin);
         let mut qt = [cf * sp.q.0[0], cf * sp.q.0[1]];
-        if sp.massless_contact && !matches!(scheme, Scheme::Hybrid) {
+        if sp.massless_contact
+            && !matches!(
+                scheme,
+                Scheme::Hybrid | Scheme::DiscreteGradient | Scheme::Kane
+            )
+        {
             // Quasi-static contact row at t^{n+1}: c (K u)₀ = c φ q₀ (or K row 0 itself if c = 0).
             qt[0] = if c == 0.0 { sp.q.0[0] } else { c * sp.q.0[0] };
             if c == 0.0 {
@@ -205,6 +230,44 @@ impl Engine {
         z[1] = qt[1];
         a_lu.solve_in_place(&mut z);
         let w = p.dot(&z);
+        let kinematic = scheme == Scheme::Newmark(NewmarkParams::central_difference())
+            && sp.method == ContactMethod::Mixed
+            && !sp.massless_contact;
+        if kinematic && sp.mass.upper.iter().any(|&x| x != 0.0) {
+            return Err(
+                "kinematic contact (central difference with the mixed method) needs a diagonal mass (`lumped`)"
+                    .into(),
+            );
+        }
+        if scheme == Scheme::DiscreteGradient
+            && !match sp.method {
+                ContactMethod::Penalty { .. } => true,
+                ContactMethod::Nitsche { theta, .. } => theta == 1.0,
+                ContactMethod::Mixed => false,
+            }
+        {
+            return Err(
+                "discrete-gradient needs a contact potential: penalty, or nitsche with Θ = 1"
+                    .into(),
+            );
+        }
+        if scheme.needs_contact_mass() && sp.massless_contact {
+            return Err(format!(
+                "{} needs inertia on the contact node (SPEC §3.2)",
+                scheme.family()
+            ));
+        }
+        let (zm, wm) = if scheme == Scheme::ContactStabilizedNewmark {
+            // The M-projection onto B u + g ≥ 0: u = ũ + φ M⁻¹q, once per run.
+            let mut zm = vec![0.0; m];
+            zm[0] = sp.q.0[0];
+            zm[1] = sp.q.0[1];
+            mass_lu.solve_in_place(&mut zm);
+            let wm = p.dot(&zm);
+            (zm, wm)
+        } else {
+            (Vec::new(), 0.0)
+        };
         Ok(Self {
             sp,
             scheme,
@@ -218,6 +281,10 @@ impl Engine {
             p,
             p0,
             factorizations: 2,
+            zm,
+            wm,
+            kinematic,
+            extra_iterations: std::cell::Cell::new(0),
         })
     }
 
@@ -270,6 +337,10 @@ impl Engine {
 
     /// Contact pressure to report for a state whose step returned `phi`.
     fn sigma(&self, u: &[f64], phi: f64) -> f64 {
+        if let Scheme::MoreauJean(_) = self.scheme {
+            // φ is the impulse p^{n+1} of the step: the force is p/τ (SPEC §3.2).
+            return phi / self.tau;
+        }
         if self.sp.method == ContactMethod::Mixed && !self.reduced {
             phi
         } else {
@@ -312,6 +383,9 @@ impl Engine {
 
     /// One step of a one-step scheme; returns φ of the step.
     fn step(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
+        if self.kinematic || self.scheme.is_comparison() {
+            return self.step_comparison(st, wk);
+        }
         let tau = self.tau;
         let m = self.sp.m;
         let sp = &self.sp;
@@ -342,6 +416,7 @@ impl Engine {
                 }
             }
             Scheme::PaoliSchatzman(_) => unreachable!("two-step scheme"),
+            _ => unreachable!("SPEC §3.2 methods step in step_comparison"),
         }
         if sp.massless_contact {
             // Massless row: only the contact force (and, for the hybrid, its own history).
@@ -394,7 +469,7 @@ impl Engine {
                 }
             }
             Scheme::Hybrid => {} // velocity set above from Δu
-            Scheme::PaoliSchatzman(_) => unreachable!(),
+            _ => unreachable!(),
         }
         if sp.massless_contact {
             st.v[0] = (wk.y[0] - st.u[0]) / tau;
@@ -403,6 +478,191 @@ impl Engine {
         std::mem::swap(&mut st.u, &mut wk.y);
         st.s_prev = s;
         Ok(phi)
+    }
+
+    /// Stiffness k of the contact potential Φ = k/2 [s]₊² (discrete gradient): κ (penalty),
+    /// 1/γ_h (Nitsche, Θ = 1).
+    fn potential_stiffness(&self) -> f64 {
+        match self.sp.method {
+            ContactMethod::Penalty { gamma0 } => self.sp.penalty_stiffness(gamma0),
+            ContactMethod::Nitsche { gamma0, .. } => 1.0 / (gamma0 * self.sp.h),
+            ContactMethod::Mixed => 0.0,
+        }
+    }
+
+    /// The right-hand side τ M vⁿ − τ²/2 K uⁿ of the increment S Δu (kane, discrete
+    /// gradient), into wk.b; wk.y keeps K uⁿ.
+    fn increment_rhs(&self, st: &State, wk: &mut Work) {
+        let tau = self.tau;
+        self.sp.mass.mul_into(&st.v, &mut wk.b);
+        self.klin.mul_into(&st.u, &mut wk.y);
+        let c = tau * tau / 2.0;
+        for (b, ku) in wk.b.iter_mut().zip(&wk.y) {
+            *b = tau * *b - c * ku;
+        }
+    }
+
+    /// One step of a method of SPEC §3.2 (or kinematic central difference); returns φ.
+    fn step_comparison(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
+        let tau = self.tau;
+        let m = self.sp.m;
+        let sp = &self.sp;
+        let s_n = self.p.dot(&st.u) + self.p0;
+        let phi = match self.scheme {
+            _ if self.kinematic => {
+                // v^{n+½} = vⁿ + τ/2 aⁿ, u^{n+1} = uⁿ + τ v^{n+½}, the contact node put back on
+                // the obstacle by an impulse on v^{n+½}; a^{n+1} = M⁻¹(−K u^{n+1}).
+                for i in 0..m {
+                    st.v[i] += 0.5 * tau * st.a[i];
+                    st.u[i] += tau * st.v[i];
+                }
+                let (u0, dv, lambda) =
+                    crate::time::kinematic_impulse(st.u[0], -sp.bar.gap, sp.mass.diag[0], tau);
+                st.u[0] = u0;
+                st.v[0] += dv;
+                self.acceleration_into(&st.u, 0.0, &mut st.a);
+                for i in 0..m {
+                    st.v[i] += 0.5 * tau * st.a[i];
+                }
+                // λ ≥ 0 pushes the node up: φ = −λ with the force φ q, q = −e₀.
+                -lambda
+            }
+            Scheme::Kane => {
+                // A massless node keeps SPEC §3.2's formula as written: its row of S Δu is
+                // (τ²/4)(K Δu)₀ = −(τ²/2)(K uⁿ)₀ + (τ²/2)φq₀, i.e. (K u^{n+½})₀ = φq₀ — quasi-static
+                // at the midpoint, where the trapezoidal rule evaluates K u. Then the step's
+                // energy change is φq₀·Δu₀ ≤ 0 for every mass; the row at t^{n+1} instead
+                // (the Newmark schemes' choice) let E^h rise by 8 % of E⁰ in one step (mod3,
+                // h = ¼, ν = 1).
+                self.increment_rhs(st, wk);
+                let (_, phi) = self.solve_step(wk, &ContactLaw::Complementarity, s_n)?;
+                self.finish_increment(st, wk, tau);
+                phi
+            }
+            Scheme::DiscreteGradient => {
+                self.increment_rhs(st, wk);
+                self.a_lu.solve_in_place(&mut wk.b);
+                std::mem::swap(&mut wk.b, &mut wk.y);
+                let s_free = self.p.dot(&wk.y) + s_n;
+                let sol = gradient::solve(self.potential_stiffness(), s_n, s_free, self.w)?;
+                self.extra_iterations
+                    .set(self.extra_iterations.get() + sol.iterations.max(1) as i64 - 1);
+                // The force −D p enters as φ q̃ with q = p (penalty; Nitsche with Θ = 1).
+                let phi = -sol.d;
+                if phi != 0.0 {
+                    for (y, z) in wk.y.iter_mut().zip(&self.z) {
+                        *y += phi * z;
+                    }
+                }
+                self.finish_increment(st, wk, tau);
+                phi
+            }
+            Scheme::ContactStabilizedNewmark => {
+                // Predictor: the M-projection of uⁿ + τvⁿ onto the admissible set.
+                for i in 0..m {
+                    wk.pred[i] = st.u[i] + tau * st.v[i];
+                }
+                let s_free = self.p.dot(&wk.pred) + self.p0;
+                let pred = contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?;
+                self.extra_iterations.set(self.extra_iterations.get() + 1);
+                if pred.phi != 0.0 {
+                    for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
+                        *x += pred.phi * z;
+                    }
+                }
+                // kane from u^pred: S Δ = −τ²/4 K(uⁿ + u^pred) + τ²/2 φ q, Δ = u^{n+1} − u^pred.
+                for i in 0..m {
+                    wk.y[i] = st.u[i] + wk.pred[i];
+                }
+                self.klin.mul_into(&wk.y, &mut wk.b);
+                let c = 0.25 * tau * tau;
+                for b in wk.b.iter_mut() {
+                    *b *= -c;
+                }
+                let s_pred = self.p.dot(&wk.pred) + self.p0;
+                let (_, phi) = self.solve_step(wk, &ContactLaw::Complementarity, s_pred)?;
+                for i in 0..m {
+                    st.v[i] += 2.0 * wk.y[i] / tau;
+                    st.u[i] = wk.pred[i] + wk.y[i];
+                }
+                phi
+            }
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                alpha_m,
+                alpha_f,
+                beta,
+                gamma,
+                ..
+            }) => {
+                // ũ = uⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (u^{n+1} − ũ)/(βτ²); the equation at
+                // t^{n+1−α} times βτ²/(1−α_m):
+                // (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f φⁿ q + c φ^{n+1} q.
+                let bt2 = beta * tau * tau;
+                let kp = tau * tau * (0.5 - beta);
+                let km = alpha_m * bt2 / (1.0 - alpha_m);
+                let kf = alpha_f * bt2 / (1.0 - alpha_m);
+                for i in 0..m {
+                    wk.pred[i] = st.u[i] + tau * st.v[i] + kp * st.a[i];
+                    wk.y[i] = wk.pred[i] - km * st.a[i];
+                }
+                sp.mass.mul_into(&wk.y, &mut wk.b);
+                self.klin.mul_into(&st.u, &mut wk.y);
+                for (b, ku) in wk.b.iter_mut().zip(&wk.y) {
+                    *b -= kf * ku;
+                }
+                wk.b[0] += kf * st.phi_prev * sp.q.0[0];
+                wk.b[1] += kf * st.phi_prev * sp.q.0[1];
+                let (_, phi) = self.solve_step(wk, &self.state_law(), self.p0)?;
+                let ib = 1.0 / bt2;
+                for i in 0..m {
+                    let an = (wk.y[i] - wk.pred[i]) * ib;
+                    st.v[i] += tau * ((1.0 - gamma) * st.a[i] + gamma * an);
+                    st.a[i] = an;
+                }
+                std::mem::swap(&mut st.u, &mut wk.y);
+                phi
+            }
+            Scheme::MoreauJean(MoreauJeanParams { theta, restitution }) => {
+                // (M + θ²τ²K)Δv = −τK(uⁿ + θτvⁿ) + Bᵀp; the contact row is active when its
+                // predicted gap (Buⁿ + g) + ½τ Bvⁿ closes, and then 0 ≤ p ⊥ Bv^{n+1} + e Bvⁿ ≥ 0.
+                for i in 0..m {
+                    wk.y[i] = st.u[i] + theta * tau * st.v[i];
+                }
+                self.klin.mul_into(&wk.y, &mut wk.b);
+                for b in wk.b.iter_mut() {
+                    *b *= -tau;
+                }
+                let vn = self.p.dot(&st.v);
+                let law = if s_n + 0.5 * tau * vn <= 0.0 {
+                    ContactLaw::Complementarity
+                } else {
+                    ContactLaw::PositivePart { k: 0.0 }
+                };
+                let (_, phi) = self.solve_step(wk, &law, (1.0 + restitution) * vn)?;
+                for i in 0..m {
+                    st.u[i] += tau * (st.v[i] + theta * wk.y[i]);
+                    st.v[i] += wk.y[i];
+                }
+                phi
+            }
+            _ => unreachable!("not a SPEC §3.2 method"),
+        };
+        st.s_prev = self.p.dot(&st.u) + self.p0;
+        st.phi_prev = phi;
+        Ok(phi)
+    }
+
+    /// wk.y = Δu of an incremental step: v^{n+1} = 2Δu/τ − vⁿ, u^{n+1} = uⁿ + Δu (a massless
+    /// node's velocity is its difference quotient).
+    fn finish_increment(&self, st: &mut State, wk: &Work, tau: f64) {
+        for ((u, v), d) in st.u.iter_mut().zip(st.v.iter_mut()).zip(&wk.y) {
+            *v = 2.0 * d / tau - *v;
+            *u += d;
+        }
+        if self.sp.massless_contact {
+            st.v[0] = wk.y[0] / tau;
+            st.a[0] = 0.0;
+        }
     }
 }
 
@@ -455,6 +715,7 @@ fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), Contac
                 .collect(),
             a,
             s_prev,
+            phi_prev: phi,
         },
         sigma,
     ))
@@ -684,6 +945,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(())
     })();
     metrics.steps = done as i64;
+    metrics.iterations += eng.extra_iterations.get();
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);

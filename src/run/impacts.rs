@@ -20,6 +20,17 @@
 //! 400-run 1D sweep) only to find these phases; a run knows them for the cost of a comparison
 //! per step, and they travel with the run's row, committed atomically with it.
 //!
+//! # Pressure oscillation (SPEC §3.2)
+//! Per contact interval, TV/(2·max|σ_C|) with TV the total variation of σ_C over the
+//! interval's steps, the rise from zero before its first step and the fall to zero after its
+//! last included: 1 for a pressure that rises once and falls once (any monotone rise and fall),
+//! 1 + (the chatter's variation)/(2·peak) otherwise. The run's `pressure_oscillation` is the
+//! largest over its intervals (None without contact). The intervals here are the maximal runs
+//! of consecutive steps with σ_C < 0 — *not* the phases above, whose one-step gaps merge: SPEC
+//! §6's figures are those of unmerged intervals (Moreau–Jean with e = 1 applies its impulses
+//! every other step through an impact, each one an interval of one step: 1.00; merged, the
+//! same run would read 30). Accumulated at every step: a decimated series would miss it.
+//!
 //! # Memory
 //! The phase list is reserved at setup for [`RESERVED_PHASES`] phases, so the time loop does
 //! not allocate (tests/alloc.rs). A run with more phases (a chattering contact) grows the list
@@ -63,6 +74,14 @@ pub struct PhaseTracker {
     /// The first step after the open phase's last contact step was observed (its values are
     /// in `open.energy_after`): the phase's `after` if no contact follows within the gap.
     after_seen: bool,
+    /// The open contact interval (σ < 0 at every step of it): total variation of σ so far
+    /// (the rise from zero included), its peak |σ| and σ at the previous step.
+    in_interval: bool,
+    tv: f64,
+    peak: f64,
+    sigma_prev: f64,
+    /// Largest TV/(2·peak) of the closed intervals.
+    oscillation: Option<f64>,
 }
 
 impl Default for PhaseTracker {
@@ -78,7 +97,48 @@ impl PhaseTracker {
             open: None,
             prev: None,
             after_seen: false,
+            in_interval: false,
+            tv: 0.0,
+            peak: 0.0,
+            sigma_prev: 0.0,
+            oscillation: None,
         }
+    }
+
+    /// Follow the contact intervals of σ (module header, pressure oscillation).
+    #[inline]
+    fn track_oscillation(&mut self, sigma: f64) {
+        if sigma < 0.0 {
+            if self.in_interval {
+                self.tv += (sigma - self.sigma_prev).abs();
+                self.peak = self.peak.max(-sigma);
+            } else {
+                // The rise from zero.
+                self.in_interval = true;
+                self.tv = -sigma;
+                self.peak = -sigma;
+            }
+        } else if self.in_interval {
+            self.close_oscillation();
+        }
+        self.sigma_prev = sigma;
+    }
+
+    /// Close the open interval: TV with the fall to zero from its last step, over twice the
+    /// peak.
+    fn close_oscillation(&mut self) {
+        if !self.in_interval {
+            return;
+        }
+        self.in_interval = false;
+        let r = (self.tv + self.sigma_prev.abs()) / (2.0 * self.peak);
+        self.oscillation = Some(self.oscillation.map_or(r, |o| o.max(r)));
+    }
+
+    /// max over the contact intervals closed so far (all of them after [`Self::finish`]) of
+    /// TV(σ)/(2·max|σ|); None if there was none.
+    pub fn pressure_oscillation(&self) -> Option<f64> {
+        self.oscillation
     }
 
     /// Record step `step` (consecutive steps, from the first observed one).
@@ -123,6 +183,7 @@ impl PhaseTracker {
                 }
             }
         }
+        self.track_oscillation(sigma);
         self.prev = Some(Prev { energy, theta });
     }
 
@@ -131,6 +192,7 @@ impl PhaseTracker {
     /// allocation within the reserve); the tracker is empty afterwards.
     pub fn finish(&mut self) -> Vec<Phase> {
         let mut out = std::mem::take(&mut self.phases);
+        self.close_oscillation();
         if let Some(mut ph) = self.open.take() {
             if !self.after_seen {
                 ph.energy_after = None;
@@ -191,6 +253,37 @@ mod tests {
         // Open phase whose gap step is the last step: that step is its `after`.
         let ph = run(&[0.0, -1.0, 0.0]);
         assert_eq!((ph[0].step_last, ph[0].energy_after), (1, Some(12.0)));
+    }
+
+    fn oscillation(sigma: &[f64]) -> Option<f64> {
+        let mut p = PhaseTracker::new();
+        for (n, &s) in sigma.iter().enumerate() {
+            p.step(n, n as f64, s, 1.0, None);
+        }
+        p.finish();
+        p.pressure_oscillation()
+    }
+
+    #[test]
+    fn pressure_oscillation_is_one_for_a_single_rise_and_fall() {
+        // Rise 0 → −1 → −2, hold, fall: TV = 4 = 2·peak (binary values: exact).
+        assert_eq!(
+            oscillation(&[0.0, -1.0, -2.0, -2.0, -1.0, 0.0, 0.0]),
+            Some(1.0)
+        );
+        // Alternating between two levels: TV = 1 + 3·1 + 2 = 6 over 2·2 → 1.5; the worse of two
+        // intervals wins. A one-step gap ends an interval (unlike a phase): pulses read 1 each.
+        assert_eq!(
+            oscillation(&[0.0, -1.0, -2.0, -1.0, -2.0, 0.0, 0.0, -3.0, 0.0, 0.0]),
+            Some(1.5)
+        );
+        assert_eq!(
+            oscillation(&[0.0, -1.0, 0.0, -1.0, 0.0, -1.0, 0.0]),
+            Some(1.0)
+        );
+        // A phase still open at the end falls to zero by definition; no contact: None.
+        assert_eq!(oscillation(&[0.0, -2.0, -1.0]), Some(1.0));
+        assert_eq!(oscillation(&[0.0, 0.0]), None);
     }
 
     #[test]

@@ -79,6 +79,8 @@ pub struct Metrics {
     pub err_impact_time: Option<f64>,
     /// The bar's mean velocity 1ᵀMv/1ᵀM1 at the last step (bar1d with a free end).
     pub exit_velocity: Option<f64>,
+    /// max over the contact phases of TV(σ_C)/(2·max|σ_C|) (SPEC §3.2), from the phases.
+    pub pressure_oscillation: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -545,6 +547,7 @@ impl Observer {
 
         metrics.contact_switches = self.switches;
         metrics.impacts = Some(self.impacts.finish());
+        metrics.pressure_oscillation = self.impacts.pressure_oscillation();
         metrics.energy_theta_initial = self.e0_theta;
         metrics.max_penetration = self.max_penetration;
         if complete && self.has_exact {

@@ -130,7 +130,7 @@ schema! {
         mass: String => "", "mass variant (SPEC §2.2)";
         mass_weights: Option<String> => "", "user element weights w1,w2,… (mass = weights)";
         contact_init: Option<String> => "", "start of a massless contact node: consistent (its quasi-static value) or interpolant (u0(0)); null when the contact node has mass";
-        scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid";
+        scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid | kane | contact-stabilized-newmark | generalized-alpha | hht | moreau-jean | discrete-gradient";
         scheme_label: String => "", "preset name when the parameters are a preset's (crank-nicolson, backward-euler, …)";
         nitsche_theta: Option<f64> => "", "Nitsche Θ";
         nitsche_gamma0: Option<f64> => "", "Nitsche γ0 (γ_h = γ0 h)";
@@ -139,6 +139,8 @@ schema! {
         newmark_gamma: Option<f64> => "", "Newmark γ";
         theta_scheme: Option<f64> => "", "θ of the θ-scheme";
         restitution: Option<f64> => "", "Paoli–Schatzman restitution e";
+        rho_inf: Option<f64> => "", "generalized-α spectral radius at infinity ρ∞ (SPEC §3.2)";
+        hht_alpha: Option<f64> => "", "HHT α (scheme = hht, SPEC §3.2)";
         length: Option<f64> => "m", "bar length L";
         young: Option<f64> => "Pa", "Young modulus E";
         density: Option<f64> => "kg/m", "density ρ";
@@ -157,7 +159,7 @@ schema! {
         repeats: i64 => "", "timing repeats (results are identical across repeats)";
         steps: i64 => "", "time steps completed";
         dofs: i64 => "", "unknowns of the space discretisation";
-        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step)";
+        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step; two with contact-stabilized-newmark; the Newton iterations of discrete-gradient)";
         factorizations: i64 => "", "matrix factorisations performed";
         solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
         contact_switches: i64 => "", "times the contact pressure switched on or off";
@@ -208,6 +210,7 @@ schema! {
         err_v_l2: Option<f64> => "m·s^-½", "oscillator: (τ Σ_n |v^n − v(t^n)|²)^½ (velocities jump at impacts: the l2(τ) norm is the meaningful one)";
         err_impact_time: Option<f64> => "s", "oscillator: max over the exact impacts in [0, T] of the distance to the nearest discrete contact start";
         exit_velocity: Option<f64> => "m/s", "bar1d with a free end: the bar's mean velocity 1ᵀMv/1ᵀM1 at T (the flying bar leaves with −v0)";
+        pressure_oscillation: Option<f64> => "", "max over the contact phases (impact_*) of TV/(2·max|σ_C|), TV the total variation of σ_C (1D) or of the total contact force (2D/3D) over the phase's steps, rise from and fall to zero included: 1 for a pressure that rises once and falls once, larger when it chatters (SPEC §3.2); null without contact";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -340,6 +343,8 @@ impl RunRecord {
             newmark_gamma: f(Key::NewmarkGamma),
             theta_scheme: f(Key::ThetaScheme),
             restitution: f(Key::Restitution),
+            rho_inf: f(Key::RhoInf),
+            hht_alpha: f(Key::HhtAlpha),
             length: f(Key::Length),
             young: f(Key::Young),
             density: f(Key::Density),
@@ -409,6 +414,7 @@ impl RunRecord {
             err_v_l2: m.err_v_l2,
             err_impact_time: m.err_impact_time,
             exit_velocity: m.exit_velocity,
+            pressure_oscillation: m.pressure_oscillation,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

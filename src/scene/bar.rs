@@ -153,7 +153,7 @@ impl Scene for BarScene {
                 format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
             ));
         }
-        if matches!(scheme, "paoli-schatzman" | "hybrid") {
+        if !matches!(scheme, "newmark" | "theta") {
             return Err((
                 "scheme",
                 format!(

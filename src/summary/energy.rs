@@ -23,7 +23,9 @@
 //! while an ill-posed method (consistent mass or Nitsche with γ0 → 0, with CN) gains 15 % to
 //! 1100 %, far above δ at every h. For the schemes with a proven non-increasing functional —
 //! the hybrid with Nitsche Θ = 1 and E_Θ (003 Cor 3.8), the 000 §5 hybrid (mixed, massless
-//! contact node) and E^h (Lemma 5.1), backward Euler with Nitsche Θ = 1 and E_Θ (003 Cor 3.2)
+//! contact node) and E^h (Lemma 5.1), backward Euler with Nitsche Θ = 1 and E_Θ (003 Cor 3.2),
+//! and the methods of SPEC §3.2 with a proof (kane with inertia on the contact node,
+//! contact-stabilized Newmark, Moreau–Jean with θ = ½ and e = 1, the discrete gradient)
 //! — a single step that raises F by more than [`ENERGY_TOL`]·F⁰ is growth as well: the proof
 //! forbids it, and rounding stays below 1e-12 (SPEC §6).
 
@@ -74,9 +76,20 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
         _ => ("E^h", r.energy_drift, r.energy_max_increase),
     };
     let nitsche_theta_one = space == "nitsche" && theta == Some(1.0) && functional == "E_Θ";
+    // SPEC §3.2: kane (contact node with inertia), contact-stabilized Newmark, Moreau–Jean with
+    // θ = ½ and e = 1 (the impulses do no work; e < 1 may gain on a separating active row, see
+    // tests/properties.rs) never increase E^h; the discrete gradient conserves its functional.
+    let with_inertia = matches!(runs.param_str(r, "mass"), Some("consistent" | "lumped"));
+    let comparison = (scheme == "kane" && with_inertia)
+        || scheme == "contact-stabilized-newmark"
+        || (scheme == "moreau-jean"
+            && theta_scheme == Some(0.5)
+            && runs.param_f64(r, "restitution") == Some(1.0))
+        || (scheme == "discrete-gradient" && (space == "penalty" || nitsche_theta_one));
     let monotone = (hybrid && (space == "mixed" || nitsche_theta_one))
         || ((backward_euler || scheme == "theta" && theta_scheme == Some(1.0))
-            && nitsche_theta_one);
+            && nitsche_theta_one)
+        || comparison;
     // The run's own length scale; folders of older versions: the bar's `length`, else 1.
     let length = r.length_scale.unwrap_or_else(|| {
         runs.param_f64(r, "length")

@@ -65,6 +65,7 @@ pub mod convergence;
 pub mod energy;
 pub mod ensemble;
 mod latex;
+pub mod methods;
 pub mod options;
 pub(crate) mod runs;
 mod search;
@@ -169,6 +170,7 @@ pub(crate) struct Sections {
     pub(crate) st: stability::Section,
     pub(crate) se: search::Section,
     pub(crate) wp: work::Section,
+    pub(crate) methods: methods::Section,
     pub(crate) warnings: Vec<String>,
 }
 
@@ -208,6 +210,7 @@ impl Sections {
         let (en, ens, st, se, wp) =
             rest.map_err(|_| anyhow::anyhow!("a summary section panicked"))?;
         let en = en?;
+        let methods = methods::section(&runs);
         Ok(Sections {
             runs,
             title,
@@ -217,6 +220,7 @@ impl Sections {
             st,
             se,
             wp,
+            methods,
             warnings,
         })
     }
@@ -231,6 +235,7 @@ impl Sections {
             st,
             se,
             wp,
+            methods,
             ..
         } = self;
         let out = dir.join("summary");
@@ -257,6 +262,9 @@ impl Sections {
             Output::Table("work_precision", &wp.table),
             Output::Table("cost_to_error", &wp.cost),
             Output::Text("work_precision.md", &wp.markdown),
+            Output::Table("methods", &methods.table),
+            Output::Text("methods.md", &methods.markdown),
+            Output::Text("methods.tex", &methods.latex),
         ];
         let out_dir: &Path = &out;
         let results: Vec<anyhow::Result<Vec<PathBuf>>> = std::thread::scope(|scope| {
@@ -306,7 +314,7 @@ impl Sections {
         terminal.push_str(&se.terminal);
         terminal.push_str(&wp.terminal);
         terminal.push_str(&format!(
-            "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error as .parquet/.csv; .md; convergence.tex, convergence_doc.tex)\n",
+            "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error, methods as .parquet/.csv; .md; convergence.tex, convergence_doc.tex, methods.tex)\n",
             out.display()
         ));
         if !conv.groups.hints.is_empty() {

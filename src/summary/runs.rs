@@ -33,6 +33,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("newmark_gamma", Kind::F64),
     ("theta_scheme", Kind::F64),
     ("restitution", Kind::F64),
+    ("rho_inf", Kind::F64),
+    ("hht_alpha", Kind::F64),
     ("length", Kind::F64),
     ("young", Kind::F64),
     ("density", Kind::F64),
@@ -69,6 +71,8 @@ const IN_LABEL: &[&str] = &[
     "newmark_gamma",
     "theta_scheme",
     "restitution",
+    "rho_inf",
+    "hht_alpha",
 ];
 
 /// The refinement axes: `h` (or `elements`), `dt` (or `courant`).
@@ -112,6 +116,8 @@ const MEASURED: &[(&str, Kind)] = &[
     ("energy_theta_initial", Kind::F64),
     ("length_scale", Kind::F64),
     ("search", Kind::Str),
+    ("max_penetration", Kind::F64),
+    ("pressure_oscillation", Kind::F64),
 ];
 
 /// One parameter value.
@@ -184,6 +190,9 @@ pub(crate) struct Run {
     pub length_scale: Option<f64>,
     /// Ensemble member index (null outside ensembles).
     pub ensemble_sample: Option<i64>,
+    /// Runs columns `max_penetration`, `pressure_oscillation` (None in older folders).
+    pub max_penetration: Option<f64>,
+    pub pressure_oscillation: Option<f64>,
     /// The `[search]` whose probe this run is (null for grid runs).
     pub search: Option<String>,
     /// The runs part the row was read from (`series/` holds the run's rows under the same name).
@@ -667,6 +676,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let theta_drift = get_f("energy_theta_drift")?;
     let theta_initial = get_f("energy_theta_initial")?;
     let length_scale = get_f("length_scale")?;
+    let (max_pen, press_osc) = (get_f("max_penetration")?, get_f("pressure_oscillation")?);
     let sample = get_i("ensemble_sample")?;
     let search = strs(&df, "search")?;
     let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
@@ -762,6 +772,8 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             energy_theta_initial: theta_initial[i],
             length_scale: finite(length_scale[i]).filter(|l| *l > 0.0),
             ensemble_sample: sample[i],
+            max_penetration: finite(max_pen[i]),
+            pressure_oscillation: finite(press_osc[i]),
             search: search.as_ref().and_then(|v| v[i].clone()),
             part: part.as_ref().and_then(|v| v[i].clone()),
             impacts: impacts.as_ref().and_then(|v| v[i].clone()),

@@ -49,6 +49,8 @@ const AXES: &[&str] = &[
     "newmark_gamma",
     "theta_scheme",
     "restitution",
+    "rho_inf",
+    "hht_alpha",
     "length",
     "young",
     "density",

@@ -43,6 +43,10 @@ pub enum Key {
     Stiffness,
     Force,
     ImpactLaw,
+    /// Generalized-α spectral radius at infinity ρ∞ (SPEC §3.2).
+    RhoInf,
+    /// HHT α (SPEC §3.2, preset `hht` of generalized-α).
+    HhtAlpha,
 }
 
 /// What a key's value must look like.
@@ -128,7 +132,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 32] = [
+    pub const ALL: [Key; 34] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -161,6 +165,8 @@ impl Key {
         Key::Stiffness,
         Key::Force,
         Key::ImpactLaw,
+        Key::RhoInf,
+        Key::HhtAlpha,
     ];
 
     pub fn name(self) -> &'static str {
@@ -197,6 +203,8 @@ impl Key {
             Key::Stiffness => "stiffness",
             Key::Force => "force",
             Key::ImpactLaw => "impact_law",
+            Key::RhoInf => "rho_inf",
+            Key::HhtAlpha => "hht_alpha",
         }
     }
 
@@ -350,6 +358,8 @@ impl Key {
             (Key::NewmarkGamma | Key::ThetaScheme | Key::Restitution, Value::Num(x)) => {
                 within(*x, 0.0, 1.0)
             }
+            (Key::RhoInf, Value::Num(x)) => within(*x, 0.0, 1.0),
+            (Key::HhtAlpha, Value::Num(x)) => within(*x, 0.0, 1.0 / 3.0),
             (Key::NitscheTheta | Key::Gravity, Value::Num(x)) => finite(*x).map(|_| ()),
             (Key::Degree, Value::Num(x)) => {
                 if *x == 1.0 || *x == 2.0 {
@@ -364,7 +374,7 @@ impl Key {
 }
 
 /// Scheme names and aliases accepted in sweep files (SPEC §3).
-pub const SCHEME_NAMES: [&str; 8] = [
+pub const SCHEME_NAMES: [&str; 14] = [
     "newmark",
     "crank-nicolson",
     "newmark-dissipative",
@@ -373,4 +383,10 @@ pub const SCHEME_NAMES: [&str; 8] = [
     "backward-euler",
     "paoli-schatzman",
     "hybrid",
+    "kane",
+    "contact-stabilized-newmark",
+    "generalized-alpha",
+    "hht",
+    "moreau-jean",
+    "discrete-gradient",
 ];

@@ -23,7 +23,10 @@ use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
 use crate::scene::{Physics, Scene, SceneKind};
 use crate::space::{ContactInit, ContactMethod, MassVariant};
-use crate::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
+use crate::time::{
+    AlphaPreset, GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, PaoliSchatzmanParams,
+    Scheme, ThetaParams,
+};
 
 /// One run of the plan.
 #[derive(Debug, Clone, PartialEq)]
@@ -141,6 +144,7 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::NewmarkBeta => Value::Num(0.25),
         Key::NewmarkGamma => Value::Num(0.5),
         Key::Restitution => Value::Num(1.0),
+        Key::RhoInf => Value::Num(1.0),
         Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
         k if k.is_physics() => physics_value(
             k,
@@ -248,6 +252,33 @@ fn resolve(
             beta: num(Key::NewmarkBeta).unwrap(),
             restitution: num(Key::Restitution).unwrap(),
         }),
+        (None, "kane") => Scheme::Kane,
+        (None, "contact-stabilized-newmark") => Scheme::ContactStabilizedNewmark,
+        (None, "generalized-alpha") => Scheme::GeneralizedAlpha(
+            GeneralizedAlphaParams::from_rho_inf(num(Key::RhoInf).unwrap()),
+        ),
+        (None, "hht") => match num(Key::HhtAlpha) {
+            Some(alpha) => Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(alpha)),
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Scheme),
+                    "scheme = hht needs hht_alpha (α ∈ [0, ⅓]; α = 0 is Crank–Nicolson)",
+                ));
+                Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(0.0))
+            }
+        },
+        // Moreau–Jean's own defaults (SPEC §3.2): θ = ½, e = 0 — not Paoli–Schatzman's e = 1.
+        (None, "moreau-jean") => Scheme::MoreauJean(MoreauJeanParams {
+            theta: user
+                .get(&Key::ThetaScheme)
+                .and_then(|(v, _)| v.as_f64())
+                .unwrap_or(0.5),
+            restitution: user
+                .get(&Key::Restitution)
+                .and_then(|(v, _)| v.as_f64())
+                .unwrap_or(0.0),
+        }),
+        (None, "discrete-gradient") => Scheme::DiscreteGradient,
         (None, _) => Scheme::Hybrid,
     };
 
@@ -312,8 +343,24 @@ fn resolve(
             Key::PenaltyGamma0 => space_name == "penalty",
             Key::NewmarkBeta => matches!(scheme, Scheme::Newmark(_) | Scheme::PaoliSchatzman(_)),
             Key::NewmarkGamma => matches!(scheme, Scheme::Newmark(_)),
-            Key::ThetaScheme => matches!(scheme, Scheme::Theta(_)),
-            Key::Restitution => matches!(scheme, Scheme::PaoliSchatzman(_)),
+            Key::ThetaScheme => matches!(scheme, Scheme::Theta(_) | Scheme::MoreauJean(_)),
+            Key::Restitution => {
+                matches!(scheme, Scheme::PaoliSchatzman(_) | Scheme::MoreauJean(_))
+            }
+            Key::RhoInf => matches!(
+                scheme,
+                Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                    preset: AlphaPreset::RhoInf(_),
+                    ..
+                })
+            ),
+            Key::HhtAlpha => matches!(
+                scheme,
+                Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                    preset: AlphaPreset::Hht(_),
+                    ..
+                })
+            ),
             Key::MassWeights => mass_name == "weights",
             Key::ContactInit => mass.massless_contact() && scene.contact_init_matters(),
             _ => true,
@@ -326,8 +373,10 @@ fn resolve(
             Key::PenaltyGamma0 => "applies to space = penalty only",
             Key::NewmarkBeta => "applies to newmark and paoli-schatzman only",
             Key::NewmarkGamma => "applies to newmark only",
-            Key::ThetaScheme => "applies to the theta scheme only",
-            Key::Restitution => "applies to paoli-schatzman only",
+            Key::ThetaScheme => "applies to the theta scheme (and moreau-jean) only",
+            Key::Restitution => "applies to paoli-schatzman (and moreau-jean) only",
+            Key::RhoInf => "applies to generalized-alpha only",
+            Key::HhtAlpha => "applies to hht only",
             Key::ContactInit => {
                 if scene.contact_init_matters() {
                     "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
@@ -357,7 +406,39 @@ fn resolve(
             "hybrid with space = mixed needs a massless contact node (mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)".into(),
         );
     }
-    if scheme.is_explicit() && method == ContactMethod::Mixed && !massless {
+    // SPEC §3.2: where each method of the comparison literature applies.
+    let family = scheme.family();
+    if matches!(
+        scheme,
+        Scheme::Kane | Scheme::ContactStabilizedNewmark | Scheme::MoreauJean(_)
+    ) && method != ContactMethod::Mixed
+    {
+        return Outcome::Inapplicable(format!("{family} is defined for space = mixed only"));
+    }
+    if scheme.needs_contact_mass() && massless {
+        return Outcome::Inapplicable(format!(
+            "{family} needs inertia on the contact dof (mass = consistent or lumped)"
+        ));
+    }
+    if scheme == Scheme::DiscreteGradient {
+        match method {
+            ContactMethod::Mixed => {
+                return Outcome::Inapplicable(
+                    "discrete-gradient needs a contact potential (space = penalty, or nitsche with Θ = 1)".into(),
+                );
+            }
+            ContactMethod::Nitsche { theta, .. } if theta != 1.0 => {
+                return Outcome::Inapplicable(
+                    "discrete-gradient with space = nitsche needs nitsche_theta = 1 (only then is the Nitsche term a potential)".into(),
+                );
+            }
+            _ => {}
+        }
+    }
+    // Central difference with `mixed` and a diagonal mass: kinematic contact (SPEC §3.2).
+    let kinematic = scheme == Scheme::Newmark(NewmarkParams::central_difference())
+        && mass == MassVariant::Lumped;
+    if scheme.is_explicit() && method == ContactMethod::Mixed && !massless && !kinematic {
         return Outcome::Inapplicable(
             "an explicit scheme cannot enforce the multiplier constraint on a contact node with mass".into(),
         );
@@ -578,7 +659,19 @@ fn resolve(
             put(Key::NewmarkBeta, Value::Num(p.beta), false);
             put(Key::Restitution, Value::Num(p.restitution), false);
         }
-        Scheme::Hybrid => {}
+        Scheme::Hybrid
+        | Scheme::Kane
+        | Scheme::ContactStabilizedNewmark
+        | Scheme::DiscreteGradient => {}
+        // New schemes: their parameters always in the id (their defaults are their own).
+        Scheme::GeneralizedAlpha(p) => match p.preset {
+            AlphaPreset::RhoInf(r) => put(Key::RhoInf, Value::Num(r), true),
+            AlphaPreset::Hht(a) => put(Key::HhtAlpha, Value::Num(a), true),
+        },
+        Scheme::MoreauJean(p) => {
+            put(Key::ThetaScheme, Value::Num(p.theta), true);
+            put(Key::Restitution, Value::Num(p.restitution), true);
+        }
     }
     for (name, value) in &physics.0 {
         let key = Key::from_name(name).unwrap();
