@@ -482,6 +482,12 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     for d in &sink.damaged {
         eprintln!("warning: {}", d.warning());
     }
+    if !sink.migrated.is_empty() {
+        eprintln!(
+            "note: {} runs part(s) written by an older version given this version's columns (new columns null), so that every reader sees one schema",
+            sink.migrated.len()
+        );
+    }
     for p in &sink.legacy_damaged {
         eprintln!(
             "note: moved {} (a damaged part set aside by an older version) out of the parts' folder",

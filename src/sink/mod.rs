@@ -32,7 +32,9 @@
 //! present exactly once. Renaming is safe while other shards write (their parts are complete
 //! files, never rewritten). Folders written before this layout kept temporaries and damaged
 //! parts as dot-files beside the parts (`runs/.tmp-NAME`, `runs/.damaged-NAME`): the clean-up
-//! removes the former and moves the latter to `damaged/`. Readers ([`read_runs`], the
+//! removes the former and moves the latter to `damaged/`, and runs parts with another column
+//! set than the current [`RunRecord`] are rewritten with it ([`conform_runs_parts`]: a glob
+//! reader takes the first part's columns as the folder's). Readers ([`read_runs`], the
 //! summaries) skip unreadable parts, with the same warning ([`Damaged::warning`]).
 
 use std::collections::HashSet;
@@ -362,6 +364,46 @@ pub fn legacy_damaged(folder: &Path) -> Result<Vec<PathBuf>, SinkError> {
     Ok(out)
 }
 
+/// Give every readable runs part of `runs_dir` the columns of the current [`RunRecord`]
+/// (written into `tmp_dir`, synced, renamed over the part: a reader sees the old part or the
+/// new one, never a mix; a crash leaves some parts converted and the next session converts the
+/// rest). Returns the parts rewritten. Unreadable parts are left to [`quarantine`]. Only
+/// called under the exclusive lock, before any session writes.
+pub fn conform_runs_parts(tmp_dir: &Path, runs_dir: &Path) -> Result<Vec<PathBuf>, SinkError> {
+    let current = parquet::record_batch(RunRecord::to_columns(&[]))
+        .map_err(|source| SinkError::Format {
+            path: runs_dir.to_path_buf(),
+            source,
+        })?
+        .schema();
+    let mut rewritten = Vec::new();
+    for part in parquet_parts(runs_dir)? {
+        match parquet::runs_part_is_current(&part, &current) {
+            Ok(true) | Err(_) => continue,
+            Ok(false) => {}
+        }
+        let name = part
+            .file_name()
+            .and_then(|n| n.to_str())
+            .unwrap_or("part")
+            .to_string();
+        match write_part_atomic(tmp_dir, runs_dir, &name, "conform", |out| {
+            parquet::conform_runs_part(&part, &current, out)
+        }) {
+            Ok(_) => rewritten.push(part),
+            // A page that cannot be decoded: the part stays as it is, for `quarantine`.
+            Err(SinkError::Format { .. }) => {
+                let _ = fs::remove_file(tmp_dir.join(format!("{name}.conform")));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    if !rewritten.is_empty() {
+        sync_dir(runs_dir)?;
+    }
+    Ok(rewritten)
+}
+
 /// Read the run_id column of every committed runs part.
 pub fn committed_run_ids(runs_dir: &Path) -> Result<HashSet<String>, SinkError> {
     let mut ids = HashSet::new();
@@ -488,6 +530,9 @@ pub struct Sink {
     /// Damaged parts of the layout before `damaged/` (dot-files beside the parts), moved to
     /// `damaged/` when the folder was opened: where each went.
     pub legacy_damaged: Vec<PathBuf>,
+    /// Runs parts of an older version rewritten with the current columns when the folder was
+    /// opened ([`conform_runs_parts`]).
+    pub migrated: Vec<PathBuf>,
     shared_with_others: bool,
     shared: Arc<Mutex<Shared>>,
     jobs: Option<mpsc::SyncSender<Job>>,
@@ -518,8 +563,11 @@ impl Sink {
             Err(fs::TryLockError::Error(e)) => return Err(io(&lock_path)(e)),
         };
         let tmp_dir = dir.join(".tmp");
+        let mut migrated = Vec::new();
         if alone {
             Self::clean(&tmp_dir, &runs_dir, &series_dir)?;
+            fs::create_dir_all(&tmp_dir).map_err(io(&tmp_dir))?;
+            migrated = conform_runs_parts(&tmp_dir, &runs_dir)?;
             lock.unlock().map_err(io(&lock_path))?;
         }
         fs::create_dir_all(&tmp_dir).map_err(io(&tmp_dir))?;
@@ -556,6 +604,7 @@ impl Sink {
                 seq: 0,
                 damaged,
                 legacy_damaged,
+                migrated,
                 shared_with_others: !alone,
                 shared,
                 jobs: Some(jobs),

@@ -230,6 +230,76 @@ pub fn write_series<W: Write + Send>(
     Ok(())
 }
 
+/// Whether a runs part already has exactly the columns of `current` (the current
+/// [`RunRecord`](crate::run::RunRecord) schema), in order.
+pub fn runs_part_is_current(path: &Path, current: &Schema) -> Result<bool, ParquetError> {
+    let b = builder(path)?;
+    let names =
+        |s: &Schema| -> Vec<String> { s.fields().iter().map(|f| f.name().clone()).collect() };
+    Ok(names(b.schema()) == names(current))
+}
+
+/// Rewrite a runs part written by an older version into `out` with the columns of `current`:
+/// its own columns as stored (read by their Parquet logical types, as every reader reads
+/// them), a column it lacks as nulls of the current type, in the current order; a column the
+/// current schema no longer has is kept, after the others (nothing computed is dropped).
+///
+/// Why: readers of a folder glob take the first part's columns as the folder's. Polars
+/// refuses a later part with a column the first lacks ("extra column in file outside of
+/// expected schema"), pyarrow's dataset (pandas) silently drops it — so a folder resumed by a
+/// version with new columns (`rho_inf`, `pressure_oscillation`, …) must hold one schema.
+pub fn conform_runs_part<W: Write + Send>(
+    path: &Path,
+    current: &Schema,
+    out: W,
+) -> Result<(), ParquetError> {
+    let file = File::open(path).map_err(|e| ParquetError::External(Box::new(e)))?;
+    let b = ParquetRecordBatchReaderBuilder::try_new_with_options(
+        file,
+        ArrowReaderOptions::new().with_skip_arrow_metadata(true),
+    )?;
+    let stored = b.schema().clone();
+    let batches = b.build()?.collect::<Result<Vec<_>, _>>()?;
+    let mut fields: Vec<Field> = Vec::new();
+    let mut source: Vec<Option<usize>> = Vec::new();
+    for f in current.fields() {
+        match stored.index_of(f.name()) {
+            Ok(k) => {
+                fields.push(stored.field(k).clone().with_nullable(true));
+                source.push(Some(k));
+            }
+            Err(_) => {
+                fields.push(f.as_ref().clone());
+                source.push(None);
+            }
+        }
+    }
+    for (k, f) in stored.fields().iter().enumerate() {
+        if current.index_of(f.name()).is_err() {
+            fields.push(f.as_ref().clone().with_nullable(true));
+            source.push(Some(k));
+        }
+    }
+    let schema = Arc::new(Schema::new(fields));
+    let options = ArrowWriterOptions::new()
+        .with_properties(properties(&schema, Compression::UNCOMPRESSED))
+        .with_skip_arrow_metadata(true);
+    let mut writer = ArrowWriter::try_new_with_options(out, Arc::clone(&schema), options)?;
+    for batch in batches {
+        let columns: Vec<ArrayRef> = source
+            .iter()
+            .zip(schema.fields())
+            .map(|(k, f)| match k {
+                Some(k) => Arc::clone(batch.column(*k)),
+                None => new_null_array(f.data_type(), batch.num_rows()),
+            })
+            .collect();
+        writer.write(&RecordBatch::try_new(Arc::clone(&schema), columns)?)?;
+    }
+    writer.close()?;
+    Ok(())
+}
+
 fn builder(path: &Path) -> Result<ParquetRecordBatchReaderBuilder<File>, ParquetError> {
     let file = File::open(path).map_err(|e| ParquetError::External(Box::new(e)))?;
     ParquetRecordBatchReaderBuilder::try_new_with_options(
