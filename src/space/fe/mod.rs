@@ -8,6 +8,9 @@
 //!   quadrature;
 //! - [`nitsche`]: the Γ_C quadrature points of the disc/ball with the linear functionals u_n and
 //!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
+//! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, via `mshio`) of the `mesh2d`/`mesh3d` scenes:
+//!   P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, physical groups by name,
+//!   validated (typed [`GmshError`]s), with `h` and the file's content hash;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
@@ -20,12 +23,14 @@
 
 pub mod ball;
 pub mod element;
+pub mod gmsh;
 pub mod mesh;
 pub mod nitsche;
 pub mod sparse;
 
 pub use ball::{BallMesh, BoundaryFace, FacePoint};
 pub use element::{ElementOp, Q1Mat2, Q1Mat3, Q2Mat2, Q2Mat3};
+pub use gmsh::{ElementKind, GmshError, GmshMesh, PhysicalGroup};
 pub use mesh::{BoxMesh, Mesh};
 pub use sparse::{Pattern, SymMatrix, assemble, assemble_into, assemble_load, fe_pattern};
 
