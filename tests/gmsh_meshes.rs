@@ -172,3 +172,45 @@ fn content_hash_is_the_files_sha256() {
     assert_eq!(mesh("cube_tet.msh").content_hash, want);
     assert_eq!(want.len(), 64);
 }
+
+/// Cells of a structured box mesh in tensor order: local node a = (i, j, k) (x fastest, p + 1
+/// per axis) sits at node 0 + (i, j, k)·spacing/p.
+fn check_tensor_order(m: &GmshMesh, p: usize, spacing: [f64; 3]) {
+    let n1 = p + 1;
+    for e in 0..m.num_elements() {
+        let x: Vec<[f64; 3]> = m.element_nodes(e).iter().map(|&n| m.coord(n)).collect();
+        for (a, xa) in x.iter().enumerate() {
+            let idx = [a % n1, (a / n1) % n1, a / (n1 * n1)];
+            for d in 0..m.dim {
+                let want = x[0][d] + idx[d] as f64 * spacing[d] / p as f64;
+                assert!((xa[d] - want).abs() < H_TOL, "cell {e} node {a}");
+            }
+        }
+    }
+}
+
+#[test]
+fn cube_q1_hexahedra_in_tensor_order() {
+    // cube_hex.geo, N = 2: 8 hexahedra, 27 nodes; contact = 4 quadrilaterals on 9 nodes at z = 0;
+    // h = the space diagonal √3/2.
+    let m = mesh("cube_hex_q1.msh");
+    assert_eq!((m.dim, m.kind), (3, ElementKind::Hex8));
+    assert_eq!((m.num_nodes(), m.num_elements()), (27, 8));
+    check_group(&m, "contact", 4, 9, 2, 0.0);
+    check_group(&m, "clamped", 4, 9, 2, 1.0);
+    assert!((m.measure() - 1.0).abs() < MEASURE_TOL, "{}", m.measure());
+    assert!((m.h - 3f64.sqrt() / 2.0).abs() < H_TOL, "h = {}", m.h);
+    check_tensor_order(&m, 1, [0.5; 3]);
+}
+
+#[test]
+fn cube_q2_hexahedra_in_tensor_order() {
+    // Degree 2 (27-node): (2N+1)^3 = 125 nodes; contact = 4 nine-node quadrilaterals, 25 nodes.
+    let m = mesh("cube_hex_q2.msh");
+    assert_eq!((m.dim, m.kind), (3, ElementKind::Hex27));
+    assert_eq!((m.num_nodes(), m.num_elements()), (125, 8));
+    check_group(&m, "contact", 4, 25, 2, 0.0);
+    assert!((m.measure() - 1.0).abs() < MEASURE_TOL, "{}", m.measure());
+    assert!((m.h - 3f64.sqrt() / 2.0).abs() < H_TOL, "h = {}", m.h);
+    check_tensor_order(&m, 2, [0.5; 3]);
+}
