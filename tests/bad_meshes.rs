@@ -271,3 +271,14 @@ fn refused_path(p: &str) -> GmshError {
     assert!(e.to_string().contains(p), "{e}");
     e
 }
+
+#[test]
+fn clockwise_surface_is_reoriented_not_refused() {
+    // Both triangles clockwise (a surface oriented towards −z): a valid mesh, mirrored on
+    // reading so that det J > 0; the measure stays 1 (exact: two triangles of area 1/2).
+    let text = edit("2 1 2 3\n3 1 3 4\n", "2 1 3 2\n3 1 4 3\n");
+    let (r, _, _dir) = read(&text);
+    let m = r.unwrap_or_else(|e| panic!("{e}"));
+    assert!(m.reoriented);
+    assert_eq!(m.measure(), 1.0);
+}
