@@ -160,3 +160,48 @@ fn p2_on_the_gmsh_square() {
     assert_eq!(m.kind, ElementKind::Tri6);
     check::<6, 12>(&m);
 }
+
+#[test]
+fn curved_p2_triangle_mass_and_rigid_motions() {
+    // Corners (0,0), (1,0), (0,1); the midpoint node of edge 12 moved out to (0.6, 0.6): that
+    // edge is the parabola through (1,0), (0.6,0.6), (0,1), which bulges by 0.1·√2 over the
+    // chord of length √2, so |K| = 1/2 + (2/3)·√2·0.1√2 = 1/2 + 0.4/3. det J is of degree 1
+    // here (degree ≤ 2 in general), the degree-4 rule integrates ρ det J exactly.
+    let x = [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [0.6, 0.6],
+        [0.0, 0.5],
+    ];
+    let m: P2Mat2 = tri_mass(&x, RHO);
+    let total: f64 = (0..6)
+        .flat_map(|a| (0..6).map(move |b| (a, b)))
+        .map(|(a, b)| m[(2 * a, 2 * b)])
+        .sum();
+    let area = 0.5 + 0.4 / 3.0;
+    // Exact quadrature: round-off of 36 entries of size ~0.1.
+    assert!(
+        (total - RHO * area).abs() < 1e-13,
+        "{total} vs {}",
+        RHO * area
+    );
+    // Isoparametric: x ↦ (1, 0), (0, 1), (−y, x) are in the P2 span of the curved cell, their
+    // strain vanishes at every quadrature point, K r = 0 to round-off.
+    let k: P2Mat2 = tri_stiffness(&x, LAMBDA, MU);
+    for f in [
+        |_: [f64; 2]| [1.0, 0.0],
+        |_: [f64; 2]| [0.0, 1.0],
+        |p: [f64; 2]| [-p[1], p[0]],
+    ] {
+        let mut u = SMatrix::<f64, 12, 1>::zeros();
+        for (a, xa) in x.iter().enumerate() {
+            let v = f(*xa);
+            u[2 * a] = v[0];
+            u[2 * a + 1] = v[1];
+        }
+        let r = (k * u).amax();
+        assert!(r <= 1e-13 * k.amax(), "|K r| = {r} vs |K| = {}", k.amax());
+    }
+}
