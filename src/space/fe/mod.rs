@@ -8,8 +8,13 @@
 //!   quadrature;
 //! - [`nitsche`]: the Γ_C quadrature points of the disc/ball with the linear functionals u_n and
 //!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
+//! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, via `mshio`) of the `mesh2d`/`mesh3d` scenes:
+//!   P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, physical groups by name,
+//!   validated (typed [`GmshError`]s), with `h` and the file's content hash;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
+//! - [`simplex`]: vector P1/P2 triangle mass and elasticity stiffness (isoparametric, degree-4
+//!   rule), the triangles of Gmsh meshes;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
 //!   element weights (the layer-weighted masses of SPEC §2.2) and the matrix operations of a
 //!   time loop (`matvec_into` allocates nothing).
@@ -20,13 +25,17 @@
 
 pub mod ball;
 pub mod element;
+pub mod gmsh;
 pub mod mesh;
 pub mod nitsche;
+pub mod simplex;
 pub mod sparse;
 
 pub use ball::{BallMesh, BoundaryFace, FacePoint};
 pub use element::{ElementOp, Q1Mat2, Q1Mat3, Q2Mat2, Q2Mat3};
+pub use gmsh::{ElementKind, GmshError, GmshMesh, PhysicalGroup};
 pub use mesh::{BoxMesh, Mesh};
+pub use simplex::{P1Mat2, P2Mat2};
 pub use sparse::{Pattern, SymMatrix, assemble, assemble_into, assemble_load, fe_pattern};
 
 /// Errors of the finite-element layer (bad shapes, bad user-given matrices).
