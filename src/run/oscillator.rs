@@ -14,13 +14,31 @@
 //! - Paoli–Schatzman(β, e): two-step, A = m + βτ²k, contact on (x^{n+1} + e x^{n−1})/(1+e) + g,
 //!   x¹ from Newmark(β, ½), v^n = (x^{n+1} − x^{n−1})/(2τ) (as the bar).
 //!
-//! Adding a scheme (the comparison methods of SPEC §3.2 on the `methods` branch): an arm in
-//! [`Coefficients::of`] (its A, c, c_f and contact argument) and one in [`Osc::step`]
-//! (predictor and update); a velocity-level scheme (`moreau-jean`) reports its impulse / τ as
-//! φ, and a scheme whose contact is decided by a predictor (`contact-stabilized-newmark`)
-//! returns `true` for `active` when its predictor is constrained — `err_impact_time` counts a
-//! contact start where a step is active after one that was not (SPEC §1.5). The observables,
-//! the exact solution and the error columns need nothing more.
+//! The methods of SPEC §3.2 with B = 1, M = m, K = k (the scalar versions of the 1D engine's
+//! steps, [`crate::run::bar1d`]):
+//! - `kane` (`mixed`): S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q, S = m + τ²/4 k,
+//!   complementarity on xⁿ + Δx + g, v^{n+1} = 2Δx/τ − vⁿ; the force does φq·Δx ≤ 0 of work
+//!   over the step, so E^h never increases;
+//! - `contact-stabilized-newmark` (`mixed`): the M-projection of xⁿ + τvⁿ onto x ≥ −g is, for
+//!   one dof, the clamp x^pred = max(xⁿ + τvⁿ, −g); then kane from x^pred,
+//!   S Δ = −τ²/4 k (xⁿ + x^pred) + τ²/2 f + τ²/2 φ q, v^{n+1} = vⁿ + (2/τ)Δ. A step whose
+//!   predictor is clamped is in contact (SPEC §1.5); its reported force is the kane step's φ;
+//! - `generalized-alpha`/`hht`: (m + ck)x^{n+1} = m(x̃ − κ_m aⁿ) − κ_f k xⁿ + κ_f φⁿ q +
+//!   c φ^{n+1} q + c f/(1−α_f), c = (1−α_f)βτ²/(1−α_m), κ_{m,f} = α_{m,f}βτ²/(1−α_m),
+//!   x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ; `mixed` (multiplier) or `penalty` (φ(x^{n+1}));
+//! - `moreau-jean` (`mixed`): (m + θ²τ²k)Δv = −τk(xⁿ + θτvⁿ) + τf + p q; active when
+//!   xⁿ + g + ½τvⁿ ≤ 0, then 0 ≤ p ⊥ v^{n+1} + e vⁿ ≥ 0 (the contact argument on Δv with offset
+//!   (1 + e)vⁿ); x^{n+1} = xⁿ + τ(vⁿ + θΔv). Reported force p/τ. θ = ½: E^{n+1} − Eⁿ =
+//!   p(v^{n+1} + vⁿ)/2, zero for e = 1 by complementarity, ≤ 0 for e < 1;
+//! - `discrete-gradient` (`penalty`): kane's step with φ = −D(sⁿ, s^{n+1}), D the difference
+//!   quotient of κ/2[s]₊² ([`crate::contact::gradient`]): E^h + Φ conserved to round-off.
+//!
+//! Adding a scheme: an arm in [`Coefficients::of`] (its A, c, c_f and the load's coefficient)
+//! and one in [`Osc::step`] (predictor and update), and its family in `Scene::supports`
+//! (`scene::oscillator`); a velocity-level scheme reports its impulse / τ as φ, and a scheme
+//! whose contact is decided by a predictor returns `true` for `active` when it is constrained
+//! — `err_impact_time` counts a contact start where a step is active after one that was not
+//! (SPEC §1.5). The observables, the exact solution and the error columns need nothing more.
 //!
 //! Errors against the exact solution (event by event, [`OscillatorExact`]): err_u_l2l2 =
 //! (τΣ|x^n − x(t^n)|²)^½, err_u_linfl2 = max|x^n − x(t^n)|, err_v_l2 = (τΣ|v^n − v(t^n)|²)^½,
