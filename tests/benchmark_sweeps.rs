@@ -93,6 +93,19 @@ fn bad_benchmark_input_names_file_key_and_reason() {
     let e =
         refused("name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nright_end = \"free\"\n");
     assert!(e.contains("right_end"), "{e}");
+    // SPEC §3.2's applicability on the oscillator: kane, CSN and Moreau–Jean are multiplier
+    // (impulse) methods, the discrete gradient is the penalty potential's.
+    let e = refused(
+        "name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nspace = \"penalty\"\npenalty_gamma0 = 1.0\nscheme = \"kane\"\n",
+    );
+    assert!(e.contains("kane") && e.contains("mixed only"), "{e}");
+    let e = refused(
+        "name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nscheme = \"discrete-gradient\"\n",
+    );
+    assert!(
+        e.contains("discrete-gradient") && e.contains("penalty only"),
+        "{e}"
+    );
 }
 
 #[test]
