@@ -93,6 +93,19 @@ fn bad_benchmark_input_names_file_key_and_reason() {
     let e =
         refused("name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nright_end = \"free\"\n");
     assert!(e.contains("right_end"), "{e}");
+    // SPEC §3.2's applicability on the oscillator: kane, CSN and Moreau–Jean are multiplier
+    // (impulse) methods, the discrete gradient is the penalty potential's.
+    let e = refused(
+        "name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nspace = \"penalty\"\npenalty_gamma0 = 1.0\nscheme = \"kane\"\n",
+    );
+    assert!(e.contains("kane") && e.contains("mixed only"), "{e}");
+    let e = refused(
+        "name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nscheme = \"discrete-gradient\"\n",
+    );
+    assert!(
+        e.contains("discrete-gradient") && e.contains("penalty only"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -118,11 +131,11 @@ fn benchmark_sweep_files_plan() {
         let sf = SweepFile::parse(&path, &text).unwrap_or_else(|e| panic!("{e}"));
         sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"))
     };
-    // 7 levels × 3 Courant numbers × 16 methods.
-    assert_eq!(load("flying_bar.toml").runs.len(), 7 * 3 * 16);
+    // 7 levels × 3 Courant numbers × 23 methods (16 of SPEC §2–§3, 7 of §3.2).
+    assert_eq!(load("flying_bar.toml").runs.len(), 7 * 3 * 23);
     assert_eq!(load("siconos_impacting_bar.toml").runs.len(), 12);
-    // 7 steps × 3 laws × 8 methods.
-    assert_eq!(load("oscillator.toml").runs.len(), 7 * 3 * 8);
+    // 7 steps × 3 laws × 15 methods (8 of SPEC §3, 7 of §3.2).
+    assert_eq!(load("oscillator.toml").runs.len(), 7 * 3 * 15);
 }
 
 /// The summary's convergence tables are per scheme and per exact law: runs with another

@@ -14,13 +14,31 @@
 //! - Paoli–Schatzman(β, e): two-step, A = m + βτ²k, contact on (x^{n+1} + e x^{n−1})/(1+e) + g,
 //!   x¹ from Newmark(β, ½), v^n = (x^{n+1} − x^{n−1})/(2τ) (as the bar).
 //!
-//! Adding a scheme (the comparison methods of SPEC §3.2 on the `methods` branch): an arm in
-//! [`Coefficients::of`] (its A, c, c_f and contact argument) and one in [`Osc::step`]
-//! (predictor and update); a velocity-level scheme (`moreau-jean`) reports its impulse / τ as
-//! φ, and a scheme whose contact is decided by a predictor (`contact-stabilized-newmark`)
-//! returns `true` for `active` when its predictor is constrained — `err_impact_time` counts a
-//! contact start where a step is active after one that was not (SPEC §1.5). The observables,
-//! the exact solution and the error columns need nothing more.
+//! The methods of SPEC §3.2 with B = 1, M = m, K = k (the scalar versions of the 1D engine's
+//! steps, [`crate::run::bar1d`]):
+//! - `kane` (`mixed`): S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q, S = m + τ²/4 k,
+//!   complementarity on xⁿ + Δx + g, v^{n+1} = 2Δx/τ − vⁿ; the force does φq·Δx ≤ 0 of work
+//!   over the step, so E^h never increases;
+//! - `contact-stabilized-newmark` (`mixed`): the M-projection of xⁿ + τvⁿ onto x ≥ −g is, for
+//!   one dof, the clamp x^pred = max(xⁿ + τvⁿ, −g); then kane from x^pred,
+//!   S Δ = −τ²/4 k (xⁿ + x^pred) + τ²/2 f + τ²/2 φ q, v^{n+1} = vⁿ + (2/τ)Δ. A step whose
+//!   predictor is clamped is in contact (SPEC §1.5); its reported force is the kane step's φ;
+//! - `generalized-alpha`/`hht`: (m + ck)x^{n+1} = m(x̃ − κ_m aⁿ) − κ_f k xⁿ + κ_f φⁿ q +
+//!   c φ^{n+1} q + c f/(1−α_f), c = (1−α_f)βτ²/(1−α_m), κ_{m,f} = α_{m,f}βτ²/(1−α_m),
+//!   x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ; `mixed` (multiplier) or `penalty` (φ(x^{n+1}));
+//! - `moreau-jean` (`mixed`): (m + θ²τ²k)Δv = −τk(xⁿ + θτvⁿ) + τf + p q; active when
+//!   xⁿ + g + ½τvⁿ ≤ 0, then 0 ≤ p ⊥ v^{n+1} + e vⁿ ≥ 0 (the contact argument on Δv with offset
+//!   (1 + e)vⁿ); x^{n+1} = xⁿ + τ(vⁿ + θΔv). Reported force p/τ. θ = ½: E^{n+1} − Eⁿ =
+//!   p(v^{n+1} + vⁿ)/2, zero for e = 1 by complementarity, ≤ 0 for e < 1;
+//! - `discrete-gradient` (`penalty`): kane's step with φ = −D(sⁿ, s^{n+1}), D the difference
+//!   quotient of κ/2[s]₊² ([`crate::contact::gradient`]): E^h + Φ conserved to round-off.
+//!
+//! Adding a scheme: an arm in [`Coefficients::of`] (its A, c, c_f and the load's coefficient)
+//! and one in [`Osc::step`] (predictor and update), and its family in `Scene::supports`
+//! (`scene::oscillator`); a velocity-level scheme reports its impulse / τ as φ, and a scheme
+//! whose contact is decided by a predictor returns `true` for `active` when it is constrained
+//! — `err_impact_time` counts a contact start where a step is active after one that was not
+//! (SPEC §1.5). The observables, the exact solution and the error columns need nothing more.
 //!
 //! Errors against the exact solution (event by event, [`OscillatorExact`]): err_u_l2l2 =
 //! (τΣ|x^n − x(t^n)|²)^½, err_u_linfl2 = max|x^n − x(t^n)|, err_v_l2 = (τΣ|v^n − v(t^n)|²)^½,
@@ -33,10 +51,10 @@ use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
-use crate::contact::{self, ContactLaw, ContactSolveError};
+use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{OscillatorExact, OscillatorParams};
 use crate::space::ContactMethod;
-use crate::time::{NewmarkParams, Scheme};
+use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
 
 /// A validated oscillator run.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,9 +124,18 @@ impl Coefficients {
     fn of(scheme: Scheme, p: &OscillatorParams, tau: f64) -> Self {
         let (c, cf) = scheme.coefficients(tau);
         // The load enters where the stiffness does: Newmark/θ at t^{n+1} (c = βτ², θ²τ²),
-        // Paoli–Schatzman with τ² (its equation at t^n), the hybrid's midpoint with τ²/2.
+        // Paoli–Schatzman with τ² (its equation at t^n), the incremental midpoint/trapezoidal
+        // steps (hybrid, kane, CSN, discrete gradient) with τ²/2 (τ²/4 (Fⁿ + F^{n+1})),
+        // Moreau–Jean's velocity step with τ (τF^{n+θ}), generalized-α's equation at
+        // t^{n+1−α_f} times βτ²/(1−α_m) with c/(1−α_f).
         let c_load = match scheme {
-            Scheme::PaoliSchatzman(_) | Scheme::Hybrid => cf,
+            Scheme::PaoliSchatzman(_)
+            | Scheme::Hybrid
+            | Scheme::Kane
+            | Scheme::ContactStabilizedNewmark
+            | Scheme::DiscreteGradient => cf,
+            Scheme::MoreauJean(_) => tau,
+            Scheme::GeneralizedAlpha(ga) => c / (1.0 - ga.alpha_f),
             _ => c,
         };
         Self {
@@ -141,6 +168,8 @@ struct State {
     v: f64,
     a: f64,
     s_prev: f64,
+    /// φⁿ, the contact force of the previous step (generalized-α carries α_f of it).
+    phi_prev: f64,
 }
 
 /// Direction of the contact force: up (q = −1 with φ ≤ 0).
@@ -255,11 +284,97 @@ impl Osc {
                 st.s_prev = s;
                 (phi, st.x + dx)
             }
+            Scheme::Kane => {
+                // S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q, complementarity on
+                // xⁿ + Δx + g; v^{n+1} = 2Δx/τ − vⁿ. No force is carried to the next step.
+                let b = tau * m * st.v - tau * tau / 2.0 * self.p.stiffness * st.x + load;
+                let (dx, s, phi) = self.solve(b, &self.law, self.p0 + self.px * st.x)?;
+                st.v = 2.0 * dx / tau - st.v;
+                st.s_prev = s;
+                (phi, st.x + dx)
+            }
+            Scheme::ContactStabilizedNewmark => {
+                // Predictor: the M-projection of xⁿ + τvⁿ onto x ≥ −g — for one dof the
+                // clamp (W = 1/m > 0, so the LCP's solution is the projection).
+                let free = st.x + tau * st.v;
+                let pred = free.max(-self.p.gap);
+                let constrained = pred != free;
+                // kane from x^pred: S Δ = −τ²/4 k (xⁿ + x^pred) + τ²/2 f + τ²/2 φ q,
+                // Δ = x^{n+1} − x^pred; v^{n+1} = vⁿ + (2/τ) Δ.
+                let b = -tau * tau / 4.0 * self.p.stiffness * (st.x + pred) + load;
+                let (dx, s, phi) = self.solve(b, &self.law, self.p0 + self.px * pred)?;
+                st.v += 2.0 * dx / tau;
+                st.a = 0.0;
+                st.s_prev = s;
+                st.x = pred + dx;
+                // SPEC §1.5: a step whose predictor is constrained is in contact.
+                return Ok((phi, constrained || phi != 0.0));
+            }
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                alpha_m,
+                alpha_f,
+                beta,
+                gamma,
+                ..
+            }) => {
+                // x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (x^{n+1} − x̃)/(βτ²); the equation at
+                // t^{n+1−α} times βτ²/(1−α_m):
+                // (m + ck)x^{n+1} = m(x̃ − κ_m aⁿ) − κ_f k xⁿ + κ_f φⁿ q + c φ^{n+1} q + c_F f.
+                let bt2 = beta * tau * tau;
+                let km = alpha_m * bt2 / (1.0 - alpha_m);
+                let kf = alpha_f * bt2 / (1.0 - alpha_m);
+                let pred = st.x + tau * st.v + tau * tau * (0.5 - beta) * st.a;
+                let b = m * (pred - km * st.a) - kf * self.p.stiffness * st.x
+                    + kf * st.phi_prev * Q
+                    + load;
+                let (x, s, phi) = self.solve(b, &self.law, self.p0)?;
+                let a = (x - pred) / bt2;
+                st.v += tau * ((1.0 - gamma) * st.a + gamma * a);
+                st.a = a;
+                st.s_prev = s;
+                (phi, x)
+            }
+            Scheme::MoreauJean(MoreauJeanParams { theta, restitution }) => {
+                // (m + θ²τ²k)Δv = −τk(xⁿ + θτvⁿ) + τf + p q; active when the predicted gap
+                // xⁿ + g + ½τvⁿ closes, then 0 ≤ p ⊥ v^{n+1} + e vⁿ ≥ 0 (the argument on Δv:
+                // p_x = 1, offset (1 + e)vⁿ), else p = 0.
+                let b = -tau * self.p.stiffness * (st.x + theta * tau * st.v) + load;
+                let law = if st.x + self.p.gap + 0.5 * tau * st.v <= 0.0 {
+                    ContactLaw::Complementarity
+                } else {
+                    ContactLaw::PositivePart { k: 0.0 }
+                };
+                let (dv, _, impulse) = self.solve(b, &law, (1.0 + restitution) * st.v)?;
+                let x = st.x + tau * (st.v + theta * dv);
+                st.v += dv;
+                st.a = dv / tau;
+                st.s_prev = x + self.p.gap;
+                // Reported force: the impulse over the step (SPEC §3.2).
+                (impulse / tau, x)
+            }
+            Scheme::DiscreteGradient => {
+                // The midpoint rule with the force the difference quotient D of the penalty
+                // potential κ/2[s]₊² (s = −x − g): S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q
+                // with φ = −D(sⁿ, s^{n+1}), so E^h + Φ is conserved to round-off.
+                let ContactLaw::PositivePart { k } = self.law else {
+                    unreachable!("the scene gives the discrete gradient the penalty method only")
+                };
+                let b = tau * m * st.v - tau * tau / 2.0 * self.p.stiffness * st.x + load;
+                let y = b / self.k.a;
+                let s_n = self.px * st.x + self.p0;
+                let sol = gradient::solve(-k, s_n, s_n + self.px * y, self.w)?;
+                let phi = -sol.d;
+                let dx = y + phi * self.z;
+                st.v = 2.0 * dx / tau - st.v;
+                st.s_prev = sol.s;
+                (phi, st.x + dx)
+            }
             // Paoli–Schatzman is two-step (its loop is in `simulate`); a family the scene does
             // not list in `supports` never reaches the engine.
             _ => unreachable!("not a one-step scheme of the oscillator"),
         };
         st.x = x_new;
+        st.phi_prev = phi;
         Ok((phi, phi != 0.0))
     }
 }
@@ -302,6 +417,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         v: p.v0,
         a: eng.accel(x0, phi0),
         s_prev: eng.px * x0 + eng.p0,
+        phi_prev: phi0,
     };
     let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
     let mut err = Errors {

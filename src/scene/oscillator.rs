@@ -123,10 +123,40 @@ impl Scene for OscillatorScene {
         }
         // The families the oscillator's engine implements (`run::oscillator`); a new family
         // is refused here, with its reason, until its arm is written there.
-        if !matches!(scheme, "newmark" | "theta" | "paoli-schatzman" | "hybrid") {
+        if !matches!(
+            scheme,
+            "newmark"
+                | "theta"
+                | "paoli-schatzman"
+                | "hybrid"
+                | "kane"
+                | "contact-stabilized-newmark"
+                | "generalized-alpha"
+                | "hht"
+                | "moreau-jean"
+                | "discrete-gradient"
+        ) {
             return Err((
                 "scheme",
                 format!("scheme = {scheme} is not implemented for the oscillator yet"),
+            ));
+        }
+        // SPEC §3.2: kane, contact-stabilized Newmark and Moreau–Jean are multiplier (impulse)
+        // methods, `mixed` only; the discrete gradient is the penalty potential's.
+        if matches!(
+            scheme,
+            "kane" | "contact-stabilized-newmark" | "moreau-jean"
+        ) && space != "mixed"
+        {
+            return Err((
+                "scheme",
+                format!("scheme = {scheme} applies to space = mixed only (SPEC §3.2)"),
+            ));
+        }
+        if scheme == "discrete-gradient" && space != "penalty" {
+            return Err((
+                "scheme",
+                "scheme = discrete-gradient applies to the oscillator with space = penalty only (SPEC §3.2)".into(),
             ));
         }
         if scheme == "hybrid" && space != "penalty" {
