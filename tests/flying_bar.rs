@@ -353,14 +353,10 @@ fn flying_ladder(
         .collect()
 }
 
-/// Least-squares slope of log(error) against log(h).
+/// Least-squares slope of log(error) against log(step or mesh size): the summary's own fit.
 fn fitted_rate(points: &[(f64, f64)]) -> f64 {
-    let n = points.len() as f64;
-    let (xs, ys): (Vec<f64>, Vec<f64>) = points.iter().map(|(h, e)| (h.ln(), e.ln())).unzip();
-    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
-    sxy / sxx
+    let (x, e): (Vec<f64>, Vec<f64>) = points.iter().copied().unzip();
+    contact_sweep::summary::convergence::lsq_slope(&x, &e).expect("a ladder of distinct sizes")
 }
 
 /// Convergence in h = cτ (issue 21, done-when 4). The exact solution's strain jumps across the

@@ -596,20 +596,13 @@ impl Engine {
                 }
                 phi
             }
-            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
-                alpha_m,
-                alpha_f,
-                beta,
-                gamma,
-                ..
-            }) => {
+            Scheme::GeneralizedAlpha(ga @ GeneralizedAlphaParams { beta, gamma, .. }) => {
                 // ũ = uⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (u^{n+1} − ũ)/(βτ²); the equation at
                 // t^{n+1−α} times βτ²/(1−α_m):
                 // (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f φⁿ q + c φ^{n+1} q.
                 let bt2 = beta * tau * tau;
                 let kp = tau * tau * (0.5 - beta);
-                let km = alpha_m * bt2 / (1.0 - alpha_m);
-                let kf = alpha_f * bt2 / (1.0 - alpha_m);
+                let (km, kf) = ga.history_coefficients(tau);
                 for i in 0..m {
                     wk.pred[i] = st.u[i] + tau * st.v[i] + kp * st.a[i];
                     wk.y[i] = wk.pred[i] - km * st.a[i];
@@ -873,19 +866,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
             );
         }
     };
-    // Checked every CLOCK_EVERY steps: the time budget and an interruption of the sweep.
-    let interrupted = |n: usize| -> Result<(), Stop<ContactSolveError>> {
-        if !n.is_multiple_of(CLOCK_EVERY) {
-            return Ok(());
-        }
-        if opts.cancelled() {
-            return Err(Stop::Cancelled);
-        }
-        if opts.timeout.is_some_and(|limit| start.elapsed() > limit) {
-            return Err(Stop::Timeout(n));
-        }
-        Ok(())
-    };
+    let interrupted = |n: usize| opts.step_stop::<ContactSolveError>(n, CLOCK_EVERY, start);
     let mut done = 0usize;
     metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
     let loop_start = Instant::now();

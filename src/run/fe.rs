@@ -1246,14 +1246,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 })
                 .map_err(Stop::Diverged)?;
             done = step;
-            if step.is_multiple_of(CLOCK_EVERY) {
-                if opts.cancelled() {
-                    return Err(Stop::Cancelled);
-                }
-                if opts.timeout.is_some_and(|limit| start.elapsed() > limit) {
-                    return Err(Stop::Timeout(step));
-                }
-            }
+            opts.step_stop(step, CLOCK_EVERY, start)?;
         }
         Ok(())
     })();

@@ -79,6 +79,26 @@ impl RunOptions {
         self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
     }
 
+    /// The time loop's checkpoint, looked at every `every` steps (reading the clock each step
+    /// would cost more than a 1D step): the time budget and an interruption of the sweep.
+    pub(crate) fn step_stop<E>(
+        &self,
+        step: usize,
+        every: usize,
+        start: std::time::Instant,
+    ) -> Result<(), Stop<E>> {
+        if !step.is_multiple_of(every) {
+            return Ok(());
+        }
+        if self.cancelled() {
+            return Err(Stop::Cancelled);
+        }
+        if self.timeout.is_some_and(|limit| start.elapsed() > limit) {
+            return Err(Stop::Timeout(step));
+        }
+        Ok(())
+    }
+
     /// A checkpoint of the setup (between its allocation-heavy phases: operators, factors,
     /// workspace): the time budget covers the setup too, and an interruption (the scheduler's
     /// SIGTERM) must not wait for the time loop. `phase` is what was just built.

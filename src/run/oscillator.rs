@@ -310,19 +310,12 @@ impl Osc {
                 // SPEC §1.5: a step whose predictor is constrained is in contact.
                 return Ok((phi, constrained || phi != 0.0));
             }
-            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
-                alpha_m,
-                alpha_f,
-                beta,
-                gamma,
-                ..
-            }) => {
+            Scheme::GeneralizedAlpha(ga @ GeneralizedAlphaParams { beta, gamma, .. }) => {
                 // x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (x^{n+1} − x̃)/(βτ²); the equation at
                 // t^{n+1−α} times βτ²/(1−α_m):
                 // (m + ck)x^{n+1} = m(x̃ − κ_m aⁿ) − κ_f k xⁿ + κ_f φⁿ q + c φ^{n+1} q + c_F f.
                 let bt2 = beta * tau * tau;
-                let km = alpha_m * bt2 / (1.0 - alpha_m);
-                let kf = alpha_f * bt2 / (1.0 - alpha_m);
+                let (km, kf) = ga.history_coefficients(tau);
                 let pred = st.x + tau * st.v + tau * tau * (0.5 - beta) * st.a;
                 let b = m * (pred - km * st.a) - kf * self.p.stiffness * st.x
                     + kf * st.phi_prev * Q
@@ -469,18 +462,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
             }),
         )
     };
-    let interrupted = |n: usize| -> Result<(), Stop<ContactSolveError>> {
-        if !n.is_multiple_of(CLOCK_EVERY) {
-            return Ok(());
-        }
-        if opts.cancelled() {
-            return Err(Stop::Cancelled);
-        }
-        if opts.timeout.is_some_and(|limit| start.elapsed() > limit) {
-            return Err(Stop::Timeout(n));
-        }
-        Ok(())
-    };
+    let interrupted = |n: usize| opts.step_stop::<ContactSolveError>(n, CLOCK_EVERY, start);
     metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
     let loop_start = Instant::now();
     let mut done = 0usize;

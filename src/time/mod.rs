@@ -146,6 +146,17 @@ impl GeneralizedAlphaParams {
     pub fn stiffness_coefficient(&self, tau: f64) -> f64 {
         (1.0 - self.alpha_f) * self.beta * tau * tau / (1.0 - self.alpha_m)
     }
+
+    /// (κ_m, κ_f) = (α_m, α_f)·βτ²/(1−α_m): the weights of the previous step's acceleration
+    /// and of its elastic and contact forces in the same scaled equation,
+    /// (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f φⁿ q + c φ^{n+1} q.
+    pub fn history_coefficients(&self, tau: f64) -> (f64, f64) {
+        let bt2 = self.beta * tau * tau;
+        (
+            self.alpha_m * bt2 / (1.0 - self.alpha_m),
+            self.alpha_f * bt2 / (1.0 - self.alpha_m),
+        )
+    }
 }
 
 /// Moreau–Jean parameters (SPEC §3.2): θ (`theta_scheme`, ½ … 1) and Newton's restitution e.
