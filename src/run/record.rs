@@ -12,21 +12,12 @@ use crate::sweep::{Key, RunSpec, Value};
 #[derive(Debug, Clone, PartialEq)]
 pub enum ColumnData {
     F64(Vec<Option<f64>>),
-    /// A float column without nulls (the series' solution columns): moved into the frame
-    /// as is, with no validity to build — half the bytes of `F64` per value.
-    F64Dense(Vec<f64>),
-    /// An integer column without nulls (the series' step).
-    I64Dense(Vec<i64>),
     I64(Vec<Option<i64>>),
     Str(Vec<Option<String>>),
-    /// A string column given as runs of equal values (value, count): the run_id of a series.
-    StrRuns(Vec<(String, usize)>),
     /// A List(Int64) column: one list per row (null: the row has none).
     ListI64(Vec<Option<Vec<i64>>>),
     /// A List(Float64) column whose elements may be null.
     ListF64(Vec<Option<Vec<Option<f64>>>>),
-    /// A float column of this many rows, all null.
-    Null(usize),
 }
 
 /// Rust types that can fill a column.

@@ -78,29 +78,10 @@ pub fn record_batch(columns: Vec<(&'static str, ColumnData)>) -> Result<RecordBa
     let mut fields = Vec::with_capacity(columns.len());
     let mut arrays: Vec<ArrayRef> = Vec::with_capacity(columns.len());
     for (name, data) in columns {
-        let nullable = std::env::var("CS_REQ").is_err()
-            || !matches!(
-                data,
-                ColumnData::F64Dense(_) | ColumnData::I64Dense(_) | ColumnData::StrRuns(_)
-            );
         let array: ArrayRef = match data {
             ColumnData::F64(v) => Arc::new(Float64Array::from(v)),
-            // Moved, not copied: a series batch has ~10⁶ rows.
-            ColumnData::F64Dense(v) => Arc::new(Float64Array::from(v)),
-            ColumnData::I64Dense(v) => Arc::new(Int64Array::from(v)),
             ColumnData::I64(v) => Arc::new(Int64Array::from(v)),
             ColumnData::Str(v) => Arc::new(StringArray::from(v)),
-            ColumnData::StrRuns(v) => {
-                let rows = v.iter().map(|(_, n)| n).sum();
-                let bytes = v.iter().map(|(id, n)| id.len() * n).sum();
-                let mut b = StringBuilder::with_capacity(rows, bytes);
-                for (id, n) in &v {
-                    for _ in 0..*n {
-                        b.append_value(id);
-                    }
-                }
-                Arc::new(b.finish())
-            }
             ColumnData::ListI64(v) => {
                 let mut b = ListBuilder::new(Int64Builder::new());
                 for l in &v {
@@ -129,9 +110,8 @@ pub fn record_batch(columns: Vec<(&'static str, ColumnData)>) -> Result<RecordBa
                 }
                 Arc::new(b.finish())
             }
-            ColumnData::Null(n) => new_null_array(&DataType::Float64, n),
         };
-        fields.push(Field::new(name, array.data_type().clone(), nullable));
+        fields.push(Field::new(name, array.data_type().clone(), true));
         arrays.push(array);
     }
     RecordBatch::try_new(Arc::new(Schema::new(fields)), arrays).map_err(ParquetError::from)
