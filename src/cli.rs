@@ -909,9 +909,7 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
         else {
             continue;
         };
-        let ratio = drift[j]
-            .map(|d| 1.0 + d)
-            .or_else(|| e0[j].zip(ef[j]).map(|(a, b)| b / a));
+        let ratio = summary::runs::energy_ratio(e0[j], ef[j], drift[j]);
         let p = |k: sweep::Key| match r.params.get(&k) {
             Some(sweep::Value::Num(x)) => summary::eng(*x),
             Some(v) => v.to_string(),

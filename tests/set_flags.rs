@@ -249,4 +249,32 @@ fn a_disc_run_prints_a_finite_energy_ratio() {
         .unwrap_or_else(|| panic!("no run row in:\n{out}"));
     assert!(!out.contains("inf"), "{out}");
     assert!(row.contains("1.000"), "{row}\n{out}");
+
+    // Regression (issue 20): the report of the same folder drew no energy history (E⁰ = 0) and
+    // its method table printed "—" for E(T)/E⁰. Now the energy is drawn in units of
+    // energy_scale and the table prints the terminal's 1 + drift.
+    let dir = tmp.path().join("disc");
+    let html_path = tmp.path().join("disc.html");
+    let r = cli(
+        tmp.path(),
+        &[
+            "report",
+            dir.to_str().unwrap(),
+            "--out",
+            html_path.to_str().unwrap(),
+        ],
+    );
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let html = std::fs::read_to_string(&html_path).unwrap();
+    assert!(
+        html.contains("energy E(t)/energy_scale"),
+        "no energy figure"
+    );
+    let table = &html[html.find("id=\"methods\"").expect("method table")..];
+    let table = &table[..table.find("</table>").expect("table end")];
+    let row = &table[table.find("<td").expect("a row")..];
+    assert!(
+        row.contains("1.000") && !row.contains("—</td></tr>"),
+        "E(T)/E⁰ missing from the report's method table: {row}"
+    );
 }

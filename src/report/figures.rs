@@ -9,10 +9,11 @@
 //!   over one interval between levels, a different one per curve so that they do not pile up.
 //! - Work-precision: error against wall time in log-log, every ok run coloured by group, the
 //!   Pareto front (no run both faster and more accurate) as a black staircase.
-//! - Time series: contact displacement, contact pressure and E/E⁰ against t for one run per
-//!   group, with the exact (closed-form) solution dashed in black. Long series are reduced to
-//!   the minimum and maximum of each of ~1500 buckets, which keeps the envelope of chattering
-//!   pressures that plain striding would alias away.
+//! - Time series: contact displacement, contact pressure and energy in units of `energy_scale`
+//!   (E/E⁰ for the bars) against t for one run per group, with the exact (closed-form) solution
+//!   dashed in black. Long series are reduced to the minimum and maximum of each of ~1500
+//!   buckets, which keeps the envelope of chattering pressures that plain striding would alias
+//!   away.
 
 use plotters::prelude::*;
 

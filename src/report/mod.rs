@@ -616,7 +616,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
     } else {
         let _ = writeln!(
             body,
-            "<p class=\"note\">One run per method group: the finest ok level of its main refinement path{}. Black dashes: the exact solution (closed form; for 2D/3D scenes the reference run). Energy relative to the run's E⁰.</p>",
+            "<p class=\"note\">One run per method group: the finest ok level of its main refinement path{}. Black dashes: the exact solution (closed form; for 2D/3D scenes the reference run). Energy in units of the run's <code>energy_scale</code> (E⁰ for the bars, so E/E⁰; m·g·gap under gravity, where E⁰ = 0).</p>",
             if runs.groups.len() > SERIES_GROUPS {
                 format!(
                     " (the first {SERIES_GROUPS} groups of {})",
@@ -652,9 +652,14 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
                 points: figures::decimate(&rs.sigma, 1500),
                 color: g,
             });
-            let e0 = rs.energy.first().map(|p| p.1).filter(|e| *e != 0.0);
-            if let Some(e0) = e0 {
-                let rel: Vec<(f64, f64)> = rs.energy.iter().map(|&(t, e)| (t, e / e0)).collect();
+            // In units of the run's energy_scale, the unit of its `energy_drift` (E⁰ for the
+            // bars: the curve E/E⁰; m·g·gap under gravity, where E⁰ = 0). Older folders without
+            // the column: E⁰ when it is not zero.
+            let scale = r
+                .energy_scale
+                .or_else(|| rs.energy.first().map(|p| p.1).filter(|e| *e != 0.0));
+            if let Some(scale) = scale {
+                let rel: Vec<(f64, f64)> = rs.energy.iter().map(|&(t, e)| (t, e / scale)).collect();
                 en.push(Curve {
                     name,
                     points: figures::decimate(&rel, 1500),
@@ -683,7 +688,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
         for (t, y, curves, exact) in [
             ("contact displacement u_C(t)", "u_C", &u, exact_u.as_ref()),
             ("contact pressure σ_C(t)", "σ_C", &s, exact_s.as_ref()),
-            ("energy E(t)/E⁰", "E/E⁰", &en, None),
+            ("energy E(t)/energy_scale", "E/E_s", &en, None),
         ] {
             if curves.is_empty() {
                 continue;

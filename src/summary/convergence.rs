@@ -320,12 +320,9 @@ fn flag_letters(f: &Fit) -> String {
     s
 }
 
-/// E(T)/E⁰ of a run (None without both energies).
+/// E(T)/E⁰ of a run (None without the energies).
 fn energy_ratio(r: &super::runs::Run) -> Option<f64> {
-    r.energy_initial
-        .zip(r.energy_final)
-        .map(|(a, b)| b / a)
-        .filter(|x| x.is_finite())
+    r.energy_ratio()
 }
 
 /// The terminal's view of the convergence section: one line per method group with the LSQ
@@ -471,9 +468,9 @@ fn group_lines(
         legend.push(pair.join(" · "));
     }
     legend.push(if refined {
-        "E(T)/E⁰: final over initial discrete energy at the path's finest ok level".into()
+        "E(T)/E⁰: final over initial discrete energy at the path's finest ok level (1 + energy_drift: relative to m·g·gap under gravity, where E⁰ = 0)".into()
     } else {
-        "E(T)/E⁰: final over initial discrete energy".into()
+        "E(T)/E⁰: final over initial discrete energy (1 + energy_drift: relative to m·g·gap under gravity, where E⁰ = 0)".into()
     });
     for l in &legend {
         let _ = writeln!(out, "  {l}");

@@ -51,7 +51,7 @@ fn energy_metrics() -> Vec<Metric> {
     vec![
         Metric {
             name: "energy_ratio",
-            get: |r| Some(r.energy_final? / r.energy_initial?),
+            get: Run::energy_ratio,
             flags: true,
         },
         Metric {

@@ -115,6 +115,7 @@ const MEASURED: &[(&str, Kind)] = &[
     ("energy_theta_drift", Kind::F64),
     ("energy_theta_initial", Kind::F64),
     ("length_scale", Kind::F64),
+    ("energy_scale", Kind::F64),
     ("search", Kind::Str),
     ("max_penetration", Kind::F64),
     ("pressure_oscillation", Kind::F64),
@@ -188,6 +189,9 @@ pub(crate) struct Run {
     pub energy_theta_initial: Option<f64>,
     /// The body's size (runs column `length_scale`; None in folders of older versions).
     pub length_scale: Option<f64>,
+    /// The energy unit of `energy_drift` (runs column `energy_scale`: E⁰ for the bars, m·g·gap
+    /// under gravity; None in folders of older versions).
+    pub energy_scale: Option<f64>,
     /// Ensemble member index (null outside ensembles).
     pub ensemble_sample: Option<i64>,
     /// Runs columns `max_penetration`, `pressure_oscillation` (None in older folders).
@@ -211,6 +215,23 @@ impl Run {
     pub(crate) fn ok(&self) -> bool {
         self.status == "ok"
     }
+
+    /// E(T)/E⁰ as every table and the terminal print it ([`energy_ratio`]).
+    pub(crate) fn energy_ratio(&self) -> Option<f64> {
+        energy_ratio(self.energy_initial, self.energy_final, self.energy_drift)
+    }
+}
+
+/// E(T)/E⁰ of a run, one definition for the summary, the report and the terminal:
+/// 1 + `energy_drift` = 1 + (E(T) − E⁰)/energy_scale. The bars' energy_scale is E⁰, so this is
+/// E(T)/E⁰; under gravity E⁰ = 0 (at rest, potential measured from the start) and the plain
+/// quotient would be ±∞, while the drift is relative to m·g·gap. Folders without the drift
+/// column fall back to the quotient.
+pub fn energy_ratio(initial: Option<f64>, last: Option<f64>, drift: Option<f64>) -> Option<f64> {
+    drift
+        .map(|d| 1.0 + d)
+        .or_else(|| initial.zip(last).map(|(a, b)| b / a))
+        .filter(|x| x.is_finite())
 }
 
 impl Runs {
@@ -676,6 +697,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let theta_drift = get_f("energy_theta_drift")?;
     let theta_initial = get_f("energy_theta_initial")?;
     let length_scale = get_f("length_scale")?;
+    let energy_scale = get_f("energy_scale")?;
     let (max_pen, press_osc) = (get_f("max_penetration")?, get_f("pressure_oscillation")?);
     let sample = get_i("ensemble_sample")?;
     let search = strs(&df, "search")?;
@@ -771,6 +793,7 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             energy_theta_drift: theta_drift[i],
             energy_theta_initial: theta_initial[i],
             length_scale: finite(length_scale[i]).filter(|l| *l > 0.0),
+            energy_scale: finite(energy_scale[i]).filter(|e| *e > 0.0),
             ensemble_sample: sample[i],
             max_penetration: finite(max_pen[i]),
             pressure_oscillation: finite(press_osc[i]),
