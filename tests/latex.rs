@@ -57,20 +57,25 @@ struct Compiled {
 /// Compile `summary/convergence_doc.tex` in its folder, twice; panics with the log's tail on
 /// an error.
 fn compile(summary: &Path) -> Compiled {
+    compile_doc(summary, "convergence_doc")
+}
+
+/// Compile `summary/NAME.tex` in its folder, twice; panics with the log's tail on an error.
+fn compile_doc(summary: &Path, name: &str) -> Compiled {
     pdflatex();
     for pass in 1..=2 {
         let o = Command::new("pdflatex")
             .args([
                 "-interaction=nonstopmode",
                 "-halt-on-error",
-                "convergence_doc.tex",
+                &format!("{name}.tex"),
             ])
             .current_dir(summary)
             .output()
             .expect("pdflatex starts");
         if !o.status.success() {
             let log =
-                std::fs::read_to_string(summary.join("convergence_doc.log")).unwrap_or_default();
+                std::fs::read_to_string(summary.join(format!("{name}.log"))).unwrap_or_default();
             let tail: Vec<&str> = log.lines().rev().take(40).collect();
             panic!(
                 "pass {pass}: pdflatex failed in {}:\n{}",
@@ -79,7 +84,7 @@ fn compile(summary: &Path) -> Compiled {
             );
         }
     }
-    let log = std::fs::read_to_string(summary.join("convergence_doc.log")).unwrap();
+    let log = std::fs::read_to_string(summary.join(format!("{name}.log"))).unwrap();
     assert!(!log.lines().any(|l| l.starts_with('!')), "error in the log");
     let overfull = log
         .lines()
@@ -101,7 +106,7 @@ fn compile(summary: &Path) -> Compiled {
     let pages = log
         .lines()
         .find_map(|l| {
-            l.strip_prefix("Output written on convergence_doc.pdf (")
+            l.strip_prefix(&format!("Output written on {name}.pdf ("))
                 .and_then(|r| r.split(' ').next())
                 .and_then(|n| n.parse().ok())
         })
@@ -273,4 +278,28 @@ fn fig10_ladder_tables_compile_and_print_the_papers_digits() {
     }
     let c = compile(&summary);
     assert_clean(&c, "003 Fig 10 ladder");
+}
+
+/// Issue 20: the method-class table (`summary/methods.tex`, a tabular for `\input`) compiles in
+/// a plain article — its labels carry ρ∞, α, θ, γ0 and τ, which must reach LaTeX as math.
+#[test]
+fn method_class_table_compiles() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("cmp");
+    run_sweep("sweeps/comparison_bar1d.toml", &out);
+    let summary = out.join("summary");
+    let tex = std::fs::read_to_string(summary.join("methods.tex")).unwrap();
+    assert!(
+        tex.contains("generalized-alpha($\\rho\\infty$=0.5)"),
+        "{tex}"
+    );
+    assert!(tex.contains("hht($\\alpha$=0.1)"), "{tex}");
+    std::fs::write(
+        summary.join("methods_doc.tex"),
+        "\\documentclass{article}\n\\usepackage[T1]{fontenc}\n\\usepackage[margin=1cm,landscape]{geometry}\n\\begin{document}\n\\input{methods.tex}\n\\end{document}\n",
+    )
+    .unwrap();
+    let c = compile_doc(&summary, "methods_doc");
+    assert_clean(&c, "method classes");
+    assert_eq!(c.pages, 1);
 }

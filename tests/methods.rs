@@ -209,3 +209,49 @@ fn interpolant_start_persists_where_the_node_row_holds_at_the_midpoint() {
     // Still energy-stable (003 Cor 3.8): E_Θ never increases beyond round-off.
     assert!(i.metrics.energy_theta_max_increase.unwrap() < 1e-12);
 }
+
+/// Issue 20: the method-class table of `sweeps/comparison_bar1d.toml` is computed from the runs
+/// (summary/methods.md) and the README prints that table, row for row. The classes themselves
+/// follow from the methods' properties (SPEC §3.2), asserted here with the reason for each.
+#[test]
+fn comparison_bar1d_method_classes_are_the_readmes() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/comparison_bar1d.toml");
+    let o = cli(tmp.path(), &["run", sweep, "--out", "cmp"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(tmp.path().join("cmp/summary/methods.md")).unwrap();
+    let table = &md[md.find("| method |").expect("the table")..];
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    assert!(
+        readme.contains(table.trim_end()),
+        "README's method-class table is stale; the sweep gives:\n{table}"
+    );
+    let row = |label: &str| -> Vec<String> {
+        let line = table
+            .lines()
+            .find(|l| l.starts_with(&format!("| {label} |")))
+            .unwrap_or_else(|| panic!("no row {label} in\n{table}"));
+        line.split('|').map(|c| c.trim().to_string()).collect()
+    };
+    // Kane's step never increases E^h (SPEC §3.2) and puts the node on the obstacle exactly.
+    let kane = row("mixed · consistent · kane");
+    assert_eq!(
+        (kane[2].as_str(), kane[4].as_str()),
+        ("dissipative", "none")
+    );
+    // Moreau–Jean with e = 1 and θ = ½ conserves E^h to round-off, at the price of an O(τ)
+    // penetration (a velocity-level constraint).
+    let mj = row("mixed · consistent · moreau-jean(θ=0.5,e=1)");
+    assert_eq!((mj[2].as_str(), mj[4].as_str()), ("conserving", "O(τ)"));
+    // The discrete gradient conserves E^h + Φ: never growing, a penalty penetrates.
+    let dg = row("penalty(γ0=1e2) · consistent · discrete-gradient");
+    assert_eq!((dg[2].as_str(), dg[4].as_str()), ("conserving", "O(τ)"));
+    // Crank–Nicolson with the consistent mass gains energy at impacts (000 §3, SPEC §6).
+    assert_eq!(row("mixed · consistent · crank-nicolson")[2], "growing");
+    // The report draws the same table.
+    let r = cli(tmp.path(), &["report", "cmp"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let html = std::fs::read_to_string(tmp.path().join("cmp/report.html")).unwrap();
+    assert!(html.contains("id=\"classes\"") && html.contains("moreau-jean(θ=0.5,e=1)"));
+}

@@ -432,6 +432,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
         en,
         wp,
         st,
+        methods,
         ..
     } = sections;
     let ses = session(dir)?;
@@ -475,7 +476,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
             .map(|f| format!(", finished {}", esc(f)))
             .unwrap_or_default(),
     );
-    body.push_str("<nav><a href=\"#convergence\">convergence</a><a href=\"#work\">work-precision</a><a href=\"#series\">time series</a><a href=\"#methods\">method table</a><a href=\"#energy\">energy</a><a href=\"#tables\">all tables</a><a href=\"#sweep\">sweep file and plan</a></nav>\n");
+    body.push_str("<nav><a href=\"#convergence\">convergence</a><a href=\"#work\">work-precision</a><a href=\"#series\">time series</a><a href=\"#methods\">method table</a><a href=\"#classes\">method classes</a><a href=\"#energy\">energy</a><a href=\"#tables\">all tables</a><a href=\"#sweep\">sweep file and plan</a></nav>\n");
     if !conv.groups.hints.is_empty() {
         body.push_str("<div class=\"hints\"><b>What to look at</b><ul>");
         for h in &conv.groups.hints {
@@ -741,6 +742,17 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
         "<details><summary>Every parameter of each group</summary>{}</details>",
         html_table(&ph, &[true, false, true], &prow)
     );
+
+    // 3b. The method classes (Doyen–Ern–Piperno's comparison), as `summary/methods.md`.
+    if !methods.rows.is_empty() {
+        body.push_str("<h2 id=\"classes\">Method classes</h2>\n");
+        body.push_str(&html_table(
+            &methods.header,
+            &[false, false, false, false, true, true],
+            &methods.rows,
+        ));
+        let _ = writeln!(body, "<p class=\"note\">{}</p>", esc(&methods.legend));
+    }
 
     // 4. Energy and the full tables.
     body.push_str("<h2 id=\"energy\">Energy behaviour</h2>\n");

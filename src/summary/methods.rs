@@ -30,6 +30,11 @@ pub(crate) struct Section {
     pub table: Table,
     pub markdown: String,
     pub latex: String,
+    /// The terminal's lines (one per group, aligned) and the rows the report draws.
+    pub terminal: String,
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+    pub legend: String,
 }
 
 /// One row per method group.
@@ -154,9 +159,33 @@ pub(crate) fn section(runs: &Runs) -> Section {
     }
     latex.push_str("\\hline\n\\end{tabular}\n");
     latex.push_str(&format!("% {}\n", table::tex(&legend)));
+    let mut terminal = String::new();
+    if !rows.is_empty() {
+        terminal.push_str(
+            "method classes (energy · pressure · penetration · L2, H1 rates; thresholds in methods.md):\n",
+        );
+        let width = rows.iter().map(|r| r[0].chars().count()).max().unwrap_or(0);
+        for r in &rows {
+            let pad = width - r[0].chars().count();
+            terminal.push_str(&format!(
+                "  {}{}  {} · {} · {} · {}, {}\n",
+                r[0],
+                " ".repeat(pad),
+                r[1],
+                r[2],
+                r[3],
+                r[4],
+                r[5]
+            ));
+        }
+    }
     Section {
         table: t,
         markdown,
         latex,
+        terminal,
+        header,
+        rows,
+        legend,
     }
 }

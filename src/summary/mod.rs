@@ -309,6 +309,7 @@ impl Sections {
         }
         terminal.push_str(&conv.terminal);
         terminal.push_str(&en.terminal);
+        terminal.push_str(&methods.terminal);
         terminal.push_str(&ens.terminal);
         terminal.push_str(&st.terminal);
         terminal.push_str(&se.terminal);

@@ -333,13 +333,54 @@ pub(crate) fn rate(x: Option<f64>) -> String {
 
 /// LaTeX-safe text: the ASCII specials and the non-ASCII characters of the run labels.
 pub(crate) fn tex(s: &str) -> String {
+    // A math symbol as `$…$`, joined with a math span just before it: "ρ∞" must read
+    // `$\rho\infty$`, since `$\rho$$\infty$` opens display math in LaTeX's text mode.
+    fn math(out: &mut String, inner: &str) {
+        let escaped = out.ends_with("\\$");
+        if out.ends_with('$') && !escaped {
+            out.pop();
+        } else {
+            out.push('$');
+        }
+        out.push_str(inner);
+        out.push('$');
+    }
     let mut out = String::with_capacity(s.len());
     let mut chars = s.chars().peekable();
     while let Some(c) = chars.next() {
         // γ0 in the labels is the Nitsche parameter γ₀.
         if c == 'γ' && chars.peek() == Some(&'0') {
             chars.next();
-            out.push_str("$\\gamma_0$");
+            math(&mut out, "\\gamma_0");
+            continue;
+        }
+        let symbol = match c {
+            '·' => "\\cdot",
+            'Θ' => "\\Theta",
+            'Φ' => "\\Phi",
+            'α' => "\\alpha",
+            'β' => "\\beta",
+            'γ' => "\\gamma",
+            'δ' => "\\delta",
+            'ε' => "\\varepsilon",
+            'θ' => "\\theta",
+            'κ' => "\\kappa",
+            'λ' => "\\lambda",
+            'μ' => "\\mu",
+            'ν' => "\\nu",
+            'ρ' => "\\rho",
+            'σ' => "\\sigma",
+            'τ' => "\\tau",
+            '∞' => "\\infty",
+            '∝' => "\\propto",
+            '×' => "\\times",
+            '≤' => "\\le",
+            '≥' => "\\ge",
+            '→' => "\\to",
+            _ => "",
+        };
+        if !symbol.is_empty() {
+            math(&mut out, symbol);
             continue;
         }
         match c {
@@ -350,16 +391,6 @@ pub(crate) fn tex(s: &str) -> String {
             }
             '~' => out.push_str("\\textasciitilde{}"),
             '^' => out.push_str("\\textasciicircum{}"),
-            '·' => out.push_str("$\\cdot$"),
-            'Θ' => out.push_str("$\\Theta$"),
-            'θ' => out.push_str("$\\theta$"),
-            'γ' => out.push_str("$\\gamma$"),
-            'β' => out.push_str("$\\beta$"),
-            'τ' => out.push_str("$\\tau$"),
-            'ν' => out.push_str("$\\nu$"),
-            'σ' => out.push_str("$\\sigma$"),
-            '≤' => out.push_str("$\\le$"),
-            '→' => out.push_str("$\\to$"),
             '−' => out.push('-'),
             c => out.push(c),
         }
