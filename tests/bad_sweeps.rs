@@ -9,6 +9,11 @@ use common::{cli, write};
 /// (file body, key the message must name, a phrase of the reason)
 const CASES: &[(&str, &str, &str)] = &[
     (
+        "name = \"x\"\nscene = \"disc2d\"\nreference = { h = 8.0, dt = 0.05 }\n[fixed]\nh = 4.0\ndt = 0.1\n",
+        "reference.h",
+        "the reference mesh (h = 8) is coarser than the run's (h = 4)",
+    ),
+    (
         "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 4.0\ndt = 0.1\n[grid]\ndegree = [2, 3]\n",
         "grid.degree[1]",
         "must be 1 or 2",

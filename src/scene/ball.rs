@@ -140,6 +140,10 @@ impl Scene for BallScene {
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)
     }
+    /// The mapped meshes of two sizes are not nested (`BallMesh::counts_for_size`).
+    fn nested_meshes(&self) -> bool {
+        false
+    }
     fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
         let (n_t, n_r) = BallMesh::counts_for_size(RADIUS, mesh.h);
         let gap = p.get("gap");

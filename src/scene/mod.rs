@@ -109,6 +109,12 @@ pub trait Scene: Send + Sync {
     }
     /// Where the errors come from.
     fn error_source(&self, physics: &Physics) -> Option<ErrorSource>;
+    /// Whether the meshes of two sizes are nested (a coarse node is a node of every finer
+    /// mesh, h_run/h_ref whole), so a reference run stores only the coarse runs' lattice; if
+    /// not, the reference stores its whole mesh and runs interpolate it at their nodes.
+    fn nested_meshes(&self) -> bool {
+        true
+    }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
 }

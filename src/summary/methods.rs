@@ -165,7 +165,15 @@ pub(crate) fn section(runs: &Runs) -> Section {
             "method classes (energy · pressure · penetration · L2, H1 rates; thresholds in methods.md):\n",
         );
         let width = rows.iter().map(|r| r[0].chars().count()).max().unwrap_or(0);
+        let dash = |c: &String| {
+            if c.is_empty() {
+                "—".to_string()
+            } else {
+                c.clone()
+            }
+        };
         for r in &rows {
+            let r: Vec<String> = r.iter().map(dash).collect();
             let pad = width - r[0].chars().count();
             terminal.push_str(&format!(
                 "  {}{}  {} · {} · {} · {}, {}\n",

@@ -798,7 +798,19 @@ fn reference_of(
         let n = q.round();
         (n >= 1.0 && (q - n).abs() <= 1e-9 * n).then_some(n as usize)
     };
-    let sx = ratio(run.h, r.h).ok_or_else(|| {
+    // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
+    let nested = sweep.scene.get().nested_meshes();
+    if !nested && r.h > run.h * (1.0 + 1e-12) {
+        return Err(vec![Issue::at(
+            &at(mesh_keys),
+            format!(
+                "the reference mesh (h = {}) is coarser than the run's (h = {})",
+                r.h, run.h
+            ),
+        )]);
+    }
+    let sx = if nested { ratio(run.h, r.h) } else { Some(1) };
+    let sx = sx.ok_or_else(|| {
         vec![Issue::at(
             &at(mesh_keys),
             format!(

@@ -62,8 +62,8 @@ pub enum ElementKind {
 
 /// Edges of the P2 simplices in Gmsh's order (midpoint node 3 + k of a triangle, 4 + k of a
 /// tetrahedron, lies on edge k).
-const TRI_EDGES: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
-const TET_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1)];
+pub(crate) const TRI_EDGES: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
+pub(crate) const TET_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1)];
 /// Gmsh's hexahedron edges (nodes 8–19 of Hex27) and faces (nodes 20–25).
 const HEX_EDGES: [(usize, usize); 12] = [
     (0, 1),

@@ -26,6 +26,7 @@
 pub mod ball;
 pub mod element;
 pub mod gmsh;
+pub mod locate;
 pub mod mesh;
 pub mod nitsche;
 pub mod simplex;
