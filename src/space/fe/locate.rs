@@ -96,10 +96,8 @@ pub fn shape_into(
                 dlam[k + 1][k] = 1.0;
             }
             if kind.degree() == 1 {
-                for a in 0..=d {
-                    n[a] = lam[a];
-                    dn[a] = dlam[a];
-                }
+                n[..=d].copy_from_slice(&lam[..=d]);
+                dn[..=d].copy_from_slice(&dlam[..=d]);
                 return;
             }
             for a in 0..=d {
