@@ -50,6 +50,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("stiffness", Kind::F64),
     ("force", Kind::F64),
     ("impact_law", Kind::F64),
+    ("solver", Kind::Str),
+    ("cg_tol", Kind::F64),
     ("T", Kind::F64),
     ("ensemble_sample", Kind::I64),
     ("ensemble_perturbation", Kind::F64),
