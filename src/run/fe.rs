@@ -15,6 +15,9 @@
 //! W = B Z are computed once per run; a step is one sparse solve y = A⁻¹(M p^n + cτ²F), the exact
 //! LCP λ ≥ 0 ⊥ By + g + cτ²Wλ ≥ 0 ([`crate::contact::lcp`], warm-started from the previous
 //! step), and u^{n+1} = y + cτ² Z λ over the active contact dofs. Never a refactorisation.
+//! With `solver = "cg"` ([`crate::space::step_solver`]) nothing is factored: the same solves
+//! (the step's and Z's columns) are made by preconditioned conjugate gradient on A itself,
+//! each step warm-started from the previous one; a CG failure ends the run `solver-failed`.
 //!
 //! Massless dofs (the bottom nodes with mod1/mod2/mod3/weights/zero-contact) need no special
 //! case: their rows of M are zero, so their row of the step system is c τ² (K u − F − Bᵀλ) = 0,

@@ -144,10 +144,17 @@ impl Cell {
         }
     }
 
-    /// The value as a person reads it (shortest round-trip form of floats).
+    /// The value as a person reads it (shortest round-trip form of floats; below 1e-4 in
+    /// exponent form: `cg_tol=1e-12`, not twelve zeros).
     pub(crate) fn show(&self) -> Option<String> {
         match self {
-            Cell::F64(x) => x.map(|x| format!("{x}")),
+            Cell::F64(x) => x.map(|x| {
+                if x != 0.0 && x.abs() < 1e-4 {
+                    format!("{x:e}")
+                } else {
+                    format!("{x}")
+                }
+            }),
             Cell::I64(x) => x.map(|x| x.to_string()),
             Cell::Str(x) => x.clone(),
         }

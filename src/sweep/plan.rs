@@ -570,8 +570,7 @@ fn resolve(
     };
     if user.contains_key(&Key::Solver) && !fe {
         dropped.push(
-            "solver applies to the finite-element scenes only (bar2d, bar3d, disc2d, sphere3d)"
-                .into(),
+            "solver applies to the finite-element scenes only (their sparse step matrix)".into(),
         );
     }
     if user.contains_key(&Key::CgTol) && solver == Solver::Direct {
