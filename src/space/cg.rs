@@ -199,8 +199,8 @@ pub fn pcg_into(
         }
         product(view, p, q);
         let pq = dot(p, q);
-        // `!(pq > 0)` also catches NaN.
-        if !(pq > 0.0) {
+        // Not `pq > 0` (NaN included).
+        if pq.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(CgError::NotPositiveDefinite {
                 iteration: it,
                 curvature: pq,
@@ -330,7 +330,7 @@ pub fn pcg_many_into(
             let mut alpha = [0.0; BLOCK];
             for c in 0..BLOCK {
                 if active[c] {
-                    if !(pq[c] > 0.0) {
+                    if pq[c].partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
                         return Err(CgError::NotPositiveDefinite {
                             iteration: it,
                             curvature: pq[c],
