@@ -264,3 +264,91 @@ impl StepSolver {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spd() -> SymMatrix {
+        // Tridiagonal (−1, 4, −1), n = 6: SPD, κ < 3.
+        let n = 6;
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            a[i * n + i] = 4.0;
+            if i + 1 < n {
+                a[i * n + i + 1] = -1.0;
+                a[(i + 1) * n + i] = -1.0;
+            }
+        }
+        SymMatrix::from_dense(n, &a).unwrap()
+    }
+
+    #[test]
+    fn cg_and_direct_agree_and_cg_warm_starts() {
+        let a = spd();
+        let direct = StepSolver::new(
+            Solver::Direct,
+            || SymbolicCholesky::new(&a.pattern),
+            a.clone(),
+        )
+        .unwrap();
+        let mut asked = false;
+        let cg = StepSolver::new(
+            Solver::Cg { tol: 1e-13 },
+            || {
+                asked = true;
+                SymbolicCholesky::new(&a.pattern)
+            },
+            a.clone(),
+        )
+        .unwrap();
+        assert!(!asked, "cg must not make the symbolic analysis");
+        assert!(direct.is_factored() && !cg.is_factored());
+        let b: Vec<f64> = (0..6).map(|i| i as f64 - 2.0).collect();
+        let (mut x, mut y) = (b.clone(), b.clone());
+        direct.solve_in_place(&mut x, &mut direct.work());
+        let mut w = cg.work();
+        cg.solve_in_place(&mut y, &mut w);
+        w.check().unwrap();
+        // κ < 3: |x − y| ≤ κ·1e-13·|x| ≈ 1e-12 (|x| ≈ 1).
+        let d = x
+            .iter()
+            .zip(&y)
+            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+        assert!(d < 1e-12, "{d}");
+        let first = w.iterations_total();
+        assert!(first > 0 && first <= 6, "{first}");
+        // The same right-hand side again: the warm start is the solution, no iteration.
+        let mut z = b.clone();
+        cg.solve_in_place(&mut z, &mut w);
+        assert_eq!(w.iterations_total(), first);
+        assert_eq!(w.iterations_max(), first as usize);
+    }
+
+    #[test]
+    fn a_cg_failure_is_kept_for_check() {
+        // Positive diagonal (Jacobi is defined), eigenvalues 3 and −1.
+        let a = SymMatrix::from_dense(2, &[1.0, 2.0, 2.0, 1.0]).unwrap();
+        let cg = StepSolver::new(
+            Solver::Cg { tol: 1e-12 },
+            || unreachable!("no symbolic analysis for cg"),
+            a,
+        )
+        .unwrap();
+        let mut w = cg.work();
+        let mut y = vec![1.0, -1.0];
+        cg.solve_in_place(&mut y, &mut w);
+        assert!(matches!(
+            w.check(),
+            Err(CgError::NotPositiveDefinite { .. })
+        ));
+        // Taken: the next check is clean.
+        assert_eq!(w.check(), Ok(()));
+        // A negative diagonal is refused when the solver is built.
+        let neg = SymMatrix::from_dense(2, &[-1.0, 0.0, 0.0, 1.0]).unwrap();
+        assert!(matches!(
+            StepSolver::new(Solver::Cg { tol: 1e-12 }, || unreachable!(), neg),
+            Err(StepSolveError::Cg(CgError::BadDiagonal { dof: 0, .. }))
+        ));
+    }
+}

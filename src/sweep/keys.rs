@@ -364,9 +364,10 @@ impl Key {
                     ))
                 }
             }
-            // A relative residual: at 1 and above CG would stop before iterating. A value
-            // below what round-off allows (≈ κ·ε) is not refused here: such a run ends
-            // solver-failed with the residual it reached.
+            // A relative residual: at 1 and above CG would stop before iterating. Values below
+            // round-off (≈ 1e-15) are accepted but buy nothing: CG's recursively updated
+            // residual keeps shrinking while the true one stays at round-off, so such a run
+            // iterates longer for the same solution (measured: cg_tol = 1e-18 runs).
             (Key::CgTol, Value::Num(x)) => {
                 finite(*x)?;
                 if *x > 0.0 && *x < 1.0 {
