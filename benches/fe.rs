@@ -29,6 +29,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use contact_sweep::run::fe::{FeConfig, cholesky_options};
 use contact_sweep::run::{RunOptions, simulate};
 use contact_sweep::scene::{BarScene, MeshChoice, Physics, Scene, SceneSetup};
+use contact_sweep::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use contact_sweep::space::fe::nitsche::contact_points;
 use contact_sweep::space::fe::{
     BallMesh, BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern,
@@ -36,6 +37,7 @@ use contact_sweep::space::fe::{
 use contact_sweep::space::linalg::{
     Cholesky, CholeskyOptions, FactorKind, Ordering, SymbolicCholesky,
 };
+use contact_sweep::space::step_solver::Solver;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
 
@@ -59,6 +61,7 @@ fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
         scheme: Scheme::Newmark(NewmarkParams::crank_nicolson()),
         dt: h / 2.0,
         steps,
+        solver: Solver::Direct,
         perturbation: None,
     }
 }
@@ -119,6 +122,42 @@ fn bench_bar(c: &mut Criterion, name: &str, dim: usize, h: f64) {
     let mut x: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
     g.bench_function("solve", |b| {
         b.iter(|| chol.solve_in_place(&mut x, &mut work))
+    });
+    // `solver = "cg"`: one product with A, by the engine's kernel (a row gather over the full
+    // symmetric storage) and by faer's sparse × dense product on the same storage; and one
+    // whole CG solve from a zero guess to 1e-12 (no warm start: an upper bound of a step's).
+    let mut y = vec![0.0; n];
+    g.bench_function("matvec", |b| b.iter(|| a.matvec_into(&x, &mut y)));
+    let view = faer::sparse::SparseColMatRef::new(
+        faer::sparse::SymbolicSparseColMatRef::new_checked(
+            n,
+            n,
+            &a.pattern.col_ptr,
+            None,
+            &a.pattern.row_idx,
+        ),
+        &a.values,
+    );
+    g.bench_function("matvec-faer", |b| {
+        b.iter(|| {
+            faer::sparse::linalg::matmul::sparse_dense_matmul(
+                faer::MatMut::from_column_major_slice_mut(&mut y, n, 1),
+                faer::Accum::Replace,
+                view,
+                faer::MatRef::from_column_major_slice(&x, n, 1),
+                1.0,
+                faer::Par::Seq,
+            )
+        })
+    });
+    let inv = jacobi(&a).unwrap();
+    let mut cg_work = CgWork::new(n);
+    let rhs = x.clone();
+    g.bench_function("cg-solve", |b| {
+        b.iter(|| {
+            y.fill(0.0);
+            pcg_into(&a, &inv, &rhs, &mut y, CgOptions::new(1e-12), &mut cg_work).unwrap()
+        })
     });
     // One step on the engine's own clock: the run's stepping time over its 64 steps.
     g.bench_function("step", |b| {

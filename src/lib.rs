@@ -9,7 +9,9 @@
 //!   engines a setup.
 //! - [`space`] — meshes, mass variants, stiffness, and how each contact method enters the
 //!   semi-discrete system; `space::fe` (Q1 elements, sparse assembly with the pattern built
-//!   once) and `space::linalg` (faer's sparse Cholesky: symbolic once, numeric per matrix).
+//!   once), `space::linalg` (faer's sparse Cholesky: symbolic once, numeric per matrix),
+//!   `space::cg` (Jacobi-preconditioned conjugate gradient, `solver = "cg"`) and
+//!   `space::step_solver` (the per-step solve, dispatching to either).
 //! - [`time`] — the time schemes as data with named presets, the methods of the comparison
 //!   literature (SPEC §3.2: kane, contact-stabilized Newmark, generalized-α/HHT, Moreau–Jean,
 //!   discrete gradient, kinematic central difference) among them.

@@ -198,6 +198,50 @@ method = [
     );
 }
 
+/// `solver = "cg"` (issue 24): the step solves by conjugate gradient, warm-started from the
+/// previous step's solution kept in the solver's work — bar3d with the LCP contact and the disc
+/// with Nitsche's Newton (its step matrix with the Θ-term).
+#[test]
+fn cg_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-cg-3d"
+scene = "bar3d"
+[fixed]
+T = T_FINAL
+h = 0.1
+dt = 0.01
+solver = "cg"
+[grid]
+method = [
+  { mass = "mod3", scheme = "crank-nicolson" },
+  { mass = "consistent", scheme = "backward-euler" },
+]
+"#,
+        1.0,
+    );
+    assert_loop_allocates_nothing_with(
+        r#"
+name = "alloc-cg-disc"
+scene = "disc2d"
+[fixed]
+T = T_FINAL
+h = 8.0
+dt = 0.1
+gap = 0.05
+degree = 1
+solver = "cg"
+[grid]
+method = [
+  { space = "mixed", scheme = "crank-nicolson" },
+  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" },
+]
+"#,
+        15.0,
+        1,
+    );
+}
+
 /// The FE engine on the disc under gravity (issue 8): mixed + CN (chatters; also with the
 /// zero-contact mass), Nitsche + CN, Nitsche + hybrid and penalty + hybrid (semismooth Newton, inactive before the impact at t ≈ 2, active after —
 /// the disc then stays in contact, so one switch is all the short run can show).

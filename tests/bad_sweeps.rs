@@ -39,6 +39,21 @@ const CASES: &[(&str, &str, &str)] = &[
         "unknown contact_init `exact` (expected consistent or interpolant",
     ),
     (
+        "name = \"x\"\nscene = \"bar3d\"\n[fixed]\nh = 0.05\ndt = 0.025\nsolver = \"gmres\"\n",
+        "fixed.solver",
+        "unknown solver `gmres` (expected direct",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar3d\"\n[fixed]\nh = 0.05\ndt = 0.025\nsolver = \"cg\"\n[grid]\ncg_tol = [1e-12, 0.0]\n",
+        "grid.cg_tol[1]",
+        "must lie in (0, 1)",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar3d\"\n[fixed]\nh = 0.05\ndt = 0.025\nsolver = \"cg\"\ncg_tol = -1e-12\n",
+        "fixed.cg_tol",
+        "must lie in (0, 1)",
+    ),
+    (
         "name = \"x\"\nscene = \"bar1d\"\nnmae = 1\n[fixed]\nh = 0.1\ndt = 0.1\n",
         "nmae",
         "unknown top-level key",

@@ -13,6 +13,10 @@
 //!   K and M ((2p+1)^d·d entries per row for degree p, 16 bytes each), the condensed contact
 //!   columns Z = A⁻¹Bᵀ (n × n_c dense; the disc and ball: n_c ≈ n^((d−1)/d), a boundary's worth),
 //!   and 12 work vectors of n. The mapped disc/ball meshes are taken with the box's fill.
+//!   With `solver = "cg"` there is no factor: the step matrix A is kept instead (one matrix
+//!   more) with CG's vectors (residual, direction, product, preconditioned residual, the
+//!   previous solution and 1/diag(A): 6 of n) and, for the condensation columns, its 8-column
+//!   block (4 × 8 of n, freed after the setup but part of the peak).
 //! - series: (steps / series_every + 2) rows of [`SeriesRow`] (the sink's batch keys a run's
 //!   rows by one id).
 //!
@@ -22,6 +26,7 @@
 
 use super::{RunConfig, SeriesRow};
 use crate::scene::FeGeometry;
+use crate::space::step_solver::Solver;
 use crate::time::Scheme;
 
 /// Bytes per bar1d element (measured, module header).
@@ -109,15 +114,22 @@ impl RunConfig {
                         (n, *dim, per_row, n.powf((*dim as f64 - 1.0) / *dim as f64))
                     }
                 };
-                let fill = if d == 2 {
-                    3.63 * n * n.max(2.0).log2()
-                } else {
-                    12.5 * n.powf(4.0 / 3.0)
+                let (fill, matrices, vectors) = match c.solver {
+                    Solver::Direct => (
+                        if d == 2 {
+                            3.63 * n * n.max(2.0).log2()
+                        } else {
+                            12.5 * n.powf(4.0 / 3.0)
+                        },
+                        3.0,
+                        12.0,
+                    ),
+                    Solver::Cg { .. } => (0.0, 4.0, 12.0 + 6.0 + 32.0),
                 };
-                let matrices = 3.0 * per_row * n * 16.0;
+                let matrices = matrices * per_row * n * 16.0;
                 (
                     n,
-                    fill * 16.0 + matrices + n * contact * 8.0 + 12.0 * n * 8.0,
+                    fill * 16.0 + matrices + n * contact * 8.0 + vectors * n * 8.0,
                 )
             }
         };

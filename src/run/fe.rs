@@ -15,6 +15,9 @@
 //! W = B Z are computed once per run; a step is one sparse solve y = A⁻¹(M p^n + cτ²F), the exact
 //! LCP λ ≥ 0 ⊥ By + g + cτ²Wλ ≥ 0 ([`crate::contact::lcp`], warm-started from the previous
 //! step), and u^{n+1} = y + cτ² Z λ over the active contact dofs. Never a refactorisation.
+//! With `solver = "cg"` ([`crate::space::step_solver`]) nothing is factored: the same solves
+//! (the step's and Z's columns) are made by preconditioned conjugate gradient on A itself,
+//! each step warm-started from the previous one; a CG failure ends the run `solver-failed`.
 //!
 //! Massless dofs (the bottom nodes with mod1/mod2/mod3/weights/zero-contact) need no special
 //! case: their rows of M are zero, so their row of the step system is c τ² (K u − F − Bᵀλ) = 0,
@@ -45,9 +48,8 @@ use crate::space::fe::nitsche::{ContactPoint, contact_points};
 use crate::space::fe::{
     BallMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
 };
-use crate::space::linalg::{
-    Cholesky, CholeskyOptions, FactorKind, Ordering, SolveWork, SymbolicCholesky,
-};
+use crate::space::linalg::{CholeskyOptions, FactorKind, LinalgError, Ordering, SymbolicCholesky};
+use crate::space::step_solver::{Solver, StepSolver, StepWork};
 use crate::space::{ContactMethod, MassVariant};
 use crate::time::Scheme;
 
@@ -66,6 +68,8 @@ pub struct FeConfig {
     pub scheme: Scheme,
     pub dt: f64,
     pub steps: usize,
+    /// Direct (Cholesky) or iterative (CG) step solves (`solver`, `cg_tol`).
+    pub solver: Solver,
     /// Ensemble member: relative amplitude of a uniform perturbation of v⁰ (u⁰ = 0 here) and
     /// its seed.
     pub perturbation: Option<(f64, u64)>,
@@ -187,7 +191,10 @@ struct Geometry {
     mesh: FeMesh,
     dofs: DofMap,
     pattern: Arc<Pattern>,
-    symbolic: Arc<SymbolicCholesky>,
+    /// The symbolic Cholesky analysis with these choices, made on first use: a `cg` run never
+    /// asks for it (at 3·10⁵ dofs in 3D its supernodal structure alone is hundreds of MB).
+    cholesky: CholeskyOptions,
+    symbolic: OnceLock<Result<Arc<SymbolicCholesky>, LinalgError>>,
     k: SymMatrix,
     /// Unweighted Gram matrix (ρ = 1) and ∫∇u:∇v, for the error norms.
     gram: SymMatrix,
@@ -211,12 +218,23 @@ struct Geometry {
     vertical: Vec<usize>,
 }
 
-/// The matrices of one run: its mass variant and the factored, condensed step matrix.
+impl Geometry {
+    /// The symbolic analysis of the pattern (made once, by the first direct run).
+    fn symbolic(&self) -> Result<Arc<SymbolicCholesky>, LinalgError> {
+        self.symbolic
+            .get_or_init(|| SymbolicCholesky::with_options(&self.pattern, &self.cholesky))
+            .clone()
+    }
+}
+
+/// The matrices of one run: its mass variant and the factored (or, with `cg`, the iterated)
+/// condensed step matrix.
 #[derive(Debug)]
 struct Factored {
     m: SymMatrix,
     mass_total: f64,
-    chol: Cholesky,
+    /// The step solves: the Cholesky factor of A, or A itself for CG.
+    chol: StepSolver,
     /// Z = A⁻¹Bᵀ, column-major (n × n_c).
     z: Vec<f64>,
     /// Mixed: H = cτ² B Z (n_c × n_c, row-major). Nitsche: W = P Z (Q × Q, row-major).
@@ -367,7 +385,6 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
             FactorKind::Supernodal
         },
     };
-    let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
     let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let contact: Vec<usize> = mesh.contact_nodes.iter().map(|&n| n * d + d - 1).collect();
     let contact_height = mesh
@@ -387,7 +404,8 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         mesh: FeMesh::Ball(mesh),
         dofs,
         pattern,
-        symbolic,
+        cholesky: opts,
+        symbolic: OnceLock::new(),
         k,
         gram,
         grad,
@@ -410,7 +428,6 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
     let dofs = DofMap::new(mesh.num_nodes() * d, |g| clamped(g / d));
     let pattern = fe_pattern(&mesh, &dofs);
     let opts = cholesky_options(&mesh, &dofs);
-    let symbolic = SymbolicCholesky::with_options(&pattern, &opts).map_err(|e| e.to_string())?;
     let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let bottom = mesh.nodes_on_plane(d - 1, 0);
     let free = |g: usize| dofs.free_index(g).expect("Γ_C is not clamped");
@@ -451,7 +468,8 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         mesh: FeMesh::Box(mesh),
         dofs,
         pattern,
-        symbolic,
+        cholesky: opts,
+        symbolic: OnceLock::new(),
         k,
         gram,
         grad,
@@ -601,7 +619,7 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
     }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
-    let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| e.to_string())?;
+    let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| e.to_string())?;
     let n = g.dofs.n_free();
     let nc = g.contact.len();
     let mut z = vec![0.0; n * nc];
@@ -609,7 +627,8 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
         z[j * n + c] = 1.0;
     }
     let mut work = chol.work_for(nc);
-    chol.solve_many_in_place(&mut z, nc, &mut work);
+    chol.try_solve_many_in_place(&mut z, nc, &mut work)
+        .map_err(|e| format!("the condensation columns A⁻¹Bᵀ: {e}"))?;
     let mut h = vec![0.0; nc * nc];
     for (i, &ci) in g.contact.iter().enumerate() {
         for j in 0..nc {
@@ -677,7 +696,7 @@ fn factor_nitsche(
             }
         }
     }
-    let chol = Cholesky::new(&g.symbolic, &a).map_err(|e| {
+    let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
     })?;
     let mut z = vec![0.0; n * nq];
@@ -690,7 +709,9 @@ fn factor_nitsche(
         }
     }
     let mut work = chol.work_for(nq);
-    chol.solve_many_in_place(&mut z, nq, &mut work);
+    chol.try_solve_many_in_place(&mut z, nq, &mut work).map_err(|e| {
+        format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) (Θ = {theta}, γ0 = {gamma0}), its condensation columns: {e}")
+    })?;
     let mut h = vec![0.0; nq * nq];
     for q in 0..nq {
         for r in 0..nq {
@@ -947,20 +968,25 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
         return fail(status, msg, metrics);
     }
+    // The solver is part of the key: a `cg` entry holds A itself, not its factor.
     let factor_key = format!(
-        "{}|{:?}|{:?}|{:e}",
+        "{}|{:?}|{:?}|{:e}|{:?}",
         geometry_key(&cfg.setup),
         cfg.mass,
         cfg.method,
-        c_tau2
+        c_tau2,
+        cfg.solver
     );
     let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
     let fac = match fac {
         Ok(f) => f,
         Err(e) => return fail(Status::SolverFailed, e, metrics),
     };
-    metrics.factorizations = i64::from(!hit);
-    metrics.factor_cache_hits = Some(i64::from(hit));
+    // CG factors nothing: no factorisation made, none reused (its matrix and condensation
+    // columns are still shared through the cache).
+    let factored = fac.chol.is_factored();
+    metrics.factorizations = i64::from(!hit && factored);
+    metrics.factor_cache_hits = factored.then_some(i64::from(hit));
     metrics.mass_total = Some(fac.mass_total);
     if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
         return fail(status, msg, metrics);
@@ -1015,7 +1041,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let mut kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
     let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
     let mut newton_max = 0usize;
-    let mut work: SolveWork = fac.chol.work();
+    let mut work: StepWork = fac.chol.work();
     for &r in &g.vertical {
         v[r] = cfg.setup.v0;
     }
@@ -1256,6 +1282,8 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
                 }
             }
             fac.chol.solve_in_place(&mut y, &mut work);
+            work.check()
+                .map_err(|e| Stop::Solver(step, e.to_string()))?;
             if let Some(ops) = nit {
                 // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
                 for (k, qk) in q.iter_mut().enumerate() {
@@ -1335,6 +1363,10 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     metrics.steps = done as i64;
     metrics.iterations = iterations;
     metrics.iterations_max_step = Some(newton_max as i64);
+    if !fac.chol.is_factored() {
+        metrics.solver_iterations = Some(work.iterations_total() as i64);
+        metrics.solver_iterations_max_step = Some(work.iterations_max() as i64);
+    }
     metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);

@@ -162,6 +162,7 @@ impl RunConfig {
                 scheme,
                 dt,
                 steps,
+                solver: crate::space::step_solver::Solver::Direct,
                 perturbation: None,
             }),
             // The oscillator's one dof is its mass: no mass variant to keep.
@@ -182,6 +183,15 @@ impl RunConfig {
     pub fn with_contact_init(mut self, init: ContactInit) -> RunConfig {
         if let RunConfig::Bar1d(c) = &mut self {
             c.contact_init = init;
+        }
+        self
+    }
+
+    /// How the step systems of a finite-element run are solved (the 1D engines' tridiagonal
+    /// solves have no choice: unchanged).
+    pub fn with_solver(mut self, solver: crate::space::step_solver::Solver) -> RunConfig {
+        if let RunConfig::Fe(c) = &mut self {
+            c.solver = solver;
         }
         self
     }

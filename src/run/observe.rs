@@ -63,6 +63,10 @@ pub struct Metrics {
     pub free_fall_error: Option<f64>,
     /// Most contact-solver iterations in one step (FE scenes).
     pub iterations_max_step: Option<i64>,
+    /// CG iterations of the step solves over the time loop, and the most in one step
+    /// (`solver = "cg"`; None for the direct solver).
+    pub solver_iterations: Option<i64>,
+    pub solver_iterations_max_step: Option<i64>,
     /// Part of the stepping time spent on observables and error norms (sampled estimate).
     pub observe_time_s: Option<f64>,
     /// Contact phases detected at every step ([`super::impacts`]); None if no step was observed.

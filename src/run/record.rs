@@ -151,7 +151,7 @@ schema! {
         steps: i64 => "", "time steps completed";
         dofs: i64 => "", "unknowns of the space discretisation";
         iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step; two with contact-stabilized-newmark; the Newton iterations of discrete-gradient)";
-        factorizations: i64 => "", "matrix factorisations performed";
+        factorizations: i64 => "", "matrix factorisations performed (0 with solver = cg, which factors nothing)";
         solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
         contact_switches: i64 => "", "times the contact pressure switched on or off";
         mass_total: Option<f64> => "kg", "1ᵀM1, the total mass the mass matrix represents";
@@ -174,7 +174,7 @@ schema! {
         err_force_l2: Option<f64> => "N·s^½", "l2(τ) error of the total contact force against the reference run (2D/3D)";
         contact_dofs: Option<i64> => "", "unknowns the contact problem is condensed onto (2D/3D: vertical dofs of Γ_C)";
         contact_toggles: Option<i64> => "", "times the total contact force switched between zero and non-zero (2D/3D; 002's chatter)";
-        factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D)";
+        factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D; null with solver = cg)";
         setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
         stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
         observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
@@ -202,6 +202,10 @@ schema! {
         err_impact_time: Option<f64> => "s", "oscillator: max over the exact impacts in [0, T] of the distance to the nearest discrete contact start";
         exit_velocity: Option<f64> => "m/s", "bar1d with a free end: the bar's mean velocity 1ᵀMv/1ᵀM1 at T (the flying bar leaves with −v0)";
         pressure_oscillation: Option<f64> => "", "max over the contact phases (impact_*) of TV/(2·max|σ_C|), TV the total variation of σ_C (1D) or of the total contact force (2D/3D) over the phase's steps, rise from and fall to zero included: 1 for a pressure that rises once and falls once, larger when it chatters (SPEC §3.2); null without contact";
+        solver: Option<String> => "", "step solves of the 2D/3D scenes (SPEC §4): direct (sparse Cholesky) | cg (Jacobi-preconditioned conjugate gradient); null for bar1d and the oscillator";
+        cg_tol: Option<f64> => "", "CG's relative residual tolerance, ‖r‖ ≤ cg_tol·‖b‖ in the D⁻¹ norm, D = diag(A) (solver = cg)";
+        solver_iterations: Option<i64> => "", "CG iterations of the step solves of the time loop, summed over the steps (solver = cg; null for direct)";
+        solver_iterations_max_step: Option<i64> => "", "most CG iterations of one step's solve (solver = cg)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -406,6 +410,10 @@ impl RunRecord {
             err_impact_time: m.err_impact_time,
             exit_velocity: m.exit_velocity,
             pressure_oscillation: m.pressure_oscillation,
+            solver: p.get(&Key::Solver).map(|v| v.to_string()),
+            cg_tol: f(Key::CgTol),
+            solver_iterations: m.solver_iterations,
+            solver_iterations_max_step: m.solver_iterations_max_step,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

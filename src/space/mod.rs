@@ -8,8 +8,10 @@
 //! method produced them.
 
 pub mod bar1d;
+pub mod cg;
 pub mod fe;
 pub mod linalg;
+pub mod step_solver;
 pub mod tridiag;
 
 pub use bar1d::Bar1dSpace;

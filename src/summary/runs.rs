@@ -50,6 +50,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &[
     ("stiffness", Kind::F64),
     ("force", Kind::F64),
     ("impact_law", Kind::F64),
+    ("solver", Kind::Str),
+    ("cg_tol", Kind::F64),
     ("T", Kind::F64),
     ("ensemble_sample", Kind::I64),
     ("ensemble_perturbation", Kind::F64),
@@ -143,10 +145,17 @@ impl Cell {
         }
     }
 
-    /// The value as a person reads it (shortest round-trip form of floats).
+    /// The value as a person reads it (shortest round-trip form of floats; below 1e-4 in
+    /// exponent form: `cg_tol=1e-12`, not twelve zeros).
     pub(crate) fn show(&self) -> Option<String> {
         match self {
-            Cell::F64(x) => x.map(|x| format!("{x}")),
+            Cell::F64(x) => x.map(|x| {
+                if x != 0.0 && x.abs() < 1e-4 {
+                    format!("{x:e}")
+                } else {
+                    format!("{x}")
+                }
+            }),
             Cell::I64(x) => x.map(|x| x.to_string()),
             Cell::Str(x) => x.clone(),
         }

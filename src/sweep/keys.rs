@@ -47,6 +47,11 @@ pub enum Key {
     RhoInf,
     /// HHT α (SPEC §3.2, preset `hht` of generalized-α).
     HhtAlpha,
+    /// The step solves of the 2D/3D scenes: `direct` (sparse Cholesky, default) or `cg`
+    /// (Jacobi-preconditioned conjugate gradient, SPEC §4).
+    Solver,
+    /// CG's relative residual tolerance (default 1e-12; `solver = "cg"` only).
+    CgTol,
 }
 
 /// What a key's value must look like.
@@ -132,7 +137,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 34] = [
+    pub const ALL: [Key; 36] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -167,6 +172,8 @@ impl Key {
         Key::ImpactLaw,
         Key::RhoInf,
         Key::HhtAlpha,
+        Key::Solver,
+        Key::CgTol,
     ];
 
     pub fn name(self) -> &'static str {
@@ -205,6 +212,8 @@ impl Key {
             Key::ImpactLaw => "impact_law",
             Key::RhoInf => "rho_inf",
             Key::HhtAlpha => "hht_alpha",
+            Key::Solver => "solver",
+            Key::CgTol => "cg_tol",
         }
     }
 
@@ -247,9 +256,12 @@ impl Key {
     pub fn value_type(self) -> ValueType {
         match self {
             Key::Elements => ValueType::Int,
-            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit | Key::RightEnd => {
-                ValueType::Str
-            }
+            Key::Space
+            | Key::Mass
+            | Key::Scheme
+            | Key::ContactInit
+            | Key::RightEnd
+            | Key::Solver => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -343,6 +355,27 @@ impl Key {
                 )),
             },
             (Key::PointMass | Key::Stiffness, Value::Num(x)) => positive(*x),
+            (Key::Solver, Value::Str(s)) => {
+                if crate::space::step_solver::Solver::NAMES.contains(&s.as_str()) {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown solver `{s}` (expected direct — sparse Cholesky — or cg — preconditioned conjugate gradient)"
+                    ))
+                }
+            }
+            // A relative residual: at 1 and above CG would stop before iterating. Values below
+            // round-off (≈ 1e-15) are accepted but buy nothing: CG's recursively updated
+            // residual keeps shrinking while the true one stays at round-off, so such a run
+            // iterates longer for the same solution (measured: cg_tol = 1e-18 runs).
+            (Key::CgTol, Value::Num(x)) => {
+                finite(*x)?;
+                if *x > 0.0 && *x < 1.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must lie in (0, 1) (a relative residual), got {x}"))
+                }
+            }
             (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),
             (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
             // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).

@@ -22,6 +22,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
 use crate::scene::{Physics, Scene, SceneKind};
+use crate::space::step_solver::Solver;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{
     AlphaPreset, GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, PaoliSchatzmanParams,
@@ -146,6 +147,8 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::Restitution => Value::Num(1.0),
         Key::RhoInf => Value::Num(1.0),
         Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
+        Key::Solver => Value::Str(Solver::Direct.name().into()),
+        Key::CgTol => Value::Num(Solver::DEFAULT_CG_TOL),
         k if k.is_physics() => physics_value(
             k,
             scene.physics().iter().find(|p| p.name == k.name())?.default,
@@ -556,6 +559,24 @@ fn resolve(
     } else {
         ContactInit::Consistent
     });
+    // The step solver (SPEC §4) is the finite-element engine's choice; the 1D engines solve
+    // tridiagonal systems, and drop the keys.
+    let fe = matches!(config, RunConfig::Fe(_));
+    let solver = match get(Key::Solver).as_ref().and_then(Value::as_str) {
+        Some("cg") if fe => Solver::Cg {
+            tol: num(Key::CgTol).expect("cg_tol has a default"),
+        },
+        _ => Solver::Direct,
+    };
+    if user.contains_key(&Key::Solver) && !fe {
+        dropped.push(
+            "solver applies to the finite-element scenes only (their sparse step matrix)".into(),
+        );
+    }
+    if user.contains_key(&Key::CgTol) && solver == Solver::Direct {
+        dropped.push("cg_tol applies to solver = cg only".into());
+    }
+    let config = config.with_solver(solver);
 
     // Memory before anything is built (the CFL check below assembles the operators).
     if let Some(budget) = limits.max_run_bytes {
@@ -568,7 +589,30 @@ fn resolve(
                 Key::H
             };
             let (at, advice) = if est.state_bytes >= est.series_bytes {
-                (origin(mesh_key), format!("lower `{}`", mesh_key.name()))
+                // Without a factor the same run may fit: say so, with its figure.
+                let cg = (fe && solver == Solver::Direct).then(|| {
+                    config
+                        .clone()
+                        .with_solver(Solver::Cg {
+                            tol: Solver::DEFAULT_CG_TOL,
+                        })
+                        .estimate(series_every)
+                        .bytes()
+                });
+                let advice = match cg {
+                    Some(b) => format!(
+                        "lower `{}`, or set solver = \"cg\" (conjugate gradient, no factor: an estimated {}{})",
+                        mesh_key.name(),
+                        human_bytes(b),
+                        if b > budget {
+                            ", also above the budget"
+                        } else {
+                            ""
+                        }
+                    ),
+                    None => format!("lower `{}`", mesh_key.name()),
+                };
+                (origin(mesh_key), advice)
             } else {
                 (
                     Origin {
@@ -676,6 +720,15 @@ fn resolve(
     for (name, value) in &physics.0 {
         let key = Key::from_name(name).unwrap();
         put(key, physics_value(key, *value), false);
+    }
+    // `direct` is the default: its runs keep the ids they had before the key existed.
+    match solver {
+        Solver::Cg { tol } => {
+            put(Key::Solver, Value::Str(solver.name().into()), false);
+            put(Key::CgTol, Value::Num(tol), false);
+        }
+        Solver::Direct if fe => put(Key::Solver, Value::Str(solver.name().into()), false),
+        Solver::Direct => {}
     }
     // Derived columns, not part of the identity.
     params.insert(Key::H, Value::Num(h));
