@@ -50,6 +50,12 @@ use crate::space::linalg::{
 use crate::space::{ContactMethod, MassVariant};
 use crate::time::Scheme;
 
+// The methods of SPEC §3.2 (kane, contact-stabilized Newmark, generalized-α, Moreau–Jean, the
+// discrete gradient, kinematic central difference): a child module, so it reuses this engine's
+// geometry, factors and caches as they are.
+#[path = "fe_methods.rs"]
+mod methods;
+
 /// Steps between two checks of the clock and of an interruption.
 const CLOCK_EVERY: usize = 64;
 /// The contact LCP: tolerance relative to the largest gap, and the iteration cap (SPEC §4).
@@ -103,6 +109,9 @@ impl FeConfig {
 
     /// Explicit schemes are not offered by the FE engine (the scene refuses them first).
     pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
+        if methods::kinematic(self) {
+            return methods::kinematic_dt_limit(self).map(Some);
+        }
         if self.scheme.is_explicit() {
             return Err((
                 "scheme",
@@ -840,6 +849,9 @@ fn record_lattice(
 
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
+    if methods::handles(cfg) {
+        return methods::simulate(cfg, opts, ctx);
+    }
     let start = Instant::now();
     let mut metrics = Metrics {
         dofs: cfg.unknowns() as i64,
