@@ -47,10 +47,15 @@
 //! Generalized-α with Nitsche/penalty (f_cⁿ = f_c(uⁿ)) is not offered on the FE scenes yet (the
 //! scenes refuse it with that reason).
 //!
-//! The energy E^h = ½vᵀMv + ½uᵀKu − Fᵀu is measured with products at every step (the schemes
-//! whose equation does not hold at t^{n+1} cannot use Newmark's identity uᵀKu = uᵀ(F + Bᵀλ −
-//! Ma)); both products are the next step's right-hand side too, so a step costs the solve and
-//! two or three sparse products. Nothing is allocated in the time loop.
+//! The energy E^h = ½vᵀMv + ½uᵀKu − Fᵀu needs Mv and Ku (the schemes whose equation does not
+//! hold at t^{n+1} cannot use Newmark's identity uᵀKu = uᵀ(F + Bᵀλ − Ma)); they are the next
+//! step's right-hand side too. They are carried: a step computes one product, KΔ (Δ its
+//! increment), and takes MΔ = AΔ − cKΔ from the system it just solved (AΔ its right-hand side
+//! plus the contact term) — a subtraction without division by c, so no round-off is amplified.
+//! Contact-stabilized Newmark and Moreau–Jean carry Kv as well (their right-hand sides need
+//! K u^pred = Kuⁿ + τKvⁿ + KM⁻¹Bᵀν and K(uⁿ + θτvⁿ)). So a step costs the solve and one sparse
+//! product, as Crank–Nicolson's does (measured: `benches/fe.rs`, `bar2d-methods`). Every 64
+//! steps the products are recomputed from the state. Nothing is allocated in the time loop.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -69,6 +74,9 @@ use crate::space::fe::SymMatrix;
 use crate::space::linalg::{Cholesky, SolveWork};
 use crate::space::{ContactMethod, MassVariant};
 use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
+
+/// Steps between two recomputations of the carried products Mv, Ku (, Kv, Mu).
+const REFRESH: usize = 64;
 
 /// The method of a run of this module.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,6 +164,8 @@ fn step_coefficient(m: Method, tau: f64) -> Option<f64> {
 struct MassInverse {
     zm: Vec<f64>,
     wm: Vec<f64>,
+    /// K M⁻¹Bᵀ (n × n_c): the predictor's K u^pred from carried products.
+    kzm: Vec<f64>,
 }
 
 static MASS_INVERSES: Cache<MassInverse> = Cache::new();
@@ -183,7 +193,11 @@ fn mass_inverse(g: &Geometry, m: &SymMatrix) -> Result<MassInverse, String> {
             wm[j * nc + i] = s;
         }
     }
-    Ok(MassInverse { zm, wm })
+    let mut kzm = vec![0.0; n * nc];
+    for j in 0..nc {
+        g.k.matvec_into(&zm[j * n..(j + 1) * n], &mut kzm[j * n..(j + 1) * n]);
+    }
+    Ok(MassInverse { zm, wm, kzm })
 }
 
 /// The largest stable step of kinematic central difference: 2/ω_max with the Gershgorin bound
@@ -463,6 +477,11 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let mut mv = vec![0.0; n];
     let mut ma = vec![0.0; n];
     let mut ku = vec![0.0; n];
+    // K v (CSN, Moreau–Jean), K Δ, and the step's right-hand side A Δ (or A u^{n+1}): the
+    // products a step carries instead of recomputing them (module header).
+    let mut kv = vec![0.0; n];
+    let mut kd = vec![0.0; n];
+    let mut sd = vec![0.0; n];
     let mut y = vec![0.0; n];
     let mut pred = vec![0.0; n];
     let mut tmp = vec![0.0; n];
@@ -664,6 +683,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let t2 = tau * tau;
     let stop = (|| -> Result<(), Stop<String>> {
         g.k.matvec_into(&u, &mut ku);
+        g.k.matvec_into(&v, &mut kv);
         if let Some(ops) = nit {
             // The state's own contact force at t = 0 (zero unless the body starts in contact).
             let (_, _, f) = ops.energy_terms_and_force(&u);
@@ -699,9 +719,11 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                     let work = work.as_mut().expect("implicit methods have solve scratch");
                     match meth {
                         Method::Kane => {
+                            // b = τMvⁿ − τ²/2 Kuⁿ + τ²/2 F, kept in `sd` for S Δ below.
                             for i in 0..n {
-                                y[i] = tau * mv[i] - 0.5 * t2 * ku[i] + 0.5 * t2 * force_vec[i];
+                                y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
                             }
+                            sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
                                 *qi = u[ci] + y[ci] + gi;
@@ -712,9 +734,15 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
                             add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
+                            // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
+                            g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
+                                let md = sd[i] - c * kd[i];
                                 v[i] = 2.0 * y[i] / tau - v[i];
+                                mv[i] = 2.0 * md / tau - mv[i];
                                 u[i] += y[i];
+                                ku[i] += kd[i];
                             }
                             for &i in &massless {
                                 v[i] = y[i] / tau;
@@ -736,13 +764,15 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                 .map_err(|e| Stop::Solver(step, format!("predictor: {e}")))?;
                             iterations += it as i64;
                             add_columns(&mi.zm, &nu, 1.0, &mut pred);
+                            // K u^pred = Kuⁿ + τKvⁿ + (KM⁻¹Bᵀ)ν, from the carried products.
                             for i in 0..n {
-                                tmp[i] = u[i] + pred[i];
+                                tmp[i] = ku[i] + tau * kv[i];
                             }
-                            g.k.matvec_into(&tmp, &mut y);
+                            add_columns(&mi.kzm, &nu, 1.0, &mut tmp);
                             for i in 0..n {
-                                y[i] = -0.25 * t2 * y[i] + 0.5 * t2 * force_vec[i];
+                                y[i] = -c * (ku[i] + tmp[i]) + 2.0 * c * force_vec[i];
                             }
+                            sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
                                 *qi = pred[ci] + y[ci] + gi;
@@ -753,9 +783,15 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             newton_max = newton_max.max(it + it2);
                             iterations += it2 as i64;
                             add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
+                            g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
+                                let md = sd[i] - c * kd[i];
                                 v[i] += 2.0 * y[i] / tau;
+                                mv[i] += 2.0 * md / tau;
                                 u[i] = pred[i] + y[i];
+                                ku[i] = tmp[i] + kd[i];
+                                kv[i] += 2.0 * kd[i] / tau;
                             }
                             0.5 * lambda.iter().sum::<f64>()
                         }
@@ -768,9 +804,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                 y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i]
                                     + (c + kf) * force_vec[i];
                             }
-                            for (&ci, l) in g.contact.iter().zip(&lambda_prev) {
-                                y[ci] += kf * l;
-                            }
+                            add_rows(&g.contact, &lambda_prev, kf, &mut y);
+                            sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
                                 *qi = y[ci] + gi;
@@ -781,32 +816,32 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
                             add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
                             lambda_prev.copy_from_slice(&lambda);
-                            // M ũ from the carried products, then M u^{n+1} by one product:
-                            // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²).
+                            // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
+                            // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
                             std::mem::swap(&mut u, &mut y);
-                            m.matvec_into(&u, &mut tmp);
+                            g.k.matvec_into(&u, &mut ku);
                             let g1 = 1.0 - ga.gamma;
                             for i in 0..n {
                                 let an = (u[i] - pred[i]) / bt2;
                                 let mpred = mu[i] + tau * mv[i] + kp * ma[i];
-                                let man = (tmp[i] - mpred) / bt2;
+                                let mun = sd[i] - c * ku[i];
+                                let man = (mun - mpred) / bt2;
                                 v[i] += tau * (g1 * a[i] + ga.gamma * an);
                                 mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
                                 a[i] = an;
                                 ma[i] = man;
+                                mu[i] = mun;
                             }
-                            std::mem::swap(&mut mu, &mut tmp);
                             lambda.iter().sum::<f64>()
                         }
                         Method::MoreauJean(mj) => {
+                            // b = −τK(uⁿ + θτvⁿ) + τF from the carried products.
                             for i in 0..n {
-                                tmp[i] = u[i] + mj.theta * tau * v[i];
+                                y[i] = -tau * (ku[i] + mj.theta * tau * kv[i]) + tau * force_vec[i];
                             }
-                            g.k.matvec_into(&tmp, &mut y);
-                            for i in 0..n {
-                                y[i] = -tau * y[i] + tau * force_vec[i];
-                            }
+                            sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             let mut any = false;
                             for (j, (&ci, gi)) in g.contact.iter().zip(&gaps).enumerate() {
@@ -826,12 +861,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                 newton_max = newton_max.max(it);
                                 iterations += it as i64;
                                 add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
                             } else {
                                 lambda.iter_mut().for_each(|l| *l = 0.0);
                             }
+                            g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
+                                let md = sd[i] - c * kd[i];
                                 u[i] += tau * (v[i] + mj.theta * y[i]);
+                                ku[i] += tau * (kv[i] + mj.theta * kd[i]);
                                 v[i] += y[i];
+                                mv[i] += md;
+                                kv[i] += kd[i];
                             }
                             // p = cμ, reported as the mean force p/τ.
                             c * lambda.iter().sum::<f64>() / tau
@@ -840,40 +881,46 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             let ops = nit.expect("the discrete gradient has contact points");
                             // b = τMvⁿ − τ²/2 K_Θuⁿ + τ²/2 F, K_Θ u = Ku − Θ Σ w γ s (s·u).
                             for i in 0..n {
-                                y[i] = tau * mv[i] - 0.5 * t2 * ku[i] + 0.5 * t2 * force_vec[i];
+                                y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
                             }
-                            if ops.theta != 0.0 {
-                                for k in 0..ops.len() {
-                                    let fk = ops.theta
-                                        * ops.w[k]
-                                        * ops.gamma[k]
-                                        * ops.apply(&ops.s, k, &u);
-                                    for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
-                                        .iter()
-                                        .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
-                                    {
-                                        y[gd] += 0.5 * t2 * fk * sk;
-                                    }
-                                }
-                            }
+                            add_theta_term(ops, &u, 2.0 * c, &mut y);
+                            sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             for k in 0..ops.len() {
                                 let sn = ops.apply(&ops.p, k, &u);
                                 grad_work.a[k] = sn - ops.gap[k];
                                 q[k] = sn + ops.apply(&ops.p, k, &y);
                             }
-                            let it = gradient_newton(ops, &f.h, 0.5 * t2, &q, &mut grad_work)
+                            let it = gradient_newton(ops, &f.h, 2.0 * c, &q, &mut grad_work)
                                 .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
-                            // Δu = y + τ²/2 Z D = y + c Z (2D).
+                            // Δu = y + τ²/2 Z D = y + c Z (2D); A Δu = b + c Σ 2D_q C_q.
                             for (l, dq) in lambda.iter_mut().zip(&grad_work.d) {
                                 *l = 2.0 * dq;
                             }
                             add_columns(&f.z, &lambda, c, &mut y);
+                            for (k, l) in lambda.iter().enumerate() {
+                                if *l != 0.0 {
+                                    for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                                        .iter()
+                                        .zip(&ops.c[k * ops.k..(k + 1) * ops.k])
+                                    {
+                                        sd[gd] += c * l * ck;
+                                    }
+                                }
+                            }
+                            // MΔ = AΔ − cK_ΘΔ with KΔ by one product.
+                            g.k.matvec_into(&y, &mut kd);
+                            for i in 0..n {
+                                sd[i] -= c * kd[i];
+                            }
+                            add_theta_term(ops, &y, c, &mut sd);
                             for i in 0..n {
                                 v[i] = 2.0 * y[i] / tau - v[i];
+                                mv[i] = 2.0 * sd[i] / tau - mv[i];
                                 u[i] += y[i];
+                                ku[i] += kd[i];
                             }
                             for &i in &massless {
                                 v[i] = y[i] / tau;
@@ -884,11 +931,17 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                     }
                 }
             };
-            if !matches!(meth, Method::Kinematic | Method::Alpha(_)) {
+            // The carried products drift by round-off (and would hide a step that does not
+            // solve its equation): every REFRESH steps they are recomputed from the state, so
+            // a discrepancy shows as an energy jump the per-step energy checks see.
+            if step.is_multiple_of(REFRESH) && !matches!(meth, Method::Kinematic) {
                 m.matvec_into(&v, &mut mv);
-            }
-            if !matches!(meth, Method::Kinematic) {
                 g.k.matvec_into(&u, &mut ku);
+                match meth {
+                    Method::Csn | Method::MoreauJean(_) => g.k.matvec_into(&v, &mut kv),
+                    Method::Alpha(_) => m.matvec_into(&u, &mut mu),
+                    _ => {}
+                }
             }
             observe_timer
                 .time(step, || {
@@ -937,6 +990,30 @@ fn add_columns(z: &[f64], mu: &[f64], s: f64, y: &mut [f64]) {
             for (yi, zi) in y.iter_mut().zip(zj) {
                 *yi += f * zi;
             }
+        }
+    }
+}
+
+/// y_{c_j} += s μ_j: s Bᵀμ on the contact rows.
+fn add_rows(contact: &[usize], mu: &[f64], s: f64, y: &mut [f64]) {
+    for (&c, l) in contact.iter().zip(mu) {
+        y[c] += s * l;
+    }
+}
+
+/// y += s Θ Σ_q w_q γ_q (s_q·x) s_q: the Nitsche Θ-term of −K_Θ x = −Kx + Θ Σ w γ s (s·x),
+/// scaled by s (nothing for the penalty, Θ = 0).
+fn add_theta_term(ops: &NitscheOps, x: &[f64], s: f64, y: &mut [f64]) {
+    if ops.theta == 0.0 {
+        return;
+    }
+    for k in 0..ops.len() {
+        let f = s * ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, x);
+        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+            .iter()
+            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+        {
+            y[gd] += f * sk;
         }
     }
 }
