@@ -255,10 +255,11 @@ method = [
     );
 }
 
-/// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1): inactive
-/// before the impact, active after.
+/// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and
+/// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried):
+/// inactive before the impact, active after.
 #[test]
-fn disc2d_discrete_gradient_allocates_nothing() {
+fn disc2d_comparison_methods_allocate_nothing() {
     assert_loop_allocates_nothing_with(
         r#"
 name = "alloc-disc-dg"
@@ -269,11 +270,12 @@ h = 8.0
 dt = 0.1
 gap = 0.05
 degree = 1
-scheme = "discrete-gradient"
 [grid]
 method = [
-  { space = "penalty", penalty_gamma0 = 20.0 },
-  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 },
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "discrete-gradient" },
+  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "discrete-gradient" },
+  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1 },
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "generalized-alpha", rho_inf = 0.5 },
 ]
 "#,
         15.0,

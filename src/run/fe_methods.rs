@@ -1,7 +1,8 @@
 //! The methods of the comparison literature (SPEC §3.2) in the sparse finite-element engine:
-//! `kane`, `contact-stabilized-newmark`, `generalized-alpha`/`hht`, `moreau-jean` with the
-//! nodal multiplier (`mixed`), the `discrete-gradient` with `penalty` and `nitsche` (Θ = 1),
-//! and `central-difference` with `mixed` and the lumped mass (kinematic contact).
+//! `kane`, `contact-stabilized-newmark`, `moreau-jean` with the nodal multiplier (`mixed`),
+//! `generalized-alpha`/`hht` with `mixed`, `nitsche` and `penalty`, the `discrete-gradient`
+//! with `penalty` and `nitsche` (Θ = 1), and `central-difference` with `mixed` and the lumped
+//! mass (kinematic contact).
 //!
 //! The 1D engine ([`crate::run::bar1d`]) holds the verified step formulas; here they act on the
 //! FE system M ü + K u = F + Bᵀλ, B the vertical dofs of the Γ_C nodes, B u + g ≥ 0, λ ≥ 0.
@@ -44,8 +45,10 @@
 //!   ω²_max ≤ max_i Σ_j |K_ij|/√(m_i m_j) (Gershgorin on M^{−½}KM^{−½}): a guaranteed-stable
 //!   step, a little below the true limit.
 //!
-//! Generalized-α with Nitsche/penalty (f_cⁿ = f_c(uⁿ)) is not offered on the FE scenes yet (the
-//! scenes refuse it with that reason).
+//! Generalized-α with Nitsche/penalty (disc/ball): the linear part K_Θ (Nitsche's Θ-term) sits in
+//! A as for the engine's Newmark steps, the contact force is f_c(u) = Σ_q φ_q(p_q·u) C_q with
+//! f_cⁿ = f_c(uⁿ) (the previous step's Newton values) and f_c^{n+1} solved by the engine's
+//! semismooth Newton with coefficient c ([`super::fe_nitsche`]).
 //!
 //! The energy E^h = ½vᵀMv + ½uᵀKu − Fᵀu needs Mv and Ku (the schemes whose equation does not
 //! hold at t^{n+1} cannot use Newmark's identity uᵀKu = uᵀ(F + Bᵀλ − Ma)); they are the next
@@ -66,7 +69,9 @@ use super::{
 };
 use crate::contact::Lcp;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
-use crate::run::fe_nitsche::{NEWTON_MAX_ITER, NEWTON_TOL, NitscheOps, lu_solve};
+use crate::run::fe_nitsche::{
+    NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
+};
 use crate::run::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use crate::run::reference::ReferenceData;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
@@ -119,9 +124,6 @@ fn method(cfg: &FeConfig) -> Result<Method, String> {
     let bad = match m {
         Method::Kane | Method::Csn | Method::MoreauJean(_) | Method::Kinematic if !mixed => {
             Some("is defined for space = mixed only")
-        }
-        Method::Alpha(_) if !mixed => {
-            Some("with nitsche or penalty is not available on the finite-element scenes")
         }
         Method::Gradient => match cfg.method {
             ContactMethod::Mixed => {
@@ -502,6 +504,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
         .as_ref()
         .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
     let mut grad_work = GradientWork::new(nit.map_or(0, NitscheOps::len));
+    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
     let mut work: Option<SolveWork> = fac.as_ref().map(|f| f.chol.work());
     let diag = m.diagonal();
     // Dofs without inertia (mod1/…/zero-contact with kane): their velocity is Δu/τ.
@@ -795,6 +798,54 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             }
                             0.5 * lambda.iter().sum::<f64>()
                         }
+                        Method::Alpha(ga) if nit.is_some() => {
+                            // Nitsche/penalty: K_Θ is in A, the contact force f_c(u) =
+                            // Σ_q φ_q(p_q·u) C_q, f_cⁿ = f_c(uⁿ) (φⁿ kept from the last step's
+                            // Newton, which solved φ at uⁿ), f_c^{n+1} by the engine's Newton.
+                            let ops = nit.expect("checked");
+                            let (km, kf) = ga.history_coefficients(tau);
+                            let kp = t2 * (0.5 - ga.beta);
+                            let bt2 = ga.beta * t2;
+                            for i in 0..n {
+                                pred[i] = u[i] + tau * v[i] + kp * a[i];
+                                y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i]
+                                    + (c + kf) * force_vec[i];
+                            }
+                            add_theta_term(ops, &u, kf, &mut y);
+                            add_point_columns(ops, &lambda_prev, kf, &mut y);
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            for (k, qk) in q.iter_mut().enumerate() {
+                                *qk = ops.apply(&ops.p, k, &y);
+                            }
+                            let it =
+                                newton(ops, &f.h, c, &q, &ops.gap, &mut lambda, &mut newton_work)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                            newton_max = newton_max.max(it);
+                            iterations += it as i64;
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            add_point_columns(ops, &lambda, c, &mut sd);
+                            lambda_prev.copy_from_slice(&lambda);
+                            // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
+                            std::mem::swap(&mut u, &mut y);
+                            g.k.matvec_into(&u, &mut ku);
+                            for i in 0..n {
+                                sd[i] -= c * ku[i];
+                            }
+                            add_theta_term(ops, &u, c, &mut sd);
+                            let g1 = 1.0 - ga.gamma;
+                            for i in 0..n {
+                                let an = (u[i] - pred[i]) / bt2;
+                                let mpred = mu[i] + tau * mv[i] + kp * ma[i];
+                                let man = (sd[i] - mpred) / bt2;
+                                v[i] += tau * (g1 * a[i] + ga.gamma * an);
+                                mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+                                a[i] = an;
+                                ma[i] = man;
+                                mu[i] = sd[i];
+                            }
+                            lambda.iter().sum::<f64>()
+                        }
                         Method::Alpha(ga) => {
                             let (km, kf) = ga.history_coefficients(tau);
                             let kp = t2 * (0.5 - ga.beta);
@@ -1014,6 +1065,21 @@ fn add_theta_term(ops: &NitscheOps, x: &[f64], s: f64, y: &mut [f64]) {
             .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
         {
             y[gd] += f * sk;
+        }
+    }
+}
+
+/// y += s Σ_q φ_q C_q: the Nitsche/penalty contact force of the point values φ (C_q = −t_q,
+/// the upward direction of point q on its element's dofs).
+fn add_point_columns(ops: &NitscheOps, phi: &[f64], s: f64, y: &mut [f64]) {
+    for (k, p) in phi.iter().enumerate() {
+        if *p != 0.0 {
+            for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                .iter()
+                .zip(&ops.c[k * ops.k..(k + 1) * ops.k])
+            {
+                y[gd] += s * p * ck;
+            }
         }
     }
 }

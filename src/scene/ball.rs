@@ -122,15 +122,6 @@ impl Scene for BallScene {
                 ),
             ));
         }
-        if matches!(scheme, "generalized-alpha" | "hht") && space != "mixed" {
-            return Err((
-                "scheme",
-                format!(
-                    "scheme = {scheme} with space = {space} is not implemented for scene {} (its contact force f_c(uⁿ) of SPEC §3.2 is 1D only for now); it runs with space = mixed",
-                    self.name()
-                ),
-            ));
-        }
         // SPEC §3.2's methods ([`crate::run::fe`]'s methods module); the planner checks their
         // contact methods and masses.
         let comparison = matches!(
