@@ -107,7 +107,8 @@ impl FeConfig {
         }
     }
 
-    /// Explicit schemes are not offered by the FE engine (the scene refuses them first).
+    /// The CFL step of kinematic central difference (mixed + lumped, [`methods`]); every other
+    /// explicit scheme is refused.
     pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
         if methods::kinematic(self) {
             return methods::kinematic_dt_limit(self).map(Some);
