@@ -19,6 +19,16 @@
 //!   paper's T = 40 by `sweeps/003_fig11_disc.toml` / `003_fig12_sphere.toml`
 //!   (`stepping_time_s / steps` of the runs table).
 //!
+//! - `bar2d-methods/…` (issue 20, done-when 4): one step of each SPEC §3.2 method against
+//!   Crank–Nicolson on bar2d at h = 0.00625 (17 × 161 nodes, 5 440 dofs, 17 contact dofs),
+//!   consistent mass, τ = h/2, T = 1 (free flight, the impact at t = 0.4 and the contact
+//!   phase): the engine's stepping time per step over the run, factor cached (as in a sweep),
+//!   contact solves (CSN's predictor LCP included) and the energy observation in it. Kinematic
+//!   central difference (lumped) at half its CFL step is listed for its own cost per step.
+//!   `disc2d-methods/…`: the discrete gradient against CN with the same Nitsche (Θ = 1,
+//!   γ0 = 1e-3) and the penalty on the paper's disc (P2, h = 4, τ = 0.1, T = 15: the impact at
+//!   t ≈ 10).
+//!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).
 
@@ -256,7 +266,130 @@ fn bench_ball(c: &mut Criterion, name: &str, dim: usize, h: f64) {
     g.finish();
 }
 
+/// The engine's stepping time per step of one run (set-up excluded, factors cached).
+fn bench_steps(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    what: &str,
+    cfg: &FeConfig,
+) {
+    let run = contact_sweep::run::RunConfig::Fe(cfg.clone());
+    let opts = RunOptions {
+        series_every: 0,
+        ..RunOptions::default()
+    };
+    let warm = simulate(&run, &opts);
+    assert_eq!(warm.status.as_str(), "ok", "{what}: {:?}", warm.message);
+    g.bench_function(what, |b| {
+        b.iter_custom(|iters| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                let out = simulate(&run, &opts);
+                let per_step = out.metrics.stepping_time_s.unwrap() / out.metrics.steps as f64;
+                total += Duration::from_secs_f64(per_step);
+            }
+            total
+        })
+    });
+}
+
+fn bench_methods(c: &mut Criterion) {
+    use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams};
+    let mut g = c.benchmark_group("bar2d-methods");
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    let h: f64 = 0.05 / 8.0;
+    let dt = h / 2.0;
+    let steps = (1.0 / dt).round() as usize;
+    let mut base = config(2, h, steps);
+    base.mass = MassVariant::Consistent;
+    for (what, scheme) in [
+        (
+            "crank-nicolson",
+            Scheme::Newmark(NewmarkParams::crank_nicolson()),
+        ),
+        ("kane", Scheme::Kane),
+        (
+            "contact-stabilized-newmark",
+            Scheme::ContactStabilizedNewmark,
+        ),
+        (
+            "generalized-alpha-0.5",
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams::from_rho_inf(0.5)),
+        ),
+        (
+            "hht-0.1",
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(0.1)),
+        ),
+        (
+            "moreau-jean",
+            Scheme::MoreauJean(MoreauJeanParams::midpoint()),
+        ),
+    ] {
+        let cfg = FeConfig {
+            scheme,
+            ..base.clone()
+        };
+        bench_steps(&mut g, what, &cfg);
+    }
+    let mut cd = FeConfig {
+        mass: MassVariant::Lumped,
+        scheme: Scheme::Newmark(NewmarkParams::central_difference()),
+        ..base.clone()
+    };
+    let limit = cd.explicit_dt_limit().unwrap().unwrap();
+    cd.dt = 0.5 * limit;
+    cd.steps = (1.0 / cd.dt).round() as usize;
+    bench_steps(&mut g, "central-difference-kinematic", &cd);
+    g.finish();
+
+    let mut g = c.benchmark_group("disc2d-methods");
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    let scene = contact_sweep::scene::BallScene { dim: 2 };
+    let physics = Physics(
+        scene
+            .physics()
+            .iter()
+            .map(|k| (k.name, k.default))
+            .collect(),
+    );
+    let SceneSetup::Fe(setup) = scene.setup(&physics, scene.mesh_from_h(&physics, 4.0).unwrap())
+    else {
+        unreachable!("the disc is an FE scene")
+    };
+    for (space, method) in [
+        (
+            "nitsche",
+            ContactMethod::Nitsche {
+                theta: 1.0,
+                gamma0: 1e-3,
+            },
+        ),
+        ("penalty", ContactMethod::Penalty { gamma0: 20.0 }),
+    ] {
+        for (what, scheme) in [
+            (
+                "crank-nicolson",
+                Scheme::Newmark(NewmarkParams::crank_nicolson()),
+            ),
+            ("discrete-gradient", Scheme::DiscreteGradient),
+        ] {
+            let cfg = FeConfig {
+                setup: setup.clone(),
+                method,
+                mass: MassVariant::Consistent,
+                scheme,
+                dt: 0.1,
+                steps: 150,
+                perturbation: None,
+                solver: Solver::Direct,
+            };
+            bench_steps(&mut g, &format!("{space}-{what}"), &cfg);
+        }
+    }
+    g.finish();
+}
+
 fn fe(c: &mut Criterion) {
+    bench_methods(c);
     bench_ball(c, "disc2d-q2-h4", 2, 4.0);
     bench_ball(c, "sphere3d-q2-h8", 3, 8.0);
     bench_bar(c, "bar3d-20k", 3, 0.0125);

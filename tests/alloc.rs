@@ -271,6 +271,62 @@ method = [
     );
 }
 
+/// The FE engine's SPEC §3.2 methods (run::fe's methods module) on bar2d: kane with the
+/// consistent and a massless contact mass, contact-stabilized Newmark's two LCPs (M⁻¹Bᵀ built
+/// at setup), generalized-α/hht, Moreau–Jean's masked LCP, kinematic central difference.
+#[test]
+fn bar2d_comparison_methods_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-fe-methods"
+scene = "bar2d"
+[fixed]
+T = T_FINAL
+h = 0.1
+dt = 0.01
+[grid]
+method = [
+  { mass = "consistent", scheme = "kane" },
+  { mass = "mod3", scheme = "kane" },
+  { mass = "consistent", scheme = "contact-stabilized-newmark" },
+  { mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5 },
+  { mass = "consistent", scheme = "hht", hht_alpha = 0.1 },
+  { mass = "consistent", scheme = "moreau-jean", restitution = 0.5 },
+  { mass = "lumped", scheme = "central-difference", dt = 0.002 },
+]
+"#,
+        1.0,
+    );
+}
+
+/// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and
+/// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried):
+/// inactive before the impact, active after.
+#[test]
+fn disc2d_comparison_methods_allocate_nothing() {
+    assert_loop_allocates_nothing_with(
+        r#"
+name = "alloc-disc-dg"
+scene = "disc2d"
+[fixed]
+T = T_FINAL
+h = 8.0
+dt = 0.1
+gap = 0.05
+degree = 1
+[grid]
+method = [
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "discrete-gradient" },
+  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "discrete-gradient" },
+  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1 },
+  { space = "penalty", penalty_gamma0 = 20.0, scheme = "generalized-alpha", rho_inf = 0.5 },
+]
+"#,
+        15.0,
+        1,
+    );
+}
+
 /// The oscillator (SPEC §1.5): every scheme family it runs, with both contact treatments —
 /// the exact solution is built at setup and the contact starts go to a buffer sized there.
 #[test]

@@ -32,7 +32,7 @@ pub fn difference_quotient(k: f64, a: f64, s: f64) -> f64 {
 }
 
 /// ∂D/∂s (a generalized derivative at the kinks).
-fn difference_quotient_slope(k: f64, a: f64, s: f64) -> f64 {
+pub fn difference_quotient_slope(k: f64, a: f64, s: f64) -> f64 {
     if (s - a).abs() <= 1e-14 * a.abs().max(1.0) {
         return if a + s > 0.0 { 0.5 * k } else { 0.0 };
     }

@@ -69,17 +69,45 @@ impl Lcp {
         max_iter: usize,
         tol: f64,
     ) -> Result<usize, LcpError> {
+        self.solve_impl(q, lambda, None, max_iter, tol)
+    }
+
+    /// [`Lcp::solve`] on the rows with `rows[i]` only: the others keep λ_i = 0 whatever their
+    /// w_i (Moreau–Jean's complementarity holds on the rows whose predicted gap closes). The
+    /// problem on the kept rows is the principal sub-LCP, SPD as well; `q` of the other rows is
+    /// not read (nor counted in the tolerance's scale).
+    pub fn solve_on(
+        &mut self,
+        q: &[f64],
+        lambda: &mut [f64],
+        rows: &[bool],
+        max_iter: usize,
+        tol: f64,
+    ) -> Result<usize, LcpError> {
+        assert_eq!(rows.len(), self.n, "one flag per row");
+        self.solve_impl(q, lambda, Some(rows), max_iter, tol)
+    }
+
+    fn solve_impl(
+        &mut self,
+        q: &[f64],
+        lambda: &mut [f64],
+        rows: Option<&[bool]>,
+        max_iter: usize,
+        tol: f64,
+    ) -> Result<usize, LcpError> {
         let n = self.n;
-        if q.iter().any(|x| !x.is_finite()) {
+        let kept = |i: usize| rows.is_none_or(|r| r[i]);
+        if (0..n).any(|i| kept(i) && !q[i].is_finite()) {
             return Err(LcpError::NonFinite);
         }
-        let scale = q
-            .iter()
-            .fold(0.0f64, |m, x| m.max(x.abs()))
+        let scale = (0..n)
+            .filter(|&i| kept(i))
+            .fold(0.0f64, |m, i| m.max(q[i].abs()))
             .max(f64::MIN_POSITIVE);
         let eps = tol * scale;
         for i in 0..n {
-            self.passive[i] = lambda[i] > 0.0;
+            self.passive[i] = kept(i) && lambda[i] > 0.0;
         }
         let mut iters = 0usize;
         // A feasible start: the warm set without the indices whose multiplier comes out
@@ -114,7 +142,7 @@ impl Lcp {
                         .map(|(a, b)| a * b)
                         .sum::<f64>();
                 self.w[i] = wi;
-                if !self.passive[i] && wi < worst {
+                if !self.passive[i] && kept(i) && wi < worst {
                     worst = wi;
                     enter = Some(i);
                 }

@@ -53,6 +53,12 @@ use crate::space::step_solver::{Solver, StepSolver, StepWork};
 use crate::space::{ContactMethod, MassVariant};
 use crate::time::Scheme;
 
+// The methods of SPEC §3.2 (kane, contact-stabilized Newmark, generalized-α, Moreau–Jean, the
+// discrete gradient, kinematic central difference): a child module, so it reuses this engine's
+// geometry, factors and caches as they are.
+#[path = "fe_methods.rs"]
+mod methods;
+
 /// Steps between two checks of the clock and of an interruption.
 const CLOCK_EVERY: usize = 64;
 /// The contact LCP: tolerance relative to the largest gap, and the iteration cap (SPEC §4).
@@ -106,8 +112,12 @@ impl FeConfig {
         }
     }
 
-    /// Explicit schemes are not offered by the FE engine (the scene refuses them first).
+    /// The CFL step of kinematic central difference (mixed + lumped, [`methods`]); every other
+    /// explicit scheme is refused.
     pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
+        if methods::kinematic(self) {
+            return methods::kinematic_dt_limit(self).map(Some);
+        }
         if self.scheme.is_explicit() {
             return Err((
                 "scheme",
@@ -937,8 +947,43 @@ fn record_lattice(
     Ok((slots, lattice))
 }
 
+/// The reference this run records, if it is one: the slots of its stored lattice and the empty
+/// data. Meshes that are not nested store themselves: a coarser run locates its nodes in this
+/// one ([`ball_ref_map`]).
+#[allow(clippy::type_complexity)]
+fn reference_record(
+    g: &Geometry,
+    cfg: &FeConfig,
+    ctx: &RunContext,
+) -> Result<Option<(Vec<Option<usize>>, ReferenceData)>, String> {
+    let Some((space_stride, time_stride)) = ctx.record_reference else {
+        return Ok(None);
+    };
+    let (slots, lattice) = record_lattice(g, cfg, space_stride)?;
+    let times = cfg.steps / time_stride + 1;
+    let mesh = g
+        .mesh
+        .as_box()
+        .is_none()
+        .then(|| PlainMesh::from_mesh(g.mesh.mesh()));
+    let data = ReferenceData::new(
+        g.mesh.dim(),
+        cfg.setup.h,
+        cfg.dt,
+        space_stride,
+        time_stride,
+        lattice,
+        times,
+        mesh,
+    );
+    Ok(Some((slots, data)))
+}
+
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
+    if methods::handles(cfg) {
+        return methods::simulate(cfg, opts, ctx);
+    }
     let start = Instant::now();
     let mut metrics = Metrics {
         dofs: cfg.unknowns() as i64,
@@ -1078,32 +1123,9 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
     let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
     // The reference lattice this run records, if it is one.
-    let mut record = match ctx.record_reference {
-        None => None,
-        Some((space_stride, time_stride)) => match record_lattice(g, cfg, space_stride) {
-            Err(e) => return fail(Status::Invalid, e, metrics),
-            Ok((slots, lattice)) => {
-                let times = cfg.steps / time_stride + 1;
-                // Meshes that are not nested store themselves: a coarser run locates its
-                // nodes in this one ([`interpolating_ref_map`]).
-                let mesh = g
-                    .mesh
-                    .as_box()
-                    .is_none()
-                    .then(|| PlainMesh::from_mesh(g.mesh.mesh()));
-                let data = ReferenceData::new(
-                    d,
-                    cfg.setup.h,
-                    tau,
-                    space_stride,
-                    time_stride,
-                    lattice,
-                    times,
-                    mesh,
-                );
-                Some((slots, data))
-            }
-        },
+    let mut record = match reference_record(g, cfg, ctx) {
+        Err(e) => return fail(Status::Invalid, e, metrics),
+        Ok(r) => r,
     };
     if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
         return fail(status, msg, metrics);

@@ -242,7 +242,12 @@ pub(crate) fn newton(
 }
 
 /// In-place LU with partial pivoting of the n×n row-major `a`, then solve for `b` (overwritten).
-fn lu_solve(a: &mut [f64], n: usize, perm: &mut [usize], b: &mut [f64]) -> Result<(), String> {
+pub(crate) fn lu_solve(
+    a: &mut [f64],
+    n: usize,
+    perm: &mut [usize],
+    b: &mut [f64],
+) -> Result<(), String> {
     for (i, p) in perm.iter_mut().enumerate() {
         *p = i;
     }

@@ -122,13 +122,25 @@ impl Scene for BallScene {
                 ),
             ));
         }
+        // SPEC §3.2's methods ([`crate::run::fe`]'s methods module); the planner checks their
+        // contact methods and masses.
+        let comparison = matches!(
+            scheme,
+            "kane"
+                | "contact-stabilized-newmark"
+                | "generalized-alpha"
+                | "hht"
+                | "moreau-jean"
+                | "discrete-gradient"
+        );
         if !(matches!(scheme, "newmark" | "theta")
+            || comparison
             || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
         {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
+                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes, the SPEC §3.2 methods; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
                     self.name()
                 ),
             ));

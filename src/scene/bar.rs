@@ -153,11 +153,23 @@ impl Scene for BarScene {
                 format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
             ));
         }
-        if !matches!(scheme, "newmark" | "theta") {
+        // SPEC §3.2's multiplier methods run with `mixed` ([`crate::run::fe`]'s methods
+        // module); the planner checks their masses (and central difference's kinematic
+        // contact needs `lumped`).
+        if !matches!(
+            scheme,
+            "newmark"
+                | "theta"
+                | "kane"
+                | "contact-stabilized-newmark"
+                | "generalized-alpha"
+                | "hht"
+                | "moreau-jean"
+        ) {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} is implemented for the 1D bar only (000 §4–5); scene {} takes newmark and theta schemes",
+                    "scheme = {scheme} is implemented for the 1D bar only (000 §4–5, or a contact potential SPEC §1.2's bars do not have); scene {} takes newmark, theta, kane, contact-stabilized-newmark, generalized-alpha, hht and moreau-jean",
                     self.name()
                 ),
             ));

@@ -1,0 +1,1200 @@
+//! The methods of the comparison literature (SPEC §3.2) in the sparse finite-element engine:
+//! `kane`, `contact-stabilized-newmark`, `moreau-jean` with the nodal multiplier (`mixed`),
+//! `generalized-alpha`/`hht` with `mixed`, `nitsche` and `penalty`, the `discrete-gradient`
+//! with `penalty` and `nitsche` (Θ = 1), and `central-difference` with `mixed` and the lumped
+//! mass (kinematic contact).
+//!
+//! The 1D engine ([`crate::run::bar1d`]) holds the verified step formulas; here they act on the
+//! FE system M ü + K u = F + Bᵀλ, B the vertical dofs of the Γ_C nodes, B u + g ≥ 0, λ ≥ 0.
+//! Every implicit step has a constant matrix A = M + cK, factored once per run through the
+//! engine's shared cache (its key is (geometry, mass, contact method, c), so a run shares the
+//! factor of every other run with the same matrix — kane, CSN and the discrete gradient use
+//! Crank–Nicolson's S = M + τ²/4 K, generalized-α with ρ∞ = 1 too), with Z = A⁻¹Bᵀ and
+//! H = c B Z condensed once. A step is one sparse solve y = A⁻¹b, a contact problem on the
+//! contact set only, and the correction y + c Z μ: the LCP's μ is the contact force scaled by
+//! the method's coefficient c_f/c of Bᵀλ in the right-hand side:
+//! - `kane`: S Δu = τMvⁿ − τ²/2 Kuⁿ + τ²/2 F + τ²/2 Bᵀλ, v^{n+1} = 2Δu/τ − vⁿ (c_f = 2c, λ = μ/2).
+//!   A massless row (mod1/…/zero-contact) is K u^{n+½} = Bᵀλ: quasi-static at the midpoint, as
+//!   in 1D; its velocity is the difference quotient Δu/τ (it carries no energy);
+//! - `contact-stabilized-newmark`: the predictor u^pred = ũ + M⁻¹Bᵀν, ũ = uⁿ + τvⁿ, with
+//!   0 ≤ ν ⊥ Bũ + g + (BM⁻¹Bᵀ)ν ≥ 0 (the M-projection of the free flight), M⁻¹Bᵀ from a sparse
+//!   Cholesky of M computed once per (geometry, mass) and cached like the step factors; then
+//!   S Δ = −τ²/4 K(uⁿ + u^pred) + τ²/2 F + τ²/2 Bᵀλ, u^{n+1} = u^pred + Δ, v^{n+1} = vⁿ + 2Δ/τ;
+//! - `generalized-alpha`: ũ = uⁿ + τvⁿ + τ²(½ − β)aⁿ, and the equation at t^{n+1−α} times
+//!   βτ²/(1−α_m): (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f Bᵀλⁿ + (c + κ_f)F + c Bᵀλ^{n+1}
+//!   ([`crate::time::GeneralizedAlphaParams::history_coefficients`]; c_f = c, λ = μ), Newmark's
+//!   updates. With ρ∞ = 1 the right-hand side is Crank–Nicolson's whenever M aⁿ = F − Kuⁿ + Bᵀλⁿ
+//!   (its equation at tⁿ), and the matrix is the same: the runs agree to round-off;
+//! - `moreau-jean`: (M + θ²τ²K)Δv = −τK(uⁿ + θτvⁿ) + τF + Bᵀp, the rows with
+//!   (Buⁿ + g) + ½τBvⁿ ≤ 0 active ([`crate::contact::Lcp::solve_on`]), there
+//!   0 ≤ p ⊥ Bv^{n+1} + eBvⁿ ≥ 0 (c_f = 1, p = cμ); u^{n+1} = uⁿ + τ(vⁿ + θΔv), reported
+//!   force p/τ;
+//! - `discrete-gradient` (penalty; Nitsche with Θ = 1, whose linear part K_Θ = K − Σ wγ s sᵀ is in
+//!   A as for the hybrid scheme): the midpoint rule (M + τ²/4 K_Θ)Δu = τMvⁿ − τ²/2 K_Θuⁿ + τ²/2 F
+//!   − τ²/2 Σ_q D_q p_q with D_q = w_q (φ_q(s_q^{n+1}) − φ_q(s_qⁿ))/(s_q^{n+1} − s_qⁿ),
+//!   φ_q(s) = (1/2γ_q)[s − g_q]_+², s_q = p_q·u. Condensed on the points: s = s⁰ + τ²/2 W D(s),
+//!   s⁰ = P(uⁿ + A⁻¹b), W = P A⁻¹C (C = −P, the same rows as the hybrid scheme's), solved by
+//!   semismooth Newton with each point's scalar difference quotient and its slope
+//!   ([`crate::contact::gradient`]) — D_q depends on s_q only, so the Jacobian is
+//!   I − τ²/2 W diag(D'_q) on the points with D_q or D'_q ≠ 0. Since Φ(s^{n+1}) − Φ(sⁿ) =
+//!   Σ D_q(s_q^{n+1} − s_qⁿ) the midpoint rule conserves E^h + Φ (penalty) and E_Θ (Θ = 1);
+//! - kinematic `central-difference` (lumped M, diagonal): v^{n+½} = vⁿ + τ/2 aⁿ,
+//!   u^{n+1} = uⁿ + τv^{n+½}, a contact dof below the obstacle put on it by the impulse
+//!   Δv = (−g − u)/τ on v^{n+½} (λ = m Δv/τ), a^{n+1} = M⁻¹(F − Ku^{n+1}),
+//!   v^{n+1} = v^{n+½} + τ/2 a^{n+1}: no solve at all. Its CFL limit τω_max ≤ 2 uses a
+//!   certified upper bound of ω²_max = λ_max(M⁻¹K): a power-iteration estimate raised until
+//!   σM − K factors ([`kinematic_dt_limit`]), within 1 % of the true value.
+//!
+//! Generalized-α with Nitsche/penalty (disc/ball): the linear part K_Θ (Nitsche's Θ-term) sits in
+//! A as for the engine's Newmark steps, the contact force is f_c(u) = Σ_q φ_q(p_q·u) C_q with
+//! f_cⁿ = f_c(uⁿ) (the previous step's Newton values) and f_c^{n+1} solved by the engine's
+//! semismooth Newton with coefficient c ([`super::fe_nitsche`]).
+//!
+//! The energy E^h = ½vᵀMv + ½uᵀKu − Fᵀu needs Mv and Ku (the schemes whose equation does not
+//! hold at t^{n+1} cannot use Newmark's identity uᵀKu = uᵀ(F + Bᵀλ − Ma)); they are the next
+//! step's right-hand side too. They are carried: a step computes one product, KΔ (Δ its
+//! increment), and takes MΔ = AΔ − cKΔ from the system it just solved (AΔ its right-hand side
+//! plus the contact term) — a subtraction without division by c, so no round-off is amplified.
+//! Contact-stabilized Newmark and Moreau–Jean carry Kv as well (their right-hand sides need
+//! K u^pred = Kuⁿ + τKvⁿ + KM⁻¹Bᵀν and K(uⁿ + θτvⁿ)). So a step costs the solve and one sparse
+//! product, as Crank–Nicolson's does (measured: `benches/fe.rs`, `bar2d-methods`). Every 64
+//! steps the products are recomputed from the state. Nothing is allocated in the time loop.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::{
+    CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
+    build_geometry, factor, geometry_key, mass_matrix, quad, ref_map, reference_record,
+};
+use crate::contact::Lcp;
+use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
+use crate::run::fe_nitsche::{
+    NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
+};
+use crate::run::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
+use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
+use crate::space::fe::SymMatrix;
+use crate::space::linalg::Cholesky;
+use crate::space::step_solver::StepWork;
+use crate::space::{ContactMethod, MassVariant};
+use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
+
+/// Steps between two recomputations of the carried products Mv, Ku (, Kv, Mu).
+const REFRESH: usize = 64;
+
+/// The method of a run of this module.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Method {
+    Kane,
+    Csn,
+    Alpha(GeneralizedAlphaParams),
+    MoreauJean(MoreauJeanParams),
+    Gradient,
+    Kinematic,
+}
+
+/// Whether `cfg` is central difference with `mixed` and the lumped mass (kinematic contact).
+pub(super) fn kinematic(cfg: &FeConfig) -> bool {
+    cfg.scheme == Scheme::Newmark(NewmarkParams::central_difference())
+        && cfg.mass == MassVariant::Lumped
+        && cfg.method == ContactMethod::Mixed
+}
+
+/// Whether this module runs `cfg`.
+pub(super) fn handles(cfg: &FeConfig) -> bool {
+    cfg.scheme.is_comparison() || kinematic(cfg)
+}
+
+fn method(cfg: &FeConfig) -> Result<Method, String> {
+    let m = match cfg.scheme {
+        _ if kinematic(cfg) => Method::Kinematic,
+        Scheme::Kane => Method::Kane,
+        Scheme::ContactStabilizedNewmark => Method::Csn,
+        Scheme::GeneralizedAlpha(p) => Method::Alpha(p),
+        Scheme::MoreauJean(p) => Method::MoreauJean(p),
+        Scheme::DiscreteGradient => Method::Gradient,
+        s => {
+            return Err(format!("scheme {} is not a SPEC §3.2 method", s.label()));
+        }
+    };
+    // The scene and the planner refuse these first; an engine entry point (tests, benches)
+    // gets the same reasons.
+    let mixed = cfg.method == ContactMethod::Mixed;
+    let bad = match m {
+        Method::Kane | Method::Csn | Method::MoreauJean(_) | Method::Kinematic if !mixed => {
+            Some("is defined for space = mixed only")
+        }
+        Method::Gradient => match cfg.method {
+            ContactMethod::Mixed => {
+                Some("needs a contact potential (penalty, or nitsche with Θ = 1)")
+            }
+            ContactMethod::Nitsche { theta, .. } if theta != 1.0 => {
+                Some("with space = nitsche needs nitsche_theta = 1")
+            }
+            _ => None,
+        },
+        _ => None,
+    };
+    if let Some(why) = bad {
+        return Err(format!("scheme {} {why}", cfg.scheme.label()));
+    }
+    let needs_mass = matches!(m, Method::Csn | Method::Alpha(_) | Method::MoreauJean(_));
+    if needs_mass && cfg.mass.massless_contact() {
+        return Err(format!(
+            "scheme {} needs inertia on the contact dofs (mass = consistent or lumped)",
+            cfg.scheme.label()
+        ));
+    }
+    Ok(m)
+}
+
+/// c of the step matrix M + cK (None: the explicit kinematic step has none).
+fn step_coefficient(m: Method, tau: f64) -> Option<f64> {
+    let t2 = tau * tau;
+    match m {
+        Method::Kane | Method::Csn | Method::Gradient => Some(0.25 * t2),
+        Method::Alpha(p) => Some(p.stiffness_coefficient(tau)),
+        Method::MoreauJean(p) => Some(p.theta * p.theta * t2),
+        Method::Kinematic => None,
+    }
+}
+
+/// M⁻¹Bᵀ (n × n_c, column-major) and W_M = B M⁻¹ Bᵀ (row-major) of one geometry and mass: the
+/// predictor of contact-stabilized Newmark.
+#[derive(Debug)]
+struct MassInverse {
+    zm: Vec<f64>,
+    wm: Vec<f64>,
+    /// K M⁻¹Bᵀ (n × n_c): the predictor's K u^pred from carried products.
+    kzm: Vec<f64>,
+}
+
+static MASS_INVERSES: Cache<MassInverse> = Cache::new();
+/// Power iterations of the CFL estimate: its Rayleigh quotient only seeds the certified bound
+/// (a low one costs a second Cholesky), 80 leave it within 1 % on the bars.
+const POWER_ITERATIONS: usize = 80;
+/// The certified ω²_max (and Gershgorin's bound) per geometry and lumped mass.
+static FREQUENCIES: Cache<(f64, f64)> = Cache::new();
+
+fn mass_inverse(g: &Geometry, m: &SymMatrix) -> Result<MassInverse, String> {
+    // M's own factor (also under `solver = "cg"`: the predictor's W = B M⁻¹ Bᵀ is made once).
+    let symbolic = g.symbolic().map_err(|e| e.to_string())?;
+    let chol = Cholesky::new(&symbolic, m)
+        .map_err(|e| format!("the mass matrix is not positive definite: {e}"))?;
+    let (n, nc) = (g.dofs.n_free(), g.contact.len());
+    let mut zm = vec![0.0; n * nc];
+    for (j, &c) in g.contact.iter().enumerate() {
+        zm[j * n + c] = 1.0;
+    }
+    let mut work = chol.work_for(nc);
+    chol.solve_many_in_place(&mut zm, nc, &mut work);
+    let mut wm = vec![0.0; nc * nc];
+    for (i, &ci) in g.contact.iter().enumerate() {
+        for j in 0..nc {
+            wm[i * nc + j] = zm[j * n + ci];
+        }
+    }
+    for i in 0..nc {
+        for j in 0..i {
+            let s = 0.5 * (wm[i * nc + j] + wm[j * nc + i]);
+            wm[i * nc + j] = s;
+            wm[j * nc + i] = s;
+        }
+    }
+    let mut kzm = vec![0.0; n * nc];
+    for j in 0..nc {
+        g.k.matvec_into(&zm[j * n..(j + 1) * n], &mut kzm[j * n..(j + 1) * n]);
+    }
+    Ok(MassInverse { zm, wm, kzm })
+}
+
+/// The largest stable step of kinematic central difference, 2/ω_max (τω_max ≤ 2, SPEC §3), with
+/// ω²_max = λ_max(M⁻¹K) of the lumped (diagonal) mass certified from above: power iteration on
+/// M^{−½}KM^{−½} gives a Rayleigh quotient θ ≤ λ_max, and σ = θ(1 + δ) is an upper bound as
+/// soon as σM − K is positive definite — one sparse Cholesky with the geometry's symbolic
+/// factor (δ = 0.5 %, doubled until it is; the Gershgorin bound max_i Σ_j |K_ij|/√(m_i m_j)
+/// caps σ and is itself guaranteed). So the step allowed is stable and at most ~0.25 % below
+/// the true limit (measured against the Gershgorin step: `tests/fe_methods.rs`). Kinematic
+/// contact removes dofs, never adds stiffness, so the contact-free bound holds in contact too.
+pub(super) fn kinematic_dt_limit(cfg: &FeConfig) -> Result<f64, (&'static str, String)> {
+    // Once per geometry and mass (the planner asks for every run of a sweep).
+    let key = format!("{}|{:?}|cfl", geometry_key(&cfg.setup), cfg.mass);
+    let (sigma, _) = *FREQUENCIES
+        .get(key, || {
+            kinematic_frequency_sq(cfg).map_err(|(k, e)| format!("{k}\u{1}{e}"))
+        })
+        .0
+        .map_err(|e| {
+            let (k, e) = e.split_once('\u{1}').unwrap_or(("mass", &e));
+            (if k == "h" { "h" } else { "mass" }, e.to_string())
+        })?;
+    let bound = cfg
+        .scheme
+        .explicit_stability_limit()
+        .expect("central difference is explicit");
+    Ok(bound / sigma.sqrt())
+}
+
+/// (certified upper bound of ω²_max, Gershgorin's bound) of the lumped mass (see
+/// [`kinematic_dt_limit`]).
+pub(super) fn kinematic_frequency_sq(cfg: &FeConfig) -> Result<(f64, f64), (&'static str, String)> {
+    let (geo, _) = GEOMETRIES.get(geometry_key(&cfg.setup), || build_geometry(&cfg.setup));
+    let g = geo.map_err(|e| ("h", e))?;
+    let (m, _) = mass_matrix(&g, &cfg.setup, &cfg.mass).map_err(|e| ("mass", e))?;
+    let diag = m.diagonal();
+    if let Some(i) = diag
+        .iter()
+        .position(|&x| x.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater))
+    {
+        return Err((
+            "mass",
+            format!(
+                "kinematic contact needs a positive lumped mass on every dof (dof {i} has {}); use degree = 1",
+                diag[i]
+            ),
+        ));
+    }
+    let p = &*g.k.pattern;
+    let n = p.n;
+    // Gershgorin on M^{−½}KM^{−½} (full storage: each entry once).
+    let mut row = vec![0.0; n];
+    for j in 0..n {
+        for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+            let i = p.row_idx[k];
+            row[i] += g.k.values[k].abs() / (diag[i] * diag[j]).sqrt();
+        }
+    }
+    let gershgorin = row.iter().fold(0.0f64, |a, &b| a.max(b));
+    // Power iteration from a seeded random start (deterministic: the planner's verdict must
+    // not change between two plans of the same sweep).
+    let scale: Vec<f64> = diag.iter().map(|d| 1.0 / d.sqrt()).collect();
+    let mut rng = fastrand::Rng::with_seed(0x5eed);
+    let mut x: Vec<f64> = (0..n).map(|_| rng.f64() - 0.5).collect();
+    let (mut t, mut y) = (vec![0.0; n], vec![0.0; n]);
+    let mut theta = 0.0;
+    for _ in 0..POWER_ITERATIONS {
+        let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+        for (ti, (xi, si)) in t.iter_mut().zip(x.iter().zip(&scale)) {
+            *ti = xi / norm * si;
+        }
+        g.k.matvec_into(&t, &mut y);
+        theta = 0.0;
+        for i in 0..n {
+            y[i] *= scale[i];
+            theta += x[i] / norm * y[i];
+        }
+        std::mem::swap(&mut x, &mut y);
+    }
+    let mut delta = 0.005;
+    loop {
+        let sigma = (theta * (1.0 + delta)).min(gershgorin);
+        if sigma >= gershgorin {
+            return Ok((gershgorin, gershgorin));
+        }
+        let a = SymMatrix::lin_comb(sigma, &m, -1.0, &g.k);
+        let symbolic = g.symbolic().map_err(|e| ("h", e.to_string()))?;
+        if Cholesky::new(&symbolic, &a).is_ok() {
+            return Ok((sigma, gershgorin));
+        }
+        delta *= 2.0;
+    }
+}
+
+/// The discrete gradient's Newton scratch (allocated once per run).
+struct GradientWork {
+    s: Vec<f64>,
+    /// sⁿ − g per point (the difference quotient's left end).
+    a: Vec<f64>,
+    d: Vec<f64>,
+    slope: Vec<f64>,
+    g: Vec<f64>,
+    delta: Vec<f64>,
+    active: Vec<usize>,
+    jac: Vec<f64>,
+    perm: Vec<usize>,
+}
+
+impl GradientWork {
+    fn new(nq: usize) -> GradientWork {
+        GradientWork {
+            s: vec![0.0; nq],
+            a: vec![0.0; nq],
+            d: vec![0.0; nq],
+            slope: vec![0.0; nq],
+            g: vec![0.0; nq],
+            delta: vec![0.0; nq],
+            active: Vec::with_capacity(nq),
+            jac: vec![0.0; nq * nq],
+            perm: vec![0; nq],
+        }
+    }
+}
+
+/// Solve G(s) = s − s⁰ − c₂ W D(s) = 0, D_q = w_q DQ(1/γ_q, a_q, s_q − g_q) (module header);
+/// on exit `wk.d` holds D(s). The residual test is at the round-off of its terms, as in the
+/// scalar solve of [`crate::contact::gradient`]: the energy balance is off by D·r. A residual
+/// that stops decreasing below SPEC §4's 1e-12 (relative) is accepted as converged.
+fn gradient_newton(
+    ops: &NitscheOps,
+    w: &[f64],
+    c2: f64,
+    s0: &[f64],
+    wk: &mut GradientWork,
+) -> Result<usize, String> {
+    let nq = ops.len();
+    let scale = s0
+        .iter()
+        .chain(&ops.gap)
+        .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+    // Start from the free motion (the previous step's s is sⁿ: a poorer guess after a kink).
+    wk.s.copy_from_slice(s0);
+    let mut prev_res = f64::INFINITY;
+    for it in 0..=NEWTON_MAX_ITER {
+        for q in 0..nq {
+            let k = ops.w[q] / ops.gamma[q];
+            let x = wk.s[q] - ops.gap[q];
+            wk.d[q] = k * difference_quotient(1.0, wk.a[q], x);
+            wk.slope[q] = k * difference_quotient_slope(1.0, wk.a[q], x);
+        }
+        let mut res = 0.0f64;
+        let mut noisy = true;
+        for q in 0..nq {
+            let row = &w[q * nq..(q + 1) * nq];
+            let (mut acc, mut mag) = (0.0, 0.0);
+            for (x, d) in row.iter().zip(&wk.d) {
+                if *d != 0.0 {
+                    acc += x * d;
+                    mag += (x * d).abs();
+                }
+            }
+            let g = wk.s[q] - s0[q] - c2 * acc;
+            wk.g[q] = g;
+            res = res.max(g.abs());
+            let noise = 8.0 * f64::EPSILON * (wk.s[q].abs() + s0[q].abs() + c2 * mag);
+            noisy &= g.abs() <= noise;
+        }
+        if noisy || (res <= NEWTON_TOL * scale && res >= prev_res) {
+            return Ok(it);
+        }
+        if it == NEWTON_MAX_ITER {
+            if res <= NEWTON_TOL * scale {
+                return Ok(it);
+            }
+            return Err(format!(
+                "discrete-gradient Newton did not converge in {NEWTON_MAX_ITER} iterations (residual {res:.3e}, scale {scale:.3e})"
+            ));
+        }
+        prev_res = res;
+        wk.active.clear();
+        wk.active
+            .extend((0..nq).filter(|&q| wk.d[q] != 0.0 || wk.slope[q] != 0.0));
+        let na = wk.active.len();
+        for (i, &qi) in wk.active.iter().enumerate() {
+            for (j, &qj) in wk.active.iter().enumerate() {
+                wk.jac[i * na + j] =
+                    f64::from(u8::from(i == j)) - c2 * w[qi * nq + qj] * wk.slope[qj];
+            }
+            wk.delta[i] = -wk.g[qi];
+        }
+        lu_solve(
+            &mut wk.jac[..na * na],
+            na,
+            &mut wk.perm[..na],
+            &mut wk.delta[..na],
+        )
+        .map_err(|e| format!("discrete-gradient Newton: {e} (iteration {it})"))?;
+        for q in 0..nq {
+            if wk.d[q] != 0.0 || wk.slope[q] != 0.0 {
+                continue;
+            }
+            let mut acc = -wk.g[q];
+            for (j, &qj) in wk.active.iter().enumerate() {
+                acc += c2 * w[q * nq + qj] * wk.slope[qj] * wk.delta[j];
+            }
+            wk.s[q] += acc;
+        }
+        for (j, &qj) in wk.active.iter().enumerate() {
+            wk.s[qj] += wk.delta[j];
+        }
+    }
+    unreachable!("the loop returns at its last iteration")
+}
+
+/// Run one finite-element simulation with a method of SPEC §3.2 (module header).
+pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
+    let start = Instant::now();
+    let mut metrics = Metrics {
+        dofs: cfg.unknowns() as i64,
+        length_scale: Some(cfg.setup.geometry.length_scale()),
+        ..Metrics::default()
+    };
+    let fail = |status, msg: String, metrics: Metrics| Outcome {
+        status,
+        message: Some(msg),
+        metrics,
+        series: Series::default(),
+        reference: None,
+    };
+    let meth = match method(cfg) {
+        Ok(m) => m,
+        Err(e) => return fail(Status::Invalid, e, metrics),
+    };
+    let tau = cfg.dt;
+    let (geo, _) = GEOMETRIES.get(geometry_key(&cfg.setup), || build_geometry(&cfg.setup));
+    let geo = match geo {
+        Ok(g) => g,
+        Err(e) => return fail(Status::Invalid, e, metrics),
+    };
+    if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
+        return fail(status, msg, metrics);
+    }
+    let g = &*geo;
+    // The step factor (the engine's cache, the engine's key) or, for the explicit step, the
+    // lumped mass alone.
+    let c = step_coefficient(meth, tau);
+    let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
+        Some(c) => {
+            let key = format!(
+                "{}|{:?}|{:?}|{:e}",
+                geometry_key(&cfg.setup),
+                cfg.mass,
+                cfg.method,
+                c
+            );
+            let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
+            let fac = match fac {
+                Ok(f) => f,
+                Err(e) => return fail(Status::SolverFailed, e, metrics),
+            };
+            metrics.factorizations = i64::from(!hit);
+            metrics.factor_cache_hits = Some(i64::from(hit));
+            metrics.mass_total = Some(fac.mass_total);
+            (Some(fac), None)
+        }
+        None => match kinematic_dt_limit(cfg) {
+            Err((_, e)) => return fail(Status::Invalid, e, metrics),
+            Ok(limit) if tau > limit * (1.0 + 1e-12) => {
+                return fail(
+                    Status::Invalid,
+                    format!(
+                        "dt = {tau:.6e} is above the CFL limit {limit:.6e} of kinematic central difference"
+                    ),
+                    metrics,
+                );
+            }
+            Ok(_) => match mass_matrix(g, &cfg.setup, &cfg.mass) {
+                Ok((m, total)) => {
+                    metrics.mass_total = Some(total);
+                    metrics.factorizations = 0;
+                    (None, Some(m))
+                }
+                Err(e) => return fail(Status::Invalid, e, metrics),
+            },
+        },
+    };
+    // The factor keeps M; the explicit step owns its lumped M.
+    let m: &SymMatrix = match (&fac, &own_mass) {
+        (Some(f), _) => &f.m,
+        (None, Some(m)) => m,
+        (None, None) => unreachable!("one of the two is built above"),
+    };
+    let minv = match meth {
+        Method::Csn => {
+            let key = format!("{}|{:?}|mass-inverse", geometry_key(&cfg.setup), cfg.mass);
+            let (mi, hit) = MASS_INVERSES.get(key, || mass_inverse(g, m));
+            // The Cholesky of M counts as a factorisation of this run when it built it.
+            metrics.factorizations += i64::from(!hit);
+            match mi {
+                Ok(x) => Some(x),
+                Err(e) => return fail(Status::SolverFailed, e, metrics),
+            }
+        }
+        _ => None,
+    };
+    if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
+        return fail(status, msg, metrics);
+    }
+    let refmap = match ctx.reference.as_ref().map(|r| ref_map(g, cfg, r)) {
+        Some(Err(e)) => return fail(Status::Invalid, e, metrics),
+        Some(Ok(m)) => Some(m),
+        None => None,
+    };
+
+    let n = g.dofs.n_free();
+    let nit = fac.as_ref().and_then(|f| f.nitsche.as_ref());
+    let nc = nit.map_or(g.contact.len(), NitscheOps::len);
+    let d = g.mesh.dim();
+    metrics.contact_dofs = Some(nc as i64);
+    let base_gap = if g.gap_in_geometry {
+        0.0
+    } else {
+        cfg.setup.gap
+    };
+    let gaps: Vec<f64> = g.contact_height.iter().map(|h| h + base_gap).collect();
+
+    // Workspace, allocated once.
+    let mut u = vec![0.0; n];
+    let mut v = vec![0.0; n];
+    let mut a = vec![0.0; n];
+    let mut mu = vec![0.0; n];
+    let mut mv = vec![0.0; n];
+    let mut ma = vec![0.0; n];
+    let mut ku = vec![0.0; n];
+    // K v (CSN, Moreau–Jean), K Δ, and the step's right-hand side A Δ (or A u^{n+1}): the
+    // products a step carries instead of recomputing them (module header).
+    let mut kv = vec![0.0; n];
+    let mut kd = vec![0.0; n];
+    let mut sd = vec![0.0; n];
+    let mut y = vec![0.0; n];
+    let mut pred = vec![0.0; n];
+    let mut tmp = vec![0.0; n];
+    let mut err = vec![0.0; n];
+    let mut q = vec![0.0; nc];
+    let mut lambda = vec![0.0; nc];
+    let mut lambda_prev = vec![0.0; nc];
+    let mut nu = vec![0.0; g.contact.len()];
+    let mut rows = vec![false; g.contact.len()];
+    let mut lcp = Lcp::new(
+        g.contact.len(),
+        match (&fac, nit) {
+            (Some(f), None) => f.h.clone(),
+            _ => vec![0.0; g.contact.len().pow(2)],
+        },
+    );
+    let mut lcp_pred = minv
+        .as_ref()
+        .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
+    let mut grad_work = GradientWork::new(nit.map_or(0, NitscheOps::len));
+    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+    let mut work: Option<StepWork> = fac.as_ref().map(|f| f.chol.work());
+    let diag = m.diagonal();
+    // Dofs without inertia (mod1/…/zero-contact with kane): their velocity is Δu/τ.
+    let massless: Vec<usize> = (0..n).filter(|&i| diag[i] == 0.0).collect();
+    for &r in &g.vertical {
+        v[r] = cfg.setup.v0;
+    }
+    if let Some((delta, seed)) = cfg.perturbation {
+        let mut rng = fastrand::Rng::with_seed(seed);
+        for x in v.iter_mut() {
+            *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
+        }
+    }
+    // Gravity F = M(f e_d) as in the engine; a⁰ = f e_d solves M a⁰ = F − Ku⁰ (u⁰ = 0, no
+    // contact at t = 0), the start of generalized-α and of central difference.
+    let fall = -cfg.setup.gravity;
+    let mut force_vec = vec![0.0; n];
+    if fall != 0.0 {
+        if g.mesh.as_box().is_some() {
+            return fail(
+                Status::Invalid,
+                format!(
+                    "scene {}: a volume load on the clamped bar is not supported",
+                    cfg.setup.scene
+                ),
+                metrics,
+            );
+        }
+        for &r in &g.vertical {
+            a[r] = fall;
+        }
+        m.matvec_into(&a, &mut force_vec);
+        ma.copy_from_slice(&force_vec);
+    }
+    m.matvec_into(&v, &mut mv);
+    let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
+    let energy_scale =
+        (fall != 0.0).then(|| metrics.mass_total.unwrap_or(0.0) * fall.abs() * cfg.setup.gap);
+    let mut record = match reference_record(g, cfg, ctx) {
+        Err(e) => return fail(Status::Invalid, e, metrics),
+        Ok(r) => r,
+    };
+    if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
+        return fail(status, msg, metrics);
+    }
+    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
+    let loop_start = Instant::now();
+
+    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
+    if let Some(sc) = energy_scale {
+        obs = obs.with_energy_scale(sc);
+    }
+    let lowest = g
+        .gap_in_geometry
+        .then(|| {
+            g.contact
+                .iter()
+                .zip(&g.contact_height)
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(&c, _)| c)
+        })
+        .flatten();
+    let mean = |x: &[f64]| -> f64 {
+        g.contact
+            .iter()
+            .zip(&g.contact_weight)
+            .map(|(&c, w)| w * x[c])
+            .sum()
+    };
+    let mut fall_error = 0.0f64;
+    let mut touched = false;
+    // Observe step n: state (u, v) with the products Mv, Ku and the step's total contact force.
+    #[allow(clippy::too_many_arguments)]
+    let mut observe = |step: usize,
+                       u: &[f64],
+                       v: &[f64],
+                       mv: &[f64],
+                       ku: &[f64],
+                       force: f64,
+                       tmp: &mut [f64],
+                       err: &mut [f64]|
+     -> Result<(), Divergence> {
+        let kinetic = 0.5 * v.iter().zip(mv).map(|(x, y)| x * y).sum::<f64>();
+        let elastic = 0.5 * u.iter().zip(ku).map(|(x, y)| x * y).sum::<f64>();
+        let gravity = -u.iter().zip(&force_vec).map(|(x, y)| x * y).sum::<f64>();
+        let penetration = g
+            .contact
+            .iter()
+            .zip(&gaps)
+            .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
+        let (e, theta_term) = match nit {
+            Some(ops) => {
+                let (pot, t, _) = ops.energy_terms_and_force(u);
+                (kinetic + elastic + gravity + pot, t)
+            }
+            None => (kinetic + elastic + gravity, None),
+        };
+        let uc = mean(u);
+        if fall != 0.0 && !touched {
+            if force > 0.0 {
+                touched = true;
+            } else {
+                let t = step as f64 * tau;
+                // e_dᵀ M u / e_dᵀ M e_d, M u from F = M f e_d: Fᵀu / (f·m_d).
+                let com: f64 = g.vertical.iter().map(|&r| force_vec[r] * u[r]).sum::<f64>()
+                    / (fall * vertical_mass);
+                fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
+            }
+        }
+        if let Some((slots, data)) = record.as_mut()
+            && step.is_multiple_of(data.time_stride)
+        {
+            data.u.extend(slots.iter().map(|s| s.map_or(0.0, |r| u[r])));
+            data.force.push(force);
+            data.energy.push(e);
+            data.u_contact.push(uc);
+        }
+        let exact = refmap.as_ref().map(|rm| {
+            let k = step * rm.time_ratio;
+            let slice = rm.data.lattice.iter().product::<usize>() * d;
+            let base = k * slice;
+            for (i, e) in err.iter_mut().enumerate() {
+                *e = u[i] - rm.data.u[base + rm.dof_offset[i]];
+            }
+            let l2_sq = quad(&g.gram, err, tmp);
+            let h1_semi_sq = quad(&g.grad, err, tmp);
+            ExactValues {
+                u_contact: rm.data.u_contact[k],
+                sigma_contact: -rm.data.force[k],
+                sigma_contact_mid: None,
+                energy: rm.data.energy[k],
+                l2_sq,
+                h1_semi_sq,
+            }
+        });
+        obs.observe(
+            StepValues {
+                step,
+                t: step as f64 * tau,
+                u_contact: uc,
+                v_contact: mean(v),
+                sigma_contact: -force,
+                sigma_mid: None,
+                energy: e,
+                energy_theta: theta_term.map(|t| e + t),
+                energy_kinetic: Some(kinetic),
+                energy_elastic: Some(elastic),
+                energy_gravity: (fall != 0.0).then_some(gravity),
+                u_lowest: lowest.map(|c| u[c]),
+                penetration: Some(penetration),
+            },
+            exact,
+        )
+    };
+
+    let mut done = 0usize;
+    let mut iterations = 0i64;
+    let mut newton_max = 0usize;
+    let mut observe_timer = SampledTimer::default();
+    let t2 = tau * tau;
+    let stop = (|| -> Result<(), Stop<String>> {
+        g.k.matvec_into(&u, &mut ku);
+        g.k.matvec_into(&v, &mut kv);
+        if let Some(ops) = nit {
+            // The state's own contact force at t = 0 (zero unless the body starts in contact).
+            let (_, _, f) = ops.energy_terms_and_force(&u);
+            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+        } else {
+            observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+        }
+        for step in 1..=cfg.steps {
+            let force = match meth {
+                Method::Kinematic => {
+                    for i in 0..n {
+                        v[i] += 0.5 * tau * a[i];
+                        u[i] += tau * v[i];
+                    }
+                    let mut force = 0.0;
+                    for (&ci, gi) in g.contact.iter().zip(&gaps) {
+                        let (uc, dv, l) = crate::time::kinematic_impulse(u[ci], -gi, diag[ci], tau);
+                        u[ci] = uc;
+                        v[ci] += dv;
+                        force += l;
+                    }
+                    g.k.matvec_into(&u, &mut ku);
+                    for i in 0..n {
+                        a[i] = (force_vec[i] - ku[i]) / diag[i];
+                        v[i] += 0.5 * tau * a[i];
+                        mv[i] = diag[i] * v[i];
+                    }
+                    force
+                }
+                _ => {
+                    let f = fac.as_ref().expect("implicit methods have a factor");
+                    let c = c.expect("implicit methods have a step matrix");
+                    let work = work.as_mut().expect("implicit methods have solve scratch");
+                    match meth {
+                        Method::Kane => {
+                            // b = τMvⁿ − τ²/2 Kuⁿ + τ²/2 F, kept in `sd` for S Δ below.
+                            for i in 0..n {
+                                y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
+                            }
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                *qi = u[ci] + y[ci] + gi;
+                            }
+                            let it = lcp
+                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            newton_max = newton_max.max(it);
+                            iterations += it as i64;
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
+                            // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
+                            g.k.matvec_into(&y, &mut kd);
+                            for i in 0..n {
+                                let md = sd[i] - c * kd[i];
+                                v[i] = 2.0 * y[i] / tau - v[i];
+                                mv[i] = 2.0 * md / tau - mv[i];
+                                u[i] += y[i];
+                                ku[i] += kd[i];
+                            }
+                            for &i in &massless {
+                                v[i] = y[i] / tau;
+                            }
+                            // μ = 2λ: the contact force enters with τ²/2 = 2c.
+                            0.5 * lambda.iter().sum::<f64>()
+                        }
+                        Method::Csn => {
+                            let mi = minv.as_ref().expect("CSN has M⁻¹Bᵀ");
+                            let lp = lcp_pred.as_mut().expect("CSN has its predictor LCP");
+                            for i in 0..n {
+                                pred[i] = u[i] + tau * v[i];
+                            }
+                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                *qi = pred[ci] + gi;
+                            }
+                            let it = lp
+                                .solve(&q, &mut nu, LCP_MAX_ITER, LCP_TOL)
+                                .map_err(|e| Stop::Solver(step, format!("predictor: {e}")))?;
+                            iterations += it as i64;
+                            add_columns(&mi.zm, &nu, 1.0, &mut pred);
+                            // K u^pred = Kuⁿ + τKvⁿ + (KM⁻¹Bᵀ)ν, from the carried products.
+                            for i in 0..n {
+                                tmp[i] = ku[i] + tau * kv[i];
+                            }
+                            add_columns(&mi.kzm, &nu, 1.0, &mut tmp);
+                            for i in 0..n {
+                                y[i] = -c * (ku[i] + tmp[i]) + 2.0 * c * force_vec[i];
+                            }
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                *qi = pred[ci] + y[ci] + gi;
+                            }
+                            let it2 = lcp
+                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            newton_max = newton_max.max(it + it2);
+                            iterations += it2 as i64;
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
+                            g.k.matvec_into(&y, &mut kd);
+                            for i in 0..n {
+                                let md = sd[i] - c * kd[i];
+                                v[i] += 2.0 * y[i] / tau;
+                                mv[i] += 2.0 * md / tau;
+                                u[i] = pred[i] + y[i];
+                                ku[i] = tmp[i] + kd[i];
+                                kv[i] += 2.0 * kd[i] / tau;
+                            }
+                            0.5 * lambda.iter().sum::<f64>()
+                        }
+                        Method::Alpha(ga) if nit.is_some() => {
+                            // Nitsche/penalty: K_Θ is in A, the contact force f_c(u) =
+                            // Σ_q φ_q(p_q·u) C_q, f_cⁿ = f_c(uⁿ) (φⁿ kept from the last step's
+                            // Newton, which solved φ at uⁿ), f_c^{n+1} by the engine's Newton.
+                            let ops = nit.expect("checked");
+                            let (km, kf) = ga.history_coefficients(tau);
+                            let kp = t2 * (0.5 - ga.beta);
+                            let bt2 = ga.beta * t2;
+                            for i in 0..n {
+                                pred[i] = u[i] + tau * v[i] + kp * a[i];
+                                y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i]
+                                    + (c + kf) * force_vec[i];
+                            }
+                            add_theta_term(ops, &u, kf, &mut y);
+                            add_point_columns(ops, &lambda_prev, kf, &mut y);
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            for (k, qk) in q.iter_mut().enumerate() {
+                                *qk = ops.apply(&ops.p, k, &y);
+                            }
+                            let it =
+                                newton(ops, &f.h, c, &q, &ops.gap, &mut lambda, &mut newton_work)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                            newton_max = newton_max.max(it);
+                            iterations += it as i64;
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            add_point_columns(ops, &lambda, c, &mut sd);
+                            lambda_prev.copy_from_slice(&lambda);
+                            // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
+                            std::mem::swap(&mut u, &mut y);
+                            g.k.matvec_into(&u, &mut ku);
+                            for i in 0..n {
+                                sd[i] -= c * ku[i];
+                            }
+                            add_theta_term(ops, &u, c, &mut sd);
+                            let g1 = 1.0 - ga.gamma;
+                            for i in 0..n {
+                                let an = (u[i] - pred[i]) / bt2;
+                                let mpred = mu[i] + tau * mv[i] + kp * ma[i];
+                                let man = (sd[i] - mpred) / bt2;
+                                v[i] += tau * (g1 * a[i] + ga.gamma * an);
+                                mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+                                a[i] = an;
+                                ma[i] = man;
+                                mu[i] = sd[i];
+                            }
+                            lambda.iter().sum::<f64>()
+                        }
+                        Method::Alpha(ga) => {
+                            let (km, kf) = ga.history_coefficients(tau);
+                            let kp = t2 * (0.5 - ga.beta);
+                            let bt2 = ga.beta * t2;
+                            for i in 0..n {
+                                pred[i] = u[i] + tau * v[i] + kp * a[i];
+                                y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i]
+                                    + (c + kf) * force_vec[i];
+                            }
+                            add_rows(&g.contact, &lambda_prev, kf, &mut y);
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                *qi = y[ci] + gi;
+                            }
+                            let it = lcp
+                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            newton_max = newton_max.max(it);
+                            iterations += it as i64;
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            add_rows(&g.contact, &lambda, c, &mut sd);
+                            lambda_prev.copy_from_slice(&lambda);
+                            // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
+                            // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
+                            std::mem::swap(&mut u, &mut y);
+                            g.k.matvec_into(&u, &mut ku);
+                            let g1 = 1.0 - ga.gamma;
+                            for i in 0..n {
+                                let an = (u[i] - pred[i]) / bt2;
+                                let mpred = mu[i] + tau * mv[i] + kp * ma[i];
+                                let mun = sd[i] - c * ku[i];
+                                let man = (mun - mpred) / bt2;
+                                v[i] += tau * (g1 * a[i] + ga.gamma * an);
+                                mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+                                a[i] = an;
+                                ma[i] = man;
+                                mu[i] = mun;
+                            }
+                            lambda.iter().sum::<f64>()
+                        }
+                        Method::MoreauJean(mj) => {
+                            // b = −τK(uⁿ + θτvⁿ) + τF from the carried products.
+                            for i in 0..n {
+                                y[i] = -tau * (ku[i] + mj.theta * tau * kv[i]) + tau * force_vec[i];
+                            }
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let mut any = false;
+                            for (j, (&ci, gi)) in g.contact.iter().zip(&gaps).enumerate() {
+                                let active = u[ci] + gi + 0.5 * tau * v[ci] <= 0.0;
+                                rows[j] = active;
+                                any |= active;
+                                q[j] = if active {
+                                    (1.0 + mj.restitution) * v[ci] + y[ci]
+                                } else {
+                                    0.0
+                                };
+                            }
+                            if any {
+                                let it = lcp
+                                    .solve_on(&q, &mut lambda, &rows, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                newton_max = newton_max.max(it);
+                                iterations += it as i64;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                            } else {
+                                lambda.iter_mut().for_each(|l| *l = 0.0);
+                            }
+                            g.k.matvec_into(&y, &mut kd);
+                            for i in 0..n {
+                                let md = sd[i] - c * kd[i];
+                                u[i] += tau * (v[i] + mj.theta * y[i]);
+                                ku[i] += tau * (kv[i] + mj.theta * kd[i]);
+                                v[i] += y[i];
+                                mv[i] += md;
+                                kv[i] += kd[i];
+                            }
+                            // p = cμ, reported as the mean force p/τ.
+                            c * lambda.iter().sum::<f64>() / tau
+                        }
+                        Method::Gradient => {
+                            let ops = nit.expect("the discrete gradient has contact points");
+                            // b = τMvⁿ − τ²/2 K_Θuⁿ + τ²/2 F, K_Θ u = Ku − Θ Σ w γ s (s·u).
+                            for i in 0..n {
+                                y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
+                            }
+                            add_theta_term(ops, &u, 2.0 * c, &mut y);
+                            sd.copy_from_slice(&y);
+                            f.chol.solve_in_place(&mut y, work);
+                            work.check()
+                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            for k in 0..ops.len() {
+                                let sn = ops.apply(&ops.p, k, &u);
+                                grad_work.a[k] = sn - ops.gap[k];
+                                q[k] = sn + ops.apply(&ops.p, k, &y);
+                            }
+                            let it = gradient_newton(ops, &f.h, 2.0 * c, &q, &mut grad_work)
+                                .map_err(|e| Stop::Solver(step, e))?;
+                            newton_max = newton_max.max(it);
+                            iterations += it as i64;
+                            // Δu = y + τ²/2 Z D = y + c Z (2D); A Δu = b + c Σ 2D_q C_q.
+                            for (l, dq) in lambda.iter_mut().zip(&grad_work.d) {
+                                *l = 2.0 * dq;
+                            }
+                            add_columns(&f.z, &lambda, c, &mut y);
+                            for (k, l) in lambda.iter().enumerate() {
+                                if *l != 0.0 {
+                                    for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                                        .iter()
+                                        .zip(&ops.c[k * ops.k..(k + 1) * ops.k])
+                                    {
+                                        sd[gd] += c * l * ck;
+                                    }
+                                }
+                            }
+                            // MΔ = AΔ − cK_ΘΔ with KΔ by one product.
+                            g.k.matvec_into(&y, &mut kd);
+                            for i in 0..n {
+                                sd[i] -= c * kd[i];
+                            }
+                            add_theta_term(ops, &y, c, &mut sd);
+                            for i in 0..n {
+                                v[i] = 2.0 * y[i] / tau - v[i];
+                                mv[i] = 2.0 * sd[i] / tau - mv[i];
+                                u[i] += y[i];
+                                ku[i] += kd[i];
+                            }
+                            for &i in &massless {
+                                v[i] = y[i] / tau;
+                            }
+                            grad_work.d.iter().sum::<f64>()
+                        }
+                        Method::Kinematic => unreachable!("explicit"),
+                    }
+                }
+            };
+            // The carried products drift by round-off (and would hide a step that does not
+            // solve its equation): every REFRESH steps they are recomputed from the state, so
+            // a discrepancy shows as an energy jump the per-step energy checks see.
+            if step.is_multiple_of(REFRESH) && !matches!(meth, Method::Kinematic) {
+                m.matvec_into(&v, &mut mv);
+                g.k.matvec_into(&u, &mut ku);
+                match meth {
+                    Method::Csn | Method::MoreauJean(_) => g.k.matvec_into(&v, &mut kv),
+                    Method::Alpha(_) => m.matvec_into(&u, &mut mu),
+                    _ => {}
+                }
+            }
+            observe_timer
+                .time(step, || {
+                    observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err)
+                })
+                .map_err(Stop::Diverged)?;
+            done = step;
+            opts.step_stop(step, CLOCK_EVERY, start)?;
+        }
+        Ok(())
+    })();
+    metrics.steps = done as i64;
+    metrics.iterations = iterations;
+    metrics.iterations_max_step = Some(newton_max as i64);
+    if let (Some(f), Some(w)) = (&fac, &work)
+        && !f.chol.is_factored()
+    {
+        metrics.solver_iterations = Some(w.iterations_total() as i64);
+        metrics.solver_iterations_max_step = Some(w.iterations_max() as i64);
+    }
+    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
+    metrics.observe_time_s = observe_timer.estimate_s();
+    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
+    obs.finish(&mut metrics, status == Status::Ok);
+    metrics.first_contact_time = obs.first_contact();
+    metrics.contact_phases = Some(obs.contact_phases());
+    metrics.free_fall_error = (fall != 0.0).then_some(fall_error);
+    metrics.err_force_l2 = metrics.err_sigma_l2.take();
+    metrics.err_sigma_mid_l2 = None;
+    metrics.contact_toggles = Some(metrics.contact_switches);
+    metrics.energy_scale = energy_scale.or(metrics.energy_initial);
+    let reference = match record {
+        Some((_, data)) if status == Status::Ok => Some(data),
+        _ => None,
+    };
+    Outcome {
+        status,
+        message,
+        metrics,
+        series: std::mem::take(&mut obs.series),
+        reference,
+    }
+}
+
+/// y += s Σ_j μ_j Z_j over the columns with μ_j ≠ 0 (Z column-major, n rows).
+fn add_columns(z: &[f64], mu: &[f64], s: f64, y: &mut [f64]) {
+    let n = y.len();
+    for (j, &l) in mu.iter().enumerate() {
+        if l != 0.0 {
+            let zj = &z[j * n..(j + 1) * n];
+            let f = s * l;
+            for (yi, zi) in y.iter_mut().zip(zj) {
+                *yi += f * zi;
+            }
+        }
+    }
+}
+
+/// y_{c_j} += s μ_j: s Bᵀμ on the contact rows.
+fn add_rows(contact: &[usize], mu: &[f64], s: f64, y: &mut [f64]) {
+    for (&c, l) in contact.iter().zip(mu) {
+        y[c] += s * l;
+    }
+}
+
+/// y += s Θ Σ_q w_q γ_q (s_q·x) s_q: the Nitsche Θ-term of −K_Θ x = −Kx + Θ Σ w γ s (s·x),
+/// scaled by s (nothing for the penalty, Θ = 0).
+fn add_theta_term(ops: &NitscheOps, x: &[f64], s: f64, y: &mut [f64]) {
+    if ops.theta == 0.0 {
+        return;
+    }
+    for k in 0..ops.len() {
+        let f = s * ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, x);
+        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+            .iter()
+            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+        {
+            y[gd] += f * sk;
+        }
+    }
+}
+
+/// y += s Σ_q φ_q C_q: the Nitsche/penalty contact force of the point values φ (C_q = −t_q,
+/// the upward direction of point q on its element's dofs).
+fn add_point_columns(ops: &NitscheOps, phi: &[f64], s: f64, y: &mut [f64]) {
+    for (k, p) in phi.iter().enumerate() {
+        if *p != 0.0 {
+            for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                .iter()
+                .zip(&ops.c[k * ops.k..(k + 1) * ops.k])
+            {
+                y[gd] += s * p * ck;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{BarScene, Physics, Scene, SceneSetup};
+    use crate::space::step_solver::Solver;
+
+    /// The certified ω²_max is an upper bound (σM − K positive definite, by construction) and
+    /// tight: 1 % below it σM − K is indefinite (so the CFL step is within ~0.5 % of the true
+    /// one), and it never exceeds Gershgorin's bound. Measured on bar2d h = 0.05 and bar3d
+    /// h = 0.1 (lumped): σ/Gershgorin printed.
+    #[test]
+    fn kinematic_frequency_bound_is_certified_and_tight() {
+        for (dim, h) in [(2, 0.05), (3, 0.1)] {
+            let scene = BarScene { dim };
+            let physics = Physics(
+                scene
+                    .physics()
+                    .iter()
+                    .map(|k| (k.name, k.default))
+                    .collect(),
+            );
+            let SceneSetup::Fe(setup) =
+                scene.setup(&physics, scene.mesh_from_h(&physics, h).unwrap())
+            else {
+                unreachable!("the bars are FE scenes")
+            };
+            let cfg = FeConfig {
+                setup,
+                method: ContactMethod::Mixed,
+                mass: MassVariant::Lumped,
+                scheme: Scheme::Newmark(NewmarkParams::central_difference()),
+                dt: 1e-3,
+                steps: 1,
+                perturbation: None,
+                solver: Solver::Direct,
+            };
+            let (sigma, gersh) = kinematic_frequency_sq(&cfg).unwrap();
+            eprintln!(
+                "bar{dim}d h = {h}: ω²_max ≤ {sigma:.6e}, Gershgorin {gersh:.6e} (ratio {:.4})",
+                sigma / gersh
+            );
+            assert!(sigma <= gersh);
+            let (geo, _) = GEOMETRIES.get(geometry_key(&cfg.setup), || build_geometry(&cfg.setup));
+            let g = geo.unwrap();
+            let (m, _) = mass_matrix(&g, &cfg.setup, &cfg.mass).unwrap();
+            let symbolic = g.symbolic().unwrap();
+            let ok =
+                |s: f64| Cholesky::new(&symbolic, &SymMatrix::lin_comb(s, &m, -1.0, &g.k)).is_ok();
+            assert!(ok(sigma), "σM − K must be positive definite");
+            assert!(!ok(0.99 * sigma), "the bound is not tight to 1 %");
+        }
+    }
+}
