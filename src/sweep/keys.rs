@@ -47,6 +47,9 @@ pub enum Key {
     RhoInf,
     /// HHT α (SPEC §3.2, preset `hht` of generalized-α).
     HhtAlpha,
+    /// The Gmsh mesh file of `mesh2d`/`mesh3d` (SPEC §1.6), relative to the sweep file; its
+    /// canonical text (the run id's) is the file's content hash, not its path.
+    Mesh,
 }
 
 /// What a key's value must look like.
@@ -132,7 +135,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 34] = [
+    pub const ALL: [Key; 35] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -167,6 +170,7 @@ impl Key {
         Key::ImpactLaw,
         Key::RhoInf,
         Key::HhtAlpha,
+        Key::Mesh,
     ];
 
     pub fn name(self) -> &'static str {
@@ -205,6 +209,7 @@ impl Key {
             Key::ImpactLaw => "impact_law",
             Key::RhoInf => "rho_inf",
             Key::HhtAlpha => "hht_alpha",
+            Key::Mesh => "mesh",
         }
     }
 
@@ -247,7 +252,7 @@ impl Key {
     pub fn value_type(self) -> ValueType {
         match self {
             Key::Elements => ValueType::Int,
-            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit | Key::RightEnd => {
+            Key::Space | Key::Mass | Key::Scheme | Key::ContactInit | Key::RightEnd | Key::Mesh => {
                 ValueType::Str
             }
             Key::MassWeights => ValueType::FloatList,
@@ -343,6 +348,13 @@ impl Key {
                 )),
             },
             (Key::PointMass | Key::Stiffness, Value::Num(x)) => positive(*x),
+            (Key::Mesh, Value::Str(s)) => {
+                if s.trim().is_empty() {
+                    Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())
+                } else {
+                    Ok(())
+                }
+            }
             (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),
             (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
             // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).

@@ -14,6 +14,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
+use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
@@ -167,9 +168,23 @@ fn same(a: &Value, b: &Value) -> bool {
     a.canonical() == b.canonical()
 }
 
+/// The folder mesh files are relative to (SPEC §1.6): the sweep file's.
+fn sweep_dir(sweep: &SweepFile) -> &Path {
+    sweep.path.parent().unwrap_or(Path::new(""))
+}
+
+/// The Gmsh file of a mesh scene's run, read and validated (cached per file): (its path as
+/// written, the resolved path, the mesh).
+type MeshFile = (
+    String,
+    std::path::PathBuf,
+    std::sync::Arc<crate::space::fe::GmshMesh>,
+);
+
 /// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
 /// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
 fn resolve(
+    sweep_dir: &Path,
     scene_kind: SceneKind,
     entries: &[&Entry],
     allow_unstable: bool,
@@ -465,7 +480,52 @@ fn resolve(
             .collect(),
     );
     let c0 = scene.wave_speed(&physics);
+    // A mesh scene's body: the file of the `mesh` key, read and validated before any run.
+    let mut mesh_file: Option<MeshFile> = None;
+    let mut file_setup = None;
+    if scene.takes_mesh_file() {
+        for k in [Key::H, Key::Elements] {
+            if let Some((_, o)) = user.get(&k) {
+                issues.push(Issue::at(
+                    o,
+                    format!(
+                        "scene {} takes its mesh from the `mesh` key (h is the file's largest element diameter), not from `{}`",
+                        scene.name(),
+                        k.name()
+                    ),
+                ));
+            }
+        }
+        match user.get(&Key::Mesh) {
+            None => issues.push(Issue {
+                line: None,
+                key: "mesh".into(),
+                reason: format!(
+                    "required: scene {} needs `mesh = \"FILE.msh\"` (a Gmsh MSH 4.1 file, relative to the sweep file) in [fixed], [grid] or [zip]",
+                    scene.name()
+                ),
+            }),
+            Some((v, o)) => {
+                let written = v.as_str().unwrap_or_default().to_string();
+                let path = sweep_dir.join(&written);
+                match crate::space::fe::GmshMesh::read_shared(&path) {
+                    Err(e) => issues.push(Issue::at(o, e.to_string())),
+                    Ok(m) => match scene.setup_from_file(&physics, &path, &m) {
+                        Err(why) => issues.push(Issue::at(o, why)),
+                        Ok((choice, setup)) => {
+                            file_setup = Some((choice, setup));
+                            mesh_file = Some((written, path, m));
+                        }
+                    },
+                }
+            }
+        }
+        if !issues.is_empty() {
+            return Outcome::Invalid(issues);
+        }
+    }
     let mesh = match (user.get(&Key::H), user.get(&Key::Elements)) {
+        _ if file_setup.is_some() => file_setup.as_ref().map(|(c, _)| *c),
         (Some(_), Some((_, o))) => {
             issues.push(Issue::at(o, "give either h or elements, not both"));
             None
@@ -543,19 +603,17 @@ fn resolve(
         )]);
     }
     let courant = c0 * dt / h;
-    let config = RunConfig::new(
-        scene.setup(&physics, mesh),
-        method,
-        mass.clone(),
-        scheme,
-        dt,
-        steps,
-    )
-    .with_contact_init(if massless && scene.contact_init_matters() {
-        contact_init
-    } else {
-        ContactInit::Consistent
-    });
+    let setup = match file_setup {
+        Some((_, setup)) => setup,
+        None => scene.setup(&physics, mesh),
+    };
+    let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps).with_contact_init(
+        if massless && scene.contact_init_matters() {
+            contact_init
+        } else {
+            ContactInit::Consistent
+        },
+    );
 
     // Memory before anything is built (the CFL check below assembles the operators).
     if let Some(budget) = limits.max_run_bytes {
@@ -677,6 +735,12 @@ fn resolve(
         let key = Key::from_name(name).unwrap();
         put(key, physics_value(key, *value), false);
     }
+    // The mesh file: its content is its identity (a moved or renamed file keeps its runs'
+    // ids), the column shows the path as written.
+    if let Some((written, _, m)) = &mesh_file {
+        canonical.insert(Key::Mesh, format!("sha256:{}", m.content_hash));
+        params.insert(Key::Mesh, Value::Str(written.clone()));
+    }
     // Derived columns, not part of the identity.
     params.insert(Key::H, Value::Num(h));
     params.insert(Key::Courant, Value::Num(courant));
@@ -775,7 +839,7 @@ fn reference_of(
                 line: None,
             })
     };
-    let r = match resolve(sweep.scene, &combined, false, limits) {
+    let r = match resolve(sweep_dir(sweep), sweep.scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
@@ -793,6 +857,19 @@ fn reference_of(
                 .collect());
         }
     };
+    if r.canonical.get(&Key::Mesh) != run.canonical.get(&Key::Mesh) {
+        return Err(vec![Issue::at(
+            &over
+                .iter()
+                .find(|e| e.key == Key::Mesh)
+                .map(|e| e.origin.clone())
+                .unwrap_or(Origin {
+                    path: "reference".into(),
+                    line: None,
+                }),
+            "the reference run must use the run's mesh file (a finer dt): references on another mesh need point location in it, not implemented yet".to_string(),
+        )]);
+    }
     let ratio = |coarse: f64, fine: f64| {
         let q = coarse / fine;
         let n = q.round();
@@ -1042,6 +1119,7 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                 let base = searches.len();
                 let tag = search_tag(sr, base);
                 let label = match resolve(
+                    sweep_dir(sweep),
                     sweep.scene,
                     &probe_entries(&entries, sr.key, sr.lo)
                         .iter()
@@ -1068,7 +1146,13 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
     let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
     for (owned, search) in &work {
         let entries: Vec<&Entry> = owned.iter().collect();
-        match resolve(sweep.scene, &entries, allow_unstable, limits) {
+        match resolve(
+            sweep_dir(sweep),
+            sweep.scene,
+            &entries,
+            allow_unstable,
+            limits,
+        ) {
             Outcome::Invalid(mut is) => issues.append(&mut is),
             Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
@@ -1215,7 +1299,7 @@ pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, Swee
         issues,
         sets: sweep.sets.clone(),
     };
-    match resolve(sweep.scene, &entries, true, &plan.limits) {
+    match resolve(sweep_dir(sweep), sweep.scene, &entries, true, &plan.limits) {
         Outcome::Run(r) => {
             let reference = match &sweep.reference {
                 None => None,

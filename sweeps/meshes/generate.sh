@@ -12,5 +12,6 @@ g square_quad.geo -2 -order 1 -o square_quad_q1.msh
 g square_quad.geo -2 -order 2 -o square_quad_q2.msh
 g cube_tet.geo -3 -order 1 -bin -o cube_tet.msh
 g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
+g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
 g cube_hex.geo -3 -order 1 -o cube_hex_q1.msh
 g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
