@@ -476,7 +476,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     }
     let mut contact_weight: Vec<f64> = cnodes.iter().map(|&n| node_weight[n]).collect();
     let total: f64 = contact_weight.iter().sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return Err(format!(
             "{}: the group \"contact\" has no boundary faces of positive measure",
             mesh.file

@@ -64,7 +64,7 @@ const MESH_PHYSICS: [PhysicsKey; 6] = [
 ];
 
 impl MeshScene {
-    fn from_file_only(&self, what: &str) -> String {
+    fn file_only(&self, what: &str) -> String {
         format!(
             "scene {} takes its mesh from the `mesh` key (a Gmsh file; h is its largest element diameter), not from `{what}`",
             self.name()
@@ -87,10 +87,10 @@ impl Scene for MeshScene {
         ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()
     }
     fn mesh_from_h(&self, _p: &Physics, _h: f64) -> Result<MeshChoice, String> {
-        Err(self.from_file_only("h"))
+        Err(self.file_only("h"))
     }
     fn mesh_from_elements(&self, _p: &Physics, _elements: usize) -> Result<MeshChoice, String> {
-        Err(self.from_file_only("elements"))
+        Err(self.file_only("elements"))
     }
     fn takes_mesh_file(&self) -> bool {
         true

@@ -408,6 +408,10 @@ pub fn assemble_load<M: Mesh + ?Sized>(
     r
 }
 
+/// An element load kernel: (node coordinates, ρ, f) ↦ ∫ ρ f·N_a (Q1/Q2 or simplex).
+type LoadKernel<const D: usize, const NN: usize, const ND: usize> =
+    fn(&[[f64; D]; NN], f64, [f64; 3]) -> SVector<f64, ND>;
+
 fn load_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND: usize>(
     r: &mut [f64],
     mesh: &M,
@@ -415,7 +419,7 @@ fn load_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND: usi
     rho: f64,
     f: [f64; 3],
     weight: &dyn Fn(usize) -> f64,
-    kernel: fn(&[[f64; D]; NN], f64, [f64; 3]) -> SVector<f64, ND>,
+    kernel: LoadKernel<D, NN, ND>,
 ) {
     for e in 0..mesh.num_elements() {
         let w = weight(e);
