@@ -160,3 +160,76 @@ fn the_mesh_file_gives_h_and_the_run_id() {
     let ids: std::collections::BTreeSet<_> = axis.runs.iter().map(|r| &r.run_id).collect();
     assert_eq!(ids.len(), 3);
 }
+
+/// mesh3d end to end on the Gmsh cube of P2 tetrahedra (clamped top z = 1, Γ_C the bottom
+/// z = 0, dropped at ½ onto a plane 0.2 below): every run ends ok, the consistent and mod3
+/// masses hold ρ|Ω| = 1, mod1 drops layer 0 (by topology: the cells with a node on Γ_C), the
+/// body reaches the plane, and the energy of the modified mass stays within 1e-3 of E⁰ as in
+/// bar3d; the errors against the reference (the same mesh, τ/2) are reported.
+#[test]
+fn mesh3d_tetrahedra_run() {
+    let rows = run(
+        "name = \"c\"\nscene = \"mesh3d\"\nreference = { dt = 0.0125, mass = \"mod3\" }\n[fixed]\nT = 1.0\ndt = 0.025\nvelocity = -0.5\nmesh = \"meshes/cube_tet_p2.msh\"\n[grid]\nmass = [\"consistent\", \"mod1\", \"mod3\"]\n",
+    );
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r.status, "ok", "{}: {:?}", r.mass, r.message);
+        // 5³ nodes, the top 25 clamped: 100 free nodes × 3; Γ_C = the 25 bottom nodes.
+        assert_eq!(r.dofs, 300);
+        assert_eq!(r.contact_dofs, Some(25));
+        assert!(
+            r.err_u_l2l2.is_some(),
+            "{}: no error against the reference",
+            r.mass
+        );
+    }
+    let by = |m: &str| rows.iter().find(|r| r.mass == m).unwrap();
+    // 1ᵀM1 = ρ|Ω| = 1: a sum of 48 exact cell masses (round-off ~1e-15).
+    for m in ["consistent", "mod3"] {
+        let total = by(m).mass_total.unwrap();
+        assert!((total - 1.0).abs() < 1e-13, "{m}: {total}");
+    }
+    // mod1 removes the cells with a node on z = 0: on this mesh those of the bottom cube
+    // layer z ∈ [0, ½] (every tetrahedron of it has a vertex on z = 0) — half the mass.
+    let m1 = by("mod1").mass_total.unwrap();
+    assert!((m1 - 0.5).abs() < 1e-13, "mod1: {m1}");
+    // Γ_C with inertia reaches the plane within T (0.2 at ½ until the clamped top's wave
+    // arrives); mod1's massless Γ_C follows the quasi-static state of the half body above it.
+    for m in ["consistent", "mod3"] {
+        let t = by(m).first_contact_time;
+        assert!(
+            t.is_some_and(|t| t > 0.0 && t < 1.0),
+            "{m}: first contact {t:?}"
+        );
+    }
+    let drift = by("mod3").energy_max_dev.unwrap();
+    assert!(drift < 1e-3, "mod3 energy deviation {drift}");
+}
+
+/// The plan's memory check covers mesh scenes and points to the cure: a coarser file.
+#[test]
+fn a_mesh_run_above_the_memory_budget_is_refused_towards_a_coarser_file() {
+    use contact_sweep::sweep::{PlanLimits, SweepFile, expand_with};
+    let sweep = SweepFile::parse(
+        &root().join("sweeps/x.toml"),
+        "name = \"m\"\nscene = \"mesh3d\"\n[fixed]\ndt = 0.025\nmesh = \"meshes/cube_tet_p2.msh\"\n",
+    )
+    .unwrap();
+    let limits = PlanLimits {
+        max_run_bytes: Some(1e5),
+        ..PlanLimits::default()
+    };
+    let e = expand_with(&sweep, &limits)
+        .expect_err("above 100 kB")
+        .to_string();
+    assert!(
+        e.contains("`fixed.mesh`") && e.contains("use a coarser mesh file"),
+        "{e}"
+    );
+    // Within a generous budget the same sweep plans.
+    let ok = PlanLimits {
+        max_run_bytes: Some(1e9),
+        ..PlanLimits::default()
+    };
+    assert_eq!(expand_with(&sweep, &ok).unwrap().runs.len(), 1);
+}

@@ -620,13 +620,21 @@ fn resolve(
         let series_every = limits.series_every.unwrap_or(1);
         let est = config.estimate(series_every);
         if est.bytes() > budget {
-            let mesh_key = if user.contains_key(&Key::Elements) {
+            let mesh_key = if scene.takes_mesh_file() {
+                Key::Mesh
+            } else if user.contains_key(&Key::Elements) {
                 Key::Elements
             } else {
                 Key::H
             };
+            // Fewer unknowns is the cure: fewer elements, a larger h, a coarser mesh file.
+            let advice = match mesh_key {
+                Key::Mesh => "use a coarser mesh file".to_string(),
+                Key::Elements => "lower `elements`".to_string(),
+                _ => "raise `h`".to_string(),
+            };
             let (at, advice) = if est.state_bytes >= est.series_bytes {
-                (origin(mesh_key), format!("lower `{}`", mesh_key.name()))
+                (origin(mesh_key), advice)
             } else {
                 (
                     Origin {
