@@ -507,7 +507,9 @@ fn resolve(
             }),
             Some((v, o)) => {
                 let written = v.as_str().unwrap_or_default().to_string();
-                let path = sweep_dir.join(&written);
+                // Absolute, so the runs find it from any working directory (a cluster job's).
+                let joined = sweep_dir.join(&written);
+                let path = std::path::absolute(&joined).unwrap_or(joined);
                 match crate::space::fe::GmshMesh::read_shared(&path) {
                     Err(e) => issues.push(Issue::at(o, e.to_string())),
                     Ok(m) => match scene.setup_from_file(&physics, &path, &m) {
