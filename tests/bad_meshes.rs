@@ -282,3 +282,128 @@ fn clockwise_surface_is_reoriented_not_refused() {
     assert!(m.reoriented);
     assert_eq!(m.measure(), 1.0);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Sweeps of the `mesh2d`/`mesh3d` scenes (SPEC §1.6) with a bad mesh or bad mesh keys: refused
+// by `plan` and by `run` with exit status 2, the message naming the sweep file, the key and the
+// reason (and the mesh file where it is at fault), no panic, nothing run (no output folder).
+
+/// (sweep body after the header, key the message must name, phrases of the reason)
+const SWEEP_CASES: &[(&str, &str, &[&str])] = &[
+    // The file does not exist (relative to the sweep file's folder).
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"nope.msh\"\n",
+        "fixed.mesh",
+        &["nope.msh", "cannot read the mesh file"],
+    ),
+    // No `contact` group.
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"no_contact.msh\"\n",
+        "fixed.mesh",
+        &["no_contact.msh", "no physical group named \"contact\""],
+    ),
+    // One bad file of a list: the axis names its item.
+    (
+        "[fixed]\ndt = 0.1\n[grid]\nmesh = [\"body.msh\", \"no_contact.msh\"]\n",
+        "grid.mesh[1]",
+        &["no_contact.msh", "\"contact\""],
+    ),
+    // A 3D mesh for the 2D scene.
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"cube.msh\"\n",
+        "fixed.mesh",
+        &["cube.msh", "a 3D mesh, scene mesh2d needs a 2D one"],
+    ),
+    // The mesh fixes h.
+    (
+        "[fixed]\ndt = 0.1\nh = 0.5\nmesh = \"body.msh\"\n",
+        "fixed.h",
+        &["takes its mesh from the `mesh` key"],
+    ),
+    // No mesh at all.
+    ("[fixed]\ndt = 0.1\n", "mesh", &["required", "mesh2d"]),
+    // Nitsche needs Γ_C's face quadrature on general meshes: not yet, and said so.
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\nspace = \"nitsche\"\nnitsche_gamma0 = 1.0\n",
+        "fixed.space",
+        &["not implemented yet for scene mesh2d"],
+    ),
+    // A reference on another mesh needs point location: refused, not run node for node.
+    (
+        "reference = { dt = 0.05, mesh = \"fine.msh\" }\n[fixed]\ndt = 0.1\nmesh = \"body.msh\"\n",
+        "reference.mesh",
+        &["must use the run's mesh file"],
+    ),
+];
+
+#[test]
+fn bad_mesh_sweeps_are_refused_with_the_file_key_and_exit_2() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("body.msh"), GOOD).unwrap();
+    std::fs::write(
+        dir.join("no_contact.msh"),
+        edit("\"contact\"", "\"bottom\""),
+    )
+    .unwrap();
+    // A finer-looking copy: another file (its bytes differ by a comment-free edit of a
+    // coordinate that keeps it valid), so its content hash differs.
+    std::fs::write(
+        dir.join("fine.msh"),
+        edit("1 1 0\n0 1 0\n", "1 1.5 0\n0 1 0\n"),
+    )
+    .unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("sweeps/meshes/cube_tet.msh"),
+        dir.join("cube.msh"),
+    )
+    .unwrap();
+    for (i, (body, key, reasons)) in SWEEP_CASES.iter().enumerate() {
+        let file = format!("bad{i}.toml");
+        let text = format!("name = \"x\"\nscene = \"mesh2d\"\n{body}");
+        std::fs::write(dir.join(&file), text).unwrap();
+        let out_dir = format!("out{i}");
+        for cmd in ["plan", "run"] {
+            let mut args = vec![cmd, file.as_str()];
+            if cmd == "run" {
+                args.extend(["--out", out_dir.as_str()]);
+            }
+            let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-sweep"))
+                .args(&args)
+                .current_dir(dir)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "case {i} ({cmd}):\n{err}");
+            assert!(!err.contains("panicked"), "case {i}: panic\n{err}");
+            assert!(err.contains(&file), "case {i}: sweep file not named\n{err}");
+            assert!(
+                err.contains(&format!("`{key}`")),
+                "case {i}: key `{key}` not named\n{err}"
+            );
+            for r in *reasons {
+                assert!(err.contains(r), "case {i}: `{r}` missing\n{err}");
+            }
+            assert!(!dir.join(&out_dir).exists(), "case {i}: output written");
+        }
+    }
+    // The baseline of the cases is itself a valid sweep: `plan` accepts it, so each case above
+    // is refused for its own edit.
+    std::fs::write(
+        dir.join("good.toml"),
+        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\ndt = 0.1\nmesh = \"body.msh\"\n",
+    )
+    .unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-sweep"))
+        .args(["plan", "good.toml"])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

@@ -113,6 +113,31 @@ impl RunConfig {
                         let per_row = ((2 * degree + 1) as f64).powi(*dim as i32) * *dim as f64;
                         (n, *dim, per_row, n.powf((*dim as f64 - 1.0) / *dim as f64))
                     }
+                    FeGeometry::Mesh {
+                        dim,
+                        nodes,
+                        clamped_nodes,
+                        contact_nodes,
+                        nodes_per_element,
+                        ..
+                    } => {
+                        let n = (nodes - clamped_nodes) as f64 * *dim as f64;
+                        // Nodes coupled to a node (its row's nodes) on a regular mesh of each
+                        // cell kind, the worst node kind: Q1/Q2 3^d/5^d as the box and ball;
+                        // triangles 7 (P1) and 19 (P2, a vertex of 6 triangles); tetrahedra
+                        // 27 (P1, a vertex of ~24 Freudenthal tetrahedra) and 85 (P2).
+                        let coupled = match (*dim, *nodes_per_element) {
+                            (2, 3) => 7.0,
+                            (2, 6) => 19.0,
+                            (2, 4) => 9.0,
+                            (2, _) => 25.0,
+                            (3, 4) => 27.0,
+                            (3, 10) => 85.0,
+                            (3, 8) => 27.0,
+                            _ => 125.0,
+                        };
+                        (n, *dim, coupled * *dim as f64, *contact_nodes as f64)
+                    }
                 };
                 let (fill, matrices, vectors) = match c.solver {
                     Solver::Direct => (

@@ -46,7 +46,7 @@ use crate::scene::{FeGeometry, FeSetup};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
 use crate::space::fe::nitsche::{ContactPoint, contact_points};
 use crate::space::fe::{
-    BallMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+    BallMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
 };
 use crate::space::linalg::{CholeskyOptions, FactorKind, LinalgError, Ordering, SymbolicCholesky};
 use crate::space::step_solver::{Solver, StepSolver, StepWork};
@@ -92,6 +92,12 @@ impl FeConfig {
                 let (nodes, top) = (count(cells), count(&cells[..d - 1]));
                 (nodes - top).saturating_mul(d)
             }
+            FeGeometry::Mesh {
+                dim,
+                nodes,
+                clamped_nodes,
+                ..
+            } => nodes.saturating_sub(*clamped_nodes).saturating_mul(*dim),
             FeGeometry::Ball {
                 dim,
                 degree,
@@ -156,11 +162,16 @@ impl FeConfig {
     }
 }
 
-/// The mesh of a geometry: the bars' box or the mapped disc/ball.
+/// The mesh of a geometry: the bars' box, the mapped disc/ball, or a Gmsh mesh with its mass
+/// layers (SPEC §1.6).
 #[derive(Debug)]
 enum FeMesh {
     Box(BoxMesh),
     Ball(BallMesh),
+    Gmsh {
+        mesh: Arc<GmshMesh>,
+        layers: Vec<usize>,
+    },
 }
 
 impl FeMesh {
@@ -168,6 +179,7 @@ impl FeMesh {
         match self {
             FeMesh::Box(m) => m,
             FeMesh::Ball(m) => m,
+            FeMesh::Gmsh { mesh, .. } => &**mesh,
         }
     }
     fn dim(&self) -> usize {
@@ -178,19 +190,21 @@ impl FeMesh {
         match self {
             FeMesh::Box(m) => m.element_layer(e),
             FeMesh::Ball(m) => m.layers[e],
+            FeMesh::Gmsh { layers, .. } => layers[e],
         }
     }
     fn num_layers(&self) -> usize {
         match self {
             FeMesh::Box(m) => m.num_layers(),
             FeMesh::Ball(m) => m.layers.iter().max().map_or(0, |l| l + 1),
+            FeMesh::Gmsh { layers, .. } => layers.iter().max().map_or(0, |l| l + 1),
         }
     }
     /// The bars' box (reference lattices are defined on it only).
     fn as_box(&self) -> Option<&BoxMesh> {
         match self {
             FeMesh::Box(m) => Some(m),
-            FeMesh::Ball(_) => None,
+            FeMesh::Ball(_) | FeMesh::Gmsh { .. } => None,
         }
     }
 }
@@ -353,7 +367,182 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
                 .map_err(|e| e.to_string())?;
             build_ball(s, mesh)
         }
+        FeGeometry::Mesh {
+            path, content_hash, ..
+        } => {
+            let mesh = GmshMesh::read_shared(path).map_err(|e| e.to_string())?;
+            if mesh.content_hash != *content_hash {
+                return Err(format!(
+                    "{}: the mesh file changed after the sweep was planned (SHA-256 {} then, {} now); plan the sweep again",
+                    path.display(),
+                    content_hash,
+                    mesh.content_hash
+                ));
+            }
+            build_gmsh(s, mesh)
+        }
     }
+}
+
+/// Mass layers of a mesh (SPEC §2.2, §1.6): layer 0 = the cells with a node in `seed`, layer
+/// k + 1 the cells not yet layered that share a node with layer k (breadth-first over shared
+/// nodes, as the disc/ball). Cells of a part never reached (a body not connected to Γ_C) take
+/// one layer past the last.
+fn node_layers(mesh: &dyn Mesh, seed: &[usize]) -> Vec<usize> {
+    let ne = mesh.num_elements();
+    let mut layers = vec![usize::MAX; ne];
+    let mut reached = vec![false; mesh.num_nodes()];
+    for &n in seed {
+        reached[n] = true;
+    }
+    let mut k = 0;
+    loop {
+        let now: Vec<usize> = (0..ne)
+            .filter(|&e| {
+                layers[e] == usize::MAX && mesh.element_nodes(e).iter().any(|&n| reached[n])
+            })
+            .collect();
+        if now.is_empty() {
+            break;
+        }
+        for &e in &now {
+            layers[e] = k;
+        }
+        for &e in &now {
+            for &n in mesh.element_nodes(e) {
+                reached[n] = true;
+            }
+        }
+        k += 1;
+    }
+    for l in layers.iter_mut().filter(|l| **l == usize::MAX) {
+        *l = k;
+    }
+    layers
+}
+
+/// A Gmsh mesh (SPEC §1.6): the `clamped` group's nodes fixed (every component), contact on the
+/// vertical dofs of the other `contact` nodes, each with its height above the lowest of them
+/// (the run's `gap` is added: the plane is x_d = lowest − gap), Γ_C's mean weighting each node
+/// by its faces' measures, mass layers by topology ([`node_layers`]).
+fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
+    let d = mesh.dim;
+    let nn = mesh.num_nodes();
+    let mut clamped = vec![false; nn];
+    if let Some(g) = mesh.group("clamped") {
+        for &n in &g.nodes {
+            clamped[n] = true;
+        }
+    }
+    let dofs = DofMap::new(nn * d, |g| clamped[g / d]);
+    let pattern = fe_pattern(&*mesh, &dofs);
+    // AMD: an unstructured mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D
+    // (the bars' measurements, `cholesky_options`).
+    let opts = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if d == 2 {
+            FactorKind::Simplicial
+        } else {
+            FactorKind::Supernodal
+        },
+    };
+    let (k, gram, grad) = operators(s, &*mesh, &dofs, &pattern);
+    let group = mesh
+        .group("contact")
+        .ok_or_else(|| format!("{}: no physical group \"contact\"", mesh.file))?;
+    let cnodes: Vec<usize> = group
+        .nodes
+        .iter()
+        .copied()
+        .filter(|&n| !clamped[n])
+        .collect();
+    if cnodes.is_empty() {
+        return Err(format!(
+            "{}: every node of the group \"contact\" is clamped",
+            mesh.file
+        ));
+    }
+    let free = |g: usize| dofs.free_index(g).expect("Γ_C nodes are not clamped here");
+    let contact: Vec<usize> = cnodes.iter().map(|&n| free(n * d + d - 1)).collect();
+    let lowest = cnodes
+        .iter()
+        .map(|&n| mesh.coords[n][d - 1])
+        .fold(f64::INFINITY, f64::min);
+    let contact_height = cnodes
+        .iter()
+        .map(|&n| mesh.coords[n][d - 1] - lowest)
+        .collect();
+    // Each Γ_C face spreads its measure (of its vertices' straight line or flat polygon) evenly
+    // over its nodes: the trapezoidal weights of the bars' bottom face for 2-node lines.
+    let mut node_weight = vec![0.0; nn];
+    for face in &group.elements {
+        let c = |i: usize| mesh.coords[face[i]];
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            let x = [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ];
+            (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
+        };
+        let measure = match (d, face.len()) {
+            (2, _) => {
+                let v = sub(c(1), c(0));
+                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+            }
+            (_, 3 | 6) => 0.5 * cross(sub(c(1), c(0)), sub(c(2), c(0))),
+            // Quadrilateral faces, Gmsh order (vertices around the face first): two triangles.
+            _ => {
+                0.5 * cross(sub(c(1), c(0)), sub(c(2), c(0)))
+                    + 0.5 * cross(sub(c(2), c(0)), sub(c(3), c(0)))
+            }
+        };
+        for &n in face {
+            node_weight[n] += measure / face.len() as f64;
+        }
+    }
+    let mut contact_weight: Vec<f64> = cnodes.iter().map(|&n| node_weight[n]).collect();
+    let total: f64 = contact_weight.iter().sum();
+    if total.is_nan() || total <= 0.0 {
+        return Err(format!(
+            "{}: the group \"contact\" has no boundary faces of positive measure",
+            mesh.file
+        ));
+    }
+    contact_weight.iter_mut().for_each(|w| *w /= total);
+    let mut contact_node = vec![false; nn];
+    for &n in &cnodes {
+        contact_node[n] = true;
+    }
+    let mut on_contact_node = vec![false; dofs.n_free()];
+    for &n in &cnodes {
+        for c in 0..d {
+            on_contact_node[free(n * d + c)] = true;
+        }
+    }
+    let vertical = (0..dofs.n_free())
+        .filter(|&r| dofs.free[r] % d == d - 1)
+        .collect();
+    let layers = node_layers(&*mesh, &group.nodes);
+    Ok(Geometry {
+        mesh: FeMesh::Gmsh { mesh, layers },
+        dofs,
+        pattern,
+        cholesky: opts,
+        symbolic: OnceLock::new(),
+        k,
+        gram,
+        grad,
+        contact,
+        contact_height,
+        gap_in_geometry: false,
+        contact_node,
+        points: Vec::new(),
+        contact_weight,
+        on_contact_node,
+        vertical,
+    })
 }
 
 /// The stiffness, Gram and grad-grad matrices of a mesh on its free dofs.
@@ -572,7 +761,9 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     let mesh = fm.mesh();
     let never = |_: usize, _: usize| false;
     let redistribution = match fm {
-        FeMesh::Ball(_) if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) => {
+        FeMesh::Ball(_) | FeMesh::Gmsh { .. }
+            if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) =>
+        {
             let layer_mass = |l: usize| {
                 let w = |e: usize| f64::from(u8::from(fm.element_layer(e) == l));
                 component_total(mesh, s.density, &w, &never)
@@ -828,12 +1019,21 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
 /// (32, 10) at h = 4, 2, 1 — each run node is located in the reference's stored mesh and the
 /// reference's finite-element function is evaluated there ([`Interpolation`]).
 fn ball_ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
-    let (d, nodes) = (g.mesh.dim(), g.mesh.mesh().num_nodes());
+    // The reference stores every free dof (`record_lattice`): n_free/d "nodes" (a mesh file's
+    // clamped nodes have every component fixed, so this is a whole number).
+    let d = g.mesh.dim();
+    let nodes = g.dofs.n_free() / d;
     let same_mesh = data.h == cfg.setup.h && data.lattice == [nodes, 1, 1];
-    if data.space_stride != 1 || (!same_mesh && data.mesh.is_none()) {
+    // Interpolating reads the reference's dofs by node (rn·d + component): every node of its
+    // stored mesh must be stored, i.e. nothing clamped (the disc and ball).
+    let interpolable = data
+        .mesh
+        .as_ref()
+        .is_some_and(|m| data.lattice == [m.coords.len(), 1, 1]);
+    if data.space_stride != 1 || (!same_mesh && !interpolable) {
         return Err(format!(
-            "scene {}: the reference (h = {}) is on another mesh than the run's (h = {}) and does not store it (written by an older version: remove DIR/references/ to record it again)",
-            cfg.setup.scene, data.h, cfg.setup.h
+            "scene {}: the reference (h = {}, {} stored nodes) is on another mesh than the run's (h = {}, {nodes} free nodes) and cannot be interpolated: it does not store its mesh (written by an older version: remove DIR/references/ to record it again) or has clamped nodes (mesh files: the reference must use the run's mesh, a finer step only)",
+            cfg.setup.scene, data.h, data.lattice[0], cfg.setup.h
         ));
     }
     let q = cfg.dt / data.dt;

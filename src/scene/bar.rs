@@ -31,15 +31,32 @@ pub enum FeGeometry {
         n_t: usize,
         n_r: usize,
     },
+    /// A Gmsh mesh file ([`crate::space::fe::GmshMesh`], scenes `mesh2d`/`mesh3d`): the engine
+    /// reads it by `path` and checks `content_hash`; the counts size the run before it is read
+    /// (memory estimate, unknowns).
+    Mesh {
+        path: std::path::PathBuf,
+        content_hash: String,
+        dim: usize,
+        nodes: usize,
+        /// Nodes of the `clamped` group (all their components fixed).
+        clamped_nodes: usize,
+        /// Nodes of Γ_C not clamped (one contact row each).
+        contact_nodes: usize,
+        nodes_per_element: usize,
+        /// The body's vertical extent (max − min of x_d over the nodes).
+        height: f64,
+    },
 }
 
 impl FeGeometry {
-    /// The body's size that mesh sizes are compared with: the box's vertical extent (the
-    /// direction the impact travels), the disc's or ball's diameter.
+    /// The body's size that mesh sizes are compared with: the box's or the mesh's vertical
+    /// extent (the direction the impact travels), the disc's or ball's diameter.
     pub fn length_scale(&self) -> f64 {
         match self {
             FeGeometry::Box { extent, .. } => extent.last().copied().unwrap_or(1.0),
             FeGeometry::Ball { radius, .. } => 2.0 * radius,
+            FeGeometry::Mesh { height, .. } => *height,
         }
     }
 }

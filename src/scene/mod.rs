@@ -15,11 +15,13 @@
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod mesh;
 pub mod oscillator;
 
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
+pub use mesh::MeshScene;
 pub use oscillator::{OscillatorExact, OscillatorParams, OscillatorScene};
 
 /// A physics parameter of a scene: its key name (SPEC §7) and default value.
@@ -117,6 +119,25 @@ pub trait Scene: Send + Sync {
     }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
+    /// Whether the body comes from a mesh file (the `mesh` key, SPEC §1.6) rather than from
+    /// `h` or `elements`.
+    fn takes_mesh_file(&self) -> bool {
+        false
+    }
+    /// The mesh choice and the setup of a run whose body is the read and validated mesh file
+    /// `path` (scenes with [`Scene::takes_mesh_file`]); `Err` says why this file does not fit.
+    fn setup_from_file(
+        &self,
+        _physics: &Physics,
+        path: &std::path::Path,
+        _mesh: &crate::space::fe::GmshMesh,
+    ) -> Result<(MeshChoice, SceneSetup), String> {
+        Err(format!(
+            "scene {} builds its own geometry and takes no mesh file ({})",
+            self.name(),
+            path.display()
+        ))
+    }
 }
 
 /// The scenes the engine can run (the registry; SPEC §1).
@@ -134,6 +155,10 @@ pub enum SceneKind {
     Sphere3d,
     /// One mass, one spring, one obstacle (SPEC §1.5).
     Oscillator,
+    /// The user's own 2D body, a Gmsh mesh (SPEC §1.6).
+    Mesh2d,
+    /// The user's own 3D body, a Gmsh mesh (SPEC §1.6).
+    Mesh3d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -142,16 +167,20 @@ static BAR3D: BarScene = BarScene { dim: 3 };
 static DISC2D: BallScene = BallScene { dim: 2 };
 static SPHERE3D: BallScene = BallScene { dim: 3 };
 static OSCILLATOR: OscillatorScene = OscillatorScene;
+static MESH2D: MeshScene = MeshScene { dim: 2 };
+static MESH3D: MeshScene = MeshScene { dim: 3 };
 
 impl SceneKind {
     /// Every scene name of SPEC §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 6] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 8] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
         ("disc2d", Some(SceneKind::Disc2d)),
         ("sphere3d", Some(SceneKind::Sphere3d)),
         ("oscillator", Some(SceneKind::Oscillator)),
+        ("mesh2d", Some(SceneKind::Mesh2d)),
+        ("mesh3d", Some(SceneKind::Mesh3d)),
     ];
 
     /// The scene behind this name.
@@ -163,6 +192,8 @@ impl SceneKind {
             SceneKind::Disc2d => &DISC2D,
             SceneKind::Sphere3d => &SPHERE3D,
             SceneKind::Oscillator => &OSCILLATOR,
+            SceneKind::Mesh2d => &MESH2D,
+            SceneKind::Mesh3d => &MESH3D,
         }
     }
 

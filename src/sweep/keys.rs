@@ -52,6 +52,9 @@ pub enum Key {
     Solver,
     /// CG's relative residual tolerance (default 1e-12; `solver = "cg"` only).
     CgTol,
+    /// The Gmsh mesh file of `mesh2d`/`mesh3d` (SPEC §1.6), relative to the sweep file; its
+    /// canonical text (the run id's) is the file's content hash, not its path.
+    Mesh,
 }
 
 /// What a key's value must look like.
@@ -137,7 +140,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 36] = [
+    pub const ALL: [Key; 37] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -174,6 +177,7 @@ impl Key {
         Key::HhtAlpha,
         Key::Solver,
         Key::CgTol,
+        Key::Mesh,
     ];
 
     pub fn name(self) -> &'static str {
@@ -214,6 +218,7 @@ impl Key {
             Key::HhtAlpha => "hht_alpha",
             Key::Solver => "solver",
             Key::CgTol => "cg_tol",
+            Key::Mesh => "mesh",
         }
     }
 
@@ -261,7 +266,8 @@ impl Key {
             | Key::Scheme
             | Key::ContactInit
             | Key::RightEnd
-            | Key::Solver => ValueType::Str,
+            | Key::Solver
+            | Key::Mesh => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -374,6 +380,13 @@ impl Key {
                     Ok(())
                 } else {
                     Err(format!("must lie in (0, 1) (a relative residual), got {x}"))
+                }
+            }
+            (Key::Mesh, Value::Str(s)) => {
+                if s.trim().is_empty() {
+                    Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())
+                } else {
+                    Ok(())
                 }
             }
             (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),

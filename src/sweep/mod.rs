@@ -477,6 +477,9 @@ impl Checker {
 
 /// Whether `scene` accepts `key`: every discretisation and method key, and its own physics.
 pub fn accepted(scene: SceneKind, key: Key) -> bool {
+    if key == Key::Mesh {
+        return scene.get().takes_mesh_file();
+    }
     !key.is_physics() || scene.accepts_physics(key.name())
 }
 

@@ -14,6 +14,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
+use std::path::Path;
 
 use sha2::{Digest, Sha256};
 
@@ -170,9 +171,23 @@ fn same(a: &Value, b: &Value) -> bool {
     a.canonical() == b.canonical()
 }
 
+/// The folder mesh files are relative to (SPEC §1.6): the sweep file's.
+fn sweep_dir(sweep: &SweepFile) -> &Path {
+    sweep.path.parent().unwrap_or(Path::new(""))
+}
+
+/// The Gmsh file of a mesh scene's run, read and validated (cached per file): (its path as
+/// written, the resolved path, the mesh).
+type MeshFile = (
+    String,
+    std::path::PathBuf,
+    std::sync::Arc<crate::space::fe::GmshMesh>,
+);
+
 /// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
 /// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
 fn resolve(
+    sweep_dir: &Path,
     scene_kind: SceneKind,
     entries: &[&Entry],
     allow_unstable: bool,
@@ -468,7 +483,54 @@ fn resolve(
             .collect(),
     );
     let c0 = scene.wave_speed(&physics);
+    // A mesh scene's body: the file of the `mesh` key, read and validated before any run.
+    let mut mesh_file: Option<MeshFile> = None;
+    let mut file_setup = None;
+    if scene.takes_mesh_file() {
+        for k in [Key::H, Key::Elements] {
+            if let Some((_, o)) = user.get(&k) {
+                issues.push(Issue::at(
+                    o,
+                    format!(
+                        "scene {} takes its mesh from the `mesh` key (h is the file's largest element diameter), not from `{}`",
+                        scene.name(),
+                        k.name()
+                    ),
+                ));
+            }
+        }
+        match user.get(&Key::Mesh) {
+            None => issues.push(Issue {
+                line: None,
+                key: "mesh".into(),
+                reason: format!(
+                    "required: scene {} needs `mesh = \"FILE.msh\"` (a Gmsh MSH 4.1 file, relative to the sweep file) in [fixed], [grid] or [zip]",
+                    scene.name()
+                ),
+            }),
+            Some((v, o)) => {
+                let written = v.as_str().unwrap_or_default().to_string();
+                // Absolute, so the runs find it from any working directory (a cluster job's).
+                let joined = sweep_dir.join(&written);
+                let path = std::path::absolute(&joined).unwrap_or(joined);
+                match crate::space::fe::GmshMesh::read_shared(&path) {
+                    Err(e) => issues.push(Issue::at(o, e.to_string())),
+                    Ok(m) => match scene.setup_from_file(&physics, &path, &m) {
+                        Err(why) => issues.push(Issue::at(o, why)),
+                        Ok((choice, setup)) => {
+                            file_setup = Some((choice, setup));
+                            mesh_file = Some((written, path, m));
+                        }
+                    },
+                }
+            }
+        }
+        if !issues.is_empty() {
+            return Outcome::Invalid(issues);
+        }
+    }
     let mesh = match (user.get(&Key::H), user.get(&Key::Elements)) {
+        _ if file_setup.is_some() => file_setup.as_ref().map(|(c, _)| *c),
         (Some(_), Some((_, o))) => {
             issues.push(Issue::at(o, "give either h or elements, not both"));
             None
@@ -546,19 +608,17 @@ fn resolve(
         )]);
     }
     let courant = c0 * dt / h;
-    let config = RunConfig::new(
-        scene.setup(&physics, mesh),
-        method,
-        mass.clone(),
-        scheme,
-        dt,
-        steps,
-    )
-    .with_contact_init(if massless && scene.contact_init_matters() {
-        contact_init
-    } else {
-        ContactInit::Consistent
-    });
+    let setup = match file_setup {
+        Some((_, setup)) => setup,
+        None => scene.setup(&physics, mesh),
+    };
+    let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps).with_contact_init(
+        if massless && scene.contact_init_matters() {
+            contact_init
+        } else {
+            ContactInit::Consistent
+        },
+    );
     // The step solver (SPEC §4) is the finite-element engine's choice; the 1D engines solve
     // tridiagonal systems, and drop the keys.
     let fe = matches!(config, RunConfig::Fe(_));
@@ -583,10 +643,18 @@ fn resolve(
         let series_every = limits.series_every.unwrap_or(1);
         let est = config.estimate(series_every);
         if est.bytes() > budget {
-            let mesh_key = if user.contains_key(&Key::Elements) {
+            let mesh_key = if scene.takes_mesh_file() {
+                Key::Mesh
+            } else if user.contains_key(&Key::Elements) {
                 Key::Elements
             } else {
                 Key::H
+            };
+            // Fewer unknowns is the cure: fewer elements, a larger h, a coarser mesh file.
+            let advice = match mesh_key {
+                Key::Mesh => "use a coarser mesh file".to_string(),
+                Key::Elements => "lower `elements`".to_string(),
+                _ => "raise `h`".to_string(),
             };
             let (at, advice) = if est.state_bytes >= est.series_bytes {
                 // Without a factor the same run may fit: say so, with its figure.
@@ -601,8 +669,7 @@ fn resolve(
                 });
                 let advice = match cg {
                     Some(b) => format!(
-                        "lower `{}`, or set solver = \"cg\" (conjugate gradient, no factor: an estimated {}{})",
-                        mesh_key.name(),
+                        "{advice}, or set solver = \"cg\" (conjugate gradient, no factor: an estimated {}{})",
                         human_bytes(b),
                         if b > budget {
                             ", also above the budget"
@@ -610,7 +677,7 @@ fn resolve(
                             ""
                         }
                     ),
-                    None => format!("lower `{}`", mesh_key.name()),
+                    None => advice,
                 };
                 (origin(mesh_key), advice)
             } else {
@@ -730,6 +797,12 @@ fn resolve(
         Solver::Direct if fe => put(Key::Solver, Value::Str(solver.name().into()), false),
         Solver::Direct => {}
     }
+    // The mesh file: its content is its identity (a moved or renamed file keeps its runs'
+    // ids), the column shows the path as written.
+    if let Some((written, _, m)) = &mesh_file {
+        canonical.insert(Key::Mesh, format!("sha256:{}", m.content_hash));
+        params.insert(Key::Mesh, Value::Str(written.clone()));
+    }
     // Derived columns, not part of the identity.
     params.insert(Key::H, Value::Num(h));
     params.insert(Key::Courant, Value::Num(courant));
@@ -828,7 +901,7 @@ fn reference_of(
                 line: None,
             })
     };
-    let r = match resolve(sweep.scene, &combined, false, limits) {
+    let r = match resolve(sweep_dir(sweep), sweep.scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
@@ -846,6 +919,19 @@ fn reference_of(
                 .collect());
         }
     };
+    if r.canonical.get(&Key::Mesh) != run.canonical.get(&Key::Mesh) {
+        return Err(vec![Issue::at(
+            &over
+                .iter()
+                .find(|e| e.key == Key::Mesh)
+                .map(|e| e.origin.clone())
+                .unwrap_or(Origin {
+                    path: "reference".into(),
+                    line: None,
+                }),
+            "the reference run must use the run's mesh file (a finer dt): references on another mesh need point location in it, not implemented yet".to_string(),
+        )]);
+    }
     let ratio = |coarse: f64, fine: f64| {
         let q = coarse / fine;
         let n = q.round();
@@ -1107,6 +1193,7 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                 let base = searches.len();
                 let tag = search_tag(sr, base);
                 let label = match resolve(
+                    sweep_dir(sweep),
                     sweep.scene,
                     &probe_entries(&entries, sr.key, sr.lo)
                         .iter()
@@ -1133,7 +1220,13 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
     let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
     for (owned, search) in &work {
         let entries: Vec<&Entry> = owned.iter().collect();
-        match resolve(sweep.scene, &entries, allow_unstable, limits) {
+        match resolve(
+            sweep_dir(sweep),
+            sweep.scene,
+            &entries,
+            allow_unstable,
+            limits,
+        ) {
             Outcome::Invalid(mut is) => issues.append(&mut is),
             Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
@@ -1280,7 +1373,7 @@ pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, Swee
         issues,
         sets: sweep.sets.clone(),
     };
-    match resolve(sweep.scene, &entries, true, &plan.limits) {
+    match resolve(sweep_dir(sweep), sweep.scene, &entries, true, &plan.limits) {
         Outcome::Run(r) => {
             let reference = match &sweep.reference {
                 None => None,

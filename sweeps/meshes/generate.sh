@@ -11,5 +11,34 @@ g square_tri.geo -2 -order 2 -o square_tri_p2.msh
 g square_quad.geo -2 -order 1 -o square_quad_q1.msh
 g square_quad.geo -2 -order 2 -o square_quad_q2.msh
 g cube_tet.geo -3 -order 1 -bin -o cube_tet.msh
+g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
+g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
 g cube_hex.geo -3 -order 1 -o cube_hex_q1.msh
 g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
+# Refinement families of the unit square and cube for the manufactured convergence test
+# (tests/fe_convergence.rs): the same .geo files with N overridden (M = N for the quadrilaterals).
+conv() { # conv GEO N DIM ORDER OUT [extra gmsh args]
+    local geo=$1 n=$2 dim=$3 order=$4 out=$5
+    shift 5
+    local tmp
+    tmp=$(mktemp --suffix .geo)
+    sed -e "s/^N = .*/N = $n;/" -e "s/^M = .*/M = $n;/" "$geo" >"$tmp"
+    g "$tmp" "-$dim" -order "$order" "$@" -o "conv/$out"
+    rm -f "$tmp"
+}
+mkdir -p conv
+for n in 4 8 16; do
+    conv square_tri.geo $n 2 1 square_tri_p1_n$n.msh
+    conv square_tri.geo $n 2 2 square_tri_p2_n$n.msh
+    conv square_quad.geo $n 2 1 square_quad_q1_n$n.msh
+    conv square_quad.geo $n 2 2 square_quad_q2_n$n.msh
+done
+# P1 simplices reach their asymptotic rate late: one more level each.
+conv square_tri.geo 32 2 1 square_tri_p1_n32.msh
+conv cube_tet.geo 8 3 1 cube_tet_p1_n8.msh -bin
+for n in 2 3 4 6; do
+    conv cube_tet.geo $n 3 1 cube_tet_p1_n$n.msh -bin
+    conv cube_tet.geo $n 3 2 cube_tet_p2_n$n.msh -bin
+    conv cube_hex.geo $n 3 1 cube_hex_q1_n$n.msh -bin
+    conv cube_hex.geo $n 3 2 cube_hex_q2_n$n.msh -bin
+done

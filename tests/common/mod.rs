@@ -144,9 +144,14 @@ pub fn assert_complete(dir: &Path, n: usize) -> std::collections::HashSet<String
 /// Plan and run a sweep given as text through the library (references computed into a
 /// temporary folder), on two threads; the records in plan order.
 pub fn run_sweep_text(text: &str) -> Vec<contact_sweep::run::RunRecord> {
+    run_sweep_text_at(Path::new("test.toml"), text)
+}
+
+/// [`run_sweep_text`] as if the sweep were the file `path` (mesh files are relative to it).
+pub fn run_sweep_text_at(path: &Path, text: &str) -> Vec<contact_sweep::run::RunRecord> {
     use contact_sweep::exec::{self, ExecOptions};
     use contact_sweep::sweep::{SweepFile, expand};
-    let sweep = SweepFile::parse(Path::new("test.toml"), text).expect("valid sweep");
+    let sweep = SweepFile::parse(path, text).expect("valid sweep");
     let plan = expand(&sweep).expect("plan");
     let dir = tempfile::tempdir().unwrap();
     let runs: Vec<_> = plan.runs.iter().collect();

@@ -154,7 +154,7 @@ pub fn shape<const D: usize, const NN: usize>(xi: [f64; D]) -> ([f64; NN], [[f64
 }
 
 /// Determinant and inverse of a 2×2 or 3×3 matrix (cofactor formulas).
-fn det_inv<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
+pub(crate) fn det_inv<const D: usize>(j: &[[f64; D]; D]) -> (f64, [[f64; D]; D]) {
     let mut inv = [[0.0; D]; D];
     let det = match D {
         2 => {

@@ -31,7 +31,9 @@
 //! includes it, SPEC §1.6).
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::SystemTime;
 
 use mshio::mshfile::ElementType;
 use sha2::{Digest, Sha256};
@@ -841,6 +843,36 @@ impl GmshMesh {
             content_hash,
             reoriented,
         })
+    }
+
+    /// [`GmshMesh::read`] through a process-wide cache: the planner validates a sweep's mesh
+    /// files once per file (a `[grid]` crosses each with many methods) and the runs of the
+    /// same process reuse the read mesh. Keyed by the path and the file's size and modification
+    /// time, so a file rewritten between two sweeps of one process is read again.
+    pub fn read_shared(path: &Path) -> Result<Arc<GmshMesh>, GmshError> {
+        type Key = (PathBuf, u64, Option<SystemTime>);
+        static CACHE: Mutex<Vec<(Key, Arc<GmshMesh>)>> = Mutex::new(Vec::new());
+        /// Distinct files kept: a refinement family of a few meshes, and its reference.
+        const CAP: usize = 8;
+        let meta = std::fs::metadata(path).map_err(|source| GmshError::Io {
+            file: path.display().to_string(),
+            source,
+        })?;
+        let key: Key = (path.to_path_buf(), meta.len(), meta.modified().ok());
+        {
+            let cache = CACHE.lock().unwrap_or_else(|p| p.into_inner());
+            if let Some((_, m)) = cache.iter().find(|(k, _)| *k == key) {
+                return Ok(Arc::clone(m));
+            }
+        }
+        let mesh = Arc::new(GmshMesh::read(path)?);
+        let mut cache = CACHE.lock().unwrap_or_else(|p| p.into_inner());
+        cache.retain(|(k, _)| k.0 != key.0);
+        cache.push((key, Arc::clone(&mesh)));
+        if cache.len() > CAP {
+            cache.remove(0);
+        }
+        Ok(mesh)
     }
 
     /// The physical group of this name, if any.

@@ -13,8 +13,9 @@
 //!   validated (typed [`GmshError`]s), with `h` and the file's content hash;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
-//! - [`simplex`]: vector P1/P2 triangle mass and elasticity stiffness (isoparametric, degree-4
-//!   rule), the triangles of Gmsh meshes;
+//! - [`simplex`]: vector P1/P2 triangle and tetrahedron mass, elasticity stiffness, grad-grad
+//!   and load (isoparametric; degree-4 rule on triangles, degree-5 on tetrahedra), the simplices
+//!   of Gmsh meshes, assembled by [`sparse`] like the Q1/Q2 cells;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
 //!   element weights (the layer-weighted masses of SPEC §2.2) and the matrix operations of a
 //!   time loop (`matvec_into` allocates nothing).
@@ -36,7 +37,7 @@ pub use ball::{BallMesh, BoundaryFace, FacePoint};
 pub use element::{ElementOp, Q1Mat2, Q1Mat3, Q2Mat2, Q2Mat3};
 pub use gmsh::{ElementKind, GmshError, GmshMesh, PhysicalGroup};
 pub use mesh::{BoxMesh, Mesh};
-pub use simplex::{P1Mat2, P2Mat2};
+pub use simplex::{P1Mat2, P1Mat3, P2Mat2, P2Mat3};
 pub use sparse::{Pattern, SymMatrix, assemble, assemble_into, assemble_load, fe_pattern};
 
 /// Errors of the finite-element layer (bad shapes, bad user-given matrices).

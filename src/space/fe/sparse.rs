@@ -18,6 +18,7 @@ use nalgebra::{SMatrix, SVector};
 pub use super::element::ElementOp;
 use super::element::{element_matrix, q1_load};
 use super::mesh::Mesh;
+use super::simplex::{simplex_element_matrix, simplex_load};
 use super::{DofMap, FeError};
 
 /// The CSC structure of a full symmetric n×n matrix (sorted rows, diagonal present).
@@ -295,7 +296,8 @@ pub fn assemble<M: Mesh + ?Sized>(
 ///
 /// # Panics
 /// If the pattern does not fit the mesh and dofs (an entry of an element is missing), or the
-/// mesh is not made of Q1 or Q2 quadrilaterals / hexahedra (4, 9 / 8, 27 nodes).
+/// mesh is not made of Q1 or Q2 quadrilaterals / hexahedra (4, 9 / 8, 27 nodes) or P1/P2
+/// triangles / tetrahedra (3, 6 / 4, 10 nodes).
 pub fn assemble_into<M: Mesh + ?Sized>(
     a: &mut SymMatrix,
     mesh: &M,
@@ -310,10 +312,21 @@ pub fn assemble_into<M: Mesh + ?Sized>(
     );
     a.values.fill(0.0);
     match (mesh.dim(), mesh.nodes_per_element()) {
-        (2, 4) => assemble_generic::<M, 2, 4, 8>(a, mesh, dofs, op, weight),
-        (3, 8) => assemble_generic::<M, 3, 8, 24>(a, mesh, dofs, op, weight),
-        (2, 9) => assemble_generic::<M, 2, 9, 18>(a, mesh, dofs, op, weight),
-        (3, 27) => assemble_generic::<M, 3, 27, 81>(a, mesh, dofs, op, weight),
+        (2, 4) => assemble_generic::<M, 2, 4, 8>(a, mesh, dofs, op, weight, element_matrix),
+        (3, 8) => assemble_generic::<M, 3, 8, 24>(a, mesh, dofs, op, weight, element_matrix),
+        (2, 9) => assemble_generic::<M, 2, 9, 18>(a, mesh, dofs, op, weight, element_matrix),
+        (3, 27) => assemble_generic::<M, 3, 27, 81>(a, mesh, dofs, op, weight, element_matrix),
+        // The simplices of Gmsh meshes: no node count collides with a tensor element's.
+        (2, 3) => assemble_generic::<M, 2, 3, 6>(a, mesh, dofs, op, weight, simplex_element_matrix),
+        (2, 6) => {
+            assemble_generic::<M, 2, 6, 12>(a, mesh, dofs, op, weight, simplex_element_matrix)
+        }
+        (3, 4) => {
+            assemble_generic::<M, 3, 4, 12>(a, mesh, dofs, op, weight, simplex_element_matrix)
+        }
+        (3, 10) => {
+            assemble_generic::<M, 3, 10, 30>(a, mesh, dofs, op, weight, simplex_element_matrix)
+        }
         (d, k) => panic!("assemble: no element for dimension {d} with {k} nodes"),
     }
 }
@@ -338,6 +351,7 @@ fn assemble_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND:
     dofs: &DofMap,
     op: ElementOp,
     weight: &dyn Fn(usize) -> f64,
+    kernel: fn(ElementOp, &[[f64; D]; NN]) -> SMatrix<f64, ND, ND>,
 ) {
     let p = Arc::clone(&a.pattern);
     let mut red = [u32::MAX; ND];
@@ -350,7 +364,7 @@ fn assemble_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND:
         for (k, r) in red.iter_mut().enumerate() {
             *r = dofs.free_of[nodes[k / D] * D + k % D];
         }
-        let ke: SMatrix<f64, ND, ND> = element_matrix(op, &element_coords::<M, D, NN>(mesh, e));
+        let ke = kernel(op, &element_coords::<M, D, NN>(mesh, e));
         for (q, &cq) in red.iter().enumerate() {
             if cq == DofMap::CONSTRAINED {
                 continue;
@@ -381,14 +395,22 @@ pub fn assemble_load<M: Mesh + ?Sized>(
 ) -> Vec<f64> {
     let mut r = vec![0.0; dofs.n_free()];
     match (mesh.dim(), mesh.nodes_per_element()) {
-        (2, 4) => load_generic::<M, 2, 4, 8>(&mut r, mesh, dofs, rho, f, weight),
-        (3, 8) => load_generic::<M, 3, 8, 24>(&mut r, mesh, dofs, rho, f, weight),
-        (2, 9) => load_generic::<M, 2, 9, 18>(&mut r, mesh, dofs, rho, f, weight),
-        (3, 27) => load_generic::<M, 3, 27, 81>(&mut r, mesh, dofs, rho, f, weight),
+        (2, 4) => load_generic::<M, 2, 4, 8>(&mut r, mesh, dofs, rho, f, weight, q1_load),
+        (3, 8) => load_generic::<M, 3, 8, 24>(&mut r, mesh, dofs, rho, f, weight, q1_load),
+        (2, 9) => load_generic::<M, 2, 9, 18>(&mut r, mesh, dofs, rho, f, weight, q1_load),
+        (3, 27) => load_generic::<M, 3, 27, 81>(&mut r, mesh, dofs, rho, f, weight, q1_load),
+        (2, 3) => load_generic::<M, 2, 3, 6>(&mut r, mesh, dofs, rho, f, weight, simplex_load),
+        (2, 6) => load_generic::<M, 2, 6, 12>(&mut r, mesh, dofs, rho, f, weight, simplex_load),
+        (3, 4) => load_generic::<M, 3, 4, 12>(&mut r, mesh, dofs, rho, f, weight, simplex_load),
+        (3, 10) => load_generic::<M, 3, 10, 30>(&mut r, mesh, dofs, rho, f, weight, simplex_load),
         (d, k) => panic!("assemble_load: no element for dimension {d} with {k} nodes"),
     }
     r
 }
+
+/// An element load kernel: (node coordinates, ρ, f) ↦ ∫ ρ f·N_a (Q1/Q2 or simplex).
+type LoadKernel<const D: usize, const NN: usize, const ND: usize> =
+    fn(&[[f64; D]; NN], f64, [f64; 3]) -> SVector<f64, ND>;
 
 fn load_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND: usize>(
     r: &mut [f64],
@@ -397,13 +419,14 @@ fn load_generic<M: Mesh + ?Sized, const D: usize, const NN: usize, const ND: usi
     rho: f64,
     f: [f64; 3],
     weight: &dyn Fn(usize) -> f64,
+    kernel: LoadKernel<D, NN, ND>,
 ) {
     for e in 0..mesh.num_elements() {
         let w = weight(e);
         if w == 0.0 {
             continue;
         }
-        let fe: SVector<f64, ND> = q1_load(&element_coords::<M, D, NN>(mesh, e), rho, f);
+        let fe = kernel(&element_coords::<M, D, NN>(mesh, e), rho, f);
         let nodes = mesh.element_nodes(e);
         for k in 0..ND {
             if let Some(i) = dofs.free_index(nodes[k / D] * D + k % D) {

@@ -1,0 +1,235 @@
+//! The `mesh2d`/`mesh3d` scenes (SPEC §1.6, issue 22): the user's body from a Gmsh file.
+//!
+//! - issue 22 "done when" 2: the 002 bar meshed by Gmsh as transfinite quadrilaterals
+//!   (sweeps/meshes/bar2d_quad.msh: the nodes and Q1 elements of bar2d's box at h = 0.05, in
+//!   Gmsh's numbering) reproduces bar2d's runs in every error and energy column;
+//! - the plan: h = the mesh's largest element diameter, the id holds the file's content hash
+//!   (a copy of the file elsewhere gives the same id; an edited file another), a list of files is
+//!   an axis.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use common::run_sweep_text_at;
+use contact_sweep::run::RunRecord;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The sweep as if it were `sweeps/NAME.toml` (mesh paths relative to `sweeps/`).
+fn run(text: &str) -> Vec<RunRecord> {
+    run_sweep_text_at(&root().join("sweeps/test_mesh_scenes.toml"), text)
+}
+
+/// Every error and energy column of a run, by name.
+fn columns(r: &RunRecord) -> Vec<(&'static str, Option<f64>)> {
+    vec![
+        ("err_u_l2l2", r.err_u_l2l2),
+        ("err_u_l2h1", r.err_u_l2h1),
+        ("err_u_linfl2", r.err_u_linfl2),
+        ("err_energy_l2", r.err_energy_l2),
+        ("err_u_contact_max", r.err_u_contact_max),
+        ("err_force_l2", r.err_force_l2),
+        ("energy_initial", r.energy_initial),
+        ("energy_final", r.energy_final),
+        ("energy_drift", r.energy_drift),
+        ("energy_max_dev", r.energy_max_dev),
+        ("energy_max_increase", r.energy_max_increase),
+        ("mass_total", r.mass_total),
+        ("max_penetration", r.max_penetration),
+        ("first_contact_time", r.first_contact_time),
+    ]
+}
+
+#[test]
+fn gmsh_bar_reproduces_bar2d() {
+    let methods = r#"
+[fixed]
+T = 2.0
+dt = 0.025
+[grid]
+mass = ["consistent", "lumped", "mod1", "mod2", "mod3", "zero-contact"]
+scheme = ["crank-nicolson", "backward-euler"]
+"#;
+    let bar = run(&format!(
+        "name = \"b\"\nscene = \"bar2d\"\nreference = {{ dt = 0.00625, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n{methods}h = [0.05]\n"
+    ));
+    let mesh = run(&format!(
+        "name = \"m\"\nscene = \"mesh2d\"\nreference = {{ dt = 0.00625, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n{methods}mesh = [\"meshes/bar2d_quad.msh\"]\nvelocity = [-0.5]\n"
+    ));
+    assert_eq!(bar.len(), 12);
+    assert_eq!(mesh.len(), bar.len());
+    let mut worst = (0.0f64, String::new());
+    for (b, m) in bar.iter().zip(&mesh) {
+        assert_eq!(b.status, "ok", "{:?}", b.message);
+        assert_eq!(m.status, "ok", "{:?}", m.message);
+        assert_eq!((&b.mass, &b.scheme_label), (&m.mass, &m.scheme_label));
+        assert_eq!(b.dofs, m.dofs);
+        assert_eq!(b.contact_dofs, m.contact_dofs);
+        assert_eq!(
+            b.contact_toggles, m.contact_toggles,
+            "{} {}",
+            b.mass, b.scheme_label
+        );
+        for ((name, x), (_, y)) in columns(b).into_iter().zip(columns(m)) {
+            match (x, y) {
+                (Some(x), Some(y)) => {
+                    let d = (x - y).abs();
+                    if d > worst.0 {
+                        worst = (
+                            d,
+                            format!("{} {} {name}: {x:e} vs {y:e}", b.mass, b.scheme_label),
+                        );
+                    }
+                    println!(
+                        "{} {} {name}: {x:e} vs {y:e} diff {d:e}",
+                        b.mass, b.scheme_label
+                    );
+                }
+                (None, None) => {}
+                _ => panic!("{} {} {name}: {x:?} vs {y:?}", b.mass, b.scheme_label),
+            }
+        }
+    }
+    // The two runs solve the same equations with the dofs numbered differently, so their
+    // factorisations round differently (~1e-16 relative) and their LCPs stop at different
+    // iterates within the tolerance 1e-12·gap = 2e-13 m; the impacts carry that through the
+    // steps. Measured: at most 7.6e-11 (the chattering lumped CN's energy_drift, which is
+    // relative to E⁰), every error column within 2e-11 m·(unit); 1e-10 is the issue's bound.
+    // (The differences are absolute, in each column's unit: an error column is a difference of
+    // nearly equal solutions, so its relative round-off is that of u times ‖u‖/‖e‖ ~ 100.)
+    println!("worst: {worst:?}");
+    assert!(worst.0 < 1e-10, "{worst:?}");
+}
+
+fn plan(path: &Path, text: &str) -> contact_sweep::sweep::Plan {
+    let sweep =
+        contact_sweep::sweep::SweepFile::parse(path, text).unwrap_or_else(|e| panic!("{e}"));
+    contact_sweep::sweep::expand(&sweep).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn the_mesh_file_gives_h_and_the_run_id() {
+    use contact_sweep::sweep::{Key, Value};
+    let text = |mesh: &str| {
+        format!("name = \"m\"\nscene = \"mesh2d\"\n[fixed]\ndt = 0.025\nmesh = \"{mesh}\"\n")
+    };
+    let here = plan(
+        &root().join("sweeps/x.toml"),
+        &text("meshes/bar2d_quad.msh"),
+    );
+    assert_eq!(here.runs.len(), 1);
+    let r = &here.runs[0];
+    // h = the largest element diameter: the 0.05 × 0.05 squares' diagonal (coordinates
+    // k·0.05 to ~1e-17, so 1e-15).
+    let h = r.params[&Key::H].as_f64().unwrap();
+    assert!((h - 0.05 * 2f64.sqrt()).abs() < 1e-15, "h = {h}");
+    assert_eq!(r.params[&Key::Elements], Value::Int(40));
+    assert_eq!(
+        r.params[&Key::Mesh],
+        Value::Str("meshes/bar2d_quad.msh".into())
+    );
+    // The same bytes under another name in another folder: the same run.
+    let tmp = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(root().join("sweeps/meshes/bar2d_quad.msh")).unwrap();
+    std::fs::write(tmp.path().join("copy.msh"), &bytes).unwrap();
+    let there = plan(&tmp.path().join("y.toml"), &text("copy.msh"));
+    assert_eq!(there.runs[0].run_id, r.run_id);
+    // Other bytes (one node moved inside the body, still a valid mesh): another run.
+    let edited = String::from_utf8(bytes)
+        .unwrap()
+        .replacen("\n0.05 0.5 0\n", "\n0.05 0.51 0\n", 1);
+    assert!(
+        edited.len()
+            == std::fs::metadata(tmp.path().join("copy.msh"))
+                .unwrap()
+                .len() as usize
+                + 1
+    );
+    std::fs::write(tmp.path().join("edited.msh"), edited).unwrap();
+    let other = plan(&tmp.path().join("y.toml"), &text("edited.msh"));
+    assert_ne!(other.runs[0].run_id, r.run_id);
+    // A list of files is an axis, ordered as written.
+    let axis = plan(
+        &root().join("sweeps/x.toml"),
+        "name = \"m\"\nscene = \"mesh2d\"\n[fixed]\ndt = 0.025\n[grid]\nmesh = [\"meshes/square_tri_p1.msh\", \"meshes/square_tri_p2.msh\", \"meshes/square_quad_q1.msh\"]\n",
+    );
+    assert_eq!(axis.runs.len(), 3);
+    let ids: std::collections::BTreeSet<_> = axis.runs.iter().map(|r| &r.run_id).collect();
+    assert_eq!(ids.len(), 3);
+}
+
+/// mesh3d end to end on the Gmsh cube of P2 tetrahedra (clamped top z = 1, Γ_C the bottom
+/// z = 0, dropped at ½ onto a plane 0.2 below): every run ends ok, the consistent and mod3
+/// masses hold ρ|Ω| = 1, mod1 drops layer 0 (by topology: the cells with a node on Γ_C), the
+/// body reaches the plane, and the energy of the modified mass stays within 1e-3 of E⁰ as in
+/// bar3d; the errors against the reference (the same mesh, τ/2) are reported.
+#[test]
+fn mesh3d_tetrahedra_run() {
+    let rows = run(
+        "name = \"c\"\nscene = \"mesh3d\"\nreference = { dt = 0.0125, mass = \"mod3\" }\n[fixed]\nT = 1.0\ndt = 0.025\nvelocity = -0.5\nmesh = \"meshes/cube_tet_p2.msh\"\n[grid]\nmass = [\"consistent\", \"mod1\", \"mod3\"]\n",
+    );
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert_eq!(r.status, "ok", "{}: {:?}", r.mass, r.message);
+        // 5³ nodes, the top 25 clamped: 100 free nodes × 3; Γ_C = the 25 bottom nodes.
+        assert_eq!(r.dofs, 300);
+        assert_eq!(r.contact_dofs, Some(25));
+        assert!(
+            r.err_u_l2l2.is_some(),
+            "{}: no error against the reference",
+            r.mass
+        );
+    }
+    let by = |m: &str| rows.iter().find(|r| r.mass == m).unwrap();
+    // 1ᵀM1 = ρ|Ω| = 1: a sum of 48 exact cell masses (round-off ~1e-15).
+    for m in ["consistent", "mod3"] {
+        let total = by(m).mass_total.unwrap();
+        assert!((total - 1.0).abs() < 1e-13, "{m}: {total}");
+    }
+    // mod1 removes the cells with a node on z = 0: on this mesh those of the bottom cube
+    // layer z ∈ [0, ½] (every tetrahedron of it has a vertex on z = 0) — half the mass.
+    let m1 = by("mod1").mass_total.unwrap();
+    assert!((m1 - 0.5).abs() < 1e-13, "mod1: {m1}");
+    // Γ_C with inertia reaches the plane within T (0.2 at ½ until the clamped top's wave
+    // arrives); mod1's massless Γ_C follows the quasi-static state of the half body above it.
+    for m in ["consistent", "mod3"] {
+        let t = by(m).first_contact_time;
+        assert!(
+            t.is_some_and(|t| t > 0.0 && t < 1.0),
+            "{m}: first contact {t:?}"
+        );
+    }
+    let drift = by("mod3").energy_max_dev.unwrap();
+    assert!(drift < 1e-3, "mod3 energy deviation {drift}");
+}
+
+/// The plan's memory check covers mesh scenes and points to the cure: a coarser file.
+#[test]
+fn a_mesh_run_above_the_memory_budget_is_refused_towards_a_coarser_file() {
+    use contact_sweep::sweep::{PlanLimits, SweepFile, expand_with};
+    let sweep = SweepFile::parse(
+        &root().join("sweeps/x.toml"),
+        "name = \"m\"\nscene = \"mesh3d\"\n[fixed]\ndt = 0.025\nmesh = \"meshes/cube_tet_p2.msh\"\n",
+    )
+    .unwrap();
+    let limits = PlanLimits {
+        max_run_bytes: Some(1e5),
+        ..PlanLimits::default()
+    };
+    let e = expand_with(&sweep, &limits)
+        .expect_err("above 100 kB")
+        .to_string();
+    assert!(
+        e.contains("`fixed.mesh`") && e.contains("use a coarser mesh file"),
+        "{e}"
+    );
+    // Within a generous budget the same sweep plans.
+    let ok = PlanLimits {
+        max_run_bytes: Some(1e9),
+        ..PlanLimits::default()
+    };
+    assert_eq!(expand_with(&sweep, &ok).unwrap().runs.len(), 1);
+}
