@@ -15,6 +15,8 @@ g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
 g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
 g cube_hex.geo -3 -order 1 -o cube_hex_q1.msh
 g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
+# The Hertz half-disc of sweeps/hertz_halfdisc.toml (P2: Mesh.ElementOrder = 2 in the .geo).
+g hertz_halfdisc.geo -2 -order 2 -o hertz_halfdisc.msh
 # Refinement families of the unit square and cube for the manufactured convergence test
 # (tests/fe_convergence.rs): the same .geo files with N overridden (M = N for the quadrilaterals).
 conv() { # conv GEO N DIM ORDER OUT [extra gmsh args]
