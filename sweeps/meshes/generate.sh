@@ -15,6 +15,10 @@ g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
 g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
 g cube_hex.geo -3 -order 1 -o cube_hex_q1.msh
 g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
+# The Hertz half-disc of sweeps/hertz_halfdisc.toml (P2: Mesh.ElementOrder = 2 in the .geo).
+g hertz_halfdisc.geo -2 -order 2 -o hertz_halfdisc.msh
+# A ball of P2 tetrahedra for mesh3d (tests/hertz.rs).
+g ball_tet.geo -3 -order 2 -o ball_tet.msh
 # Refinement families of the unit square and cube for the manufactured convergence test
 # (tests/fe_convergence.rs): the same .geo files with N overridden (M = N for the quadrilaterals).
 conv() { # conv GEO N DIM ORDER OUT [extra gmsh args]
