@@ -870,9 +870,11 @@ dt = [0.1, 0.05]
 /// (≤ 1e-12·D, D = 40).
 #[test]
 fn comparison_disc_methods_have_their_properties() {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/comparison_disc.toml"))
-            .unwrap();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/sweeps/comparison_disc.toml"
+    ))
+    .unwrap();
     let rows = run_sweep_text(&text);
     assert_eq!(rows.len(), 11);
     let row = |label: &str| -> &RunRecord {
@@ -890,7 +892,10 @@ fn comparison_disc_methods_have_their_properties() {
         "penalty(γ0=1e2) · consistent · discrete-gradient",
     ] {
         let inc = row(label).energy_max_increase.unwrap();
-        assert!(inc <= 1e-12, "{label}: E^h rose by {inc:e} energy scales in a step");
+        assert!(
+            inc <= 1e-12,
+            "{label}: E^h rose by {inc:e} energy scales in a step"
+        );
     }
     let dg = row("nitsche(Θ=1, γ0=1e-3) · consistent · discrete-gradient");
     assert!(dg.energy_theta_max_increase.unwrap() <= 1e-12);

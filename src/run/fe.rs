@@ -251,6 +251,16 @@ impl Geometry {
     }
 }
 
+/// The status of a run whose matrices could not be made: a mass variant the mesh cannot take
+/// ("mass = …", [`mass_matrix`]) is the input's fault, anything else the solver's.
+pub(super) fn factor_failure(message: &str) -> Status {
+    if message.starts_with("mass = ") {
+        Status::Invalid
+    } else {
+        Status::SolverFailed
+    }
+}
+
 /// The matrices of one run: its mass variant and the factored (or, with `cg`, the iterated)
 /// condensed step matrix.
 #[derive(Debug)]
@@ -777,7 +787,19 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     let rho = ElementOp::Mass { rho: s.density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
-        MassVariant::Lumped => m = SymMatrix::diagonal_from(&g.pattern, &m.row_sums()),
+        MassVariant::Lumped => {
+            let sums = m.row_sums();
+            // Row-sum lumping of P2 simplices gives the vertices no mass (triangles: their rows
+            // of the P2 mass matrix sum to 0) or a negative one (tetrahedra): the step then
+            // has massless or anti-inertial dofs and blows up at the contact (the Hertz
+            // half-disc, README). Refused rather than run.
+            if let Some((i, x)) = sums.iter().enumerate().find(|(_, x)| **x <= 0.0) {
+                return Err(format!(
+                    "mass = lumped: row-sum lumping gives free dof {i} the mass {x:.3e} ≤ 0 (the vertices of P2 triangles and tetrahedra); use consistent or a modified mass, or degree-1 elements"
+                ));
+            }
+            m = SymMatrix::diagonal_from(&g.pattern, &sums);
+        }
         MassVariant::ZeroContact => {
             let p = &g.pattern;
             for j in 0..p.n {
@@ -1225,7 +1247,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
     let fac = match fac {
         Ok(f) => f,
-        Err(e) => return fail(Status::SolverFailed, e, metrics),
+        Err(e) => return fail(factor_failure(&e), e, metrics),
     };
     // CG factors nothing: no factorisation made, none reused (its matrix and condensation
     // columns are still shared through the cache).

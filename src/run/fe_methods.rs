@@ -65,7 +65,8 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, geometry_key, mass_matrix, quad, ref_map, reference_record,
+    build_geometry, factor, factor_failure, geometry_key, mass_matrix, quad, ref_map,
+    reference_record,
 };
 use crate::contact::Lcp;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -465,7 +466,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
-                Err(e) => return fail(Status::SolverFailed, e, metrics),
+                Err(e) => return fail(factor_failure(&e), e, metrics),
             };
             metrics.factorizations = i64::from(!hit);
             metrics.factor_cache_hits = Some(i64::from(hit));
