@@ -322,11 +322,15 @@ const SWEEP_CASES: &[(&str, &str, &[&str])] = &[
     ),
     // No mesh at all.
     ("[fixed]\ndt = 0.1\n", "mesh", &["required", "mesh2d"]),
-    // Nitsche needs Γ_C's face quadrature on general meshes: not yet, and said so.
+    // The hybrid scheme needs a contact potential (Nitsche or the penalty, which the mesh
+    // scenes take on the `contact` group's faces): refused with mixed, and said so.
     (
-        "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\nspace = \"nitsche\"\nnitsche_gamma0 = 1.0\n",
-        "fixed.space",
-        &["not implemented yet for scene mesh2d"],
+        "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\nscheme = \"hybrid\"\n",
+        "fixed.scheme",
+        &[
+            "not available for scene mesh2d with space = mixed",
+            "hybrid with nitsche or penalty",
+        ],
     ),
     // A reference on another mesh needs point location: refused, not run node for node.
     (

@@ -394,8 +394,8 @@ method = [
 }
 
 /// Where the methods apply on the FE scenes (SPEC §3.2): the planner leaves out what needs
-/// inertia on a massless contact dof with its reason; the bars (no contact potential) take no
-/// discrete gradient.
+/// inertia on a massless contact dof with its reason, and the discrete gradient with mixed (no
+/// contact potential) on the bars too.
 #[test]
 fn fe_applicability_is_planned_with_reasons() {
     let parse = |t: &str| SweepFile::parse(std::path::Path::new("t.toml"), t).unwrap();
@@ -413,15 +413,21 @@ fn fe_applicability_is_planned_with_reasons() {
             .any(|k| k.contains("contact-stabilized-newmark needs inertia on the contact dof")),
         "{reasons:?}"
     );
-    // The bars have no contact potential: the discrete gradient is refused there.
-    let e = expand(&parse(
-        "name = \"a\"\nscene = \"bar2d\"\n[fixed]\nT = 0.5\nh = 0.1\ndt = 0.01\nscheme = \"discrete-gradient\"\n",
+    // The discrete gradient needs a contact potential: on the bars too it takes the penalty
+    // (and Nitsche with Θ = 1, on the bottom face's quadrature points) and leaves out mixed,
+    // with the reason.
+    let p = expand(&parse(
+        "name = \"a\"\nscene = \"bar2d\"\n[fixed]\nT = 0.5\nh = 0.1\ndt = 0.01\npenalty_gamma0 = 10.0\nscheme = \"discrete-gradient\"\n[grid]\nspace = [\"mixed\", \"penalty\"]\n",
     ))
-    .map(|p| format!("{} runs, inapplicable {:?}", p.runs.len(), p.inapplicable.keys().collect::<Vec<_>>()))
-    .unwrap_or_else(|e| e.to_string());
+    .unwrap();
+    assert_eq!(p.runs.len(), 1);
+    assert!(p.runs[0].label.contains("penalty"), "{}", p.runs[0].label);
+    let reasons: Vec<&String> = p.inapplicable.keys().collect();
     assert!(
-        e.contains("discrete-gradient") && !e.starts_with("1 runs"),
-        "{e}"
+        reasons
+            .iter()
+            .any(|k| k.contains("discrete-gradient needs a contact potential")),
+        "{reasons:?}"
     );
 }
 

@@ -358,13 +358,19 @@ fn bar2d_refuses_what_it_cannot_model_with_the_key_and_reason() {
         e.contains("key `reference.dt`") && e.contains("whole number"),
         "{e}"
     );
-    let e = plan_err(&format!(
-        "{BAR2D}{base}space = \"nitsche\"\nnitsche_gamma0 = 1e-3\n"
+    // Nitsche and the penalty run on the bars (the bottom face's quadrature points); the hybrid
+    // scheme needs their contact potential, so with mixed it is refused, with the reason.
+    let p = plan(&format!(
+        "{BAR2D}{base}space = \"nitsche\"\nnitsche_gamma0 = 1e-3\nscheme = \"hybrid\"\n"
     ));
+    assert_eq!(p.runs.len(), 1);
+    let e = plan_err(&format!("{BAR2D}{base}scheme = \"hybrid\"\n"));
     assert!(
-        e.contains("key `fixed.space`") && e.contains("bar2d"),
+        e.contains("key `fixed.scheme`") && e.contains("bar2d") && e.contains("space = mixed"),
         "{e}"
     );
+    let e = plan_err(&format!("{BAR2D}{base}space = \"dual\"\n"));
+    assert!(e.contains("key `fixed.space`"), "{e}");
     let e = plan_err(&format!("{BAR2D}{base}mass = \"singular-dynamic\"\n"));
     assert!(
         e.contains("key `fixed.mass`") && e.contains("1D bar only"),

@@ -44,7 +44,9 @@ use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::contact::Lcp;
 use crate::scene::{FeGeometry, FeSetup};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
-use crate::space::fe::nitsche::{ContactPoint, contact_points};
+use crate::space::fe::nitsche::{
+    ContactPoint, box_contact_faces, contact_points, face_contact_points, gmsh_contact_faces,
+};
 use crate::space::fe::{
     BallMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
 };
@@ -232,8 +234,9 @@ struct Geometry {
     gap_in_geometry: bool,
     /// Whether each node is on Γ_C (all nodes, clamped ones included).
     contact_node: Vec<bool>,
-    /// Nitsche's quadrature points of Γ_C with γ0 = 1 (their `gamma` is h_K); ball only.
-    points: Vec<ContactPoint>,
+    /// Nitsche's quadrature points of Γ_C with γ0 = 1 (their `gamma` is h_K), dofs reduced; or
+    /// why the mesh has none (a Gmsh `contact` group without boundary faces: `mixed` still runs).
+    points: Result<Vec<ContactPoint>, String>,
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     contact_weight: Vec<f64>,
     /// Reduced dofs that belong to a Γ_C node (all components).
@@ -535,6 +538,13 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
     let layers = node_layers(&*mesh, &group.nodes);
+    // Heights above the lowest Γ_C node, as the nodes' (the run adds its gap, [`factor`]).
+    let points = gmsh_contact_faces(&mesh, group).map(|faces| {
+        reduce_points(
+            face_contact_points(&*mesh, &faces, s.lame_lambda, s.lame_mu, 1.0, lowest),
+            &dofs,
+        )
+    });
     Ok(Geometry {
         mesh: FeMesh::Gmsh { mesh, layers },
         dofs,
@@ -548,7 +558,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         contact_height,
         gap_in_geometry: false,
         contact_node,
-        points: Vec::new(),
+        points,
         contact_weight,
         on_contact_node,
         vertical,
@@ -602,7 +612,9 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         .map(|&n| mesh.coords[n][d - 1])
         .collect();
     let contact_weight = mesh.contact_node_weights();
-    let points = contact_points(&mesh, s.lame_lambda, s.lame_mu, 1.0);
+    // The ball keeps its own face quadrature (its run ids and figures predate the general one);
+    // all its dofs are free, so global and reduced dofs coincide.
+    let points = Ok(contact_points(&mesh, s.lame_lambda, s.lame_mu, 1.0));
     let mut contact_node = vec![false; mesh.coords.len()];
     for &n in &mesh.contact_nodes {
         contact_node[n] = true;
@@ -669,6 +681,18 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
     let contact_height = vec![0.0; contact.len()];
+    // Heights above the bottom face x_d = 0; the run adds its gap ([`factor`]).
+    let points = Ok(reduce_points(
+        face_contact_points(
+            &mesh,
+            &box_contact_faces(&mesh),
+            s.lame_lambda,
+            s.lame_mu,
+            1.0,
+            0.0,
+        ),
+        &dofs,
+    ));
     let mut contact_node = vec![false; mesh.num_nodes()];
     for &n in &bottom {
         contact_node[n] = true;
@@ -686,11 +710,36 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         contact_height,
         gap_in_geometry: false,
         contact_node,
-        points: Vec::new(),
+        points,
         contact_weight,
         on_contact_node,
         vertical,
     })
+}
+
+/// The points with their dofs as reduced indices (the run's unknowns). A clamped dof's value is
+/// 0, so its coefficients are dropped: it keeps its slot (every point has the element's k
+/// dofs, [`NitscheOps`]) with coefficient 0 on a free dof of the same element, which keeps
+/// every rank-one update of [`factor_nitsche`] inside the FE pattern. A point whose element is
+/// clamped entirely has u_n = σ_n = 0 for every u and is left out.
+fn reduce_points(points: Vec<ContactPoint>, dofs: &DofMap) -> Vec<ContactPoint> {
+    points
+        .into_iter()
+        .filter_map(|mut p| {
+            let any = p.dofs.iter().find_map(|&g| dofs.free_index(g))?;
+            for k in 0..p.dofs.len() {
+                match dofs.free_index(p.dofs[k]) {
+                    Some(r) => p.dofs[k] = r,
+                    None => {
+                        p.dofs[k] = any;
+                        p.un[k] = 0.0;
+                        p.sn[k] = 0.0;
+                    }
+                }
+            }
+            Some(p)
+        })
+        .collect()
 }
 
 /// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
@@ -822,24 +871,53 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
     Ok((m, total))
 }
 
+/// The part of a factor's cache key beyond geometry, mass, method and step: the run's gap when
+/// the Nitsche/penalty rows carry it (box and Gmsh meshes, [`factor`]); empty otherwise, so the
+/// mixed runs and the ball share their entries as before.
+fn factor_key_gap(g: &Geometry, cfg: &FeConfig) -> String {
+    if cfg.method == ContactMethod::Mixed || g.gap_in_geometry {
+        String::new()
+    } else {
+        format!("|gap {:e}", cfg.setup.gap)
+    }
+}
+
 fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
-    match cfg.method {
-        ContactMethod::Nitsche { theta, gamma0 } => {
-            return factor_nitsche(g, cfg, c_tau2, NitscheOps::new(&g.points, theta, gamma0));
+    let points = || -> Result<&[ContactPoint], String> {
+        match &g.points {
+            Ok(p) if !p.is_empty() => Ok(p),
+            Ok(_) => Err(format!(
+                "space = {} is not available for scene {}: Γ_C has no quadrature points",
+                cfg.method.name(),
+                cfg.setup.scene
+            )),
+            Err(e) => Err(format!(
+                "space = {} is not available for scene {}: {e}",
+                cfg.method.name(),
+                cfg.setup.scene
+            )),
         }
+    };
+    let mut ops = match cfg.method {
+        ContactMethod::Nitsche { theta, gamma0 } => NitscheOps::new(points()?, theta, gamma0),
         ContactMethod::Penalty { gamma0 } => {
             // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (SPEC §2.4).
             let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
             let young = m * (3.0 * l + 2.0 * m) / (l + m);
-            return factor_nitsche(
-                g,
-                cfg,
-                c_tau2,
-                NitscheOps::penalty(&g.points, young, gamma0),
-            );
+            NitscheOps::penalty(points()?, young, gamma0)
         }
-        ContactMethod::Mixed => {}
+        ContactMethod::Mixed => return factor_mixed(g, cfg, c_tau2),
+    };
+    // The box's and Gmsh meshes' points hold their heights above Γ_C's lowest level; the
+    // plane is the run's gap below it (the ball's gap is in its geometry: nothing added).
+    if !g.gap_in_geometry {
+        ops.gap.iter_mut().for_each(|x| *x += cfg.setup.gap);
     }
+    factor_nitsche(g, cfg, c_tau2, ops)
+}
+
+/// The mixed method's factor: A = M + cτ²K, Z = A⁻¹Bᵀ, H = cτ² B Z.
+fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| e.to_string())?;
@@ -885,13 +963,6 @@ fn factor_nitsche(
     c_tau2: f64,
     ops: NitscheOps,
 ) -> Result<Factored, String> {
-    if g.points.is_empty() {
-        return Err(format!(
-            "space = {} is not available for scene {}",
-            cfg.method.name(),
-            cfg.setup.scene
-        ));
-    }
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let mut a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let (theta, gamma0) = match cfg.method {
@@ -899,11 +970,8 @@ fn factor_nitsche(
         _ => (0.0, 0.0),
     };
     let (k, nq, n) = (ops.k, ops.len(), g.dofs.n_free());
-    let red = |gd: usize| {
-        g.dofs
-            .free_index(gd)
-            .expect("the ball has no constrained dof")
-    };
+    // The points' dofs are reduced indices already ([`reduce_points`]).
+    let red = |gd: usize| gd;
     if theta != 0.0 {
         for q in 0..nq {
             let f = c_tau2 * theta * ops.w[q] * ops.gamma[q];
@@ -1243,7 +1311,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         cfg.method,
         c_tau2,
         cfg.solver
-    );
+    ) + &factor_key_gap(&geo, cfg);
     let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
     let fac = match fac {
         Ok(f) => f,

@@ -65,8 +65,8 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, geometry_key, mass_matrix, quad, ref_map,
-    reference_record,
+    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, mass_matrix, quad,
+    ref_map, reference_record,
 };
 use crate::contact::Lcp;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -462,7 +462,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                 cfg.mass,
                 cfg.method,
                 c
-            );
+            ) + &factor_key_gap(g, cfg);
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,

@@ -101,11 +101,11 @@ impl Scene for MeshScene {
         mass: &str,
         scheme: &str,
     ) -> Result<(), (&'static str, String)> {
-        if space != "mixed" {
+        if !matches!(space, "mixed" | "nitsche" | "penalty") {
             return Err((
                 "space",
                 format!(
-                    "space = {space} is not implemented yet for scene {}: Nitsche and the penalty need the quadrature of Γ_C's faces on a general mesh; use mixed",
+                    "space = {space} is not available for scene {} (mixed, nitsche, penalty)",
                     self.name()
                 ),
             ));
@@ -116,11 +116,15 @@ impl Scene for MeshScene {
                 format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
             ));
         }
-        if !matches!(scheme, "newmark" | "theta") {
+        // Nitsche and the penalty integrate over the `contact` group's boundary faces
+        // (`space::fe::nitsche::gmsh_contact_faces`); hybrid needs their contact potential.
+        if !(matches!(scheme, "newmark" | "theta")
+            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
+        {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} is not available for scene {}; it takes the bars' newmark and theta schemes",
+                    "scheme = {scheme} is not available for scene {} with space = {space}; it takes the bars' newmark and theta schemes, and hybrid with nitsche or penalty",
                     self.name()
                 ),
             ));

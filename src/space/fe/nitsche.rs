@@ -9,10 +9,23 @@
 //!   Σ_q w_q (1/γ_q) [P_γ,q(u) − g_q]_+ P_Θγ,q(v)  and  −Θ Σ_q w_q γ_q σ_n,q(u) σ_n,q(v),
 //! only involve the dofs of the elements with a face on Γ_C — what the per-step solve condenses
 //! onto (SPEC §4). The face rule has 3 Gauss points per direction (order 5 ≥ 4, 003 §4.2).
+//!
+//! Any other mesh (the bars' box, a Gmsh mesh: [`face_contact_points`]) gives its Γ_C as
+//! [`ContactFace`]s: an element and the reference coordinates of the vertices of its face on
+//! Γ_C. Every supported reference face is flat (a segment, a triangle, an axis-aligned square),
+//! so ξ(s) = ξ_0 + Σ_k s_k (ξ_k − ξ_0) is an exact affine parametrisation of it (for a square,
+//! ξ_1 and ξ_3 the neighbours of ξ_0); the physical tangents are t_k = J(ξ)(ξ_k − ξ_0) and the
+//! surface element |t_1| (2D) or |t_1 × t_2| (3D), so curved P2/Q2 faces are integrated on their
+//! own geometry. The rule in s: 3 Gauss points on [0, 1] per direction (segments, squares) and
+//! the collapsed 3 × 3 Gauss rule on triangles (s = (1+a)/2, t = (1−s)(1+b)/2, Jacobian
+//! (1−s)/4): all of degree 5, as the ball's. h_K is the element's diameter (its largest
+//! node-to-node distance, the Gmsh mesh's h per cell).
 
 use super::ball::BallMesh;
-use super::element::map_at;
-use super::mesh::Mesh;
+use super::element::{det_inv, gauss_legendre, map_at, shape};
+use super::gmsh::{GmshMesh, PhysicalGroup};
+use super::mesh::{BoxMesh, Mesh};
+use super::simplex::simplex_shape;
 use super::sparse::element_coords;
 
 /// One quadrature point of Γ_C with its two linear functionals over `dofs`.
@@ -83,6 +96,254 @@ fn points_generic<const D: usize, const NN: usize>(
         }
     }
     out
+}
+
+/// A face of Γ_C on a general mesh: its element and the reference coordinates of the face's
+/// vertices (2 in 2D; 3, or 4 around the square, in 3D).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactFace {
+    pub element: usize,
+    pub vertices: Vec<[f64; 3]>,
+}
+
+/// The bottom face x_d = 0 of the box: the face ξ_d = −1 of every element of layer 0.
+pub fn box_contact_faces(mesh: &BoxMesh) -> Vec<ContactFace> {
+    let d = mesh.dim;
+    let vertices: Vec<[f64; 3]> = if d == 2 {
+        vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0]]
+    } else {
+        vec![
+            [-1.0, -1.0, -1.0],
+            [1.0, -1.0, -1.0],
+            [1.0, 1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+        ]
+    };
+    (0..mesh.num_elements())
+        .filter(|&e| mesh.element_layer(e) == 0)
+        .map(|element| ContactFace {
+            element,
+            vertices: vertices.clone(),
+        })
+        .collect()
+}
+
+/// The faces of a Gmsh mesh's group (its boundary lines in 2D, triangles or quadrilaterals in
+/// 3D): each matched with the cell that has all its vertices (Gmsh's local order lists a
+/// boundary element's vertices first, around the face), the vertices' reference coordinates
+/// read from the cell's local nodes.
+pub fn gmsh_contact_faces(
+    mesh: &GmshMesh,
+    group: &PhysicalGroup,
+) -> Result<Vec<ContactFace>, String> {
+    let d = mesh.dim;
+    if group.dim + 1 != d {
+        return Err(format!(
+            "{}: the group \"{}\" has entities of dimension {}, not the boundary faces (dimension {}) that Nitsche's and the penalty's quadrature of Γ_C integrates over",
+            mesh.file,
+            group.name,
+            group.dim,
+            d - 1
+        ));
+    }
+    let nn = mesh.kind.num_nodes();
+    let reference = mesh.kind.reference_nodes();
+    // Cells by node, for the cells around a face's first vertex.
+    let mut around: Vec<Vec<usize>> = vec![Vec::new(); mesh.coords.len()];
+    for (c, nodes) in mesh.elements.chunks_exact(nn).enumerate() {
+        for &n in nodes {
+            around[n].push(c);
+        }
+    }
+    let mut out = Vec::with_capacity(group.elements.len());
+    for face in &group.elements {
+        let nv = match (d, face.len()) {
+            (2, _) => 2,
+            (_, 3 | 6) => 3,
+            _ => 4,
+        };
+        let verts = &face[..nv.min(face.len())];
+        let found = around[verts[0]].iter().find_map(|&c| {
+            let cell = &mesh.elements[c * nn..(c + 1) * nn];
+            let local: Option<Vec<usize>> = verts
+                .iter()
+                .map(|v| cell.iter().position(|n| n == v))
+                .collect();
+            local.map(|l| (c, l))
+        });
+        let Some((element, local)) = found else {
+            return Err(format!(
+                "{}: a face of the group \"{}\" (nodes {:?}) is no face of any cell",
+                mesh.file,
+                group.name,
+                verts.iter().map(|&n| mesh.node_tags[n]).collect::<Vec<_>>()
+            ));
+        };
+        out.push(ContactFace {
+            element,
+            vertices: local.iter().map(|&a| reference[a]).collect(),
+        });
+    }
+    Ok(out)
+}
+
+/// The contact points of `faces` on any mesh (see the module header), for Lamé (λ, μ) and γ0;
+/// the gap of a point is its height x_d above `plane` (the obstacle's height minus the run's
+/// gap for the box and Gmsh meshes, where the run adds it). Dofs are global (node·d + i).
+pub fn face_contact_points(
+    mesh: &dyn Mesh,
+    faces: &[ContactFace],
+    lambda: f64,
+    mu: f64,
+    gamma0: f64,
+    plane: f64,
+) -> Vec<ContactPoint> {
+    let args = (faces, lambda, mu, gamma0, plane);
+    match (mesh.dim(), mesh.nodes_per_element()) {
+        (2, 4) => faces_generic::<2, 4>(mesh, args, shape::<2, 4>),
+        (2, 9) => faces_generic::<2, 9>(mesh, args, shape::<2, 9>),
+        (3, 8) => faces_generic::<3, 8>(mesh, args, shape::<3, 8>),
+        (3, 27) => faces_generic::<3, 27>(mesh, args, shape::<3, 27>),
+        (2, 3) => faces_generic::<2, 3>(mesh, args, simplex_shape::<2, 3>),
+        (2, 6) => faces_generic::<2, 6>(mesh, args, simplex_shape::<2, 6>),
+        (3, 4) => faces_generic::<3, 4>(mesh, args, simplex_shape::<3, 4>),
+        (3, 10) => faces_generic::<3, 10>(mesh, args, simplex_shape::<3, 10>),
+        (d, k) => unreachable!("no element of dimension {d} with {k} nodes"),
+    }
+}
+
+/// The reference face rule in s (module header): (s, weight) with s ∈ [0, 1]^{nv−1} or the
+/// unit triangle, for a face of `nv` vertices.
+fn face_rule(nv: usize) -> Vec<([f64; 2], f64)> {
+    let g: Vec<(f64, f64)> = gauss_legendre(3)
+        .iter()
+        .map(|&(x, w)| (0.5 * (1.0 + x), 0.5 * w))
+        .collect();
+    match nv {
+        2 => g.iter().map(|&(s, w)| ([s, 0.0], w)).collect(),
+        3 => {
+            let mut out = Vec::with_capacity(9);
+            for &(s, ws) in &g {
+                for &(b, wb) in &g {
+                    out.push(([s, (1.0 - s) * b], ws * wb * (1.0 - s)));
+                }
+            }
+            out
+        }
+        _ => {
+            let mut out = Vec::with_capacity(9);
+            for &(t, wt) in &g {
+                for &(s, ws) in &g {
+                    out.push(([s, t], ws * wt));
+                }
+            }
+            out
+        }
+    }
+}
+
+type ShapeFn<const D: usize, const NN: usize> = fn([f64; D]) -> ([f64; NN], [[f64; D]; NN]);
+
+fn faces_generic<const D: usize, const NN: usize>(
+    mesh: &dyn Mesh,
+    (faces, lambda, mu, gamma0, plane): (&[ContactFace], f64, f64, f64, f64),
+    shape_at: ShapeFn<D, NN>,
+) -> Vec<ContactPoint> {
+    let mut out = Vec::new();
+    for face in faces {
+        let e = face.element;
+        let x: [[f64; D]; NN] = element_coords(mesh, e);
+        let nodes = mesh.element_nodes(e);
+        let mut diameter: f64 = 0.0;
+        for a in 0..NN {
+            for b in a + 1..NN {
+                let r: f64 = (0..D).map(|i| (x[a][i] - x[b][i]).powi(2)).sum();
+                diameter = diameter.max(r.sqrt());
+            }
+        }
+        let dofs: Vec<usize> = nodes
+            .iter()
+            .flat_map(|&n| (0..D).map(move |i| n * D + i))
+            .collect();
+        let v = &face.vertices;
+        let nv = v.len();
+        // The reference directions ξ_k − ξ_0 of the parametrisation (the square's two
+        // neighbours of ξ_0: vertices 1 and 3).
+        let dirs: Vec<[f64; 3]> = match nv {
+            2 => vec![sub3(v[1], v[0])],
+            3 => vec![sub3(v[1], v[0]), sub3(v[2], v[0])],
+            _ => vec![sub3(v[1], v[0]), sub3(v[3], v[0])],
+        };
+        for (s, w) in face_rule(nv) {
+            let mut xi = [0.0; D];
+            for (i, xk) in xi.iter_mut().enumerate() {
+                *xk = v[0][i] + dirs.iter().zip(s).map(|(dk, sk)| sk * dk[i]).sum::<f64>();
+            }
+            let (n, dn) = shape_at(xi);
+            let mut jac = [[0.0; D]; D];
+            let mut xq = [0.0; D];
+            for a in 0..NN {
+                for i in 0..D {
+                    xq[i] += n[a] * x[a][i];
+                    for j in 0..D {
+                        jac[i][j] += x[a][i] * dn[a][j];
+                    }
+                }
+            }
+            let tangent = |dk: &[f64; 3]| -> [f64; 3] {
+                let mut t = [0.0; 3];
+                for (i, ti) in t.iter_mut().enumerate().take(D) {
+                    *ti = (0..D).map(|j| jac[i][j] * dk[j]).sum();
+                }
+                t
+            };
+            let area = if D == 2 {
+                norm3(tangent(&dirs[0]))
+            } else {
+                norm3(cross3(tangent(&dirs[0]), tangent(&dirs[1])))
+            };
+            let (_, jinv) = det_inv(&jac);
+            let mut un = vec![0.0; NN * D];
+            let mut sn = vec![0.0; NN * D];
+            for a in 0..NN {
+                // ∇N_a = J⁻ᵀ ∇_ξ N_a.
+                let mut g = [0.0; D];
+                for (i, gi) in g.iter_mut().enumerate() {
+                    *gi = (0..D).map(|j| jinv[j][i] * dn[a][j]).sum();
+                }
+                un[a * D + D - 1] = -n[a];
+                for i in 0..D {
+                    sn[a * D + i] = lambda * g[i];
+                }
+                sn[a * D + D - 1] += 2.0 * mu * g[D - 1];
+            }
+            out.push(ContactPoint {
+                weight: w * area,
+                gamma: gamma0 * diameter,
+                gap: xq[D - 1] - plane,
+                dofs: dofs.clone(),
+                un,
+                sn,
+            });
+        }
+    }
+    out
+}
+
+fn sub3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross3(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn norm3(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 /// The global dofs the Nitsche terms involve (the dofs of the elements with a face on Γ_C),
