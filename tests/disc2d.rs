@@ -918,3 +918,53 @@ fn comparison_disc_methods_have_their_properties() {
         }
     }
 }
+
+/// Regression (issue 22 × 20): the SPEC §3.2 methods' time loop read a reference on another
+/// mesh as if it were on the run's own (`data.u[base + i]`, the nested path), so their errors
+/// against a finer disc were read at the wrong reference dofs. Through the first impact
+/// (contact from t = √(2·gap/g) = 10; T = 12) generalized-α with ρ∞ = 1 is Crank–Nicolson to
+/// round-off (SPEC §3.2, `tests/fe_methods.rs`), so both loops must report the same errors
+/// against one non-nested reference (h = 4: (n_t, n_r) = (8, 3), in the reference's (16, 5))
+/// — to 1e-8 relative, far above the schemes' round-off difference and far below the O(1)
+/// change of reading the wrong dofs. (The free fall alone would not do: both meshes carry the
+/// rigid motion exactly, and its errors are round-off.)
+#[test]
+fn comparison_methods_read_a_non_nested_reference_like_the_seeds() {
+    let rows = run_sweep_text(
+        r#"
+name = "disc-ref"
+scene = "disc2d"
+reference = { h = 2.0, dt = 0.05, scheme = "crank-nicolson" }
+[fixed]
+T = 12.0
+h = 4.0
+dt = 0.1
+degree = 2
+space = "mixed"
+[grid]
+method = [
+  { scheme = "crank-nicolson" },
+  { scheme = "generalized-alpha", rho_inf = 1.0 },
+]
+"#,
+    );
+    assert_eq!(rows.len(), 2);
+    for r in &rows {
+        assert_eq!(r.status, "ok", "{}: {:?}", r.label, r.message);
+    }
+    let (cn, ga) = (&rows[0], &rows[1]);
+    for (what, a, b) in [
+        ("L2", cn.err_u_l2l2, ga.err_u_l2l2),
+        ("H1", cn.err_u_l2h1, ga.err_u_l2h1),
+    ] {
+        let (a, b) = (a.unwrap(), b.unwrap());
+        assert!(
+            a > 1e-3,
+            "{what}: the impact differs from the finer disc ({a:e})"
+        );
+        assert!(
+            (a - b).abs() <= 1e-8 * a,
+            "{what}: CN {a:e}, generalized-α {b:e}"
+        );
+    }
+}

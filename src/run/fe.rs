@@ -1039,6 +1039,34 @@ struct Interpolation {
 }
 
 impl RefMap {
+    /// The run at step n against the reference at the same time: e = u − I u_ref into `err`,
+    /// its squared L2 and H1-seminorm (the Gram and grad-grad matrices, `tmp` as scratch), and
+    /// the reference's scalar observables. One definition for every time loop of the engine.
+    pub(super) fn compare(
+        &self,
+        g: &Geometry,
+        step: usize,
+        u: &[f64],
+        err: &mut [f64],
+        tmp: &mut [f64],
+    ) -> ExactValues {
+        let k = step * self.time_ratio;
+        let base = k * self.data.lattice.iter().product::<usize>() * self.data.dim;
+        for (i, e) in err.iter_mut().enumerate() {
+            *e = u[i] - self.value(base, i);
+        }
+        let l2_sq = quad(&g.gram, err, tmp);
+        let h1_semi_sq = quad(&g.grad, err, tmp);
+        ExactValues {
+            u_contact: self.data.u_contact[k],
+            sigma_contact: -self.data.force[k],
+            sigma_contact_mid: None,
+            energy: self.data.energy[k],
+            l2_sq,
+            h1_semi_sq,
+        }
+    }
+
     /// The reference's value at free dof i in the stored slice starting at `base`.
     #[inline]
     fn value(&self, base: usize, i: usize) -> f64 {
@@ -1337,7 +1365,6 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     let nit = fac.nitsche.as_ref();
     // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
     let nc = nit.map_or(g.contact.len(), NitscheOps::len);
-    let d = g.mesh.dim();
     metrics.contact_dofs = Some(nc as i64);
     // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
     let base_gap = if g.gap_in_geometry {
@@ -1514,24 +1541,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             data.energy.push(e);
             data.u_contact.push(uc);
         }
-        let exact = refmap.as_ref().map(|rm| {
-            let k = step * rm.time_ratio;
-            let slice = rm.data.lattice.iter().product::<usize>() * d;
-            let base = k * slice;
-            for (i, e) in err.iter_mut().enumerate() {
-                *e = u[i] - rm.value(base, i);
-            }
-            let l2_sq = quad(&g.gram, err, tmp);
-            let h1_semi_sq = quad(&g.grad, err, tmp);
-            ExactValues {
-                u_contact: rm.data.u_contact[k],
-                sigma_contact: -rm.data.force[k],
-                sigma_contact_mid: None,
-                energy: rm.data.energy[k],
-                l2_sq,
-                h1_semi_sq,
-            }
-        });
+        let exact = refmap.as_ref().map(|rm| rm.compare(g, step, u, err, tmp));
         obs.observe(
             StepValues {
                 step,

@@ -65,15 +65,15 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, mass_matrix, quad,
-    ref_map, reference_record,
+    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, mass_matrix, ref_map,
+    reference_record,
 };
 use crate::contact::Lcp;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
 use crate::run::fe_nitsche::{
     NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
 };
-use crate::run::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
+use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::space::fe::SymMatrix;
 use crate::space::linalg::Cholesky;
@@ -525,7 +525,6 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let n = g.dofs.n_free();
     let nit = fac.as_ref().and_then(|f| f.nitsche.as_ref());
     let nc = nit.map_or(g.contact.len(), NitscheOps::len);
-    let d = g.mesh.dim();
     metrics.contact_dofs = Some(nc as i64);
     let base_gap = if g.gap_in_geometry {
         0.0
@@ -685,24 +684,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             data.energy.push(e);
             data.u_contact.push(uc);
         }
-        let exact = refmap.as_ref().map(|rm| {
-            let k = step * rm.time_ratio;
-            let slice = rm.data.lattice.iter().product::<usize>() * d;
-            let base = k * slice;
-            for (i, e) in err.iter_mut().enumerate() {
-                *e = u[i] - rm.data.u[base + rm.dof_offset[i]];
-            }
-            let l2_sq = quad(&g.gram, err, tmp);
-            let h1_semi_sq = quad(&g.grad, err, tmp);
-            ExactValues {
-                u_contact: rm.data.u_contact[k],
-                sigma_contact: -rm.data.force[k],
-                sigma_contact_mid: None,
-                energy: rm.data.energy[k],
-                l2_sq,
-                h1_semi_sq,
-            }
-        });
+        let exact = refmap.as_ref().map(|rm| rm.compare(g, step, u, err, tmp));
         obs.observe(
             StepValues {
                 step,
