@@ -133,6 +133,7 @@ mass = ["mod3"]
     for threads in [1usize, 2] {
         let opts = ExecOptions {
             threads,
+            lockstep: ExecOptions::LOCKSTEP_DEFAULT,
             run: RunOptions {
                 series_every: 0,
                 timeout: None,

@@ -217,6 +217,12 @@ pub struct RunArgs {
     /// Worker threads; 1 runs the serial reference loop; 0 uses every core.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Most runs per lockstep group: runs sharing their step matrix (2D/3D, direct solver) make
+    /// one multi-column solve per step; 1 steps every run alone. Rows equal the runs alone to
+    /// round-off (only `lockstep` and the timings differ).
+    #[arg(long, default_value_t = ExecOptions::LOCKSTEP_DEFAULT, value_name = "N",
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    pub lockstep: usize,
     /// Add to a folder holding results of another sweep (runs already present are skipped;
     /// resuming is automatic when the folder holds the same sweep).
     #[arg(long)]
@@ -338,6 +344,7 @@ impl RunArgs {
             shard,
             exec: ExecOptions {
                 threads: self.threads,
+                lockstep: self.lockstep,
                 run: RunOptions {
                     series_every,
                     timeout: self.run_timeout.map(Duration::from_secs_f64),

@@ -4,6 +4,13 @@
 //! A run that panics becomes a row (`solver-failed`, "internal error: …"); the sweep goes on.
 //! Rows do not depend on the thread count: every run is a pure function of its spec, so the
 //! 1-thread and N-thread outputs are identical except the timing columns (tested).
+//!
+//! Lockstep groups (issue 24): runs whose step matrix is the same ([`run::lockstep_key`]) are
+//! cut into groups of at most [`ExecOptions::lockstep`] members, each group one unit of work
+//! stepped together ([`run::simulate_group`]: one multi-column solve per step). A member's
+//! numbers equal its run alone to round-off; only its `lockstep` and timing columns differ.
+//! Groups are cut to keep every thread busy: a key's runs are split into more, smaller groups
+//! when there are fewer units than threads.
 
 pub mod references;
 pub mod shard;
@@ -37,7 +44,120 @@ pub struct RunResult {
 pub struct ExecOptions {
     /// 1: the serial reference loop; N > 1: a rayon pool of N threads; 0: rayon's default.
     pub threads: usize,
+    /// Most members of a lockstep group (1: every run steps alone).
+    pub lockstep: usize,
     pub run: RunOptions,
+}
+
+impl ExecOptions {
+    /// The default group size, measured on the 2D bar at 21 120 dofs (README, Performance):
+    /// the time per member falls up to 8 members and no further at 16 (the factor is read once
+    /// per step either way; the members' own work then dominates), while a group's workspace
+    /// grows with its members.
+    pub const LOCKSTEP_DEFAULT: usize = 8;
+}
+
+/// A unit of work: one run, or a lockstep group (members in plan order).
+type Unit<'a> = Vec<&'a RunSpec>;
+
+/// Cut `runs` into units: runs with a lockstep key and no timing repeats (a repeat measures a
+/// run alone) grouped by key, at most `max` per group and in more groups when there would be
+/// fewer units than `threads`; units in the plan order of their first member.
+fn units<'a>(runs: &[&'a RunSpec], max: usize, threads: usize) -> Vec<Unit<'a>> {
+    let mut keyed: Vec<(String, Vec<usize>)> = Vec::new();
+    let mut alone: Vec<usize> = Vec::new();
+    for (i, spec) in runs.iter().enumerate() {
+        match run::lockstep_key(&spec.config).filter(|_| max > 1 && spec.repeats <= 1) {
+            Some(k) => match keyed.iter_mut().find(|(key, _)| *key == k) {
+                Some((_, v)) => v.push(i),
+                None => keyed.push((k, vec![i])),
+            },
+            None => alone.push(i),
+        }
+    }
+    // Groups per key: enough for `max`, then split further while threads would idle.
+    let mut parts: Vec<usize> = keyed.iter().map(|(_, v)| v.len().div_ceil(max)).collect();
+    loop {
+        let total = alone.len() + parts.iter().sum::<usize>();
+        if total >= threads {
+            break;
+        }
+        // The key with the largest groups gets one more group, if its groups can shrink.
+        let best = (0..parts.len())
+            .filter(|&k| parts[k] < keyed[k].1.len())
+            .max_by(|&a, &b| {
+                let size = |k: usize| keyed[k].1.len() as f64 / parts[k] as f64;
+                size(a).total_cmp(&size(b))
+            });
+        match best {
+            Some(k) => parts[k] += 1,
+            None => break,
+        }
+    }
+    let mut out: Vec<(usize, Unit<'a>)> = alone.into_iter().map(|i| (i, vec![runs[i]])).collect();
+    for ((_, idx), p) in keyed.iter().zip(parts) {
+        // p near-equal groups of consecutive members.
+        let (q, r) = (idx.len() / p, idx.len() % p);
+        let mut at = 0;
+        for g in 0..p {
+            let len = q + usize::from(g < r);
+            let members = &idx[at..at + len];
+            out.push((members[0], members.iter().map(|&i| runs[i]).collect()));
+            at += len;
+        }
+    }
+    out.sort_by_key(|(first, _)| *first);
+    out.into_iter().map(|(_, u)| u).collect()
+}
+
+/// Run a unit: a single run through [`run_one`], a group in lockstep (one repeat; each
+/// member's time is the group's divided among its members).
+fn run_unit(
+    sweep: &str,
+    unit: &[&RunSpec],
+    opts: &RunOptions,
+    refs: &References,
+) -> Vec<RunResult> {
+    if let [spec] = unit {
+        return vec![run_one(sweep, spec, opts, refs)];
+    }
+    let ctxs: Vec<RunContext> = unit
+        .iter()
+        .map(|spec| RunContext {
+            reference: spec.reference.as_ref().and_then(|id| refs.get(id).cloned()),
+            record_reference: None,
+        })
+        .collect();
+    let configs: Vec<&run::RunConfig> = unit.iter().map(|s| &s.config).collect();
+    let start = Instant::now();
+    let outs = catch_unwind(AssertUnwindSafe(|| {
+        run::simulate_group(&configs, opts, &ctxs)
+    }));
+    let outs = match outs {
+        Ok(o) => o,
+        // A panic in the group: every member again alone, each guarded (the panic is then its
+        // own row, the others' rows are what they would have been).
+        Err(_) => {
+            return unit
+                .iter()
+                .map(|spec| run_one(sweep, spec, opts, refs))
+                .collect();
+        }
+    };
+    let share = start.elapsed().as_secs_f64() / unit.len() as f64;
+    let timing = Timing {
+        median_s: share,
+        min_s: share,
+        max_s: share,
+        repeats: 1,
+    };
+    unit.iter()
+        .zip(outs)
+        .map(|(spec, mut out)| RunResult {
+            record: RunRecord::new(sweep, spec, &out, timing),
+            series: std::mem::take(&mut out.series),
+        })
+        .collect()
 }
 
 /// Run `f`; a panic becomes a `solver-failed` outcome carrying the panic message, so one bad
@@ -109,8 +229,9 @@ pub fn run_one(sweep: &str, spec: &RunSpec, opts: &RunOptions, refs: &References
     }
 }
 
-/// Execute `runs`, calling `on_result` in this thread as each finishes (in plan order for the
-/// serial path, in completion order otherwise). Stops early if `on_result` returns an error.
+/// Execute `runs`, calling `on_result` in this thread as each finishes (in plan order of the
+/// units for the serial path — a lockstep group's members together, at its first member's
+/// place — in completion order otherwise). Stops early if `on_result` returns an error.
 /// When `opts.run.cancel` is raised no run starts any more, and the runs it interrupted are
 /// dropped (they are redone on resume); every run finished before is still handed over.
 pub fn execute<E: Send>(
@@ -121,14 +242,21 @@ pub fn execute<E: Send>(
     mut on_result: impl FnMut(RunResult) -> Result<(), E>,
 ) -> Result<(), E> {
     let keep = |r: &RunResult| r.record.status != Status::Cancelled.as_str();
+    let threads = if opts.threads == 0 {
+        rayon::current_num_threads()
+    } else {
+        opts.threads
+    };
+    let units = units(runs, opts.lockstep, threads);
     if opts.threads == 1 {
-        for spec in runs {
+        for unit in &units {
             if opts.run.cancelled() {
                 break;
             }
-            let r = run_one(sweep, spec, &opts.run, refs);
-            if keep(&r) {
-                on_result(r)?;
+            for r in run_unit(sweep, unit, &opts.run, refs) {
+                if keep(&r) {
+                    on_result(r)?;
+                }
             }
         }
         return Ok(());
@@ -144,13 +272,14 @@ pub fn execute<E: Send>(
         let cancel = &cancel;
         scope.spawn(move || {
             pool.install(|| {
-                runs.par_iter().for_each_with(tx, |tx, spec| {
+                units.par_iter().for_each_with(tx, |tx, unit| {
                     // The consumer failed (e.g. the disk is full) or the sweep was interrupted:
                     // start nothing new.
                     if !cancel.load(Ordering::Relaxed) && !run_opts.cancelled() {
-                        let r = run_one(sweep, spec, &run_opts, refs);
-                        if keep(&r) {
-                            let _ = tx.send(r);
+                        for r in run_unit(sweep, unit, &run_opts, refs) {
+                            if keep(&r) {
+                                let _ = tx.send(r);
+                            }
                         }
                     }
                 });

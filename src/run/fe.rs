@@ -63,6 +63,11 @@ use crate::time::Scheme;
 #[path = "fe_methods.rs"]
 mod methods;
 
+// Lockstep groups: runs sharing the step matrix make their solves together (issue 24).
+#[path = "fe_lockstep.rs"]
+mod lockstep;
+pub use lockstep::{lockstep_key, simulate_group};
+
 /// Steps between two checks of the clock and of an interruption.
 const CLOCK_EVERY: usize = 64;
 /// The contact LCP: tolerance relative to the largest gap, and the iteration cap (SPEC §4).
@@ -271,6 +276,9 @@ pub(super) fn factor_failure(message: &str) -> Status {
 #[derive(Debug)]
 struct Factored {
     m: SymMatrix,
+    /// M without its stored zeros, for the products of the time loop ([`SymMatrix::without_zeros`]:
+    /// the same numbers, half the entries of the 2D vector mass).
+    m_products: SymMatrix,
     mass_total: f64,
     /// The step solves: the Cholesky factor of A, or A itself for CG.
     chol: StepSolver,
@@ -346,16 +354,35 @@ fn geometry_key(s: &FeSetup) -> String {
     )
 }
 
+/// From this many unknowns a 2D step matrix is factored with supernodes, below column by
+/// column. Measured with faer 0.24 on the 2D bar's A = M + τ²/4 K, AMD ordering, ms per
+/// right-hand side for k right-hand sides solved at once (`examples`-free: `cargo bench --bench
+/// fe -- lockstep`): 5 440 dofs simplicial 0.23 (k = 1) / 0.11 (k = 8), supernodal 0.24 /
+/// 0.09; 21 120 dofs 1.32 / 0.57 against 1.33 / 0.45; 83 200 dofs 7.6 / 3.6 against 6.4 / 2.3.
+/// A single solve costs the same from ≈ 2·10⁴ dofs, and only the supernodal factor's dense
+/// blocks keep gaining past k = 4 — the lockstep groups' case ([`lockstep`]), whose members
+/// must use the factor of their runs alone so that their numbers are the same bit for bit.
+const SUPERNODAL_2D_FROM: usize = 16_000;
+
+/// The factor kind of a 2D step matrix of `n` unknowns ([`SUPERNODAL_2D_FROM`]).
+fn kind_2d(n: usize) -> FactorKind {
+    if n >= SUPERNODAL_2D_FROM {
+        FactorKind::Supernodal
+    } else {
+        FactorKind::Simplicial
+    }
+}
+
 /// The engine's fill-reducing ordering and factor kind, measured on M + τ²/4 K of the bars (one
-/// solve): 2D 65 × 641 nodes: AMD simplicial 4.9 M entries in L, 14.0 ms (AMD supernodal
-/// 6.2 M, 15.4 ms; nested dissection 5.3–6.9 M, 16 ms); 3D 9 × 9 × 81: the geometric nested
-/// dissection of the box with supernodes, 6.6 M, 9.5 ms (AMD supernodal 10.0 M, 13.5 ms).
+/// solve): 2D: AMD ([`kind_2d`]; nested dissection gives 5.3–6.9 M entries in L at 65 × 641
+/// nodes against AMD's 4.9–6.2 M); 3D 9 × 9 × 81: the geometric nested dissection of the box
+/// with supernodes, 6.6 M, 9.5 ms (AMD supernodal 10.0 M, 13.5 ms).
 pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
     let d = mesh.dim;
     if d == 2 {
         CholeskyOptions {
             ordering: Ordering::Amd,
-            kind: FactorKind::Simplicial,
+            kind: kind_2d(dofs.n_free()),
         }
     } else {
         CholeskyOptions {
@@ -456,7 +483,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            FactorKind::Simplicial
+            kind_2d(dofs.n_free())
         } else {
             FactorKind::Supernodal
         },
@@ -601,7 +628,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            FactorKind::Simplicial
+            kind_2d(dofs.n_free())
         } else {
             FactorKind::Supernodal
         },
@@ -876,6 +903,20 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
 /// The part of a factor's cache key beyond geometry, mass, method and step: the run's gap when
 /// the Nitsche/penalty rows carry it (box and Gmsh meshes, [`factor`]); empty otherwise, so the
 /// mixed runs and the ball share their entries as before.
+/// The identity of a run's step matrix and condensation (the [`FACTORS`] cache's key): the
+/// geometry, mass, contact method, cτ² and solver — and the gap where it enters the operators.
+/// The solver is part of it: a `cg` entry holds A itself, not its factor.
+fn factor_key(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> String {
+    format!(
+        "{}|{:?}|{:?}|{:e}|{:?}",
+        geometry_key(&cfg.setup),
+        cfg.mass,
+        cfg.method,
+        c_tau2,
+        cfg.solver
+    ) + &factor_key_gap(g, cfg)
+}
+
 fn factor_key_gap(g: &Geometry, cfg: &FeConfig) -> String {
     if cfg.method == ContactMethod::Mixed || g.gap_in_geometry {
         String::new()
@@ -947,6 +988,7 @@ fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, S
         }
     }
     Ok(Factored {
+        m_products: m.without_zeros(),
         m,
         mass_total,
         chol,
@@ -1012,6 +1054,7 @@ fn factor_nitsche(
         }
     }
     Ok(Factored {
+        m_products: m.without_zeros(),
         m,
         mass_total,
         chol,
@@ -1323,209 +1366,320 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     if methods::handles(cfg) {
         return methods::simulate(cfg, opts, ctx);
     }
-    let start = Instant::now();
-    let mut metrics = Metrics {
-        dofs: cfg.unknowns() as i64,
-        // Known before anything can fail: a failed row still gets its energy tolerance.
-        length_scale: Some(cfg.setup.geometry.length_scale()),
-        ..Metrics::default()
-    };
-    let fail = |status, msg: String, metrics: Metrics| Outcome {
-        status,
-        message: Some(msg),
-        metrics,
-        series: Series::default(),
-        reference: None,
-    };
-    let (c1, c, gamma) = match cfg.coefficients() {
-        Ok(x) => x,
-        Err(e) => return fail(Status::Invalid, e, metrics),
-    };
-    let tau = cfg.dt;
-    let c_tau2 = c * tau * tau;
-    let (geo, _) = GEOMETRIES.get(geometry_key(&cfg.setup), || build_geometry(&cfg.setup));
-    let geo = match geo {
-        Ok(g) => g,
-        Err(e) => return fail(Status::Invalid, e, metrics),
-    };
-    // Checked outside the shared caches: an entry is never left half built.
-    if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
-        return fail(status, msg, metrics);
-    }
-    // The solver is part of the key: a `cg` entry holds A itself, not its factor.
-    let factor_key = format!(
-        "{}|{:?}|{:?}|{:e}|{:?}",
-        geometry_key(&cfg.setup),
-        cfg.mass,
-        cfg.method,
-        c_tau2,
-        cfg.solver
-    ) + &factor_key_gap(&geo, cfg);
-    let (fac, hit) = FACTORS.get(factor_key, || factor(&geo, cfg, c_tau2));
-    let fac = match fac {
-        Ok(f) => f,
-        Err(e) => return fail(factor_failure(&e), e, metrics),
-    };
-    // CG factors nothing: no factorisation made, none reused (its matrix and condensation
-    // columns are still shared through the cache).
-    let factored = fac.chol.is_factored();
-    metrics.factorizations = i64::from(!hit && factored);
-    metrics.factor_cache_hits = factored.then_some(i64::from(hit));
-    metrics.mass_total = Some(fac.mass_total);
-    if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
-        return fail(status, msg, metrics);
-    }
-    let refmap = match ctx.reference.as_ref().map(|r| ref_map(&geo, cfg, r)) {
-        Some(Err(e)) => return fail(Status::Invalid, e, metrics),
-        Some(Ok(m)) => Some(m),
-        None => None,
-    };
-
-    let g = &*geo;
-    let n = g.dofs.n_free();
-    let nit = fac.nitsche.as_ref();
-    // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
-    let nc = nit.map_or(g.contact.len(), NitscheOps::len);
-    metrics.contact_dofs = Some(nc as i64);
-    // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
-    let base_gap = if g.gap_in_geometry {
-        0.0
-    } else {
-        cfg.setup.gap
-    };
-    let gaps: Vec<f64> = g.contact_height.iter().map(|h| h + base_gap).collect();
-
-    // Workspace: every vector of the time loop, allocated once. M u, M v and M a are carried
-    // along the recursions of u, v, a, so a step costs one product with M (M a^{n+1}) besides
-    // the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at all,
-    // uᵀKu = uᵀ(F + Bᵀλ − M a) by the equation at t^{n+1}.
-    let mut u = vec![0.0; n];
-    let mut v = vec![0.0; n];
-    let mut a = vec![0.0; n];
-    let mut mu = vec![0.0; n];
-    let mut mv = vec![0.0; n];
-    let mut ma = vec![0.0; n];
-    let mut pred = vec![0.0; n];
-    let mut y = vec![0.0; n];
-    let mut tmp = vec![0.0; n];
-    let mut err = vec![0.0; n];
-    let mut q = vec![0.0; nc];
-    let mut lambda = vec![0.0; nc];
-    let mut lcp = Lcp::new(
-        g.contact.len(),
-        if nit.is_some() {
-            vec![0.0; g.contact.len().pow(2)]
-        } else {
-            fac.h.clone()
-        },
-    );
-    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
-    // Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
-    let mut kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
-    let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
-    let mut newton_max = 0usize;
-    let mut work: StepWork = fac.chol.work();
-    for &r in &g.vertical {
-        v[r] = cfg.setup.v0;
-    }
-    if let Some((delta, seed)) = cfg.perturbation {
-        let mut rng = fastrand::Rng::with_seed(seed);
-        for x in v.iter_mut() {
-            *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
+    // Alone is a lockstep group of one: the same loop, each solve with the run's own work
+    // (CG warm-starts from its previous step).
+    match Stepper::new(cfg, opts, ctx) {
+        Err(out) => *out,
+        Ok(s) => {
+            let mut done = lockstep::step_together(vec![(0, s)]);
+            done.pop().expect("one member, one outcome").1
         }
     }
-    fac.m.matvec_into(&v, &mut mv);
-    // Gravity: F = M (f e_d) with the run's mass, f = −gravity — the load ∫ρ f·v of the
-    // consistent mass, whose row sums the lumped mass keeps. Then a⁰ = M⁻¹(F − Ku⁰) = f e_d
-    // exactly (u⁰ = 0): the rigid acceleration, and M a⁰ = F. The bars have no load (F = 0).
-    let fall = -cfg.setup.gravity;
-    let mut force_vec = vec![0.0; n];
-    if fall != 0.0 {
-        if g.mesh.as_box().is_some() {
-            return fail(
-                Status::Invalid,
-                format!(
-                    "scene {}: a volume load on the clamped bar is not supported",
-                    cfg.setup.scene
-                ),
+}
+
+/// One run of the engine between its setup and its outcome: the shared operators, the run's own
+/// workspace, observer and counters. A step is split around its one linear solve —
+/// [`Stepper::prepare`] leaves the right-hand side in `y`, the solve replaces it by A⁻¹y,
+/// [`Stepper::complete`] does the contact and the updates — so runs sharing A can make their
+/// solves together ([`lockstep`]), and also their other reads of shared operators: u^{n+1} =
+/// y + cτ²Zλ and the products with M. A run alone is a group of one.
+struct Stepper<'a> {
+    cfg: &'a FeConfig,
+    opts: &'a RunOptions,
+    geo: Arc<Geometry>,
+    fac: Arc<Factored>,
+    refmap: Option<RefMap>,
+    metrics: Metrics,
+    start: Instant,
+    loop_start: Instant,
+    // The scheme: p^n = u + τv + c₁τ²a, γ, cτ²; the θ-midpoint (hybrid) has its own update.
+    tau: f64,
+    c1: f64,
+    gamma: f64,
+    c_tau2: f64,
+    hybrid: bool,
+    /// f = −gravity (downward acceleration), F = M f e_d its load.
+    fall: f64,
+    force_vec: Vec<f64>,
+    vertical_mass: f64,
+    energy_scale: Option<f64>,
+    /// Gap of each contact dof, and the Γ_C node nearest the plane (disc/ball).
+    gaps: Vec<f64>,
+    lowest: Option<usize>,
+    // State and workspace (module header: M u, M v, M a carried along).
+    u: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    mu: Vec<f64>,
+    mv: Vec<f64>,
+    ma: Vec<f64>,
+    pred: Vec<f64>,
+    /// The step's right-hand side, then (after the solve) its solution.
+    y: Vec<f64>,
+    tmp: Vec<f64>,
+    err: Vec<f64>,
+    q: Vec<f64>,
+    lambda: Vec<f64>,
+    lcp: Lcp,
+    newton_work: NewtonWork,
+    /// Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
+    kink: Vec<f64>,
+    newton_max: usize,
+    iterations: i64,
+    work: StepWork,
+    record: Option<(Vec<Option<usize>>, ReferenceData)>,
+    obs: Observer,
+    observe_timer: SampledTimer,
+    /// Centre of mass against free fall until the first contact (scenes with gravity).
+    fall_error: f64,
+    touched: bool,
+    done: usize,
+}
+
+impl<'a> Stepper<'a> {
+    /// The setup: operators and factor from the shared caches, the reference map, the workspace
+    /// and the initial state. A run that cannot start is returned as its outcome.
+    fn new(
+        cfg: &'a FeConfig,
+        opts: &'a RunOptions,
+        ctx: &RunContext,
+    ) -> Result<Stepper<'a>, Box<Outcome>> {
+        let start = Instant::now();
+        let mut metrics = Metrics {
+            dofs: cfg.unknowns() as i64,
+            // Known before anything can fail: a failed row still gets its energy tolerance.
+            length_scale: Some(cfg.setup.geometry.length_scale()),
+            ..Metrics::default()
+        };
+        let fail = |status, msg: String, metrics: Metrics| {
+            Box::new(Outcome {
+                status,
+                message: Some(msg),
                 metrics,
-            );
+                series: Series::default(),
+                reference: None,
+            })
+        };
+        let (c1, c, gamma) = match cfg.coefficients() {
+            Ok(x) => x,
+            Err(e) => return Err(fail(Status::Invalid, e, metrics)),
+        };
+        let tau = cfg.dt;
+        let c_tau2 = c * tau * tau;
+        let (geo, _) = GEOMETRIES.get(geometry_key(&cfg.setup), || build_geometry(&cfg.setup));
+        let geo = match geo {
+            Ok(g) => g,
+            Err(e) => return Err(fail(Status::Invalid, e, metrics)),
+        };
+        // Checked outside the shared caches: an entry is never left half built.
+        if let Some((status, msg)) = opts.setup_stop(start, "the mesh and operators") {
+            return Err(fail(status, msg, metrics));
         }
-        for &r in &g.vertical {
-            a[r] = fall;
+        let (fac, hit) = FACTORS.get(factor_key(&geo, cfg, c_tau2), || factor(&geo, cfg, c_tau2));
+        let fac = match fac {
+            Ok(f) => f,
+            Err(e) => return Err(fail(factor_failure(&e), e, metrics)),
+        };
+        // CG factors nothing: no factorisation made, none reused (its matrix and condensation
+        // columns are still shared through the cache).
+        let factored = fac.chol.is_factored();
+        metrics.factorizations = i64::from(!hit && factored);
+        metrics.factor_cache_hits = factored.then_some(i64::from(hit));
+        metrics.mass_total = Some(fac.mass_total);
+        if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
+            return Err(fail(status, msg, metrics));
         }
-        fac.m.matvec_into(&a, &mut force_vec);
-        ma.copy_from_slice(&force_vec);
-    }
-    // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
-    let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
-    let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
-    // The reference lattice this run records, if it is one.
-    let mut record = match reference_record(g, cfg, ctx) {
-        Err(e) => return fail(Status::Invalid, e, metrics),
-        Ok(r) => r,
-    };
-    if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
-        return fail(status, msg, metrics);
-    }
-    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
-    let loop_start = Instant::now();
+        let refmap = match ctx.reference.as_ref().map(|r| ref_map(&geo, cfg, r)) {
+            Some(Err(e)) => return Err(fail(Status::Invalid, e, metrics)),
+            Some(Ok(m)) => Some(m),
+            None => None,
+        };
 
-    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
-    if let Some(sc) = energy_scale {
-        obs = obs.with_energy_scale(sc);
+        let g = &*geo;
+        let n = g.dofs.n_free();
+        let nit = fac.nitsche.as_ref();
+        // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
+        let nc = nit.map_or(g.contact.len(), NitscheOps::len);
+        metrics.contact_dofs = Some(nc as i64);
+        // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
+        let base_gap = if g.gap_in_geometry {
+            0.0
+        } else {
+            cfg.setup.gap
+        };
+        let gaps: Vec<f64> = g.contact_height.iter().map(|h| h + base_gap).collect();
+
+        // Workspace: every vector of the time loop, allocated once. M u, M v and M a are
+        // carried along the recursions of u, v, a, so a step costs one product with M (M a^{n+1})
+        // besides the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at
+        // all, uᵀKu = uᵀ(F + Bᵀλ − M a) by the equation at t^{n+1}.
+        let mut v = vec![0.0; n];
+        let mut a = vec![0.0; n];
+        let mut mv = vec![0.0; n];
+        let mut ma = vec![0.0; n];
+        let lcp = Lcp::new(
+            g.contact.len(),
+            if nit.is_some() {
+                vec![0.0; g.contact.len().pow(2)]
+            } else {
+                fac.h.clone()
+            },
+        );
+        let newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+        let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
+        let work: StepWork = fac.chol.work();
+        for &r in &g.vertical {
+            v[r] = cfg.setup.v0;
+        }
+        if let Some((delta, seed)) = cfg.perturbation {
+            let mut rng = fastrand::Rng::with_seed(seed);
+            for x in v.iter_mut() {
+                *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
+            }
+        }
+        fac.m.matvec_into(&v, &mut mv);
+        // Gravity: F = M (f e_d) with the run's mass, f = −gravity — the load ∫ρ f·v of the
+        // consistent mass, whose row sums the lumped mass keeps. Then a⁰ = M⁻¹(F − Ku⁰) = f e_d
+        // exactly (u⁰ = 0): the rigid acceleration, and M a⁰ = F. The bars have no load (F = 0).
+        let fall = -cfg.setup.gravity;
+        let mut force_vec = vec![0.0; n];
+        if fall != 0.0 {
+            if g.mesh.as_box().is_some() {
+                return Err(fail(
+                    Status::Invalid,
+                    format!(
+                        "scene {}: a volume load on the clamped bar is not supported",
+                        cfg.setup.scene
+                    ),
+                    metrics,
+                ));
+            }
+            for &r in &g.vertical {
+                a[r] = fall;
+            }
+            fac.m.matvec_into(&a, &mut force_vec);
+            ma.copy_from_slice(&force_vec);
+        }
+        // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
+        let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
+        let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
+        // The reference lattice this run records, if it is one.
+        let record = match reference_record(g, cfg, ctx) {
+            Err(e) => return Err(fail(Status::Invalid, e, metrics)),
+            Ok(r) => r,
+        };
+        if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
+            return Err(fail(status, msg, metrics));
+        }
+        // The lowest point of the reference configuration (disc/ball): the Γ_C node nearest the
+        // plane, whose vertical dof gives `u_lowest`. The bars' bottom face is flat: none.
+        let lowest = g
+            .gap_in_geometry
+            .then(|| {
+                g.contact
+                    .iter()
+                    .zip(&g.contact_height)
+                    .min_by(|a, b| a.1.total_cmp(b.1))
+                    .map(|(&c, _)| c)
+            })
+            .flatten();
+        let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
+        if let Some(sc) = energy_scale {
+            obs = obs.with_energy_scale(sc);
+        }
+        metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
+        Ok(Stepper {
+            cfg,
+            opts,
+            refmap,
+            metrics,
+            start,
+            loop_start: Instant::now(),
+            tau,
+            c1,
+            gamma,
+            c_tau2,
+            hybrid: matches!(cfg.scheme, Scheme::Hybrid),
+            fall,
+            force_vec,
+            vertical_mass,
+            energy_scale,
+            gaps,
+            lowest,
+            u: vec![0.0; n],
+            v,
+            a,
+            mu: vec![0.0; n],
+            mv,
+            ma,
+            pred: vec![0.0; n],
+            y: vec![0.0; n],
+            tmp: vec![0.0; n],
+            err: vec![0.0; n],
+            q: vec![0.0; nc],
+            lambda: vec![0.0; nc],
+            lcp,
+            newton_work,
+            kink,
+            newton_max: 0,
+            iterations: 0,
+            work,
+            record,
+            obs,
+            observe_timer: SampledTimer::default(),
+            fall_error: 0.0,
+            touched: false,
+            done: 0,
+            geo,
+            fac,
+        })
     }
-    // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
-    // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product with
-    // K (into the scratch `tmp`) instead.
-    // Returns the parts (½vᵀMv, ½uᵀKu, −Fᵀu), whose sum is E^h.
-    let energy = |u: &[f64], v: &[f64], mv: &[f64], ma: &[f64], lambda: &[f64], tmp: &mut [f64]| {
-        let kinetic: f64 = v.iter().zip(mv).map(|(x, y)| x * y).sum();
-        let fu: f64 = u.iter().zip(&force_vec).map(|(x, y)| x * y).sum();
+
+    /// Observe step n with the current state (u, v) and contact forces λ (SPEC §1.3).
+    fn observe(&mut self, step: usize) -> Result<(), Divergence> {
+        let Stepper {
+            geo,
+            fac,
+            refmap,
+            tau,
+            fall,
+            force_vec,
+            vertical_mass,
+            gaps,
+            lowest,
+            u,
+            v,
+            mu,
+            mv,
+            ma,
+            tmp,
+            err,
+            lambda,
+            record,
+            obs,
+            fall_error,
+            touched,
+            ..
+        } = self;
+        let (g, nit, tau, fall) = (&**geo, fac.nitsche.as_ref(), *tau, *fall);
+        // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
+        // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product
+        // with K (into the scratch `tmp`) instead.
+        let kinetic: f64 = v.iter().zip(mv.iter()).map(|(x, y)| x * y).sum();
+        let fu: f64 = u.iter().zip(force_vec.iter()).map(|(x, y)| x * y).sum();
         let uku = if nit.is_some() {
             quad(&g.k, u, tmp)
         } else {
-            let contact: f64 = g.contact.iter().zip(lambda).map(|(&c, l)| l * u[c]).sum();
-            let uma: f64 = u.iter().zip(ma).map(|(x, y)| x * y).sum();
+            let contact: f64 = g
+                .contact
+                .iter()
+                .zip(lambda.iter())
+                .map(|(&c, l)| l * u[c])
+                .sum();
+            let uma: f64 = u.iter().zip(ma.iter()).map(|(x, y)| x * y).sum();
             fu + contact - uma
         };
-        [0.5 * kinetic, 0.5 * uku, -fu]
-    };
-    // The lowest point of the reference configuration (disc/ball): the Γ_C node nearest the
-    // plane, whose vertical dof gives `u_lowest`. The bars' bottom face is flat: none.
-    let lowest = g
-        .gap_in_geometry
-        .then(|| {
-            g.contact
-                .iter()
-                .zip(&g.contact_height)
-                .min_by(|a, b| a.1.total_cmp(b.1))
-                .map(|(&c, _)| c)
-        })
-        .flatten();
-    let mean = |x: &[f64]| -> f64 {
-        g.contact
-            .iter()
-            .zip(&g.contact_weight)
-            .map(|(&c, w)| w * x[c])
-            .sum()
-    };
-    // Centre of mass against free fall until the first contact (scenes with gravity).
-    let mut fall_error = 0.0f64;
-    let mut touched = false;
-    // Observe step n with state (u, v) and contact forces λ.
-    #[allow(clippy::too_many_arguments)]
-    let mut observe = |step: usize,
-                       u: &[f64],
-                       v: &[f64],
-                       mu: &[f64],
-                       mv: &[f64],
-                       ma: &[f64],
-                       lambda: &[f64],
-                       tmp: &mut [f64],
-                       err: &mut [f64]|
-     -> Result<(), Divergence> {
-        let [kinetic, elastic, gravity] = energy(u, v, mv, ma, lambda, tmp);
+        let [kinetic, elastic, gravity] = [0.5 * kinetic, 0.5 * uku, -fu];
         let e = kinetic + elastic + gravity;
         // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (SPEC §1.3 decisions): the
         // points where the mixed method enforces the constraint, and where Nitsche/penalty
@@ -1533,7 +1687,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         let penetration = g
             .contact
             .iter()
-            .zip(&gaps)
+            .zip(gaps.iter())
             .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
         // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
         // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
@@ -1544,14 +1698,21 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             }
             None => (e, None, lambda.iter().sum()),
         };
+        let mean = |x: &[f64]| -> f64 {
+            g.contact
+                .iter()
+                .zip(&g.contact_weight)
+                .map(|(&c, w)| w * x[c])
+                .sum()
+        };
         let uc = mean(u);
-        if fall != 0.0 && !touched {
+        if fall != 0.0 && !*touched {
             if force > 0.0 {
-                touched = true;
+                *touched = true;
             } else {
                 let t = step as f64 * tau;
-                let com: f64 = g.vertical.iter().map(|&r| mu[r]).sum::<f64>() / vertical_mass;
-                fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
+                let com: f64 = g.vertical.iter().map(|&r| mu[r]).sum::<f64>() / *vertical_mass;
+                *fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
             }
         }
         if let Some((slots, data)) = record.as_mut()
@@ -1581,157 +1742,191 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             },
             exact,
         )
-    };
+    }
 
-    let mut done = 0usize;
-    let mut iterations = 0i64;
-    let mut observe_timer = SampledTimer::default();
-    let stop = (|| -> Result<(), Stop<String>> {
-        observe(0, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err).map_err(Stop::Diverged)?;
-        let (t1, ct2) = (tau, c1 * tau * tau);
-        for step in 1..=cfg.steps {
-            if hybrid {
-                // Midpoint rule: (M + τ²/4 K_Θ) u^{n+1} = M(u + τv) − τ²/4 K_Θ u + τ²/2 F − τ²/2 N_Φ
-                // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u).
-                g.k.matvec_into(&u, &mut tmp);
-                if let Some(ops) = nit
-                    && ops.theta != 0.0
-                {
-                    for k in 0..ops.len() {
-                        let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &u);
-                        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
-                            .iter()
-                            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
-                        {
-                            tmp[gd] -= f * sk;
-                        }
-                    }
-                }
-                for i in 0..n {
-                    y[i] = mu[i] + tau * mv[i] - c_tau2 * tmp[i] + 2.0 * c_tau2 * force_vec[i];
-                }
-            } else {
-                // p^n and M p^n (the right-hand side) from the carried products.
-                for i in 0..n {
-                    pred[i] = u[i] + t1 * v[i] + ct2 * a[i];
-                    y[i] = mu[i] + t1 * mv[i] + ct2 * ma[i];
-                }
-                // M p^n is M u^{n+1} before the correction below; keep it. Then + cτ²F.
-                mu.copy_from_slice(&y);
-                if fall != 0.0 {
-                    for (yi, fi) in y.iter_mut().zip(&force_vec) {
-                        *yi += c_tau2 * fi;
+    /// The right-hand side of step n into `y` (before the solve with A).
+    fn prepare(&mut self) {
+        let n = self.y.len();
+        let (tau, c_tau2) = (self.tau, self.c_tau2);
+        if self.hybrid {
+            // Midpoint rule: (M + τ²/4 K_Θ) u^{n+1} = M(u + τv) − τ²/4 K_Θ u + τ²/2 F − τ²/2 N_Φ
+            // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u).
+            let tmp = &mut self.tmp;
+            self.geo.k.matvec_into(&self.u, tmp);
+            if let Some(ops) = self.fac.nitsche.as_ref()
+                && ops.theta != 0.0
+            {
+                for k in 0..ops.len() {
+                    let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &self.u);
+                    for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                        .iter()
+                        .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+                    {
+                        tmp[gd] -= f * sk;
                     }
                 }
             }
-            fac.chol.solve_in_place(&mut y, &mut work);
-            work.check()
+            let (mu, mv, f) = (&self.mu, &self.mv, &self.force_vec);
+            for i in 0..n {
+                self.y[i] = mu[i] + tau * mv[i] - c_tau2 * tmp[i] + 2.0 * c_tau2 * f[i];
+            }
+        } else {
+            // p^n and M p^n (the right-hand side) from the carried products. M p^n is
+            // M u^{n+1} before the correction by a^{n+1}: kept in `mu`. Then + cτ²F. (Slices cut
+            // to n: the loop runs without bounds checks.)
+            let ct2 = self.c1 * tau * tau;
+            let (u, v, a) = (&self.u[..n], &self.v[..n], &self.a[..n]);
+            let (mv, ma) = (&self.mv[..n], &self.ma[..n]);
+            let (pred, y, mu) = (&mut self.pred[..n], &mut self.y[..n], &mut self.mu[..n]);
+            for i in 0..n {
+                pred[i] = u[i] + tau * v[i] + ct2 * a[i];
+                let mp = mu[i] + tau * mv[i] + ct2 * ma[i];
+                y[i] = mp;
+                mu[i] = mp;
+            }
+            if self.fall != 0.0 {
+                for (yi, fi) in self.y.iter_mut().zip(&self.force_vec) {
+                    *yi += c_tau2 * fi;
+                }
+            }
+        }
+    }
+
+    /// Step n's contact problem once `y` = A⁻¹(right-hand side): the forces λ (upward) from
+    /// the exact LCP (mixed) or Newton (Nitsche/penalty). u^{n+1} = y + cτ² Z λ is then made by
+    /// the group ([`lockstep`]), which reads each column of Z once for all its members.
+    fn contact(&mut self, step: usize) -> Result<(), Stop<String>> {
+        let c_tau2 = self.c_tau2;
+        let fac = &*self.fac;
+        if let Some(ops) = fac.nitsche.as_ref() {
+            // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
+            for (k, qk) in self.q.iter_mut().enumerate() {
+                *qk = ops.apply(&ops.p, k, &self.y);
+            }
+            if self.hybrid {
+                // Kinks g − max(P̃ⁿ, 0) from u^n (fe_nitsche header).
+                for (k, kk) in self.kink.iter_mut().enumerate() {
+                    let pn = ops.apply(&ops.p, k, &self.u) - ops.gap[k];
+                    *kk = ops.gap[k] - pn.max(0.0);
+                }
+            }
+            let it = newton(
+                ops,
+                &fac.h,
+                c_tau2,
+                &self.q,
+                &self.kink,
+                &mut self.lambda,
+                &mut self.newton_work,
+            )
+            .map_err(|e| Stop::Solver(step, e))?;
+            self.newton_max = self.newton_max.max(it);
+            self.iterations += it as i64;
+        } else {
+            let g = &*self.geo;
+            for ((qi, &ci), gi) in self.q.iter_mut().zip(&g.contact).zip(&self.gaps) {
+                *qi = self.y[ci] + gi;
+            }
+            let it = self
+                .lcp
+                .solve(&self.q, &mut self.lambda, LCP_MAX_ITER, LCP_TOL)
                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-            if let Some(ops) = nit {
-                // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
-                for (k, qk) in q.iter_mut().enumerate() {
-                    *qk = ops.apply(&ops.p, k, &y);
-                }
-                if hybrid {
-                    // Kinks g − max(P̃ⁿ, 0) from u^n (fe_nitsche header).
-                    for (k, kk) in kink.iter_mut().enumerate() {
-                        let pn = ops.apply(&ops.p, k, &u) - ops.gap[k];
-                        *kk = ops.gap[k] - pn.max(0.0);
-                    }
-                }
-                let it = newton(
-                    ops,
-                    &fac.h,
-                    c_tau2,
-                    &q,
-                    &kink,
-                    &mut lambda,
-                    &mut newton_work,
-                )
-                .map_err(|e| Stop::Solver(step, e))?;
-                newton_max = newton_max.max(it);
-                iterations += it as i64;
-            } else {
-                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                    *qi = y[ci] + gi;
-                }
-                let it = lcp
-                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                newton_max = newton_max.max(it);
-                iterations += it as i64;
-            }
-            for (j, &l) in lambda.iter().enumerate() {
-                if l > 0.0 {
-                    let zj = &fac.z[j * n..(j + 1) * n];
-                    let s = c_tau2 * l;
-                    for (yi, zi) in y.iter_mut().zip(zj) {
-                        *yi += s * zi;
-                    }
-                }
-            }
-            if hybrid {
-                // v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n; M u and M v by products (a is not used).
-                for i in 0..n {
-                    v[i] = 2.0 * (y[i] - u[i]) / tau - v[i];
-                }
-                std::mem::swap(&mut u, &mut y);
-                fac.m.matvec_into(&u, &mut mu);
-                fac.m.matvec_into(&v, &mut mv);
-            } else {
-                // y = u^{n+1}; tmp = a^{n+1} = (u^{n+1} − p^n)/(cτ²), then M a^{n+1} into pred.
-                for i in 0..n {
-                    tmp[i] = (y[i] - pred[i]) / c_tau2;
-                }
-                fac.m.matvec_into(&tmp, &mut pred);
-                for i in 0..n {
-                    v[i] += tau * ((1.0 - gamma) * a[i] + gamma * tmp[i]);
-                    mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * pred[i]);
-                    mu[i] += c_tau2 * pred[i];
-                }
-                std::mem::swap(&mut a, &mut tmp);
-                std::mem::swap(&mut ma, &mut pred);
-                std::mem::swap(&mut u, &mut y);
-            }
-            observe_timer
-                .time(step, || {
-                    observe(step, &u, &v, &mu, &mv, &ma, &lambda, &mut tmp, &mut err)
-                })
-                .map_err(Stop::Diverged)?;
-            done = step;
-            opts.step_stop(step, CLOCK_EVERY, start)?;
+            self.newton_max = self.newton_max.max(it);
+            self.iterations += it as i64;
         }
         Ok(())
-    })();
-    metrics.steps = done as i64;
-    metrics.iterations = iterations;
-    metrics.iterations_max_step = Some(newton_max as i64);
-    if !fac.chol.is_factored() {
-        metrics.solver_iterations = Some(work.iterations_total() as i64);
-        metrics.solver_iterations_max_step = Some(work.iterations_max() as i64);
     }
-    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
-    metrics.observe_time_s = observe_timer.estimate_s();
-    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
-    obs.finish(&mut metrics, status == Status::Ok);
-    metrics.first_contact_time = obs.first_contact();
-    metrics.contact_phases = Some(obs.contact_phases());
-    metrics.free_fall_error = (fall != 0.0).then_some(fall_error);
-    // The observer's pressure columns are the total force here; there is no midpoint pressure.
-    metrics.err_force_l2 = metrics.err_sigma_l2.take();
-    metrics.err_sigma_mid_l2 = None;
-    metrics.contact_toggles = Some(metrics.contact_switches);
-    metrics.energy_scale = energy_scale.or(metrics.energy_initial);
-    let reference = match record {
-        Some((_, data)) if status == Status::Ok => Some(data),
-        _ => None,
-    };
-    Outcome {
-        status,
-        message,
-        metrics,
-        series: std::mem::take(&mut obs.series),
-        reference,
+
+    /// With `y` = u^{n+1}: the acceleration a^{n+1} = (u^{n+1} − p^n)/(cτ²) into `tmp`
+    /// (Newmark/θ), or v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n and u ← u^{n+1} (hybrid). The products
+    /// with M that follow are the group's ([`Stepper::mass_pairs`]).
+    fn accelerate(&mut self) {
+        let (tau, c_tau2) = (self.tau, self.c_tau2);
+        if self.hybrid {
+            for ((vi, yi), ui) in self.v.iter_mut().zip(&self.y).zip(&self.u) {
+                *vi = 2.0 * (yi - ui) / tau - *vi;
+            }
+            std::mem::swap(&mut self.u, &mut self.y);
+        } else {
+            for ((ti, yi), pi) in self.tmp.iter_mut().zip(&self.y).zip(&self.pred) {
+                *ti = (yi - pi) / c_tau2;
+            }
+        }
+    }
+
+    /// The products with M of this step, as (x, M x) pairs: M a^{n+1} into `pred` (Newmark/θ),
+    /// or M u and M v (hybrid, whose u and v are not carried through recursions).
+    fn mass_pairs(&mut self) -> [Option<(&[f64], &mut [f64])>; 2] {
+        if self.hybrid {
+            [
+                Some((self.u.as_slice(), self.mu.as_mut_slice())),
+                Some((self.v.as_slice(), self.mv.as_mut_slice())),
+            ]
+        } else {
+            [Some((self.tmp.as_slice(), self.pred.as_mut_slice())), None]
+        }
+    }
+
+    /// The end of step n after the products with M: v, M v, M u and a (Newmark/θ), the
+    /// observation, the clock.
+    fn end_step(&mut self, step: usize) -> Result<(), Stop<String>> {
+        if !self.hybrid {
+            let (tau, gamma, c_tau2) = (self.tau, self.gamma, self.c_tau2);
+            let n = self.y.len();
+            let (a, an, ma, man) = (&self.a[..n], &self.tmp[..n], &self.ma[..n], &self.pred[..n]);
+            let (v, mv, mu) = (&mut self.v[..n], &mut self.mv[..n], &mut self.mu[..n]);
+            for i in 0..n {
+                v[i] += tau * ((1.0 - gamma) * a[i] + gamma * an[i]);
+                mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * man[i]);
+                mu[i] += c_tau2 * man[i];
+            }
+            std::mem::swap(&mut self.a, &mut self.tmp);
+            std::mem::swap(&mut self.ma, &mut self.pred);
+            std::mem::swap(&mut self.u, &mut self.y);
+        }
+        let mut timer = self.observe_timer;
+        let r = timer.time(step, || self.observe(step));
+        self.observe_timer = timer;
+        r.map_err(Stop::Diverged)?;
+        self.done = step;
+        self.opts.step_stop(step, CLOCK_EVERY, self.start)
+    }
+
+    /// The outcome of the run, however its loop ended.
+    fn finish(mut self, stop: Result<(), Stop<String>>) -> Outcome {
+        let cfg = self.cfg;
+        let metrics = &mut self.metrics;
+        metrics.steps = self.done as i64;
+        metrics.iterations = self.iterations;
+        metrics.iterations_max_step = Some(self.newton_max as i64);
+        if !self.fac.chol.is_factored() {
+            metrics.solver_iterations = Some(self.work.iterations_total() as i64);
+            metrics.solver_iterations_max_step = Some(self.work.iterations_max() as i64);
+        }
+        metrics.stepping_time_s = Some(self.loop_start.elapsed().as_secs_f64());
+        metrics.observe_time_s = self.observe_timer.estimate_s();
+        let (status, message) = Stop::status(stop, self.tau, cfg.steps, self.start, metrics);
+        self.obs.finish(metrics, status == Status::Ok);
+        metrics.first_contact_time = self.obs.first_contact();
+        metrics.contact_phases = Some(self.obs.contact_phases());
+        metrics.free_fall_error = (self.fall != 0.0).then_some(self.fall_error);
+        // The observer's pressure columns are the total force here; there is no midpoint
+        // pressure.
+        metrics.err_force_l2 = metrics.err_sigma_l2.take();
+        metrics.err_sigma_mid_l2 = None;
+        metrics.contact_toggles = Some(metrics.contact_switches);
+        metrics.energy_scale = self.energy_scale.or(metrics.energy_initial);
+        let reference = match self.record {
+            Some((_, data)) if status == Status::Ok => Some(data),
+            _ => None,
+        };
+        Outcome {
+            status,
+            message,
+            metrics: self.metrics,
+            series: std::mem::take(&mut self.obs.series),
+            reference,
+        }
     }
 }
 

@@ -67,6 +67,8 @@ pub struct Metrics {
     /// (`solver = "cg"`; None for the direct solver).
     pub solver_iterations: Option<i64>,
     pub solver_iterations_max_step: Option<i64>,
+    /// Members of the lockstep group the run was stepped in (None: alone).
+    pub lockstep: Option<i64>,
     /// Part of the stepping time spent on observables and error norms (sampled estimate).
     pub observe_time_s: Option<f64>,
     /// Contact phases detected at every step ([`super::impacts`]); None if no step was observed.

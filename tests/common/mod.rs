@@ -168,6 +168,7 @@ pub fn run_sweep_text_at(path: &Path, text: &str) -> Vec<contact_sweep::run::Run
         &refs,
         &ExecOptions {
             threads: 2,
+            lockstep: ExecOptions::LOCKSTEP_DEFAULT,
             run: opts,
         },
         |r| {

@@ -177,6 +177,68 @@ impl SymMatrix {
         }
     }
 
+    /// The same matrix without its stored zeros off the diagonal, on a pattern of its own: for
+    /// products only (a vector mass matrix on the stiffness's pattern stores the zero coupling
+    /// of different components, half its entries in 2D). A product with it equals one with
+    /// `self` for finite vectors: the dropped terms are 0·x. `self` when the structure would
+    /// not be symmetric (it always is for an assembled symmetric matrix).
+    pub fn without_zeros(&self) -> SymMatrix {
+        let p = &*self.pattern;
+        let mut col_ptr = Vec::with_capacity(p.n + 1);
+        let (mut rows, mut values) = (Vec::new(), Vec::new());
+        col_ptr.push(0);
+        for j in 0..p.n {
+            for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                let i = p.row_idx[k];
+                if i == j || self.values[k] != 0.0 {
+                    rows.push(i);
+                    values.push(self.values[k]);
+                }
+            }
+            col_ptr.push(rows.len());
+        }
+        match Pattern::new(p.n, col_ptr, rows) {
+            Ok(pattern) => SymMatrix {
+                pattern: Arc::new(pattern),
+                values,
+            },
+            Err(_) => self.clone(),
+        }
+    }
+
+    /// y_m = A x_m for several vectors at once (at most 8), the matrix read once for all: the
+    /// products of a lockstep group. Each y_m gets exactly [`Self::matvec_into`]'s arithmetic
+    /// (the same order of summation), so a run's numbers do not depend on its group.
+    ///
+    /// # Panics
+    /// If more than 8 vectors are given, or a length is not n.
+    pub fn matvec_many_into(&self, xs: &[&[f64]], ys: &mut [&mut [f64]]) {
+        const MAX: usize = 8;
+        let p = &*self.pattern;
+        let k = xs.len();
+        assert!(k == ys.len() && k <= MAX, "matvec_many_into: 1–{MAX} pairs");
+        assert!(
+            xs.iter().all(|x| x.len() == p.n) && ys.iter().all(|y| y.len() == p.n),
+            "matvec_many_into: length vs n"
+        );
+        if k == 1 {
+            return self.matvec_into(xs[0], ys[0]);
+        }
+        for j in 0..p.n {
+            let (s, e) = (p.col_ptr[j], p.col_ptr[j + 1]);
+            // Accumulate from −0.0 as the iterator sum does (the additive identity of f64).
+            let mut acc = [-0.0f64; MAX];
+            for (&i, &v) in p.row_idx[s..e].iter().zip(&self.values[s..e]) {
+                for (a, x) in acc[..k].iter_mut().zip(xs) {
+                    *a += v * x[i];
+                }
+            }
+            for (y, a) in ys.iter_mut().zip(&acc[..k]) {
+                y[j] = *a;
+            }
+        }
+    }
+
     /// xᵀ A x.
     pub fn quad_form(&self, x: &[f64]) -> f64 {
         let p = &*self.pattern;

@@ -1,0 +1,266 @@
+//! Lockstep groups (issue 24): runs that share their step matrix A = M + cτ²K advance together,
+//! one multi-column solve per step.
+//!
+//! Why: a 2D/3D step is one forward and one backward triangular solve, which stream the whole
+//! Cholesky factor from memory; the engine is at that wall. With k right-hand sides the factor
+//! is read once for all k, so the time per right-hand side falls by several times (README's
+//! Performance table). Many runs of a sweep share A — the contact enters only through the
+//! condensed contact set: the members of a round-off ensemble, runs differing only in the gap,
+//! the initial velocity, γ at fixed β or T.
+//!
+//! Each member keeps its own state, contact solve, observer and outcome ([`Stepper`]); only the
+//! solve is shared. Column j of the block solve is member j's right-hand side, and each
+//! column's arithmetic is that of a single solve up to the blocking of the triangular kernels,
+//! so a member's numbers equal its run alone to round-off (tested to 1e-12). A member that
+//! fails, diverges or reaches its last step leaves the group; the others go on. Members whose
+//! factors are not the same shared object (a cache eviction between their setups) are stepped
+//! as separate groups: one solve must use one factor.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use super::{Factored, FeConfig, Stepper, methods};
+use crate::run::{Outcome, RunContext, RunOptions, Stop};
+use crate::space::step_solver::Solver;
+
+/// The key under which runs may share a lockstep group: equal keys mean the same step matrix
+/// and condensation (the geometry, mass, method, cτ², the direct solver; the gap where the
+/// method puts it into the operators). `None`: the run steps alone — the methods of SPEC §3.2
+/// (their own loops), CG runs (nothing factored to share), invalid schemes.
+pub fn lockstep_key(cfg: &FeConfig) -> Option<String> {
+    if methods::handles(cfg) || cfg.solver != Solver::Direct {
+        return None;
+    }
+    let (_, c, _) = cfg.coefficients().ok()?;
+    let c_tau2 = c * cfg.dt * cfg.dt;
+    Some(format!(
+        "{}|{:?}|{:?}|{:e}|gap {:e}",
+        super::geometry_key(&cfg.setup),
+        cfg.mass,
+        cfg.method,
+        c_tau2,
+        if cfg.method == crate::space::ContactMethod::Mixed {
+            0.0
+        } else {
+            cfg.setup.gap
+        }
+    ))
+}
+
+/// Run `cfgs` (which share a [`lockstep_key`]) in lockstep, each with its context; the
+/// outcomes in the order of `cfgs`. The caller times the whole group; each member's
+/// `stepping_time_s` is the group's stepping time divided among the members.
+pub fn simulate_group(cfgs: &[&FeConfig], opts: &RunOptions, ctxs: &[RunContext]) -> Vec<Outcome> {
+    assert_eq!(cfgs.len(), ctxs.len(), "one context per member");
+    let mut outcomes: Vec<Option<Outcome>> = vec![None; cfgs.len()];
+    // Members set up, by their shared factor.
+    let mut groups: Vec<Vec<(usize, Stepper)>> = Vec::new();
+    for (i, (cfg, ctx)) in cfgs.iter().zip(ctxs).enumerate() {
+        if methods::handles(cfg) {
+            outcomes[i] = Some(super::simulate(cfg, opts, ctx));
+            continue;
+        }
+        match Stepper::new(cfg, opts, ctx) {
+            Err(out) => outcomes[i] = Some(*out),
+            Ok(s) => match groups.iter_mut().find(|g| Arc::ptr_eq(&g[0].1.fac, &s.fac)) {
+                Some(g) => g.push((i, s)),
+                None => groups.push(vec![(i, s)]),
+            },
+        }
+    }
+    for group in groups {
+        for (i, out) in step_together(group) {
+            outcomes[i] = Some(out);
+        }
+    }
+    outcomes
+        .into_iter()
+        .map(|o| o.expect("every member has an outcome"))
+        .collect()
+}
+
+/// Most vectors of one joint product with M (accumulators kept in registers).
+const MASS_CHUNK: usize = 8;
+
+/// The time loop of runs sharing one factor (a run alone is a group of one). Per step: each
+/// member's right-hand side; one solve for all (alone: the member's own work, so CG
+/// warm-starts); each member's contact problem; u^{n+1} = y + cτ²Zλ with each column of Z read
+/// once for all; each member's acceleration; the products with M, the matrix read once per
+/// [`MASS_CHUNK`] vectors; each member's updates and observation. The shared operations do, for
+/// each member, exactly the arithmetic of its run alone (same order of summation); only the
+/// blocked triangular solves may round differently.
+pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Outcome)> {
+    let members = active.len();
+    let mut finished = Vec::with_capacity(members);
+    if members == 0 {
+        return finished;
+    }
+    let fac: Arc<Factored> = Arc::clone(&active[0].1.fac);
+    let n = fac.chol.n();
+    let nz = fac.z.len().checked_div(n).unwrap_or(0);
+    let c_tau2 = active[0].1.c_tau2;
+    let mut block = if members > 1 {
+        vec![0.0; n * members]
+    } else {
+        Vec::new()
+    };
+    let mut work = (members > 1).then(|| fac.chol.work_for(members));
+    let loop_start = Instant::now();
+    // A member that stops leaves with its outcome; the order of the others is kept.
+    let leave = |active: &mut Vec<(usize, Stepper)>,
+                 finished: &mut Vec<(usize, Outcome)>,
+                 j: usize,
+                 stop: Result<(), Stop<String>>| {
+        let (idx, s) = active.remove(j);
+        finished.push((idx, s.finish(stop)));
+    };
+    // Step 0's observation; a member may already diverge there.
+    let mut j = 0;
+    while j < active.len() {
+        active[j].1.loop_start = loop_start;
+        match active[j].1.observe(0) {
+            Ok(()) => j += 1,
+            Err(d) => leave(&mut active, &mut finished, j, Err(Stop::Diverged(d))),
+        }
+    }
+    let last = active.iter().map(|(_, s)| s.cfg.steps).max().unwrap_or(0);
+    for step in 1..=last {
+        // Members past their last step leave with their whole run done.
+        let mut j = 0;
+        while j < active.len() {
+            if active[j].1.cfg.steps < step {
+                leave(&mut active, &mut finished, j, Ok(()));
+            } else {
+                j += 1;
+            }
+        }
+        let k = active.len();
+        if k == 0 {
+            break;
+        }
+        for (_, s) in active.iter_mut() {
+            s.prepare();
+        }
+        // The solve. The direct solve cannot fail; CG's failure is the member's (alone).
+        if let (Some(work), true) = (work.as_mut(), k > 1) {
+            for (j, (_, s)) in active.iter().enumerate() {
+                block[j * n..(j + 1) * n].copy_from_slice(&s.y);
+            }
+            fac.chol.solve_many_in_place(&mut block[..k * n], k, work);
+            let failed = work.check().err().map(|e| e.to_string());
+            for (j, (_, s)) in active.iter_mut().enumerate() {
+                s.y.copy_from_slice(&block[j * n..(j + 1) * n]);
+            }
+            if let Some(e) = failed {
+                while !active.is_empty() {
+                    leave(
+                        &mut active,
+                        &mut finished,
+                        0,
+                        Err(Stop::Solver(step, e.clone())),
+                    );
+                }
+                break;
+            }
+        } else {
+            let mut j = 0;
+            while j < active.len() {
+                let s = &mut active[j].1;
+                fac.chol.solve_in_place(&mut s.y, &mut s.work);
+                match s.work.check() {
+                    Ok(()) => j += 1,
+                    Err(e) => leave(
+                        &mut active,
+                        &mut finished,
+                        j,
+                        Err(Stop::Solver(step, e.to_string())),
+                    ),
+                }
+            }
+        }
+        let mut j = 0;
+        while j < active.len() {
+            match active[j].1.contact(step) {
+                Ok(()) => j += 1,
+                Err(stop) => leave(&mut active, &mut finished, j, Err(stop)),
+            }
+        }
+        add_contact(&fac, c_tau2, nz, &mut active);
+        for (_, s) in active.iter_mut() {
+            s.accelerate();
+        }
+        mass_products(&fac, &mut active);
+        let mut j = 0;
+        while j < active.len() {
+            match active[j].1.end_step(step) {
+                Ok(()) => j += 1,
+                Err(stop) => leave(&mut active, &mut finished, j, Err(stop)),
+            }
+        }
+    }
+    for (idx, s) in active {
+        finished.push((idx, s.finish(Ok(()))));
+    }
+    if members > 1 {
+        let share = loop_start.elapsed().as_secs_f64() / members as f64;
+        for (_, out) in &mut finished {
+            out.metrics.stepping_time_s = Some(share);
+        }
+    }
+    finished
+}
+
+/// Rows per tile of [`add_contact`]: 8 members' tiles of y and one of z_c (9 × 16 KiB) stay in
+/// the L2 cache while the tile's columns are added.
+const TILE: usize = 2048;
+
+/// u^{n+1} = y + cτ² Σ_{λ_c > 0} λ_c z_c for every member, by tiles of rows: each tile of a
+/// column z_c is read once for all members while their tiles of y stay in cache (column by
+/// column over the whole vectors, a group of 8 would stream its y's from memory once per
+/// column). Each entry of y receives the columns' terms in ascending c, as in the run alone.
+fn add_contact(fac: &Factored, c_tau2: f64, nz: usize, active: &mut [(usize, Stepper)]) {
+    let n = fac.chol.n();
+    let touched = active
+        .iter()
+        .any(|(_, s)| s.lambda.iter().any(|&l| l > 0.0));
+    if !touched {
+        return;
+    }
+    for lo in (0..n).step_by(TILE) {
+        let hi = (lo + TILE).min(n);
+        for c in 0..nz {
+            let zc = &fac.z[c * n + lo..c * n + hi];
+            for (_, s) in active.iter_mut() {
+                let l = s.lambda[c];
+                if l > 0.0 {
+                    let f = c_tau2 * l;
+                    for (yi, zi) in s.y[lo..hi].iter_mut().zip(zc) {
+                        *yi += f * zi;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Every member's products with M ([`Stepper::mass_pairs`]), [`MASS_CHUNK`] vectors per pass
+/// over the matrix; no allocation (the pairs live in arrays on the stack).
+fn mass_products(fac: &Factored, active: &mut [(usize, Stepper)]) {
+    let mut xs: [&[f64]; MASS_CHUNK] = [&[]; MASS_CHUNK];
+    let mut ys: [&mut [f64]; MASS_CHUNK] = Default::default();
+    let mut c = 0;
+    for (_, s) in active.iter_mut() {
+        for (x, y) in s.mass_pairs().into_iter().flatten() {
+            if c == MASS_CHUNK {
+                fac.m_products.matvec_many_into(&xs[..c], &mut ys[..c]);
+                c = 0;
+            }
+            xs[c] = x;
+            ys[c] = y;
+            c += 1;
+        }
+    }
+    if c > 0 {
+        fac.m_products.matvec_many_into(&xs[..c], &mut ys[..c]);
+    }
+}
