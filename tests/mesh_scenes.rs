@@ -233,3 +233,185 @@ fn a_mesh_run_above_the_memory_budget_is_refused_towards_a_coarser_file() {
     };
     assert_eq!(expand_with(&sweep, &ok).unwrap().runs.len(), 1);
 }
+
+/// References on another mesh (SPEC §1.6, issue 22 done-when 3's second half on the mesh
+/// scenes): the Gmsh bar `bar2d_quad.msh` (h = 0.05) measured against a finer mesh *file*
+/// (`bar2d_quad_n4.msh`, h = 0.025: a mesh2d reference, located node by node) and against a
+/// `bar2d` reference (`reference = { scene = "bar2d", … }`: the box stored whole, located)
+/// gives the errors bar2d's own runs get from the same reference node for node (nested
+/// lattice, stride 2). Every coarse node is a node of the finer mesh, so the interpolation is
+/// exact there and only round-off separates the paths.
+#[test]
+fn references_on_another_mesh_file_or_on_bar2d_equal_the_nested_path() {
+    let methods = "[fixed]\nT = 2.0\ndt = 0.025\n[grid]\nmass = [\"consistent\", \"mod3\"]\nscheme = [\"crank-nicolson\"]\n";
+    let bar = run(&format!(
+        "name = \"b\"\nscene = \"bar2d\"\nreference = {{ h = 0.025, dt = 0.0125, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n{methods}h = [0.05]\n"
+    ));
+    let file = run(&format!(
+        "name = \"f\"\nscene = \"mesh2d\"\nreference = {{ mesh = \"meshes/bar2d_quad_n4.msh\", dt = 0.0125, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n{methods}mesh = [\"meshes/bar2d_quad.msh\"]\nvelocity = [-0.5]\n"
+    ));
+    let scene = run(&format!(
+        "name = \"s\"\nscene = \"mesh2d\"\nreference = {{ scene = \"bar2d\", h = 0.025, dt = 0.0125, mass = \"mod3\", scheme = \"crank-nicolson\" }}\n{methods}mesh = [\"meshes/bar2d_quad.msh\"]\nvelocity = [-0.5]\n"
+    ));
+    assert_eq!(bar.len(), 2);
+    let mut worst = (0.0f64, String::new());
+    for (what, rows) in [("mesh file", &file), ("bar2d scene", &scene)] {
+        assert_eq!(rows.len(), bar.len(), "{what}");
+        for (b, m) in bar.iter().zip(rows) {
+            assert_eq!(b.status, "ok", "{:?}", b.message);
+            assert_eq!(m.status, "ok", "{what}: {:?}", m.message);
+            assert_eq!(b.mass, m.mass);
+            for ((name, x), (_, y)) in columns(b).into_iter().zip(columns(m)) {
+                let (Some(x), Some(y)) = (x, y) else {
+                    assert_eq!(x.is_some(), y.is_some(), "{what} {} {name}", b.mass);
+                    continue;
+                };
+                let d = (x - y).abs();
+                println!("{what} {} {name}: {x:e} vs {y:e} diff {d:e}", b.mass);
+                if d > worst.0 {
+                    worst = (d, format!("{what} {} {name}: {x:e} vs {y:e}", b.mass));
+                }
+            }
+            // The errors exist (the reference was found and read), and are not zero.
+            assert!(m.err_u_l2l2.is_some_and(|e| e > 1e-6), "{what} {}", m.mass);
+        }
+    }
+    // As `gmsh_bar_reproduces_bar2d`: the same equations with other dof numberings round
+    // differently and the impacts carry it; the located weights are 1 at a coincident node to
+    // ~1e-16 (Newton on the inverse map of a square). 1e-10 is the issue's bound for the
+    // node-for-node comparison.
+    println!("worst: {worst:?}");
+    assert!(worst.0 < 1e-10, "{worst:?}");
+}
+
+/// A reference of another scene must be the run's problem: bar2d's initial velocity is −½,
+/// a mesh run left at `velocity = 0` is refused, naming the difference; a 3D scene cannot be
+/// the reference of a 2D mesh, nor can a built-in scene take a reference of another scene.
+#[test]
+fn a_reference_of_another_scene_is_checked() {
+    use contact_sweep::sweep::{SweepFile, expand};
+    let path = root().join("sweeps/x.toml");
+    let text = |scene: &str, reference: &str, extra: &str| {
+        format!(
+            "name = \"m\"\nscene = \"{scene}\"\nreference = {{ {reference} }}\n[fixed]\ndt = 0.025\n{extra}"
+        )
+    };
+    let mesh = "mesh = \"meshes/bar2d_tri_n2.msh\"\n";
+    let sweep = SweepFile::parse(
+        &path,
+        &text("mesh2d", "scene = \"bar2d\", h = 0.025, dt = 0.0125", mesh),
+    )
+    .unwrap();
+    let e = expand(&sweep)
+        .expect_err("velocity 0 against −½")
+        .to_string();
+    assert!(
+        e.contains("reference.scene")
+            && e.contains("velocity = 0 in the run, -0.5 in the reference"),
+        "{e}"
+    );
+    let ok = SweepFile::parse(
+        &path,
+        &text(
+            "mesh2d",
+            "scene = \"bar2d\", h = 0.025, dt = 0.0125",
+            &format!("{mesh}velocity = -0.5\n"),
+        ),
+    )
+    .unwrap();
+    let plan = expand(&ok).unwrap();
+    assert_eq!(plan.references.len(), 1);
+    assert!(plan.references[0].spec.label.contains("bar2d"));
+    assert_eq!(plan.references[0].space_stride, 1);
+    // Another dimension, and a built-in scene's sweep: refused when the file is read.
+    let e = SweepFile::parse(&path, &text("mesh2d", "scene = \"bar3d\", h = 0.025", mesh))
+        .expect_err("3D reference of a 2D mesh")
+        .to_string();
+    assert!(
+        e.contains("reference.scene") && e.contains("same dimension"),
+        "{e}"
+    );
+    let e = SweepFile::parse(
+        &path,
+        &text("bar2d", "scene = \"mesh2d\", dt = 0.0125", "h = 0.05\n"),
+    )
+    .expect_err("bar2d against a mesh scene")
+    .to_string();
+    assert!(
+        e.contains("reference.scene") && e.contains("is for runs on a mesh file"),
+        "{e}"
+    );
+}
+
+/// Issue 22 done-when 2, second half: the 002 bar meshed with P1 triangles at three sizes
+/// (`sweeps/bar2d_triangles.toml`: N × 10N squares cut in two, N = 2, 4, 8, τ = 0.05/N) against
+/// the bar2d reference of `bar2d_convergence.toml` (Q1 at h = 0.05/32, τ/32, mod3 + CN, a run
+/// of scene bar2d located node by node). Measured (README "The 002 bar in triangles"), LSQ
+/// slopes in h over the three levels, with bar2d's own on the same ladder in brackets:
+/// l2(τ;L2) mod1 0.85 [0.83], mod2 0.80 [0.82], mod3 0.71 [0.91]; l2(τ;H1) stagnates for both
+/// element kinds (|slope| ≤ 0.06 here, ≤ 0.15 for bar2d) — the impact's velocity jump.
+#[test]
+fn triangles_converge_to_the_bar2d_reference() {
+    let path = root().join("sweeps/bar2d_triangles.toml");
+    let rows = run_sweep_text_at(&path, &std::fs::read_to_string(&path).unwrap());
+    assert_eq!(rows.len(), 12);
+    let slope = |mass: &str, err: fn(&RunRecord) -> Option<f64>| {
+        let mut pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.mass == mass)
+            .map(|r| {
+                assert_eq!(r.status, "ok", "{mass}: {:?}", r.message);
+                (
+                    r.h.ln(),
+                    err(r).expect("an error against the reference").ln(),
+                )
+            })
+            .collect();
+        assert_eq!(pts.len(), 3, "{mass}");
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let n = pts.len() as f64;
+        let (mx, my) = (
+            pts.iter().map(|p| p.0).sum::<f64>() / n,
+            pts.iter().map(|p| p.1).sum::<f64>() / n,
+        );
+        pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+            / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>()
+    };
+    // The massless-Γ_C masses are well-posed: their runs reproduce to round-off (the two
+    // numberings of `gmsh_bar_reproduces_bar2d` differ by 1e-10 in an error of ~1e-3), which
+    // moves a slope by ~1e-7; 0.02 leaves room for another faer or compiler and still
+    // separates the triangles' mod3 (0.71) from bar2d's (0.91).
+    for (mass, l2) in [("mod1", 0.847), ("mod2", 0.796), ("mod3", 0.709)] {
+        let s = slope(mass, |r| r.err_u_l2l2);
+        println!("{mass}: l2(τ;L2) slope {s:.4}");
+        assert!((s - l2).abs() < 0.02, "{mass}: L2 slope {s}, measured {l2}");
+        // H1 does not converge at these sizes, as for bar2d (README): measured −0.04 … 0.05.
+        let s1 = slope(mass, |r| r.err_u_l2h1);
+        println!("{mass}: l2(τ;H1) slope {s1:.4}");
+        assert!(s1.abs() < 0.1, "{mass}: H1 slope {s1}");
+    }
+    // The finest level's L2 error against bar2d's at h = 0.0125 (README): the triangles' is
+    // larger by 6 % (mod1), 9 % (mod2), 54 % (mod3) — one order, the same reference.
+    let finest = |mass: &str| {
+        rows.iter()
+            .filter(|r| r.mass == mass)
+            .map(|r| r.err_u_l2l2.unwrap())
+            .fold(f64::INFINITY, f64::min)
+    };
+    for (mass, bar2d) in [
+        ("mod1", 9.9305e-4),
+        ("mod2", 8.9475e-4),
+        ("mod3", 3.7831e-4),
+    ] {
+        let ratio = finest(mass) / bar2d;
+        println!(
+            "{mass}: finest L2 {:.4e}, {ratio:.3} × bar2d's",
+            finest(mass)
+        );
+        assert!((1.0..1.6).contains(&ratio), "{mass}: {ratio}");
+    }
+    // The consistent mass with CN is ill-posed (SPEC §2.1): no convergence in L2 (measured
+    // slope −0.01; bar2d's 0.25), energy growing (E(T)/E⁰ 1.98 → 4.93).
+    let s = slope("consistent", |r| r.err_u_l2l2);
+    assert!(s < 0.3, "consistent: L2 slope {s}");
+}

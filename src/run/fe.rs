@@ -26,8 +26,10 @@
 //!
 //! Errors against a reference run (nested mesh and step): e^n = u^n − I_h u_ref(t^n) at the
 //! coarse nodes, ‖e‖²_L2 = eᵀ G e with the unweighted Gram matrix, H1 = L2 + eᵀ D e with
-//! D = ∫∇e:∇e (SPEC §1.2). The disc/ball's references share the run's mesh (a finer step
-//! only; its mapped meshes of different sizes are not nested, [`ball_ref_map`]).
+//! D = ∫∇e:∇e (SPEC §1.2). The disc/ball's and the mesh files' references may be on another
+//! mesh (the mapped meshes of different sizes are not nested; another mesh file; the bars' box
+//! for a mesh file of the bar): the reference's function is interpolated at the run's nodes
+//! ([`ball_ref_map`]).
 //!
 //! Observables per step (SPEC §1.3): the parts ½vᵀMv, ½uᵀKu, −Fᵀu of E^h, the lowest Γ_C
 //! node's u_d (disc/ball), and the penetration max (u_n − g)_+ = max(−u_d − g)_+ over the Γ_C
@@ -1174,27 +1176,40 @@ fn ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<Re
     })
 }
 
-/// The disc/ball against its reference. On the run's own mesh (a finer step only) the stored
-/// dofs are the run's, read one to one. On another mesh — the mapped meshes of two sizes are
-/// not nested: n_t = 2·round(πR/(4h)) and n_r = round((R − a)/h) give (8, 3), (16, 5),
-/// (32, 10) at h = 4, 2, 1 — each run node is located in the reference's stored mesh and the
+/// The disc/ball or a mesh file's run against its reference. On the run's own mesh (a finer
+/// step only) the stored dofs are the run's, read one to one. On another mesh — the mapped
+/// meshes of two sizes are not nested: n_t = 2·round(πR/(4h)) and n_r = round((R − a)/h) give
+/// (8, 3), (16, 5), (32, 10) at h = 4, 2, 1; another mesh file; the bars' box meshed by a mesh
+/// file (SPEC §1.6) — each run node is located in the reference's stored mesh and the
 /// reference's finite-element function is evaluated there ([`Interpolation`]).
 fn ball_ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Result<RefMap, String> {
-    // The reference stores every free dof (`record_lattice`): n_free/d "nodes" (a mesh file's
-    // clamped nodes have every component fixed, so this is a whole number).
+    // The reference stores every node of its mesh, node-major (`record_lattice`; a mesh
+    // file's clamped nodes as zeros, a box's at stride 1 in its lattice order = node order).
     let d = g.mesh.dim();
-    let nodes = g.dofs.n_free() / d;
-    let same_mesh = data.h == cfg.setup.h && data.lattice == [nodes, 1, 1];
+    let mesh = g.mesh.mesh();
+    let nodes = mesh.num_nodes();
+    let same_mesh = data.h == cfg.setup.h
+        && data.lattice == [nodes, 1, 1]
+        && data.mesh.as_ref().is_none_or(|m| {
+            m.dim == d
+                && m.nodes_per_element == mesh.nodes_per_element()
+                && m.coords.len() == nodes
+                && (0..nodes).all(|n| m.coords[n] == mesh.coord(n))
+                && (0..mesh.num_elements()).all(|e| m.element_nodes(e) == mesh.element_nodes(e))
+        });
     // Interpolating reads the reference's dofs by node (rn·d + component): every node of its
-    // stored mesh must be stored, i.e. nothing clamped (the disc and ball).
+    // stored mesh must be stored.
     let interpolable = data
         .mesh
         .as_ref()
-        .is_some_and(|m| data.lattice == [m.coords.len(), 1, 1]);
+        .is_some_and(|m| data.lattice.iter().product::<usize>() == m.coords.len());
     if data.space_stride != 1 || (!same_mesh && !interpolable) {
         return Err(format!(
-            "scene {}: the reference (h = {}, {} stored nodes) is on another mesh than the run's (h = {}, {nodes} free nodes) and cannot be interpolated: it does not store its mesh (written by an older version: remove DIR/references/ to record it again) or has clamped nodes (mesh files: the reference must use the run's mesh, a finer step only)",
-            cfg.setup.scene, data.h, data.lattice[0], cfg.setup.h
+            "scene {}: the reference (h = {}, {} stored nodes) is on another mesh than the run's (h = {}, {nodes} nodes) and cannot be interpolated: it does not store its whole mesh (written by an older version: remove DIR/references/ to record it again)",
+            cfg.setup.scene,
+            data.h,
+            data.lattice.iter().product::<usize>(),
+            cfg.setup.h
         ));
     }
     let q = cfg.dt / data.dt;
@@ -1214,23 +1229,24 @@ fn ball_ref_map(g: &Geometry, cfg: &FeConfig, data: &Arc<ReferenceData>) -> Resu
         ));
     }
     let interp = match (&data.mesh, same_mesh) {
-        (Some(mesh), false) => {
+        (Some(ref_mesh), false) => {
             let key = format!(
                 "{}|{:p}|{:e}|{}|{}",
                 geometry_key(&cfg.setup),
                 Arc::as_ptr(data),
                 data.h,
                 data.times,
-                mesh.coords.len()
+                ref_mesh.coords.len()
             );
-            let (ip, _) = INTERPOLATIONS.get(key, || interpolation(g, mesh));
+            let (ip, _) = INTERPOLATIONS.get(key, || interpolation(g, ref_mesh));
             Some(ip.map_err(|e| format!("scene {}: {e}", cfg.setup.scene))?)
         }
         _ => None,
     };
     Ok(RefMap {
         data: Arc::clone(data),
-        dof_offset: (0..g.dofs.n_free()).collect(),
+        // On the same mesh: free dof i is global dof free[i] = node·d + component.
+        dof_offset: g.dofs.free.clone(),
         interp,
         time_ratio: rt,
     })
@@ -1270,7 +1286,8 @@ fn interpolation(g: &Geometry, reference: &PlainMesh) -> Result<Interpolation, S
 
 /// The stored slots (a reduced dof or none, per lattice node and component) and the lattice of
 /// a reference run: every `space_stride`-th node of the bars' box, or every node of the
-/// disc/ball (stride 1 only: its meshes are not nested, [`ball_ref_map`]).
+/// disc/ball or mesh file, clamped ones included (stride 1 only: its meshes are not nested,
+/// [`ball_ref_map`]).
 fn record_lattice(
     g: &Geometry,
     cfg: &FeConfig,
@@ -1284,8 +1301,13 @@ fn record_lattice(
                 cfg.setup.scene
             ));
         }
-        let n = g.dofs.n_free();
-        return Ok(((0..n).map(Some).collect(), [n / d, 1, 1]));
+        // Node-major over every node: a run on another mesh reads the reference by node
+        // ([`interpolation`]); a clamped dof (mesh files) has no slot and is stored as 0.
+        let n = g.mesh.mesh().num_nodes() * d;
+        return Ok((
+            (0..n).map(|gd| g.dofs.free_index(gd)).collect(),
+            [n / d, 1, 1],
+        ));
     };
     let lattice = [0, 1, 2].map(|ax| {
         if ax < d {
@@ -1310,7 +1332,9 @@ fn record_lattice(
 
 /// The reference this run records, if it is one: the slots of its stored lattice and the empty
 /// data. Meshes that are not nested store themselves: a coarser run locates its nodes in this
-/// one ([`ball_ref_map`]).
+/// one ([`ball_ref_map`]). So does the bars' box stored whole (stride 1: its lattice is its
+/// node numbering), for the runs on a mesh file of the same bar (SPEC §1.6); a nested bar run
+/// still reads it node for node.
 #[allow(clippy::type_complexity)]
 fn reference_record(
     g: &Geometry,
@@ -1322,10 +1346,7 @@ fn reference_record(
     };
     let (slots, lattice) = record_lattice(g, cfg, space_stride)?;
     let times = cfg.steps / time_stride + 1;
-    let mesh = g
-        .mesh
-        .as_box()
-        .is_none()
+    let mesh = (g.mesh.as_box().is_none() || space_stride == 1)
         .then(|| PlainMesh::from_mesh(g.mesh.mesh()));
     let data = ReferenceData::new(
         g.mesh.dim(),

@@ -4,10 +4,11 @@
 //! reads its own nodes and times from it (nested meshes: every coarse node is a reference node,
 //! every coarse time a reference time, so I_h u_ref is a plain lookup).
 //!
-//! Meshes that are not nested (the disc and ball's mapped meshes of two sizes, SPEC §1.6) store
-//! every node (`space_stride` 1) and the mesh itself ([`ReferenceData::mesh`]): a coarse run
-//! locates its nodes in it and evaluates the reference's finite-element function there
-//! ([`crate::space::fe::locate`]).
+//! Meshes that are not nested (the disc and ball's mapped meshes of two sizes, mesh files, SPEC
+//! §1.6) store every node (`space_stride` 1; a mesh file's clamped nodes as zeros) and the mesh
+//! itself ([`ReferenceData::mesh`]): a coarse run locates its nodes in it and evaluates the
+//! reference's finite-element function there ([`crate::space::fe::locate`]). The bars' box
+//! stored at stride 1 keeps its mesh too, for the runs on a mesh file of the same bar.
 //!
 //! On disk (`DIR/references/<run_id>.ref`): a JSON header line, then the values as
 //! little-endian f64 — the file is written to a temporary name, fsynced and renamed, so it is

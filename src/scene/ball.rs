@@ -69,6 +69,9 @@ const BALL_PHYSICS: [PhysicsKey; 6] = [
 ];
 
 impl Scene for BallScene {
+    fn fe_dim(&self) -> Option<usize> {
+        Some(self.dim)
+    }
     fn name(&self) -> &'static str {
         if self.dim == 2 { "disc2d" } else { "sphere3d" }
     }

@@ -125,6 +125,9 @@ impl BarScene {
 }
 
 impl Scene for BarScene {
+    fn fe_dim(&self) -> Option<usize> {
+        Some(self.dim)
+    }
     fn name(&self) -> &'static str {
         if self.dim == 2 { "bar2d" } else { "bar3d" }
     }

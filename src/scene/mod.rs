@@ -117,6 +117,12 @@ pub trait Scene: Send + Sync {
     fn nested_meshes(&self) -> bool {
         true
     }
+    /// The dimension of a finite-element body in 2D/3D (the bars, the disc/ball, the mesh
+    /// files), None for the others: a mesh file's run may take its reference from another
+    /// scene of the same dimension (SPEC §1.6, `reference = { scene = … }`).
+    fn fe_dim(&self) -> Option<usize> {
+        None
+    }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
     /// Whether the body comes from a mesh file (the `mesh` key, SPEC §1.6) rather than from

@@ -207,6 +207,10 @@ pub struct SweepFile {
     /// `reference = {…}`: the parameters that turn each run into its reference run (SPEC §7;
     /// scenes without a closed form).
     pub reference: Option<Vec<Entry>>,
+    /// `reference = { scene = "bar2d", … }`: the reference is a run of another scene (a mesh
+    /// file's body measured against the built-in scene it meshes, SPEC §1.6); None: the
+    /// sweep's own scene.
+    pub reference_scene: Option<SceneKind>,
     /// `[search]`: a boundary to find by bisection for every method of the grid.
     pub search: Option<Search>,
     /// `allow_unstable = true`: an explicit scheme beyond its CFL limit runs (and ends
@@ -473,6 +477,50 @@ impl Checker {
             items: alts,
         })
     }
+}
+
+/// The scene named by `reference = { scene = NAME, … }` in a sweep of scene `own`: the same
+/// scene, or — for a body from a mesh file (SPEC §1.6) — a finite-element scene of the same
+/// dimension whose errors come from a reference run (the built-in bar or disc/ball the file
+/// meshes): the run's nodes are located in the reference's mesh. Other pairs have no common
+/// body to compare.
+fn reference_scene_of(own: SceneKind, name: &str) -> Result<SceneKind, String> {
+    let kind = match SceneKind::NAMES.iter().find(|(n, _)| *n == name) {
+        Some((_, Some(kind))) => *kind,
+        Some((_, None)) => {
+            return Err(format!(
+                "scene `{name}` is specified (SPEC §1) but not implemented in this version"
+            ));
+        }
+        None => {
+            return Err(format!(
+                "unknown scene `{name}` (expected one of {})",
+                SceneKind::NAMES.map(|(n, _)| n).join(", ")
+            ));
+        }
+    };
+    if kind == own {
+        return Ok(kind);
+    }
+    if !own.get().takes_mesh_file() {
+        return Err(format!(
+            "a reference of another scene ({name}) is for runs on a mesh file (mesh2d, mesh3d); scene {} is measured against its own",
+            own.name()
+        ));
+    }
+    let dim = own.get().fe_dim();
+    if kind.get().fe_dim() != dim {
+        let fits: Vec<&str> = SceneKind::NAMES
+            .iter()
+            .filter_map(|(n, k)| k.filter(|k| k.get().fe_dim() == dim).map(|_| *n))
+            .collect();
+        return Err(format!(
+            "scene {name} cannot be the reference of scene {}: a finite-element scene of the same dimension is needed ({})",
+            own.name(),
+            fits.join(", ")
+        ));
+    }
+    Ok(kind)
 }
 
 /// Whether `scene` accepts `key`: every discretisation and method key, and its own physics.
@@ -813,6 +861,7 @@ impl SweepFile {
             None => SummaryOptions::default(),
         };
         let mut reference = None;
+        let mut reference_scene = None;
         if let Some((_, line, node)) = get("reference") {
             let uses_reference = ck.scene.map(|s| {
                 let scene = s.get();
@@ -835,7 +884,40 @@ impl SweepFile {
                     ),
                 ),
                 (Kind::Table(t), _) if !t.is_empty() => {
-                    reference = Some(ck.bundle(t, "reference"));
+                    // `scene` names the reference's scene; the other keys are that scene's
+                    // parameters, checked against it rather than against the sweep's.
+                    let (scene_entries, rest): (Vec<_>, Vec<_>) =
+                        t.iter().cloned().partition(|(k, _, _)| k == "scene");
+                    if let Some((_, sl, node)) = scene_entries.first() {
+                        match (&node.kind, ck.scene) {
+                            (Kind::Str(name), Some(own)) => {
+                                match reference_scene_of(own, name) {
+                                    Ok(kind) => reference_scene = Some(kind),
+                                    Err(why) => ck.issue("reference.scene", *sl, why),
+                                }
+                            }
+                            (Kind::Str(_), None) => {}
+                            (k, _) => ck.issue(
+                                "reference.scene",
+                                *sl,
+                                format!("expected a scene name, found a {}", k.type_name()),
+                            ),
+                        }
+                    }
+                    let own = ck.scene;
+                    if reference_scene.is_some() {
+                        ck.scene = reference_scene;
+                    }
+                    let entries = ck.bundle(&rest, "reference");
+                    ck.scene = own;
+                    if !scene_entries.is_empty() && rest.is_empty() {
+                        ck.issue(
+                            "reference",
+                            *line,
+                            "a reference of another scene needs its mesh and step (h or elements, dt or courant)",
+                        );
+                    }
+                    reference = Some(entries);
                 }
                 (k, _) => ck.issue(
                     "reference",
@@ -942,6 +1024,7 @@ impl SweepFile {
                 series_every,
                 overridden,
                 reference,
+                reference_scene,
                 search,
                 allow_unstable,
                 summary,

@@ -871,7 +871,14 @@ fn gcd(a: usize, b: usize) -> usize {
 /// The reference run of one combination: its entries overridden by `reference = {…}` (keys not
 /// given are the run's; a reference giving h or elements replaces both, likewise dt or
 /// courant). Returns the reference's spec and the run's (space, time) refinement ratios; the
-/// reference must be nested: h_run/h_ref and dt_run/dt_ref whole numbers, and last as long.
+/// reference must be nested in time (dt_run/dt_ref whole) and last as long; in space nested
+/// (h_run/h_ref whole) where the scene's meshes are, otherwise at least as fine, stored whole
+/// and interpolated at the run's nodes (SPEC §1.6).
+///
+/// `reference = { scene = …, … }` (a mesh file's body against the built-in scene it meshes):
+/// the reference is resolved as a run of that scene, with the run's keys that scene accepts
+/// (not `mesh` nor `velocity`); its physics (density, Lamé constants, gap, gravity, initial
+/// velocity) must be the run's, or the errors would compare two problems.
 fn reference_of(
     sweep: &SweepFile,
     limits: &PlanLimits,
@@ -891,8 +898,13 @@ fn reference_of(
                 || over.iter().any(|o| o.key == e.key))
         })
         .collect();
+    let ref_scene = sweep.reference_scene.unwrap_or(sweep.scene);
+    let other_scene = ref_scene != sweep.scene;
+    if other_scene {
+        combined.retain(|e| super::accepted(ref_scene, e.key));
+    }
     combined.extend(over.iter());
-    let at = |keys: [Key; 2]| {
+    let at = |keys: &[Key]| {
         over.iter()
             .find(|e| keys.contains(&e.key))
             .map(|e| e.origin.clone())
@@ -901,11 +913,11 @@ fn reference_of(
                 line: None,
             })
     };
-    let r = match resolve(sweep_dir(sweep), sweep.scene, &combined, false, limits) {
+    let r = match resolve(sweep_dir(sweep), ref_scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
-                &at(mesh_keys),
+                &at(&[Key::H, Key::Elements, Key::Mesh]),
                 format!("the reference run is meaningless: {why}"),
             )]);
         }
@@ -919,18 +931,34 @@ fn reference_of(
                 .collect());
         }
     };
-    if r.canonical.get(&Key::Mesh) != run.canonical.get(&Key::Mesh) {
-        return Err(vec![Issue::at(
-            &over
-                .iter()
-                .find(|e| e.key == Key::Mesh)
-                .map(|e| e.origin.clone())
-                .unwrap_or(Origin {
-                    path: "reference".into(),
+    if other_scene && let (RunConfig::Fe(a), RunConfig::Fe(b)) = (&run.config, &r.config) {
+        let (a, b) = (&a.setup, &b.setup);
+        let differ: Vec<String> = [
+            ("density", a.density, b.density),
+            ("lame_lambda", a.lame_lambda, b.lame_lambda),
+            ("lame_mu", a.lame_mu, b.lame_mu),
+            ("gap", a.gap, b.gap),
+            ("gravity", a.gravity, b.gravity),
+            ("velocity", a.v0, b.v0),
+        ]
+        .into_iter()
+        .filter(|(_, x, y)| (x - y).abs() > 1e-12 * x.abs().max(y.abs()))
+        .map(|(name, x, y)| format!("{name} = {x} in the run, {y} in the reference"))
+        .collect();
+        if !differ.is_empty() {
+            return Err(vec![Issue::at(
+                &Origin {
+                    path: "reference.scene".into(),
                     line: None,
-                }),
-            "the reference run must use the run's mesh file (a finer dt): references on another mesh need point location in it, not implemented yet".to_string(),
-        )]);
+                },
+                format!(
+                    "the reference (scene {}) is another problem than the run (scene {}): {}",
+                    ref_scene.name(),
+                    sweep.scene.name(),
+                    differ.join(", ")
+                ),
+            )]);
+        }
     }
     let ratio = |coarse: f64, fine: f64| {
         let q = coarse / fine;
@@ -938,10 +966,10 @@ fn reference_of(
         (n >= 1.0 && (q - n).abs() <= 1e-9 * n).then_some(n as usize)
     };
     // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
-    let nested = sweep.scene.get().nested_meshes();
+    let nested = !other_scene && sweep.scene.get().nested_meshes();
     if !nested && r.h > run.h * (1.0 + 1e-12) {
         return Err(vec![Issue::at(
-            &at(mesh_keys),
+            &at(&[Key::H, Key::Elements, Key::Mesh]),
             format!(
                 "the reference mesh (h = {}) is coarser than the run's (h = {})",
                 r.h, run.h
@@ -951,7 +979,7 @@ fn reference_of(
     let sx = if nested { ratio(run.h, r.h) } else { Some(1) };
     let sx = sx.ok_or_else(|| {
         vec![Issue::at(
-            &at(mesh_keys),
+            &at(&[Key::H, Key::Elements, Key::Mesh]),
             format!(
                 "the reference mesh (h = {}) is not nested in the run's (h = {}): h_run/h_ref = {} must be a whole number ≥ 1",
                 r.h,
@@ -962,7 +990,7 @@ fn reference_of(
     })?;
     let st = ratio(run.dt, r.dt).ok_or_else(|| {
         vec![Issue::at(
-            &at(step_keys),
+            &at(&step_keys),
             format!(
                 "the reference step (dt = {}) does not divide the run's (dt = {}): dt_run/dt_ref = {} must be a whole number ≥ 1",
                 r.dt,
@@ -973,23 +1001,27 @@ fn reference_of(
     })?;
     if r.t_final < run.t_final * (1.0 - 1e-12) {
         return Err(vec![Issue::at(
-            &at([Key::T, Key::T]),
+            &at(&[Key::T]),
             format!(
                 "the reference run ends at T = {} before the run (T = {})",
                 r.t_final, run.t_final
             ),
         )]);
     }
-    let id = run_id(sweep.scene, &r.canonical, "");
+    let id = run_id(ref_scene, &r.canonical, "");
     let spec = RunSpec {
         run_id: id,
-        label: format!("reference: {}", r.label),
+        label: if other_scene {
+            format!("reference: {} {}", ref_scene.name(), r.label)
+        } else {
+            format!("reference: {}", r.label)
+        },
         params: r.params.clone(),
         scheme_label: r.scheme_label.clone(),
         config: r.config.clone(),
         repeats: 1,
         sample: None,
-        scene: sweep.scene,
+        scene: ref_scene,
         reference: None,
         search: None,
     };

@@ -13,6 +13,21 @@ g square_quad.geo -2 -order 2 -o square_quad_q2.msh
 g cube_tet.geo -3 -order 1 -bin -o cube_tet.msh
 g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
 g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
+# The same bar at h/2 (N = 4, M = 40): a finer mesh file as the reference of bar2d_quad.msh
+# (tests/mesh_scenes.rs: the interpolating path equals bar2d's node-for-node one).
+bar() { # bar GEO N OUT: the 002 bar with N cells across, M = 10 N along
+    local tmp
+    tmp=$(mktemp --suffix .geo)
+    sed -e "s/^N = .*/N = $2;/" -e "s/^M = .*/M = $(($2 * 10));/" "$1" >"$tmp"
+    g "$tmp" -2 -order 1 -o "$3"
+    rm -f "$tmp"
+}
+bar bar2d_quad.geo 4 bar2d_quad_n4.msh
+# The same bar in P1 triangles at three sizes, against a bar2d reference (tests/mesh_scenes.rs,
+# sweeps/bar2d_triangles.toml).
+for n in 2 4 8; do
+    bar bar2d_tri.geo $n bar2d_tri_n$n.msh
+done
 g cube_hex.geo -3 -order 1 -o cube_hex_q1.msh
 g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
 # The Hertz half-disc of sweeps/hertz_halfdisc.toml (P2: Mesh.ElementOrder = 2 in the .geo).

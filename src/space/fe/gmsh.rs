@@ -342,12 +342,35 @@ fn tensor_gradients<const D: usize, const NN: usize>(xi: [f64; 3]) -> Vec<[f64; 
         .collect()
 }
 
+/// Node tag → node index of a file (see `from_bytes`).
+enum TagIndex {
+    Dense { lo: u64, table: Vec<usize> },
+    Map(HashMap<u64, usize>),
+}
+
+impl TagIndex {
+    fn get(&self, t: u64) -> Option<usize> {
+        match self {
+            TagIndex::Dense { lo, table } => t
+                .checked_sub(*lo)
+                .and_then(|k| table.get(k as usize))
+                .copied()
+                .filter(|&i| i != usize::MAX),
+            TagIndex::Map(m) => m.get(&t).copied(),
+        }
+    }
+}
+
 /// det J at `xi` of the cell with node coordinates `x` (engine order).
 fn jacobian_det(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> f64 {
-    let d = kind.dim();
-    let grads = kind.shape_gradients(xi);
+    det_from_gradients(kind.dim(), x, &kind.shape_gradients(xi))
+}
+
+/// det J of the cell with node coordinates `x` from the reference shape gradients at one point
+/// (computed once per point for every cell of a mesh by the validation).
+fn det_from_gradients(d: usize, x: &[[f64; 3]], grads: &[[f64; 3]]) -> f64 {
     let mut j = [[0.0; 3]; 3];
-    for (xa, ga) in x.iter().zip(&grads) {
+    for (xa, ga) in x.iter().zip(grads) {
         for i in 0..d {
             for k in 0..d {
                 j[i][k] += xa[i] * ga[k];
@@ -549,8 +572,23 @@ impl GmshMesh {
                 coords.extend(block.nodes.iter().map(|n| [n.x, n.y, n.z]));
             }
         }
-        let index_of: HashMap<u64, usize> =
-            node_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+        // Tag → index: a table when the tags are dense (Gmsh numbers nodes 1..n; a 10⁵-node
+        // file spent 5 % of its reading in SipHash), a map otherwise. A tag given twice keeps
+        // its last position, as the map's collect did.
+        let index_of = {
+            let (lo, hi) = node_tags
+                .iter()
+                .fold((u64::MAX, 0), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+            if !node_tags.is_empty() && hi - lo <= 2 * node_tags.len() as u64 + 16 {
+                let mut table = vec![usize::MAX; (hi - lo + 1) as usize];
+                for (i, &t) in node_tags.iter().enumerate() {
+                    table[(t - lo) as usize] = i;
+                }
+                TagIndex::Dense { lo, table }
+            } else {
+                TagIndex::Map(node_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect())
+            }
+        };
 
         // Element types: every block supported; the cells are the highest dimension.
         let blocks = msh
@@ -579,14 +617,11 @@ impl GmshMesh {
             return Err(GmshError::NoCells { file: f() });
         }
         let node_index = |element: u64, t: u64| {
-            index_of
-                .get(&t)
-                .copied()
-                .ok_or_else(|| GmshError::UnknownNode {
-                    file: f(),
-                    element,
-                    node: t,
-                })
+            index_of.get(t).ok_or_else(|| GmshError::UnknownNode {
+                file: f(),
+                element,
+                node: t,
+            })
         };
 
         // Cells.
@@ -672,17 +707,23 @@ impl GmshMesh {
             }
             c
         };
-        let cell_x = |els: &[usize], e: usize| -> Vec<[f64; 3]> {
-            els[e * nn..(e + 1) * nn]
-                .iter()
-                .map(|&n| coords[n])
-                .collect()
+        // One buffer for the cells' coordinates, the shape gradients once per point: the
+        // checks below run at every cell of the mesh.
+        let mut x = vec![[0.0; 3]; nn];
+        let cell_x = |x: &mut [[f64; 3]], els: &[usize], e: usize| {
+            for (xa, &n) in x.iter_mut().zip(&els[e * nn..(e + 1) * nn]) {
+                *xa = coords[n];
+            }
         };
         let ne = element_tags.len();
         let mut reoriented = false;
         if dim == 2 {
+            let at_centre = kind.shape_gradients(centre);
             let negative = (0..ne)
-                .filter(|&e| jacobian_det(kind, &cell_x(&elements, e), centre) < 0.0)
+                .filter(|&e| {
+                    cell_x(&mut x, &elements, e);
+                    det_from_gradients(dim, &x, &at_centre) < 0.0
+                })
                 .count();
             if 2 * negative > ne {
                 reoriented = true;
@@ -697,6 +738,8 @@ impl GmshMesh {
         }
         let mut checks = kind.reference_nodes();
         checks.extend(kind.quadrature().into_iter().map(|(xi, _)| xi));
+        let check_grads: Vec<Vec<[f64; 3]>> =
+            checks.iter().map(|&xi| kind.shape_gradients(xi)).collect();
         // Reference measure: det J of an undistorted cell of diameter h_K is ~ h_K^d times this.
         let ref_measure = if kind.is_simplex() {
             0.5
@@ -705,7 +748,7 @@ impl GmshMesh {
         };
         let mut h: f64 = 0.0;
         for e in 0..ne {
-            let x = cell_x(&elements, e);
+            cell_x(&mut x, &elements, e);
             let mut diam: f64 = 0.0;
             for a in 0..nn {
                 for b in a + 1..nn {
@@ -714,8 +757,8 @@ impl GmshMesh {
             }
             h = h.max(diam);
             let scale = diam.powi(dim as i32) * ref_measure;
-            for &xi in &checks {
-                let det = jacobian_det(kind, &x, xi);
+            for (&xi, grads) in checks.iter().zip(&check_grads) {
+                let det = det_from_gradients(dim, &x, grads);
                 let relative = det / scale;
                 if relative.is_nan() || relative.abs() <= 1e-10 {
                     return Err(GmshError::Degenerate {

@@ -1,0 +1,204 @@
+//! Reading and assembling a Gmsh mesh against one factorisation of its step matrix (issue 22,
+//! done-when 5, SPEC §1.6): a mesh scene's set-up (read, validate, assemble) must cost less
+//! than the factorisation every run of a sweep makes anyway, or the file format would be the
+//! bottleneck of a sweep over meshes.
+//!
+//! The mesh: the unit square as n × n squares each cut into two triangles, written by this bench
+//! as a Gmsh MSH 4.1 ASCII file (what Gmsh writes for a transfinite surface: the physical
+//! groups `contact` (bottom), `clamped` (top) and `body`) into a temporary folder, so no large
+//! file is committed: P1 with n = 223 (224² nodes, 99 904 free dofs) and P2 with n = 112
+//! (225² nodes, 100 800 free dofs).
+//!
+//! - `…/read-assemble`: [`GmshMesh::read`] (parse, tags, groups, the det J check of every cell
+//!   at its nodes and quadrature points, h, the SHA-256 of the file), the dof map with the
+//!   `clamped` group removed, the sparse pattern, K and M, and A = M + τ²/4 K — the engine's
+//!   `build_gmsh` and `factor` up to the factorisation.
+//! - `…/symbolic`: the symbolic analysis of A's pattern (once per mesh in the engine).
+//! - `…/factorization`: the numeric factorisation of A with the engine's choice for a 2D mesh
+//!   file (AMD, simplicial: `run::fe`'s `build_gmsh`) — made by every run whose matrix differs.
+//!
+//! `cargo bench --bench mesh_read`; the README's Performance section has the medians.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+
+use contact_sweep::space::fe::{
+    DofMap, ElementOp, GmshMesh, Mesh, SymMatrix, assemble, fe_pattern,
+};
+use contact_sweep::space::linalg::{
+    Cholesky, CholeskyOptions, FactorKind, Ordering, SymbolicCholesky,
+};
+
+/// The MSH 4.1 text of the unit square as `n` × `n` squares, two triangles each, of degree
+/// `p` (1: 3-node triangles, Gmsh type 2; 2: 6-node, type 9, with 3-node lines, type 8). Nodes
+/// are the (pn + 1)² lattice, tag 1 + i + (pn + 1) j; every node is written in the surface's
+/// block (Gmsh would put the boundary ones in the curves' blocks: the reader takes the tags
+/// wherever they are).
+fn square_msh(n: usize, p: usize) -> String {
+    let m = p * n + 1;
+    let tag = |i: usize, j: usize| 1 + i + m * j;
+    let mut s = String::new();
+    s.push_str("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    s.push_str(
+        "$PhysicalNames\n3\n1 1 \"contact\"\n1 2 \"clamped\"\n2 3 \"body\"\n$EndPhysicalNames\n",
+    );
+    // Two curves (bottom: tag 1, physical 1; top: tag 2, physical 2), one surface (physical 3).
+    s.push_str("$Entities\n0 2 1 0\n");
+    s.push_str("1 0 0 0 1 0 0 1 1 0\n2 0 1 0 1 1 0 1 2 0\n");
+    s.push_str("1 0 0 0 1 1 0 1 3 2 1 2\n$EndEntities\n");
+    let nn = m * m;
+    writeln!(s, "$Nodes\n1 {nn} 1 {nn}\n2 1 0 {nn}").unwrap();
+    for t in 1..=nn {
+        writeln!(s, "{t}").unwrap();
+    }
+    let h = 1.0 / (m - 1) as f64;
+    for j in 0..m {
+        for i in 0..m {
+            writeln!(s, "{} {} 0", i as f64 * h, j as f64 * h).unwrap();
+        }
+    }
+    s.push_str("$EndNodes\n");
+    let (line_type, tri_type) = if p == 1 { (1, 2) } else { (8, 9) };
+    let tris = 2 * n * n;
+    let total = 2 * n + tris;
+    writeln!(s, "$Elements\n3 {total} 1 {total}").unwrap();
+    let mut e = 1;
+    // A line of the boundary row j from lattice column a: its ends, then (P2) its midpoint.
+    let line = |s: &mut String, e: &mut usize, j: usize, a: usize| {
+        write!(s, "{e} {} {}", tag(a, j), tag(a + p, j)).unwrap();
+        if p == 2 {
+            write!(s, " {}", tag(a + 1, j)).unwrap();
+        }
+        s.push('\n');
+        *e += 1;
+    };
+    writeln!(s, "1 1 {line_type} {n}").unwrap();
+    for c in 0..n {
+        line(&mut s, &mut e, 0, c * p);
+    }
+    writeln!(s, "1 2 {line_type} {n}").unwrap();
+    for c in 0..n {
+        line(&mut s, &mut e, m - 1, c * p);
+    }
+    writeln!(s, "2 1 {tri_type} {tris}").unwrap();
+    for b in 0..n {
+        for a in 0..n {
+            let (i, j) = (a * p, b * p);
+            // Counter-clockwise: (00, 10, 11) and (00, 11, 01); P2 adds the edge midpoints in
+            // Gmsh's order (edge 0–1, 1–2, 2–0).
+            let q = p / 2;
+            let lower = [
+                tag(i, j),
+                tag(i + p, j),
+                tag(i + p, j + p),
+                tag(i + q, j),
+                tag(i + p, j + q),
+                tag(i + q, j + q),
+            ];
+            let upper = [
+                tag(i, j),
+                tag(i + p, j + p),
+                tag(i, j + p),
+                tag(i + q, j + q),
+                tag(i + q, j + p),
+                tag(i, j + q),
+            ];
+            for t in [lower, upper] {
+                write!(s, "{e}").unwrap();
+                for v in &t[..3 * p] {
+                    write!(s, " {v}").unwrap();
+                }
+                s.push('\n');
+                e += 1;
+            }
+        }
+    }
+    s.push_str("$EndElements\n");
+    s
+}
+
+/// What a mesh scene does before its factorisation: read and validate the file, remove the
+/// `clamped` dofs, the pattern, K and M, A = M + τ²/4 K.
+fn read_assemble(path: &Path, tau: f64) -> (GmshMesh, DofMap, SymMatrix) {
+    let mesh = GmshMesh::read(path).expect("a valid mesh");
+    let d = mesh.dim;
+    let mut clamped = vec![false; mesh.num_nodes()];
+    for &n in &mesh.group("clamped").expect("a clamped group").nodes {
+        clamped[n] = true;
+    }
+    let dofs = DofMap::new(mesh.num_nodes() * d, |g| clamped[g / d]);
+    let p = fe_pattern(&mesh, &dofs);
+    let k = assemble(
+        &mesh,
+        &dofs,
+        &p,
+        ElementOp::Stiffness {
+            lambda: 0.25,
+            mu: 0.5,
+        },
+        &|_| 1.0,
+    );
+    let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
+    let a = SymMatrix::lin_comb(1.0, &m, tau * tau / 4.0, &k);
+    (mesh, dofs, a)
+}
+
+fn bench_square(c: &mut Criterion, name: &str, n: usize, p: usize) {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let path = dir.path().join(format!("{name}.msh"));
+    std::fs::write(&path, square_msh(n, p)).expect("the mesh written");
+    let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    // τ = h/2 as the bars' runs (the value does not change the factor's cost).
+    let tau = 0.5 / n as f64;
+    let mut g = c.benchmark_group(name);
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    g.bench_function("read-assemble", |b| b.iter(|| read_assemble(&path, tau)));
+    g.bench_function("read", |b| {
+        b.iter(|| GmshMesh::read(&path).expect("a valid mesh"))
+    });
+    let (mesh, dofs, a) = read_assemble(&path, tau);
+    // The engine's choice for a 2D mesh file (`run::fe::build_gmsh`).
+    let opts = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: FactorKind::Simplicial,
+    };
+    g.bench_function("symbolic", |b| {
+        b.iter(|| SymbolicCholesky::with_options(&a.pattern, &opts).unwrap())
+    });
+    let sym = SymbolicCholesky::with_options(&a.pattern, &opts).unwrap();
+    g.bench_function("factorization", |b| {
+        b.iter(|| Cholesky::new(&sym, &a).unwrap())
+    });
+    // The other factor kind faer offers, for comparison: supernodal (the bars' 2D table in the
+    // README: fewer flops per entry of L, more entries).
+    let opts_sn = CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: FactorKind::Supernodal,
+    };
+    let sym_sn = SymbolicCholesky::with_options(&a.pattern, &opts_sn).unwrap();
+    g.bench_function("factorization-supernodal", |b| {
+        b.iter(|| Cholesky::new(&sym_sn, &a).unwrap())
+    });
+    println!(
+        "{name}: {} nodes, {} cells, {} free dofs, file {:.1} MB, nnz(A) {}, nnz(L) {} (supernodal {})",
+        mesh.num_nodes(),
+        mesh.num_elements(),
+        dofs.n_free(),
+        bytes as f64 / 1e6,
+        a.pattern.nnz(),
+        sym.factor_nnz(),
+        sym_sn.factor_nnz()
+    );
+    g.finish();
+}
+
+fn mesh_read(c: &mut Criterion) {
+    bench_square(c, "mesh-p1-1e5", 223, 1);
+    bench_square(c, "mesh-p2-1e5", 112, 2);
+}
+
+criterion_group!(benches, mesh_read);
+criterion_main!(benches);
