@@ -356,8 +356,8 @@ fn geometry_key(s: &FeSetup) -> String {
 
 /// From this many unknowns a 2D step matrix is factored with supernodes, below column by
 /// column. Measured with faer 0.24 on the 2D bar's A = M + τ²/4 K, AMD ordering, ms per
-/// right-hand side for k right-hand sides solved at once (`examples`-free: `cargo bench --bench
-/// fe -- lockstep`): 5 440 dofs simplicial 0.23 (k = 1) / 0.11 (k = 8), supernodal 0.24 /
+/// right-hand side for k right-hand sides solved at once (medians of 15 solves on a quiet
+/// machine; README, Performance): 5 440 dofs simplicial 0.23 (k = 1) / 0.11 (k = 8), supernodal 0.24 /
 /// 0.09; 21 120 dofs 1.32 / 0.57 against 1.33 / 0.45; 83 200 dofs 7.6 / 3.6 against 6.4 / 2.3.
 /// A single solve costs the same from ≈ 2·10⁴ dofs, and only the supernodal factor's dense
 /// blocks keep gaining past k = 4 — the lockstep groups' case ([`lockstep`]), whose members
