@@ -19,6 +19,8 @@
 //!   solved exactly by branch enumeration (1D); a small dense LCP on the contact dofs solved
 //!   exactly by an active-set method (2D/3D); the discrete gradient's scalar equation by a
 //!   safeguarded semismooth Newton iteration ([`contact::gradient`]).
+//! - [`model`] — the data that crosses layers: SPEC §7's parameter keys and values, the
+//!   column choice of the summary tables.
 //! - [`run`] — one run: setup (factorisations once, shared between runs with the same matrix),
 //!   the allocation-free time loop of the tridiagonal, the sparse and the one-dof engine,
 //!   observables (energies, error norms against the closed form or a reference run), and the
@@ -41,6 +43,7 @@
 pub mod cli;
 pub mod contact;
 pub mod exec;
+pub mod model;
 pub mod report;
 pub mod run;
 pub mod scene;

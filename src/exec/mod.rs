@@ -32,12 +32,8 @@ use crate::run::reference::ReferenceData;
 use crate::run::{self, Metrics, Outcome, RunContext, RunOptions, RunRecord, Series, Status};
 use crate::sweep::RunSpec;
 
-/// A finished run: its row and its (possibly decimated) time series.
-#[derive(Debug, Clone)]
-pub struct RunResult {
-    pub record: RunRecord,
-    pub series: Series,
-}
+/// A finished run (defined with the runs, so the sink below the executor can take it).
+pub use crate::run::RunResult;
 
 /// How to execute.
 #[derive(Debug, Clone, Copy)]

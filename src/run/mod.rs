@@ -15,6 +15,7 @@ pub mod observe;
 pub mod oscillator;
 pub mod record;
 pub mod reference;
+mod spec;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
@@ -25,6 +26,15 @@ use crate::time::Scheme;
 
 pub use observe::{Metrics, Series, SeriesRow};
 pub use record::{RunRecord, SERIES_COLUMNS};
+pub use spec::RunSpec;
+
+/// A finished run: its row and its (possibly decimated) time series — what the executor hands
+/// the sink.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub record: RunRecord,
+    pub series: Series,
+}
 
 /// Final state of a run (the `status` column).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -6,7 +6,8 @@
 use std::collections::BTreeMap;
 
 use super::Outcome;
-use crate::sweep::{Key, RunSpec, Value};
+use super::RunSpec;
+use crate::model::{Key, Value};
 
 /// A typed column ready for the sink.
 #[derive(Debug, Clone, PartialEq)]

@@ -128,51 +128,11 @@ impl Scene for Bar1dScene {
     }
 }
 
-/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0, clamped
-/// at x = L, at rest).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BarParams {
-    pub length: f64,
-    pub young: f64,
-    pub density: f64,
-    pub amplitude: f64,
-    pub gap: f64,
-    /// The end x = L is traction-free (SPEC §1.4) instead of clamped.
-    pub free_end: bool,
-    /// Uniform initial velocity v0 (negative towards the obstacle).
-    pub velocity: f64,
-}
-
-impl Default for BarParams {
-    fn default() -> Self {
-        Self {
-            length: 1.0,
-            young: 1.0,
-            density: 1.0,
-            amplitude: 0.5,
-            gap: 0.0,
-            free_end: false,
-            velocity: 0.0,
-        }
-    }
-}
+/// The bar's physical parameters: defined with its discretisation ([`crate::space::bar1d`]),
+/// which builds M and K from them; the scene fills them from the sweep's keys.
+pub use crate::space::bar1d::BarParams;
 
 impl BarParams {
-    /// Wave speed c0 = sqrt(E/ρ).
-    pub fn wave_speed(&self) -> f64 {
-        (self.young / self.density).sqrt()
-    }
-
-    /// Initial displacement u0(x) = a (1 − x/L).
-    pub fn initial_displacement(&self, x: f64) -> f64 {
-        self.amplitude * (1.0 - x / self.length)
-    }
-
-    /// Initial velocity v0(x): uniform.
-    pub fn initial_velocity(&self, _x: f64) -> f64 {
-        self.velocity
-    }
-
     /// The closed form: the clamped bar released at rest with a zero gap (SPEC §1.1), or the
     /// flying bar — free end, no initial strain, moving towards the obstacle (SPEC §1.4).
     /// Other combinations have none.

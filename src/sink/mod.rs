@@ -52,8 +52,7 @@ pub mod parquet;
 
 pub use manifest::{Manifest, ManifestState};
 
-use crate::exec::RunResult;
-use crate::run::{RunRecord, Series};
+use crate::run::{RunRecord, RunResult, Series};
 
 /// Failures of the output folder.
 #[derive(Debug, thiserror::Error)]

@@ -18,7 +18,52 @@
 //! In each case φ is the contact pressure σ_C (negative in compression).
 
 use super::{ContactMethod, MassVariant, Tridiag};
-use crate::scene::BarParams;
+
+/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0, clamped
+/// at x = L, at rest).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BarParams {
+    pub length: f64,
+    pub young: f64,
+    pub density: f64,
+    pub amplitude: f64,
+    pub gap: f64,
+    /// The end x = L is traction-free (SPEC §1.4) instead of clamped.
+    pub free_end: bool,
+    /// Uniform initial velocity v0 (negative towards the obstacle).
+    pub velocity: f64,
+}
+
+impl Default for BarParams {
+    fn default() -> Self {
+        Self {
+            length: 1.0,
+            young: 1.0,
+            density: 1.0,
+            amplitude: 0.5,
+            gap: 0.0,
+            free_end: false,
+            velocity: 0.0,
+        }
+    }
+}
+
+impl BarParams {
+    /// Wave speed c0 = sqrt(E/ρ).
+    pub fn wave_speed(&self) -> f64 {
+        (self.young / self.density).sqrt()
+    }
+
+    /// Initial displacement u0(x) = a (1 − x/L).
+    pub fn initial_displacement(&self, x: f64) -> f64 {
+        self.amplitude * (1.0 - x / self.length)
+    }
+
+    /// Initial velocity v0(x): uniform.
+    pub fn initial_velocity(&self, _x: f64) -> f64 {
+        self.velocity
+    }
+}
 
 /// A sparse vector on the first two nodes (all contact vectors of the 1D bar live there).
 #[derive(Debug, Clone, Copy, PartialEq)]

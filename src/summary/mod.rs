@@ -66,7 +66,9 @@ pub mod energy;
 pub mod ensemble;
 mod latex;
 pub mod methods;
-pub mod options;
+/// The column choice of the text tables: plain data, one layer down ([`crate::model`]) so the
+/// planner can parse it without importing the summaries.
+pub use crate::model::summary_options as options;
 pub(crate) mod runs;
 mod search;
 pub mod stability;

@@ -86,15 +86,7 @@ pub(crate) const REFINEMENT: &[(&str, Kind)] = &[
 ];
 
 /// The error columns of SPEC §5, in output order.
-pub(crate) const ERRORS: &[&str] = &[
-    "err_u_l2l2",
-    "err_u_l2h1",
-    "err_u_linfl2",
-    "err_sigma_l2",
-    "err_sigma_mid_l2",
-    "err_energy_l2",
-    "err_u_contact_max",
-];
+pub(crate) const ERRORS: &[&str] = crate::model::ERROR_COLUMNS;
 
 /// Measured columns read besides parameters and errors.
 const MEASURED: &[(&str, Kind)] = &[

@@ -3,14 +3,15 @@
 //! A sweep file names a scene and a parameter space: `[fixed]` values, a cartesian `[grid]`
 //! (items may be bundles — inline tables setting several parameters at once), equal-length
 //! `[zip]` lists advanced together, and `exclude` filters; a `[summary]` table chooses the
-//! columns of the convergence tables ([`crate::summary::SummaryOptions`]; [`summary_options`]
+//! columns of the convergence tables ([`crate::model::SummaryOptions`]; [`summary_options`]
 //! reads it back from the text stored in a results folder). Everything is checked before
 //! anything runs: each problem is reported with the file, the key path, the line and the
 //! reason ([`SweepError`]). [`plan::expand`] turns the file into [`plan::Plan`]: deterministic
 //! order, meaningless combinations dropped, parameters that do not apply to a run's method
 //! removed and the resulting duplicates merged, each run keyed by a stable [`plan::RunSpec::run_id`].
 
-pub mod keys;
+/// SPEC §7's keys live one layer down ([`crate::model::keys`]): a run's row names them too.
+pub use crate::model::keys;
 pub mod overrides;
 pub mod plan;
 pub mod tree;
@@ -22,8 +23,8 @@ pub use keys::{Key, Value, ValueType};
 pub use plan::{Plan, PlanLimits, PlanSize, RunSpec, expand, expand_with};
 use tree::{Kind, Node};
 
+use crate::model::{SummaryOptions, parse_errors};
 use crate::scene::SceneKind;
-use crate::summary::options::{SummaryOptions, parse_errors};
 
 /// Where a value was written: its key path in the file and its line.
 #[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]

@@ -30,26 +30,9 @@ use crate::time::{
     Scheme, ThetaParams,
 };
 
-/// One run of the plan.
-#[derive(Debug, Clone, PartialEq)]
-pub struct RunSpec {
-    pub run_id: String,
-    /// Human label: method · mass · scheme.
-    pub label: String,
-    /// Every parameter column of the run (defaults filled, derived ones included, keys that do
-    /// not apply absent).
-    pub params: BTreeMap<Key, Value>,
-    pub scheme_label: String,
-    pub config: RunConfig,
-    pub repeats: usize,
-    /// Ensemble member (sample index, relative perturbation).
-    pub sample: Option<(usize, f64)>,
-    pub scene: SceneKind,
-    /// The run_id of the reference run its errors are measured against (SPEC §1.2, §7).
-    pub reference: Option<String>,
-    /// The `[search]` this run is a probe of ([`search_tag`]); None for grid runs.
-    pub search: Option<String>,
-}
+/// One run of the plan: defined with the runs ([`crate::run::RunSpec`]), which build their row
+/// from it; the planner makes it.
+pub use crate::run::RunSpec;
 
 /// One method of a sweep with a `[search]`: the grid combination without the searched key.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,0 +1,34 @@
+//! A run's parameters as the planner resolved them: its id, its label, every parameter column
+//! (SPEC §7's keys with defaults filled), the engine configuration and where its errors are
+//! measured against.
+//!
+//! Why here and not with the planner: a run builds its row from these ([`super::RunRecord`]),
+//! and a layer imports only those below it; the planner (`sweep`) makes them, the executor runs
+//! them.
+
+use std::collections::BTreeMap;
+
+use super::RunConfig;
+use crate::model::{Key, Value};
+use crate::scene::SceneKind;
+
+/// One run of the plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSpec {
+    pub run_id: String,
+    /// Human label: method · mass · scheme.
+    pub label: String,
+    /// Every parameter column of the run (defaults filled, derived ones included, keys that do
+    /// not apply absent).
+    pub params: BTreeMap<Key, Value>,
+    pub scheme_label: String,
+    pub config: RunConfig,
+    pub repeats: usize,
+    /// Ensemble member (sample index, relative perturbation).
+    pub sample: Option<(usize, f64)>,
+    pub scene: SceneKind,
+    /// The run_id of the reference run its errors are measured against (SPEC §1.2, §7).
+    pub reference: Option<String>,
+    /// The `[search]` this run is a probe of ([`crate::sweep::plan::search_tag`]); None for grid runs.
+    pub search: Option<String>,
+}
