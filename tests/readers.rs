@@ -218,36 +218,66 @@ fn a_folder_written_before_reads_alike_and_resumes() {
     check(&out, 8, true);
 }
 
-/// The README's analysis snippet (the ```python block of "## Outputs"), exactly as printed,
-/// in a folder holding `out/quickstart`.
+/// Every ```python block of a Markdown text.
+fn python_blocks(text: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut rest = text;
+    while let Some(k) = rest.find("```python\n") {
+        let body = &rest[k + "```python\n".len()..];
+        let end = body.find("```").expect("a closed python block");
+        out.push(body[..end].to_string());
+        rest = &body[end..];
+    }
+    out
+}
+
+/// The analysis snippets as printed — the README's, and the guide's (the ```python block of
+/// docs/guide.md "## Outputs") — run exactly as printed in a folder holding `out/quickstart`.
 #[test]
 fn the_readme_analysis_snippet_runs_as_printed() {
     readers();
-    let readme =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
-    let outputs = &readme[readme.find("\n## Outputs").expect("an Outputs section")..];
-    let start = outputs.find("```python\n").expect("a python snippet") + "```python\n".len();
-    let snippet = &outputs[start..start + outputs[start..].find("```").unwrap()];
+    let root = env!("CARGO_MANIFEST_DIR");
+    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let guide = std::fs::read_to_string(format!("{root}/docs/guide.md")).unwrap();
+    let outputs = &guide[guide.find("\n## Outputs").expect("an Outputs section")..];
+    let guide_snippet = python_blocks(outputs)
+        .into_iter()
+        .next()
+        .expect("a python snippet in the guide's Outputs");
+    let readme_snippets = python_blocks(&readme);
     assert!(
-        snippet.contains("out/quickstart/runs/*.parquet"),
-        "{snippet}"
+        !readme_snippets.is_empty(),
+        "the README shows how to read the output"
     );
     let tmp = tempfile::tempdir().unwrap();
     let sweep = concat!(env!("CARGO_MANIFEST_DIR"), "/sweeps/quickstart.toml");
     let o = cli(tmp.path(), &["run", sweep, "--no-summary"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    // The snippet, then a line that proves it read what the folder holds.
-    let program = format!(
-        "{snippet}\nassert runs.height == 60 and len(runs_pd) == 60, (runs.height, len(runs_pd))\n"
+    // Each snippet, then a line that proves it read what the folder holds (60 runs).
+    let checks = std::iter::once((
+        guide_snippet,
+        "assert runs.height == 60 and len(runs_pd) == 60, (runs.height, len(runs_pd))",
+    ))
+    .chain(
+        readme_snippets
+            .into_iter()
+            .map(|s| (s, "assert runs.height == 60, runs.height")),
     );
-    let o = Command::new("python3")
-        .args(["-c", &program])
-        .current_dir(tmp.path())
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "the README's snippet failed:\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    for (snippet, check) in checks {
+        assert!(
+            snippet.contains("out/quickstart/runs/*.parquet"),
+            "{snippet}"
+        );
+        let program = format!("{snippet}\n{check}\n");
+        let o = Command::new("python3")
+            .args(["-c", &program])
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "the snippet failed:\n{snippet}\n{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
 }

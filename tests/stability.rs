@@ -556,7 +556,7 @@ fn hard_cases_every_run_ends_with_a_status_and_a_message() {
         seen += 1;
     }
     assert_eq!(seen, 4 * 14 + 4 * 3, "cells checked");
-    // The README's map is this one condensed: one row per method, each ν cell the states at
+    // docs/methods.md's map is this one condensed: one row per method, each ν cell the states at
     // h = 1/16, 0.01, 1/4096 in that order (· where not run). Every row must be there verbatim.
     let sym = |s: &str| match s {
         "stable" => '✓',
@@ -574,7 +574,7 @@ fn hard_cases_every_run_ends_with_a_status_and_a_message() {
             sym(&st[i]),
         );
     }
-    let readme = std::fs::read_to_string(repo().join("README.md")).unwrap();
+    let readme = std::fs::read_to_string(repo().join("docs/methods.md")).unwrap();
     let methods: std::collections::BTreeSet<&String> = meth.iter().collect();
     assert_eq!(methods.len(), 17, "{methods:?}");
     for method in methods {
@@ -591,6 +591,9 @@ fn hard_cases_every_run_ends_with_a_status_and_a_message() {
             })
             .collect();
         let row = format!("| {method} | {} |", cells.join(" | "));
-        assert!(readme.contains(&row), "README lacks the map row\n{row}");
+        assert!(
+            readme.contains(&row),
+            "docs/methods.md lacks the map row\n{row}"
+        );
     }
 }
