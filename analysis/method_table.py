@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Build the README's method table from sweep outputs.
+"""Build docs/methods.md's method table from sweep outputs.
 
 For every method of the 1D bar (contact treatment · mass · scheme) it prints what the papers
 report and what contact-sweep measures: E(T)/E0 at the 003 setting (h = 0.01, τ = 0.015,

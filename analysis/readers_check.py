@@ -9,7 +9,7 @@
 
 Both print one JSON line: reads made, errors (reader: message), the runs seen by the last read.
 
-The readers, with the calls the README prints: polars' glob `DIR/runs/*.parquet` (which
+The readers, with the calls docs/guide.md prints: polars' glob `DIR/runs/*.parquet` (which
 expands to dot-files too: a temporary or damaged part beside the parts breaks it) and a
 filtered lazy scan of one run's series; pandas' `read_parquet(DIR/runs)`; pyarrow's dataset of
 the folder; DuckDB's `read_parquet('DIR/runs/*.parquet')`.

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Render the LaTeX convergence tables of the 003 Fig 10 ladder, below the paper's own values, to
-# one PNG (the README's analysis/figures/003_fig10_table.png):
+# one PNG (docs/guide.md's analysis/figures/003_fig10_table.png):
 #
 #   bash analysis/render_fig10_table.sh [OUT_DIR] [PNG]
 #

@@ -17,7 +17,7 @@
 //! - `…/factorization`: the numeric factorisation of A with the engine's choice for a 2D mesh
 //!   file (AMD, simplicial: `run::fe`'s `build_gmsh`) — made by every run whose matrix differs.
 //!
-//! `cargo bench --bench mesh_read`; the README's Performance section has the medians.
+//! `cargo bench --bench mesh_read`; docs/performance.md has the medians.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -173,7 +173,7 @@ fn bench_square(c: &mut Criterion, name: &str, n: usize, p: usize) {
         b.iter(|| Cholesky::new(&sym, &a).unwrap())
     });
     // The other factor kind faer offers, for comparison: supernodal (the bars' 2D table in the
-    // README: fewer flops per entry of L, more entries).
+    // docs/performance.md: fewer flops per entry of L, more entries).
     let opts_sn = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: FactorKind::Supernodal,

@@ -179,7 +179,7 @@ pub struct SlurmArgs {
 /// Where a sweep comes from: a file, or `--scene` alone, with `--set` on top.
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// The sweep file (TOML, see README); omit it to give everything with --scene and --set.
+    /// The sweep file (TOML, see docs/guide.md); omit it to give everything with --scene and --set.
     pub sweep: Option<PathBuf>,
     /// Without a sweep file: the scene (bar1d, bar2d, bar3d); the sweep is named after it and
     /// its parameters come from --set.
@@ -942,7 +942,7 @@ fn result_table(dir: &Path, plan: &Plan, ids: &HashSet<&str>) -> Result<String> 
     Ok(out)
 }
 
-/// The schema of DIR/runs and DIR/series as Markdown tables (the README's are generated here).
+/// The schema of DIR/runs and DIR/series as Markdown tables (docs/guide.md's are generated here).
 pub fn schema_markdown() -> String {
     let mut s = String::from(
         "### `DIR/runs/*.parquet` — one row per run\n\n| column | type | unit | meaning |\n|---|---|---|---|\n",

@@ -231,7 +231,7 @@ fn cg_runs_have_their_own_ids_and_direct_ids_are_unchanged() {
 }
 
 /// The plan's memory estimate: without a factor, a 3D run the direct estimate refuses fits
-/// (the README's 305 k-dof row; the figures are the estimate's, `run::estimate`). The refusal
+/// (docs/performance.md's 305 k-dof row; the figures are the estimate's, `run::estimate`). The refusal
 /// names `solver = "cg"` and what it would need.
 #[test]
 fn the_estimate_for_cg_has_no_factor() {

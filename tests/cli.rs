@@ -71,7 +71,7 @@ fn quickstart_runs_and_prints_errors_against_the_exact_solution() {
         assert!(stdout.contains(legend), "no legend `{legend}`:\n{stdout}");
     }
     assert!(stdout.contains("look at:"), "{stdout}");
-    // zero-contact + CN converges fastest in l2(τ;H1) (README: rate ≈ 0.4 at ν = 0.5)
+    // zero-contact + CN converges fastest in l2(τ;H1) (docs/methods.md: rate ≈ 0.4 at ν = 0.5)
     assert!(
         stdout.contains("highest l2(τ;H1) rate: 0.42 (group 4"),
         "{stdout}"

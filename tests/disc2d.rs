@@ -212,7 +212,7 @@ fn ball_nitsche_hybrid_and_modified_mass_keep_the_energy_mixed_gains() {
 /// E_Θ (gravity included) never increases from one step to the next, for every h, τ and γ0.
 /// Random cases (seeded) over h, τ, γ0 and both degrees in 2D, and γ0 in 3D; T = 20 covers
 /// the free fall, the impact at t ≈ 10 and the release. γ0 stays ≤ 5e-4, below the
-/// coercivity limit of K_Θ on these meshes (≈ 3e-3, README): above it the step itself is
+/// coercivity limit of K_Θ on these meshes (≈ 3e-3, docs/methods.md): above it the step itself is
 /// unstable and the corollary's hypothesis (a well-posed step) fails. What the scheme
 /// guarantees is E_Θ^{n+1} ≤ E_Θ^n in exact arithmetic; the rounding of E_Θ (sums of ~10⁴
 /// terms of size ≤ energy_scale) is ~1e-13: bound 1e-12 of energy_scale, as the issue asks.
@@ -623,7 +623,7 @@ method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nits
 }
 
 /// `sweeps/003_disc_gamma0_theta.toml` in full (paper setting: Q2, h = 4, τ = 0.1, T = 40;
-/// 30 runs, ≈ 1 s on two threads — diverging runs stop early). The map of README "The disc's
+/// 30 runs, ≈ 1 s on two threads — diverging runs stop early). The map of docs/methods.md "The disc's
 /// γ0 × Θ map": Θ = 1 loses the positivity of the step matrix M + τ²/4·K_Θ between γ0 = 1e-3
 /// and 1e-2 (K_Θ = K − Θ Σ w γ s sᵀ; the inverse trace constant of Q2 at h = 4 puts the limit
 /// near 3e-3, SPEC §6), which the factorisation reports before the first step; γ0 = 1e-4 is
@@ -859,7 +859,7 @@ dt = [0.1, 0.05]
 
 /// Issue 20: `sweeps/comparison_disc.toml` — SPEC §3.2's methods on the 003 §4.2 disc beside
 /// the seeds' — with the properties SPEC §3.2 states, per step and relative to the energy
-/// scale m·g·gap (README "Methods of the comparison literature on the disc" prints these runs):
+/// scale m·g·gap (docs/methods.md "The same methods on the disc" prints these runs):
 /// kane, contact-stabilized Newmark and Moreau–Jean (θ = ½) never raise E^h by more than
 /// 1e-12 (measured ≤ 1.7e-14); the discrete gradient with the penalty conserves E^h + Φ and
 /// with Nitsche Θ = 1 keeps E_Θ (≤ 1e-12, measured 2.4e-14 and 9.6e-15); generalized-α with

@@ -280,7 +280,7 @@ fn paper000_mass_redistribution_errors() {
 #[test]
 fn paper000_mass_redistribution_errors_with_the_interpolant_start() {
     // The interpolant start (u₀(0) = a, E0 = 1/8) at 000 §4.2's setting. No independent
-    // implementation printed these: they are this engine's figures (README, "Methods against
+    // implementation printed these: they are this engine's figures (docs/methods.md, "Methods against
     // the papers"), asserted to the digits printed there, i.e. ±½ unit in the last place of a
     // deterministic computation (round-off is ~1e-13 of it). They differ from the consistent
     // start's 0.1123 / 0.05567 / 0.04349 by −2.5, −3.2 and +0.5 %.

@@ -11,7 +11,7 @@
 //!     given the columns added since, and every column reads with one type in polars and
 //!     pandas across old and new parts,
 //!
-//! with 0 errors and every committed run present exactly once. The README's analysis snippet
+//! with 0 errors and every committed run present exactly once. The README's and docs/guide.md's analysis snippets
 //! runs exactly as printed, on the quickstart's folder.
 //!
 //! The readers are driven by `analysis/readers_check.py` (one JSON line per call).

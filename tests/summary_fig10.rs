@@ -98,7 +98,7 @@ fn fig10_ladder_summary_reproduces_the_papers_conclusion() {
     }
     // Contact pressure at midpoint: the modified masses converge (≈ 0.3); mixed/Nitsche + CN
     // stagnate. Nitsche-Hybrid decreases, slowly (measured LSQ slope 0.11; the paper says it
-    // converges, slower than the modified mass — the README reports the figures).
+    // converges, slower than the modified mass — docs/methods.md reports the figures).
     for label in [
         "mixed · mod3 · crank-nicolson",
         "mixed · zero-contact · crank-nicolson",

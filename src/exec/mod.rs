@@ -46,7 +46,7 @@ pub struct ExecOptions {
 }
 
 impl ExecOptions {
-    /// The default group size, measured on the 2D bar at 21 120 dofs (README, Performance):
+    /// The default group size, measured on the 2D bar at 21 120 dofs (docs/performance.md):
     /// the time per member falls up to 8 members and no further at 16 (the factor is read once
     /// per step either way; the members' own work then dominates), while a group's workspace
     /// grows with its members.

@@ -8,7 +8,7 @@
 //!   Paoli–Schatzman scheme keeps a second engine for its start (+ half again).
 //! - FE scenes: the sparse Cholesky factor dominates. Its fill on the structured box is that of
 //!   nested dissection, nnz(L) ≈ c·n·log₂n in 2D and c·n^{4/3} in 3D, with c calibrated on the
-//!   factors measured for the README (2D: 4.92 M entries at n = 83 200 → c = 3.63; 3D: 6.55 M at
+//!   factors measured for docs/performance.md (2D: 4.92 M entries at n = 83 200 → c = 3.63; 3D: 6.55 M at
 //!   n = 19 440 → c = 12.5); 16 bytes per entry (value and row index). Besides: the step matrix,
 //!   K and M ((2p+1)^d·d entries per row for degree p, 16 bytes each), the condensed contact
 //!   columns Z = A⁻¹Bᵀ (n × n_c dense; the disc and ball: n_c ≈ n^((d−1)/d), a boundary's worth),

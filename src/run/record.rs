@@ -1,7 +1,7 @@
 //! The output schema, defined once: [`RunRecord`] is one row of `DIR/runs/*.parquet`,
 //! [`SeriesRow`](super::SeriesRow) one row of `DIR/series/*.parquet`. The sink derives the
 //! Parquet schema from these declarations ([`RunRecord::COLUMNS`], [`SERIES_COLUMNS`]), and the
-//! README's schema table is generated from the same docs (`contact-sweep schema`).
+//! docs/guide.md's schema table is generated from the same docs (`contact-sweep schema`).
 
 use std::collections::BTreeMap;
 

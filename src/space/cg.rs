@@ -14,7 +14,7 @@
 //! 20 and 30 iterations on every mesh — each one sparse matrix–vector product, streaming A once.
 //! (A direct solve streams the factor twice: 4× the entries of A on the 3D bar at 19 440 dofs,
 //! ≈ 10× at 3·10⁵ by the n^{4/3} fill — which is why a factor still wins in time where it fits,
-//! README Performance.) Larger Courant numbers
+//! docs/performance.md.) Larger Courant numbers
 //! raise κ like cν² (iterations like √c·ν).
 //!
 //! Stopping test: ‖r‖_{D⁻¹} ≤ tol·‖b‖_{D⁻¹}, with ‖r‖²_{D⁻¹} = rᵀD⁻¹r (computed anyway, it is
