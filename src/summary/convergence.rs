@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use super::latex;
 use super::options::SummaryOptions;
 use super::runs::{RefPath, Runs, group_heading};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 
 /// Pair rates spread over more than this: the errors are not yet in the asymptotic regime.
 /// A clean power law gives spread 0; the converging ladders of SPEC §6 (h = 1/4 … 1/256, ratio
@@ -75,6 +75,54 @@ pub(crate) struct LevelFit {
     pub rate: Option<f64>,
     /// Index of the coarser level of that pair (≠ level − 1 when a level was skipped).
     pub rate_from: Option<usize>,
+}
+
+/// How a format marks a level's cells: an excluded level's value (in parentheses, then the
+/// format's mark) and a rate taken against a level further back than the previous one.
+pub(crate) struct LevelMarks {
+    pub excluded: &'static str,
+    pub skipped: &'static str,
+}
+
+/// The Markdown tables' marks.
+pub(crate) const MARKDOWN_MARKS: LevelMarks = LevelMarks {
+    excluded: " ✗",
+    skipped: " †",
+};
+
+/// A level's value and rate cells as a table prints them, and what they mark.
+pub(crate) struct LevelCells {
+    pub value: String,
+    pub rate: String,
+    /// The value is shown but excluded from the fits.
+    pub excluded: bool,
+    /// The rate is against a level further back (a level in between was excluded).
+    pub skipped: bool,
+}
+
+impl LevelFit {
+    /// The cells of level `li` from its formatted value and rate, marked as `marks` says
+    /// (one rule for every format, so the Markdown and LaTeX tables mark the same levels).
+    pub(crate) fn cells(
+        &self,
+        li: usize,
+        value: String,
+        rate: String,
+        marks: &LevelMarks,
+    ) -> LevelCells {
+        let excluded = !(self.used || value.is_empty());
+        let skipped = self.rate_from.is_some_and(|from| from + 1 != li);
+        LevelCells {
+            value: if excluded {
+                format!("({value}){}", marks.excluded)
+            } else {
+                value
+            },
+            rate: if skipped { rate + marks.skipped } else { rate },
+            excluded,
+            skipped,
+        }
+    }
 }
 
 /// Rates, slopes and flags of one error column along one path.
@@ -347,21 +395,23 @@ fn group_lines(
         };
     }
     let refined = main.iter().any(Option::is_some);
-    let mut header: Vec<String> = vec!["#".into(), "method".into()];
-    let mut align = vec![Align::Right, Align::Left];
+    let mut cols: Vec<(String, Align)> =
+        vec![("#".into(), Align::Right), ("method".into(), Align::Left)];
     if refined {
-        header.extend(["path".into(), "levels".into()]);
-        align.extend([Align::Left, Align::Right]);
+        cols.extend([
+            ("path".into(), Align::Left),
+            ("levels".into(), Align::Right),
+        ]);
     } else {
-        header.push("runs".into());
-        align.push(Align::Right);
+        cols.push(("runs".into(), Align::Right));
     }
     for &e in &shown {
-        header.push(table::error_abbrev(runs.errors[e]).0.to_string());
-        align.push(Align::Right);
+        cols.push((
+            table::error_abbrev(runs.errors[e]).0.to_string(),
+            Align::Right,
+        ));
     }
-    header.push("E(T)/E⁰".into());
-    align.push(Align::Right);
+    cols.push(("E(T)/E⁰".into(), Align::Right));
     let mut rows = Vec::new();
     // (group, rate) per shown column, and (group, E(T)/E⁰) — for the hints.
     let mut best: Vec<Option<(usize, f64)>> = vec![None; shown.len()];
@@ -445,7 +495,8 @@ fn group_lines(
     } else {
         let _ = writeln!(out, "errors by method group (no refinement path):");
     }
-    out.push_str(&table::plain(&header, &align, &rows));
+    let text = TextTable::new(cols).with_rows(rows);
+    out.push_str(&text.plain());
     // Legend: every abbreviation of the table, one per line for the error columns.
     let mut legend: Vec<String> = Vec::new();
     if refined {
@@ -534,9 +585,9 @@ fn group_lines(
         } else {
             "errors by method group (no refinement path)".into()
         },
-        header,
-        right: align.iter().map(|a| matches!(a, Align::Right)).collect(),
-        rows,
+        header: text.header().to_vec(),
+        right: text.right(),
+        rows: text.rows().to_vec(),
         legend,
         hints,
         terminal: out,
@@ -747,15 +798,16 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
         if shown.is_empty() {
             md.push_str("None of the error columns shown has a value on this path.\n\n");
         }
-        let mut header: Vec<String> =
-            vec!["level".into(), "h".into(), "dt".into(), "status".into()];
-        let mut align = vec![Align::Right, Align::Right, Align::Right, Align::Left];
+        let mut cols: Vec<(&str, Align)> = vec![
+            ("level", Align::Right),
+            ("h", Align::Right),
+            ("dt", Align::Right),
+            ("status", Align::Left),
+        ];
         for (e, _) in &shown {
-            header.push(runs.errors[*e].into());
-            align.push(Align::Right);
+            cols.push((runs.errors[*e], Align::Right));
             if opts.rates {
-                header.push("rate".into());
-                align.push(Align::Right);
+                cols.push(("rate", Align::Right));
             }
         }
         let mut rows: Vec<Vec<String>> = Vec::new();
@@ -774,19 +826,16 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
             ];
             for (e, f) in &shown {
                 let lf = &f.levels[li];
-                let v = table::sci(r.errors[*e]);
-                row.push(if lf.used || v.is_empty() {
-                    v
-                } else {
-                    format!("({v}) ✗")
-                });
+                let cells = lf.cells(
+                    li,
+                    table::sci(r.errors[*e]),
+                    table::rate(lf.rate),
+                    &MARKDOWN_MARKS,
+                );
+                row.push(cells.value);
                 if opts.rates {
-                    let mut rt = table::rate(lf.rate);
-                    if lf.rate_from.is_some_and(|from| from + 1 != li) {
-                        rt.push_str(" †");
-                        skipped = true;
-                    }
-                    row.push(rt);
+                    skipped |= cells.skipped;
+                    row.push(cells.rate);
                 }
             }
             rows.push(row);
@@ -832,7 +881,11 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
             rows.push(stat_row("flags", &|f| (f.flags(), String::new())));
         }
         if !shown.is_empty() {
-            md.push_str(&table::markdown(&header, &align, &rows));
+            md.push_str(
+                &TextTable::new(cols.iter().copied())
+                    .with_rows(rows)
+                    .markdown(),
+            );
             md.push('\n');
         }
         if skipped {

@@ -33,7 +33,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
 
 use super::runs::{Run, Runs};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 
 /// A one-step increase of a provably non-increasing functional above this fraction of its
 /// initial value is growth. SPEC §6: the schemes that provably do not gain energy stay below
@@ -722,23 +722,17 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
          are over the ok runs.\n"
     );
     md.push_str("## Per group (across refinement)\n\n");
-    let gh: Vec<String> = [
-        "#",
-        "group",
-        "ok/runs",
-        "drift",
-        "max dev",
-        "max increase",
-        "max increase E_Θ",
-        "energy classes",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let mut ga = vec![Align::Right, Align::Left];
-    ga.extend([Align::Right; 5]);
-    ga.push(Align::Left);
-    md.push_str(&table::markdown(&gh, &ga, &group_rows_md));
+    let per_group = TextTable::new([
+        ("#", Align::Right),
+        ("group", Align::Left),
+        ("ok/runs", Align::Right),
+        ("drift", Align::Right),
+        ("max dev", Align::Right),
+        ("max increase", Align::Right),
+        ("max increase E_Θ", Align::Right),
+        ("energy classes", Align::Left),
+    ]);
+    md.push_str(&per_group.with_rows(group_rows_md).markdown());
     md.push_str("\n## Per run\n\n");
     match &series {
         Ok(_) => {
@@ -764,35 +758,23 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             let _ = writeln!(md, "Impacts: not computed ({why}).\n");
         }
     }
-    let rh: Vec<String> = [
-        "#",
-        "label",
-        "h",
-        "dt",
-        "status",
-        "drift",
-        "max dev",
-        "max increase",
-        "functional drift",
-        "δ",
-        "class",
-        "impacts",
-        "impact loss",
-        "decimated",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let mut ra = vec![
-        Align::Right,
-        Align::Left,
-        Align::Right,
-        Align::Right,
-        Align::Left,
-    ];
-    ra.extend([Align::Right; 5]);
-    ra.extend([Align::Left, Align::Right, Align::Right, Align::Left]);
-    md.push_str(&table::markdown(&rh, &ra, &run_rows_md));
+    let run_text = TextTable::new([
+        ("#", Align::Right),
+        ("label", Align::Left),
+        ("h", Align::Right),
+        ("dt", Align::Right),
+        ("status", Align::Left),
+        ("drift", Align::Right),
+        ("max dev", Align::Right),
+        ("max increase", Align::Right),
+        ("functional drift", Align::Right),
+        ("δ", Align::Right),
+        ("class", Align::Left),
+        ("impacts", Align::Right),
+        ("impact loss", Align::Right),
+        ("decimated", Align::Left),
+    ]);
+    md.push_str(&run_text.with_rows(run_rows_md).markdown());
 
     let mut terminal = format!(
         "energy classes (scheme's functional, δ = max(1, ν)·h/L): {} runs —",

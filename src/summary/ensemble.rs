@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::runs::{Cell, Run, Runs, float_key};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 
 /// The relative spread above which an ensemble is sensitive, for perturbations of relative
 /// size `eps` (see the module header).
@@ -289,25 +289,20 @@ pub(crate) fn section(runs: &Runs) -> Section {
              members end with different statuses — the result is decided by round-off and no \
              single digit of it means anything.\n"
         );
-        let header: Vec<String> = [
-            "#",
-            "group",
-            "h",
-            "dt",
-            "ok/members",
-            "E(T)/E⁰ min · median · max",
-            "spread",
-            "l2(τ;H1) min · median · max",
-            "sensitive",
-            "why",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let mut align = vec![Align::Right, Align::Left, Align::Right, Align::Right];
-        align.extend([Align::Right; 4]);
-        align.extend([Align::Left, Align::Left]);
-        md.push_str(&table::markdown(&header, &align, &md_rows));
+        let text = TextTable::new([
+            ("#", Align::Right),
+            ("group", Align::Left),
+            ("h", Align::Right),
+            ("dt", Align::Right),
+            ("ok/members", Align::Right),
+            ("E(T)/E⁰ min · median · max", Align::Right),
+            ("spread", Align::Right),
+            ("l2(τ;H1) min · median · max", Align::Right),
+            ("sensitive", Align::Left),
+            ("why", Align::Left),
+        ])
+        .with_rows(md_rows);
+        md.push_str(&text.markdown());
         let n_sens = out.iter().filter(|e| e.sensitive).count();
         let _ = writeln!(
             terminal,
@@ -315,7 +310,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
             n_sens,
             out.len()
         );
-        for (row, e) in md_rows.iter().zip(&out) {
+        for (row, e) in text.rows().iter().zip(&out) {
             let _ = writeln!(
                 terminal,
                 "  {:<9} {} (h = {}, dt = {}): E(T)/E⁰ {}{}",

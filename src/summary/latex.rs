@@ -32,10 +32,17 @@
 
 use std::fmt::Write as _;
 
-use super::convergence::{Fit, PRE_ASYMPTOTIC_SPREAD, STAGNATION_SLOPE};
+use super::convergence::{Fit, LevelMarks, PRE_ASYMPTOTIC_SPREAD, STAGNATION_SLOPE};
 use super::options::SummaryOptions;
 use super::runs::{Fixed, RefPath, Runs};
 use super::table;
+
+/// The LaTeX tables' marks: an excluded level's value in parentheses alone (the caption says
+/// why), a rate against a level further back with a dagger.
+const LATEX_MARKS: LevelMarks = LevelMarks {
+    excluded: "",
+    skipped: "$^\\dagger$",
+};
 
 /// At most this many group tables are floats. LaTeX keeps 18 floats waiting at most; a paper
 /// has its own figures and tables in that queue, so the summary takes fewer than its share.
@@ -409,20 +416,17 @@ fn path_rows(
                 continue;
             };
             let lf = &f.levels[li];
-            let v = value(r.errors[e]);
-            row.push(if lf.used || v.is_empty() {
-                v
-            } else {
-                excluded = true;
-                format!("({v})")
-            });
+            let cells = lf.cells(
+                li,
+                value(r.errors[e]),
+                table::tex_rate(lf.rate),
+                &LATEX_MARKS,
+            );
+            excluded |= cells.excluded;
+            row.push(cells.value);
             if opts.rates {
-                let mut rt = table::tex_rate(lf.rate);
-                if lf.rate_from.is_some_and(|from| from + 1 != li) {
-                    rt.push_str("$^\\dagger$");
-                    skipped = true;
-                }
-                row.push(rt);
+                skipped |= cells.skipped;
+                row.push(cells.rate);
             }
         }
         let _ = writeln!(out, "    {} \\\\", row.join(" & "));
@@ -555,13 +559,15 @@ fn group_table(runs: &Runs, opts: &SummaryOptions, gt: &GroupTex, long: bool) ->
             out,
             "  \\caption[{short}]{{{caption}}}\\label{{{label}}} \\\\"
         );
-        let _ = writeln!(out, "    \\toprule");
-        out.push_str(&header);
-        let _ = writeln!(out, "    \\midrule\n  \\endfirsthead");
+        // The head on the first page, then again under a "continued" caption on the others.
+        let head = |out: &mut String, end: &str| {
+            let _ = writeln!(out, "    \\toprule");
+            out.push_str(&header);
+            let _ = writeln!(out, "    \\midrule\n  \\{end}");
+        };
+        head(&mut out, "endfirsthead");
         let _ = writeln!(out, "  \\caption[]{{{short} (continued)}} \\\\");
-        let _ = writeln!(out, "    \\toprule");
-        out.push_str(&header);
-        let _ = writeln!(out, "    \\midrule\n  \\endhead");
+        head(&mut out, "endhead");
         let _ = writeln!(
             out,
             "    \\midrule\n    \\multicolumn{{{ncols}}}{{r}}{{\\textit{{continued on the next page}}}} \\\\\n  \\endfoot"

@@ -18,7 +18,7 @@
 use super::convergence::lsq_slope;
 use super::energy::classify;
 use super::runs::{Fixed, Runs};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 
 /// Largest `pressure_oscillation` read as a smooth pressure.
 pub const SMOOTH_PRESSURE: f64 = 5.0;
@@ -124,31 +124,19 @@ pub(crate) fn section(runs: &Runs) -> Section {
             table::rate(r1),
         ]);
     }
-    let header: Vec<String> = [
-        "method",
-        "energy",
-        "pressure",
-        "penetration",
-        "L2 rate",
-        "H1 rate",
-    ]
-    .map(String::from)
-    .to_vec();
-    let align = [
-        Align::Left,
-        Align::Left,
-        Align::Left,
-        Align::Left,
-        Align::Right,
-        Align::Right,
-    ];
+    let text = TextTable::new([
+        ("method", Align::Left),
+        ("energy", Align::Left),
+        ("pressure", Align::Left),
+        ("penetration", Align::Left),
+        ("L2 rate", Align::Right),
+        ("H1 rate", Align::Right),
+    ])
+    .with_rows(rows.clone());
     let legend = format!(
         "energy: the worst energy class of the group's ok runs (see energy.md: scheme's functional, δ = max(1, ν)·h/L); pressure: smooth if max pressure_oscillation ≤ {SMOOTH_PRESSURE} (1 = one rise and one fall), oscillating above; penetration: none if max_penetration ≤ {NO_PENETRATION:e}·L, O(τ) above; rates: least-squares slopes of err_u_l2l2 and err_u_l2h1 against h along the group's longest path with τ ∝ h (ok levels)."
     );
-    let markdown = format!(
-        "# Method classes\n\n{legend}\n\n{}",
-        table::markdown(&header, &align, &rows)
-    );
+    let markdown = format!("# Method classes\n\n{legend}\n\n{}", text.markdown());
     let mut latex = String::from(
         "% Method classes (contact-sweep summary)\n\\begin{tabular}{llllrr}\n\\hline\nmethod & energy & pressure & penetration & L2 rate & H1 rate \\\\\n\\hline\n",
     );
@@ -192,7 +180,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
         markdown,
         latex,
         terminal,
-        header,
+        header: text.header().to_vec(),
         rows,
         legend,
     }

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::runs::{Run, Runs};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 use crate::sweep::{Search, SearchState};
 
 /// The search section's outputs.
@@ -204,27 +204,20 @@ pub(crate) fn section(runs: &Runs) -> Section {
              between which it changes (bisection to the search's relative tolerance; every \
              probe is a row of runs/ tagged with its search).\n\n",
         );
-        let header: Vec<String> = [
-            "search",
-            "method",
-            "key",
-            "criterion",
-            "bracket",
-            "state",
-            "last holding",
-            "first failing",
-            "probes",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let mut align = vec![Align::Left; 6];
-        align.extend([Align::Right; 3]);
-        md.push_str(&table::markdown(&header, &align, &rows_md));
-        terminal.insert_str(
-            0,
-            &format!("boundaries ({} searched methods):\n", rows_md.len()),
-        );
+        let text = TextTable::new([
+            ("search", Align::Left),
+            ("method", Align::Left),
+            ("key", Align::Left),
+            ("criterion", Align::Left),
+            ("bracket", Align::Left),
+            ("state", Align::Left),
+            ("last holding", Align::Right),
+            ("first failing", Align::Right),
+            ("probes", Align::Right),
+        ]);
+        let searched = rows_md.len();
+        md.push_str(&text.with_rows(rows_md).markdown());
+        terminal.insert_str(0, &format!("boundaries ({searched} searched methods):\n"));
     }
     Section {
         table: t,

@@ -24,7 +24,7 @@ use std::fmt::Write as _;
 
 use super::energy::classify;
 use super::runs::{Run, Runs};
-use super::table::{self, Align, Kind, Table};
+use super::table::{Align, Kind, Table, TextTable};
 
 /// Cell states, worst first.
 pub const STATES: [&str; 6] = [
@@ -277,8 +277,8 @@ pub(crate) fn section(runs: &Runs) -> Section {
                         row
                     })
                     .collect();
-                let align = vec![Align::Right; header.len()];
-                md.push_str(&table::markdown(&header, &align, &rows));
+                let map = TextTable::new(header.into_iter().map(|h| (h, Align::Right)));
+                md.push_str(&map.with_rows(rows).markdown());
                 md.push('\n');
                 let summary: Vec<String> = STATES
                     .iter()

@@ -250,8 +250,66 @@ pub(crate) enum Align {
     Right,
 }
 
+/// A text table declared column by column — each column its header with its alignment — and
+/// filled row by row; one renderer per format ([`markdown`], [`plain`]) serves every table.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct TextTable {
+    header: Vec<String>,
+    align: Vec<Align>,
+    rows: Vec<Vec<String>>,
+}
+
+impl TextTable {
+    pub(crate) fn new<S: Into<String>>(cols: impl IntoIterator<Item = (S, Align)>) -> Self {
+        let (header, align) = cols.into_iter().map(|(h, a)| (h.into(), a)).unzip();
+        TextTable {
+            header,
+            align,
+            rows: Vec::new(),
+        }
+    }
+
+    /// The table with these rows (built before the columns were declared).
+    pub(crate) fn with_rows(mut self, rows: Vec<Vec<String>>) -> Self {
+        self.rows = rows;
+        self
+    }
+
+    pub(crate) fn row(&mut self, cells: Vec<String>) {
+        self.rows.push(cells);
+    }
+
+    pub(crate) fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    pub(crate) fn header(&self) -> &[String] {
+        &self.header
+    }
+
+    pub(crate) fn rows(&self) -> &[Vec<String>] {
+        &self.rows
+    }
+
+    /// Whether each column is right-aligned (the report's HTML tables).
+    pub(crate) fn right(&self) -> Vec<bool> {
+        self.align
+            .iter()
+            .map(|a| matches!(a, Align::Right))
+            .collect()
+    }
+
+    pub(crate) fn markdown(&self) -> String {
+        markdown(&self.header, &self.align, &self.rows)
+    }
+
+    pub(crate) fn plain(&self) -> String {
+        plain(&self.header, &self.align, &self.rows)
+    }
+}
+
 /// A GitHub-flavoured Markdown table. `|` inside cells is escaped.
-pub(crate) fn markdown(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
+fn markdown(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
     let esc = |s: &str| s.replace('|', "\\|");
     let mut out = String::new();
     out.push_str("| ");
@@ -280,7 +338,7 @@ pub(crate) fn markdown(header: &[String], align: &[Align], rows: &[Vec<String>])
 
 /// A plain-text table for the terminal: columns padded to their widest cell (counted in
 /// characters, the labels carry Θ, γ, ·).
-pub(crate) fn plain(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
+fn plain(header: &[String], align: &[Align], rows: &[Vec<String>]) -> String {
     let n = header.len();
     let mut width = vec![0usize; n];
     for r in std::iter::once(header).chain(rows.iter().map(|r| r.as_slice())) {

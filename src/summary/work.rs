@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::runs::{Fixed, Runs};
-use super::table::{self, Align, Kind, Table};
+use super::table::{self, Align, Kind, Table, TextTable};
 
 /// The Pareto front of (cost, error) points, both minimised: `true` where no other point is
 /// at least as good in both and strictly better in one. O(n log n): sort by cost, sweep.
@@ -253,60 +253,23 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 .unwrap_or(0.0)
                 .total_cmp(&runs.runs[b].wall_time_s.unwrap_or(0.0))
         });
-        let header: Vec<String> = [
-            "#",
-            "family",
-            "h",
-            "dt",
-            ename,
-            "wall time [min, max] s",
-            "work",
-            "repeats",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let align = [
-            Align::Right,
-            Align::Left,
-            Align::Right,
-            Align::Right,
-            Align::Right,
-            Align::Right,
-            Align::Right,
-            Align::Right,
-        ];
-        let wall_cell = |i: usize| {
+        let mut front_table = run_table("family", false, ename, ("repeats", Align::Right));
+        for &i in &front {
             let r = &runs.runs[i];
-            format!(
-                "{} [{}, {}]",
-                table::sci(r.wall_time_s),
-                table::sci(r.wall_time_min_s),
-                table::sci(r.wall_time_max_s)
-            )
-        };
-        let rows: Vec<Vec<String>> = front
-            .iter()
-            .map(|&i| {
-                let r = &runs.runs[i];
-                vec![
-                    (r.group + 1).to_string(),
-                    runs.groups[r.group].title.clone(),
-                    table::sci(r.h),
-                    table::sci(r.dt),
-                    table::sci(r.errors[e]),
-                    wall_cell(i),
-                    work_of(r.steps, r.dofs)
-                        .map(|w| w.to_string())
-                        .unwrap_or_default(),
-                    r.repeats.map(|x| x.to_string()).unwrap_or_default(),
-                ]
-            })
-            .collect();
-        if rows.is_empty() {
+            let repeats = r.repeats.map(|x| x.to_string()).unwrap_or_default();
+            front_table.row(run_cells(
+                runs,
+                i,
+                e,
+                runs.groups[r.group].title.clone(),
+                false,
+                repeats,
+            ));
+        }
+        if front_table.is_empty() {
             md.push_str("No ok run with a timed, positive error.\n\n");
         } else {
-            md.push_str(&table::markdown(&header, &align, &rows));
+            md.push_str(&front_table.markdown());
             md.push('\n');
         }
 
@@ -455,67 +418,34 @@ pub(crate) fn section(runs: &Runs) -> Section {
             cost_rows.push(md_row);
         }
         if !decades.is_empty() && !cost_rows.is_empty() {
-            let mut header: Vec<String> = vec!["#".into(), "family".into()];
-            header.extend(decades.iter().map(|d| format!("ε = {d:.0e}")));
-            let mut align = vec![Align::Right, Align::Left];
-            align.extend(decades.iter().map(|_| Align::Right));
-            md.push_str(&table::markdown(&header, &align, &cost_rows));
+            let cols = [
+                ("#".to_string(), Align::Right),
+                ("family".into(), Align::Left),
+            ]
+            .into_iter()
+            .chain(
+                decades
+                    .iter()
+                    .map(|d| (format!("ε = {d:.0e}"), Align::Right)),
+            );
+            md.push_str(&TextTable::new(cols).with_rows(cost_rows).markdown());
             md.push('\n');
         }
 
         // Markdown: every run (error against cost), by family.
         let _ = writeln!(md, "### All runs\n");
-        let header: Vec<String> = [
-            "#",
-            "label",
-            "h",
-            "dt",
-            "status",
-            ename,
-            "wall time [min, max] s",
-            "work",
-            "front",
-        ]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-        let align = [
-            Align::Right,
-            Align::Left,
-            Align::Right,
-            Align::Right,
-            Align::Left,
-            Align::Right,
-            Align::Right,
-            Align::Right,
-            Align::Left,
-        ];
-        let rows: Vec<Vec<String>> = order
-            .iter()
-            .map(|&i| {
-                let r = &runs.runs[i];
-                let front = match (on_wall[i], on_work[i]) {
-                    (Some(true), Some(true)) => "wall, work",
-                    (Some(true), _) => "wall",
-                    (_, Some(true)) => "work",
-                    _ => "",
-                };
-                vec![
-                    (r.group + 1).to_string(),
-                    r.label.clone(),
-                    table::sci(r.h),
-                    table::sci(r.dt),
-                    r.status.clone(),
-                    table::sci(r.errors[e]),
-                    wall_cell(i),
-                    work_of(r.steps, r.dofs)
-                        .map(|w| w.to_string())
-                        .unwrap_or_default(),
-                    front.to_string(),
-                ]
-            })
-            .collect();
-        md.push_str(&table::markdown(&header, &align, &rows));
+        let mut all = run_table("label", true, ename, ("front", Align::Left));
+        for &i in &order {
+            let front = match (on_wall[i], on_work[i]) {
+                (Some(true), Some(true)) => "wall, work",
+                (Some(true), _) => "wall",
+                (_, Some(true)) => "work",
+                _ => "",
+            };
+            let label = runs.runs[i].label.clone();
+            all.row(run_cells(runs, i, e, label, true, front.to_string()));
+        }
+        md.push_str(&all.markdown());
         md.push('\n');
 
         // Terminal: the front of the first (main) error column only.
@@ -570,4 +500,61 @@ pub(crate) fn section(runs: &Runs) -> Section {
         markdown: md,
         terminal,
     }
+}
+
+/// The columns of a metric's two run tables (the Pareto front, every run): `#`, the run's
+/// `first` (its family or label), h, dt, the status if `status`, the error `ename`, the wall
+/// time with its spread, the work, and the table's `last` column.
+fn run_table(first: &str, status: bool, ename: &str, last: (&str, Align)) -> TextTable {
+    let mut cols = vec![
+        ("#", Align::Right),
+        (first, Align::Left),
+        ("h", Align::Right),
+        ("dt", Align::Right),
+    ];
+    if status {
+        cols.push(("status", Align::Left));
+    }
+    cols.extend([
+        (ename, Align::Right),
+        ("wall time [min, max] s", Align::Right),
+        ("work", Align::Right),
+        last,
+    ]);
+    TextTable::new(cols)
+}
+
+/// A row of [`run_table`]: run `i`'s cells for error column `e`.
+fn run_cells(
+    runs: &Runs,
+    i: usize,
+    e: usize,
+    first: String,
+    status: bool,
+    last: String,
+) -> Vec<String> {
+    let r = &runs.runs[i];
+    let mut cells = vec![
+        (r.group + 1).to_string(),
+        first,
+        table::sci(r.h),
+        table::sci(r.dt),
+    ];
+    if status {
+        cells.push(r.status.clone());
+    }
+    cells.extend([
+        table::sci(r.errors[e]),
+        format!(
+            "{} [{}, {}]",
+            table::sci(r.wall_time_s),
+            table::sci(r.wall_time_min_s),
+            table::sci(r.wall_time_max_s)
+        ),
+        work_of(r.steps, r.dofs)
+            .map(|w| w.to_string())
+            .unwrap_or_default(),
+        last,
+    ]);
+    cells
 }
