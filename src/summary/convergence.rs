@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use super::latex;
 use super::options::SummaryOptions;
 use super::runs::{RefPath, Runs, group_heading};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Align, Kind, Table, TextTable, columns};
 
 /// Pair rates spread over more than this: the errors are not yet in the asymptotic regime.
 /// A clean power law gives spread 0; the converging ladders of SPEC §6 (h = 1/4 … 1/256, ratio
@@ -305,46 +305,18 @@ fn displayed(runs: &Runs, opts: &SummaryOptions) -> (Vec<usize>, Vec<String>) {
 }
 
 fn columns(runs: &Runs) -> Vec<(String, Kind)> {
-    let mut c: Vec<(String, Kind)> = [
-        ("group", Kind::I64),
-        ("group_title", Kind::Str),
-        ("path", Kind::I64),
-        ("fixed", Kind::Str),
-        ("fixed_value", Kind::F64),
-        ("refined", Kind::Str),
-        ("levels", Kind::I64),
-        ("level", Kind::I64),
-        ("run_id", Kind::Str),
-        ("label", Kind::Str),
-        ("status", Kind::Str),
-        ("message", Kind::Str),
-        ("h", Kind::F64),
-        ("dt", Kind::F64),
-        ("courant", Kind::F64),
-        ("elements", Kind::I64),
-        ("refinement", Kind::F64),
-        ("error", Kind::Str),
-        ("value", Kind::F64),
-        ("used_in_fit", Kind::Bool),
-        ("excluded", Kind::Str),
-        ("rate", Kind::F64),
-        ("rate_from_level", Kind::I64),
-        ("slope_all", Kind::F64),
-        ("fit_levels", Kind::I64),
-        ("slope_finest3", Kind::F64),
-        ("finest_levels", Kind::I64),
-        ("rate_spread", Kind::F64),
-        ("pre_asymptotic", Kind::Bool),
-        ("stagnating", Kind::Bool),
-        ("roundoff_floor", Kind::Bool),
-        ("failed_levels", Kind::I64),
-        ("flags", Kind::Str),
-    ]
-    .iter()
-    .map(|(n, k)| (n.to_string(), *k))
-    .collect();
-    c.extend(runs.param_columns());
-    c
+    table::with_params(
+        &columns![
+            group: I64, group_title: Str, path: I64, fixed: Str, fixed_value: F64, refined: Str,
+            levels: I64, level: I64, run_id: Str, label: Str, status: Str, message: Str, h: F64,
+            dt: F64, courant: F64, elements: I64, refinement: F64, error: Str, value: F64,
+            used_in_fit: Bool, excluded: Str, rate: F64, rate_from_level: I64, slope_all: F64,
+            fit_levels: I64, slope_finest3: F64, finest_levels: I64, rate_spread: F64,
+            pre_asymptotic: Bool, stagnating: Bool, roundoff_floor: Bool, failed_levels: I64,
+            flags: Str,
+        ],
+        runs,
+    )
 }
 
 /// A group's main refinement path: its index and the fits of its error columns.
@@ -757,13 +729,9 @@ pub(crate) fn section(runs: &Runs, opts: &SummaryOptions, title: &str) -> Sectio
                 t.str("refined", Some(p.fixed.refined()));
                 t.i64("levels", Some(p.levels.len() as i64));
                 t.i64("level", Some(li as i64));
-                t.str("run_id", Some(&r.run_id));
-                t.str("label", Some(&r.label));
-                t.str("status", Some(&r.status));
+                t.run_identity(r);
                 t.str("message", r.message.as_deref());
-                t.f64("h", r.h);
-                t.f64("dt", r.dt);
-                t.f64("courant", r.courant);
+                t.run_level(r);
                 t.i64("elements", r.elements);
                 t.f64("refinement", Some(x));
                 t.str("error", Some(runs.errors[*e]));

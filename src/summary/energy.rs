@@ -33,7 +33,7 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
 
 use super::runs::{Run, Runs};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Table, TextTable, columns, text_columns};
 
 /// A one-step increase of a provably non-increasing functional above this fraction of its
 /// initial value is growth. SPEC §6: the schemes that provably do not gain energy stay below
@@ -387,16 +387,6 @@ pub(crate) struct Section {
     pub terminal: String,
 }
 
-fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
-    let mut c = cols_without_params(list);
-    c.extend(runs.param_columns());
-    c
-}
-
-fn cols_without_params(list: &[(&str, Kind)]) -> Vec<(String, Kind)> {
-    list.iter().map(|(n, k)| (n.to_string(), *k)).collect()
-}
-
 fn minmax(v: impl Iterator<Item = Option<f64>>) -> (Option<f64>, Option<f64>) {
     let mut lo: Option<f64> = None;
     let mut hi: Option<f64> = None;
@@ -430,34 +420,16 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             other => other,
         }
     };
-    let mut per_run = Table::new(&cols(
-        &[
-            ("group", Kind::I64),
-            ("group_title", Kind::Str),
-            ("run_id", Kind::Str),
-            ("label", Kind::Str),
-            ("status", Kind::Str),
-            ("search", Kind::Str),
-            ("h", Kind::F64),
-            ("dt", Kind::F64),
-            ("courant", Kind::F64),
-            ("energy_initial", Kind::F64),
-            ("energy_final", Kind::F64),
-            ("energy_drift", Kind::F64),
-            ("energy_max_dev", Kind::F64),
-            ("energy_max_increase", Kind::F64),
-            ("energy_theta_max_increase", Kind::F64),
-            ("energy_theta_drift", Kind::F64),
-            ("energy_class", Kind::Str),
-            ("energy_functional", Kind::Str),
-            ("energy_functional_drift", Kind::F64),
-            ("energy_functional_max_increase", Kind::F64),
-            ("energy_tolerance", Kind::F64),
-            ("energy_monotone_by_proof", Kind::Bool),
-            ("impacts", Kind::I64),
-            ("impact_loss_total", Kind::F64),
-            ("series_decimated", Kind::Bool),
-            ("series_stride", Kind::I64),
+    let mut per_run = Table::new(&table::with_params(
+        &columns![
+            group: I64, group_title: Str, run_id: Str, label: Str, status: Str, search: Str,
+            h: F64, dt: F64, courant: F64, energy_initial: F64, energy_final: F64,
+            energy_drift: F64, energy_max_dev: F64, energy_max_increase: F64,
+            energy_theta_max_increase: F64, energy_theta_drift: F64, energy_class: Str,
+            energy_functional: Str, energy_functional_drift: F64,
+            energy_functional_max_increase: F64, energy_tolerance: F64,
+            energy_monotone_by_proof: Bool, impacts: I64, impact_loss_total: F64,
+            series_decimated: Bool, series_stride: I64,
         ],
         runs,
     ));
@@ -465,31 +437,13 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     // parameters are not repeated on each (25 columns, half of impacts.csv's 7.9 MB and of its
     // encoding time on issue 12's sweep); they are one join away, on `run_id`, in the energy
     // table or `runs/`.
-    let mut impacts = Table::new(&cols_without_params(&[
-        ("group", Kind::I64),
-        ("group_title", Kind::Str),
-        ("run_id", Kind::Str),
-        ("label", Kind::Str),
-        ("status", Kind::Str),
-        ("h", Kind::F64),
-        ("dt", Kind::F64),
-        ("impact", Kind::I64),
-        ("step_first", Kind::I64),
-        ("step_last", Kind::I64),
-        ("t_first", Kind::F64),
-        ("t_last", Kind::F64),
-        ("step_before", Kind::I64),
-        ("step_after", Kind::I64),
-        ("energy_e0", Kind::F64),
-        ("energy_before", Kind::F64),
-        ("energy_after", Kind::F64),
-        ("energy_loss_rel", Kind::F64),
-        ("energy_theta_before", Kind::F64),
-        ("energy_theta_after", Kind::F64),
-        ("energy_theta_loss_rel", Kind::F64),
-        ("phase_complete", Kind::Bool),
-        ("series_decimated", Kind::Bool),
-        ("series_stride", Kind::I64),
+    let mut impacts = Table::new(&table::owned(&columns![
+        group: I64, group_title: Str, run_id: Str, label: Str, status: Str, h: F64, dt: F64,
+        impact: I64, step_first: I64, step_last: I64, t_first: F64, t_last: F64, step_before: I64,
+        step_after: I64, energy_e0: F64, energy_before: F64, energy_after: F64,
+        energy_loss_rel: F64, energy_theta_before: F64, energy_theta_after: F64,
+        energy_theta_loss_rel: F64, phase_complete: Bool, series_decimated: Bool,
+        series_stride: I64,
     ]));
 
     let mut run_rows_md: Vec<Vec<String>> = Vec::new();
@@ -529,11 +483,8 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
                 (Some(b), Some(a), Some(e0)) if e0 != 0.0 => Some((b - a) / e0),
                 _ => None,
             };
-            impacts.i64("group", Some(r.group as i64 + 1));
-            impacts.str("group_title", Some(&runs.groups[r.group].title));
-            impacts.str("run_id", Some(&r.run_id));
-            impacts.str("label", Some(&r.label));
-            impacts.str("status", Some(&r.status));
+            impacts.run_group(runs, r);
+            impacts.run_identity(r);
             impacts.f64("h", r.h);
             impacts.f64("dt", r.dt);
             impacts.i64("impact", Some(k as i64 + 1));
@@ -543,12 +494,20 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             impacts.f64("t_last", ph.t_last);
             impacts.i64("step_before", ph.step_before);
             impacts.i64("step_after", ph.step_after);
-            impacts.f64("energy_e0", e0);
-            impacts.f64("energy_before", eb);
-            impacts.f64("energy_after", ea);
+            // The energy across the phase: E^h, and E_Θ where the scheme has it.
+            let energies = [
+                ("energy_e0", e0),
+                ("energy_before", eb),
+                ("energy_after", ea),
+            ];
+            let theta = [("energy_theta_before", tb), ("energy_theta_after", ta)];
+            for (name, v) in energies {
+                impacts.f64(name, v);
+            }
             impacts.f64("energy_loss_rel", loss);
-            impacts.f64("energy_theta_before", tb);
-            impacts.f64("energy_theta_after", ta);
+            for (name, v) in theta {
+                impacts.f64(name, v);
+            }
             impacts.f64("energy_theta_loss_rel", tloss);
             impacts.bool("phase_complete", Some(complete));
             impacts.bool("series_decimated", Some(decimated));
@@ -564,15 +523,10 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         let c = &classes[ri];
         let b = c.class.as_deref();
         *counts.entry(b.unwrap_or("unknown")).or_default() += 1;
-        per_run.i64("group", Some(r.group as i64 + 1));
-        per_run.str("group_title", Some(&runs.groups[r.group].title));
-        per_run.str("run_id", Some(&r.run_id));
-        per_run.str("label", Some(&r.label));
-        per_run.str("status", Some(&r.status));
+        per_run.run_group(runs, r);
+        per_run.run_identity(r);
         per_run.str("search", r.search.as_deref());
-        per_run.f64("h", r.h);
-        per_run.f64("dt", r.dt);
-        per_run.f64("courant", r.courant);
+        per_run.run_level(r);
         per_run.f64("energy_initial", r.energy_initial);
         per_run.f64("energy_final", r.energy_final);
         per_run.f64("energy_drift", r.energy_drift);
@@ -622,27 +576,14 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
 
     // Per group, across refinement: ranges over the ok runs (a diverged run's energy is
     // where it stopped, not a property of the method).
-    let mut groups = Table::new(&cols(
-        &[
-            ("group", Kind::I64),
-            ("group_title", Kind::Str),
-            ("label", Kind::Str),
-            ("runs", Kind::I64),
-            ("ok_runs", Kind::I64),
-            ("energy_drift_min", Kind::F64),
-            ("energy_drift_max", Kind::F64),
-            ("energy_max_dev_min", Kind::F64),
-            ("energy_max_dev_max", Kind::F64),
-            ("energy_max_increase_min", Kind::F64),
-            ("energy_max_increase_max", Kind::F64),
-            ("energy_theta_max_increase_min", Kind::F64),
-            ("energy_theta_max_increase_max", Kind::F64),
-            ("conservative_runs", Kind::I64),
-            ("dissipative_runs", Kind::I64),
-            ("growing_runs", Kind::I64),
-            ("diverged_runs", Kind::I64),
-            ("failed_runs", Kind::I64),
-            ("energy_classes", Kind::Str),
+    let mut groups = Table::new(&table::with_params(
+        &columns![
+            group: I64, group_title: Str, label: Str, runs: I64, ok_runs: I64,
+            energy_drift_min: F64, energy_drift_max: F64, energy_max_dev_min: F64,
+            energy_max_dev_max: F64, energy_max_increase_min: F64, energy_max_increase_max: F64,
+            energy_theta_max_increase_min: F64, energy_theta_max_increase_max: F64,
+            conservative_runs: I64, dissipative_runs: I64, growing_runs: I64, diverged_runs: I64,
+            failed_runs: I64, energy_classes: Str,
         ],
         runs,
     ));
@@ -722,15 +663,9 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
          are over the ok runs.\n"
     );
     md.push_str("## Per group (across refinement)\n\n");
-    let per_group = TextTable::new([
-        ("#", Align::Right),
-        ("group", Align::Left),
-        ("ok/runs", Align::Right),
-        ("drift", Align::Right),
-        ("max dev", Align::Right),
-        ("max increase", Align::Right),
-        ("max increase E_Θ", Align::Right),
-        ("energy classes", Align::Left),
+    let per_group = TextTable::new(text_columns![
+        "#" => Right, "group" => Left, "ok/runs" => Right, "drift" => Right, "max dev" => Right,
+        "max increase" => Right, "max increase E_Θ" => Right, "energy classes" => Left,
     ]);
     md.push_str(&per_group.with_rows(group_rows_md).markdown());
     md.push_str("\n## Per run\n\n");
@@ -758,21 +693,11 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             let _ = writeln!(md, "Impacts: not computed ({why}).\n");
         }
     }
-    let run_text = TextTable::new([
-        ("#", Align::Right),
-        ("label", Align::Left),
-        ("h", Align::Right),
-        ("dt", Align::Right),
-        ("status", Align::Left),
-        ("drift", Align::Right),
-        ("max dev", Align::Right),
-        ("max increase", Align::Right),
-        ("functional drift", Align::Right),
-        ("δ", Align::Right),
-        ("class", Align::Left),
-        ("impacts", Align::Right),
-        ("impact loss", Align::Right),
-        ("decimated", Align::Left),
+    let run_text = TextTable::new(text_columns![
+        "#" => Right, "label" => Left, "h" => Right, "dt" => Right, "status" => Left,
+        "drift" => Right, "max dev" => Right, "max increase" => Right,
+        "functional drift" => Right, "δ" => Right, "class" => Left, "impacts" => Right,
+        "impact loss" => Right, "decimated" => Left,
     ]);
     md.push_str(&run_text.with_rows(run_rows_md).markdown());
 

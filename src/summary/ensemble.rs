@@ -31,7 +31,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::runs::{Cell, Run, Runs, float_key};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Kind, Table, TextTable, columns, text_columns};
 
 /// The relative spread above which an ensemble is sensitive, for perturbations of relative
 /// size `eps` (see the module header).
@@ -47,33 +47,24 @@ struct Metric {
     flags: bool,
 }
 
+/// The energy columns an ensemble summarises: E(T)/E⁰ flags (with the errors), the others are
+/// shown.
 fn energy_metrics() -> Vec<Metric> {
+    let shown = |name, get| Metric {
+        name,
+        get,
+        flags: false,
+    };
     vec![
         Metric {
             name: "energy_ratio",
             get: Run::energy_ratio,
             flags: true,
         },
-        Metric {
-            name: "energy_max_dev",
-            get: |r| r.energy_max_dev,
-            flags: false,
-        },
-        Metric {
-            name: "energy_max_increase",
-            get: |r| r.energy_max_increase,
-            flags: false,
-        },
-        Metric {
-            name: "energy_theta_drift",
-            get: |r| r.energy_theta_drift,
-            flags: false,
-        },
-        Metric {
-            name: "energy_theta_max_increase",
-            get: |r| r.energy_theta_max_increase,
-            flags: false,
-        },
+        shown("energy_max_dev", |r| r.energy_max_dev),
+        shown("energy_max_increase", |r| r.energy_max_increase),
+        shown("energy_theta_drift", |r| r.energy_theta_drift),
+        shown("energy_theta_max_increase", |r| r.energy_theta_max_increase),
     ]
 }
 
@@ -123,24 +114,11 @@ pub(crate) struct Section {
 /// Build the ensemble section (empty tables when the folder holds no ensemble).
 pub(crate) fn section(runs: &Runs) -> Section {
     let energy = energy_metrics();
-    let mut columns: Vec<(String, Kind)> = [
-        ("group", Kind::I64),
-        ("group_title", Kind::Str),
-        ("label", Kind::Str),
-        ("h", Kind::F64),
-        ("dt", Kind::F64),
-        ("courant", Kind::F64),
-        ("perturbation", Kind::F64),
-        ("members", Kind::I64),
-        ("ok_members", Kind::I64),
-        ("statuses", Kind::Str),
-        ("tolerance", Kind::F64),
-        ("sensitive", Kind::Bool),
-        ("sensitive_columns", Kind::Str),
-    ]
-    .iter()
-    .map(|(n, k)| (n.to_string(), *k))
-    .collect();
+    let mut columns: Vec<(String, Kind)> = table::owned(&columns![
+        group: I64, group_title: Str, label: Str, h: F64, dt: F64, courant: F64,
+        perturbation: F64, members: I64, ok_members: I64, statuses: Str, tolerance: F64,
+        sensitive: Bool, sensitive_columns: Str,
+    ]);
     let metric_names: Vec<&str> = energy
         .iter()
         .map(|m| m.name)
@@ -289,17 +267,10 @@ pub(crate) fn section(runs: &Runs) -> Section {
              members end with different statuses — the result is decided by round-off and no \
              single digit of it means anything.\n"
         );
-        let text = TextTable::new([
-            ("#", Align::Right),
-            ("group", Align::Left),
-            ("h", Align::Right),
-            ("dt", Align::Right),
-            ("ok/members", Align::Right),
-            ("E(T)/E⁰ min · median · max", Align::Right),
-            ("spread", Align::Right),
-            ("l2(τ;H1) min · median · max", Align::Right),
-            ("sensitive", Align::Left),
-            ("why", Align::Left),
+        let text = TextTable::new(text_columns![
+            "#" => Right, "group" => Left, "h" => Right, "dt" => Right, "ok/members" => Right,
+            "E(T)/E⁰ min · median · max" => Right, "spread" => Right,
+            "l2(τ;H1) min · median · max" => Right, "sensitive" => Left, "why" => Left,
         ])
         .with_rows(md_rows);
         md.push_str(&text.markdown());

@@ -18,7 +18,7 @@
 use super::convergence::lsq_slope;
 use super::energy::classify;
 use super::runs::{Fixed, Runs};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Kind, Table, TextTable, columns, text_columns};
 
 /// Largest `pressure_oscillation` read as a smooth pressure.
 pub const SMOOTH_PRESSURE: f64 = 5.0;
@@ -39,20 +39,10 @@ pub(crate) struct Section {
 
 /// One row per method group.
 pub(crate) fn section(runs: &Runs) -> Section {
-    let cols: Vec<(String, Kind)> = [
-        ("method", Kind::Str),
-        ("runs", Kind::I64),
-        ("energy", Kind::Str),
-        ("pressure", Kind::Str),
-        ("pressure_oscillation_max", Kind::F64),
-        ("penetration", Kind::Str),
-        ("max_penetration_rel", Kind::F64),
-        ("rate_l2", Kind::F64),
-        ("rate_h1", Kind::F64),
-    ]
-    .iter()
-    .map(|(n, k)| (n.to_string(), *k))
-    .collect();
+    let cols: Vec<(String, Kind)> = table::owned(&columns![
+        method: Str, runs: I64, energy: Str, pressure: Str, pressure_oscillation_max: F64,
+        penetration: Str, max_penetration_rel: F64, rate_l2: F64, rate_h1: F64,
+    ]);
     let mut t = Table::new(&cols);
     let mut rows: Vec<Vec<String>> = Vec::new();
     let err_index = |name: &str| runs.errors.iter().position(|e| *e == name);
@@ -124,13 +114,9 @@ pub(crate) fn section(runs: &Runs) -> Section {
             table::rate(r1),
         ]);
     }
-    let text = TextTable::new([
-        ("method", Align::Left),
-        ("energy", Align::Left),
-        ("pressure", Align::Left),
-        ("penetration", Align::Left),
-        ("L2 rate", Align::Right),
-        ("H1 rate", Align::Right),
+    let text = TextTable::new(text_columns![
+        "method" => Left, "energy" => Left, "pressure" => Left, "penetration" => Left,
+        "L2 rate" => Right, "H1 rate" => Right,
     ])
     .with_rows(rows.clone());
     let legend = format!(

@@ -229,17 +229,8 @@ impl Sections {
 
     /// Write the tables under `DIR/summary/` and compose the terminal report.
     pub(crate) fn write(&self, dir: &Path) -> anyhow::Result<Summary> {
-        let Sections {
-            runs,
-            conv,
-            en,
-            ens,
-            st,
-            se,
-            wp,
-            methods,
-            ..
-        } = self;
+        let (runs, conv, en, ens) = (&self.runs, &self.conv, &self.en, &self.ens);
+        let (st, se, wp, methods) = (&self.st, &self.se, &self.wp, &self.methods);
         let out = dir.join("summary");
         std::fs::create_dir_all(&out)
             .with_context(|| format!("{}: cannot create", out.display()))?;

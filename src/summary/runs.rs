@@ -12,49 +12,20 @@ use std::path::Path;
 use anyhow::{Context as _, bail};
 use polars::prelude::*;
 
-use super::table::Kind;
+use super::table::{Kind, columns};
 
 /// Parameter columns (SPEC §7, §8) that identify a method group, in output order. The
 /// refinement axes ([`REFINEMENT`]) and the derived `label` are not among them: `label` is a
 /// function of these parameters and is carried, not grouped by. `sweep` is not a parameter:
 /// the same method run by two sweeps into one folder (`--resume`) is one group.
-pub(crate) const PARAMS: &[(&str, Kind)] = &[
-    ("scene", Kind::Str),
-    ("space", Kind::Str),
-    ("mass", Kind::Str),
-    ("mass_weights", Kind::Str),
-    ("contact_init", Kind::Str),
-    ("scheme", Kind::Str),
-    ("scheme_label", Kind::Str),
-    ("nitsche_theta", Kind::F64),
-    ("nitsche_gamma0", Kind::F64),
-    ("penalty_gamma0", Kind::F64),
-    ("newmark_beta", Kind::F64),
-    ("newmark_gamma", Kind::F64),
-    ("theta_scheme", Kind::F64),
-    ("restitution", Kind::F64),
-    ("rho_inf", Kind::F64),
-    ("hht_alpha", Kind::F64),
-    ("length", Kind::F64),
-    ("young", Kind::F64),
-    ("density", Kind::F64),
-    ("amplitude", Kind::F64),
-    ("gap", Kind::F64),
-    ("lame_lambda", Kind::F64),
-    ("lame_mu", Kind::F64),
-    ("gravity", Kind::F64),
-    ("degree", Kind::I64),
-    ("right_end", Kind::Str),
-    ("velocity", Kind::F64),
-    ("point_mass", Kind::F64),
-    ("stiffness", Kind::F64),
-    ("force", Kind::F64),
-    ("impact_law", Kind::F64),
-    ("solver", Kind::Str),
-    ("cg_tol", Kind::F64),
-    ("T", Kind::F64),
-    ("ensemble_sample", Kind::I64),
-    ("ensemble_perturbation", Kind::F64),
+pub(crate) const PARAMS: &[(&str, Kind)] = &columns![
+    scene: Str, space: Str, mass: Str, mass_weights: Str, contact_init: Str, scheme: Str,
+    scheme_label: Str, nitsche_theta: F64, nitsche_gamma0: F64, penalty_gamma0: F64,
+    newmark_beta: F64, newmark_gamma: F64, theta_scheme: F64, restitution: F64, rho_inf: F64,
+    hht_alpha: F64, length: F64, young: F64, density: F64, amplitude: F64, gap: F64,
+    lame_lambda: F64, lame_mu: F64, gravity: F64, degree: I64, right_end: Str, velocity: F64,
+    point_mass: F64, stiffness: F64, force: F64, impact_law: F64, solver: Str, cg_tol: F64,
+    T: F64, ensemble_sample: I64, ensemble_perturbation: F64,
 ];
 
 /// The parameters already spelled out in a run's `label` (contact method · mass · scheme);
@@ -66,6 +37,11 @@ const IN_LABEL: &[&str] = &[
     "contact_init",
     "scheme",
     "scheme_label",
+];
+
+/// The contact methods' and schemes' numeric parameters: spelled out in a run's label too,
+/// and the candidate axes of a stability map ([`super::stability`]).
+pub(crate) const METHOD_PARAMS: &[&str] = &[
     "nitsche_theta",
     "nitsche_gamma0",
     "penalty_gamma0",
@@ -78,41 +54,21 @@ const IN_LABEL: &[&str] = &[
 ];
 
 /// The refinement axes: `h` (or `elements`), `dt` (or `courant`).
-pub(crate) const REFINEMENT: &[(&str, Kind)] = &[
-    ("h", Kind::F64),
-    ("elements", Kind::I64),
-    ("dt", Kind::F64),
-    ("courant", Kind::F64),
+pub(crate) const REFINEMENT: &[(&str, Kind)] = &columns![
+    h: F64, elements: I64, dt: F64, courant: F64,
 ];
 
 /// The error columns of SPEC §5, in output order.
 pub(crate) const ERRORS: &[&str] = crate::model::ERROR_COLUMNS;
 
 /// Measured columns read besides parameters and errors.
-const MEASURED: &[(&str, Kind)] = &[
-    ("run_id", Kind::Str),
-    ("label", Kind::Str),
-    ("status", Kind::Str),
-    ("message", Kind::Str),
-    ("wall_time_s", Kind::F64),
-    ("wall_time_min_s", Kind::F64),
-    ("wall_time_max_s", Kind::F64),
-    ("repeats", Kind::I64),
-    ("steps", Kind::I64),
-    ("dofs", Kind::I64),
-    ("energy_initial", Kind::F64),
-    ("energy_final", Kind::F64),
-    ("energy_drift", Kind::F64),
-    ("energy_max_dev", Kind::F64),
-    ("energy_max_increase", Kind::F64),
-    ("energy_theta_max_increase", Kind::F64),
-    ("energy_theta_drift", Kind::F64),
-    ("energy_theta_initial", Kind::F64),
-    ("length_scale", Kind::F64),
-    ("energy_scale", Kind::F64),
-    ("search", Kind::Str),
-    ("max_penetration", Kind::F64),
-    ("pressure_oscillation", Kind::F64),
+const MEASURED: &[(&str, Kind)] = &columns![
+    run_id: Str, label: Str, status: Str, message: Str, wall_time_s: F64, wall_time_min_s: F64,
+    wall_time_max_s: F64, repeats: I64, steps: I64, dofs: I64, energy_initial: F64,
+    energy_final: F64, energy_drift: F64, energy_max_dev: F64, energy_max_increase: F64,
+    energy_theta_max_increase: F64, energy_theta_drift: F64, energy_theta_initial: F64,
+    length_scale: F64, energy_scale: F64, search: Str, max_penetration: F64,
+    pressure_oscillation: F64,
 ];
 
 /// One parameter value.
@@ -307,21 +263,21 @@ impl Fixed {
     }
 
     pub(crate) fn describe(&self) -> String {
-        match self {
-            Fixed::Courant(x) => format!("courant = {x} fixed, h refined"),
-            Fixed::Ratio(x) => format!("dt/h = {x} fixed, h refined"),
-            Fixed::Dt(x) => format!("dt = {x} fixed, h refined"),
-            Fixed::H(x) => format!("h = {x} fixed, dt refined"),
-        }
+        let name = self.name();
+        format!(
+            "{name} = {} fixed, {} refined",
+            self.value(),
+            self.refined()
+        )
     }
 
+    /// The terminal's form: `ν=0.5, h↓` (the Courant number as ν).
     pub(crate) fn short(&self) -> String {
-        match self {
-            Fixed::Courant(x) => format!("ν={x}, h↓"),
-            Fixed::Ratio(x) => format!("dt/h={x}, h↓"),
-            Fixed::Dt(x) => format!("dt={x}, h↓"),
-            Fixed::H(x) => format!("h={x}, dt↓"),
-        }
+        let name = match self {
+            Fixed::Courant(_) => "ν",
+            _ => self.name(),
+        };
+        format!("{name}={}, {}↓", self.value(), self.refined())
     }
 }
 
@@ -364,7 +320,10 @@ impl Runs {
     /// Parameters that vary across the folder, excluding those in the label.
     fn varying(&self) -> Vec<usize> {
         (0..self.params.len())
-            .filter(|&i| !IN_LABEL.contains(&self.params[i].0))
+            .filter(|&i| {
+                let name = &self.params[i].0;
+                !IN_LABEL.contains(name) && !METHOD_PARAMS.contains(name)
+            })
             .filter(|&i| self.params[i].0 != "ensemble_sample")
             .filter(|&i| {
                 let keys: HashSet<String> = self.runs.iter().map(|r| r.params[i].key()).collect();

@@ -12,7 +12,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
 use super::runs::{Run, Runs};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Table, TextTable, columns, text_columns};
 use crate::sweep::{Search, SearchState};
 
 /// The search section's outputs.
@@ -65,25 +65,11 @@ fn method_text(runs: &Runs, r: &Run, key: &str) -> String {
 /// Build the boundary table.
 pub(crate) fn section(runs: &Runs) -> Section {
     let mut t = Table::new(
-        &[
-            ("search", Kind::Str),
-            ("key", Kind::Str),
-            ("criterion", Kind::Str),
-            ("threshold", Kind::F64),
-            ("method", Kind::Str),
-            ("base", Kind::I64),
-            ("lo", Kind::F64),
-            ("hi", Kind::F64),
-            ("holds_at_lo", Kind::Bool),
-            ("holds_at_hi", Kind::Bool),
-            ("state", Kind::Str),
-            ("last_holding", Kind::F64),
-            ("first_failing", Kind::F64),
-            ("boundary", Kind::F64),
-            ("rel_width", Kind::F64),
-            ("rel_tol", Kind::F64),
-            ("probes", Kind::I64),
-            ("failing_status", Kind::Str),
+        &columns![
+            search: Str, key: Str, criterion: Str, threshold: F64, method: Str, base: I64,
+            lo: F64, hi: F64, holds_at_lo: Bool, holds_at_hi: Bool, state: Str, last_holding: F64,
+            first_failing: F64, boundary: F64, rel_width: F64, rel_tol: F64, probes: I64,
+            failing_status: Str,
         ]
         .map(|(n, k)| (n.to_string(), k)),
     );
@@ -204,16 +190,10 @@ pub(crate) fn section(runs: &Runs) -> Section {
              between which it changes (bisection to the search's relative tolerance; every \
              probe is a row of runs/ tagged with its search).\n\n",
         );
-        let text = TextTable::new([
-            ("search", Align::Left),
-            ("method", Align::Left),
-            ("key", Align::Left),
-            ("criterion", Align::Left),
-            ("bracket", Align::Left),
-            ("state", Align::Left),
-            ("last holding", Align::Right),
-            ("first failing", Align::Right),
-            ("probes", Align::Right),
+        let text = TextTable::new(text_columns![
+            "search" => Left, "method" => Left, "key" => Left, "criterion" => Left,
+            "bracket" => Left, "state" => Left, "last holding" => Right, "first failing" => Right,
+            "probes" => Right,
         ]);
         let searched = rows_md.len();
         md.push_str(&text.with_rows(rows_md).markdown());

@@ -24,7 +24,7 @@ use std::fmt::Write as _;
 
 use super::energy::classify;
 use super::runs::{Run, Runs};
-use super::table::{Align, Kind, Table, TextTable};
+use super::table::{Align, Table, TextTable, columns};
 
 /// Cell states, worst first.
 pub const STATES: [&str; 6] = [
@@ -36,21 +36,10 @@ pub const STATES: [&str; 6] = [
     "stable",
 ];
 
-/// Candidate axes, in the order maps put them (x before y).
-const AXES: &[&str] = &[
-    "courant",
-    "h",
-    "dt",
-    "T",
-    "nitsche_theta",
-    "nitsche_gamma0",
-    "penalty_gamma0",
-    "newmark_beta",
-    "newmark_gamma",
-    "theta_scheme",
-    "restitution",
-    "rho_inf",
-    "hht_alpha",
+/// Candidate axes, in the order maps put them (x before y): the levels, the method parameters
+/// ([`super::runs::METHOD_PARAMS`]), the physics.
+const LEVEL_AXES: &[&str] = &["courant", "h", "dt", "T"];
+const PHYSICS_AXES: &[&str] = &[
     "length",
     "young",
     "density",
@@ -64,7 +53,16 @@ const AXES: &[&str] = &[
     "stiffness",
     "force",
     "impact_law",
+    "];",
 ];
+
+fn axes() -> impl Iterator<Item = &'static str> {
+    LEVEL_AXES
+        .iter()
+        .chain(super::runs::METHOD_PARAMS)
+        .chain(PHYSICS_AXES)
+        .copied()
+}
 
 fn state(runs: &Runs, r: &Run) -> &'static str {
     match r.status.as_str() {
@@ -119,24 +117,10 @@ pub(crate) struct Section {
 /// Build the stability maps.
 pub(crate) fn section(runs: &Runs) -> Section {
     let mut t = Table::new(
-        &[
-            ("method", Kind::Str),
-            ("x_axis", Kind::Str),
-            ("y_axis", Kind::Str),
-            ("x", Kind::F64),
-            ("y", Kind::F64),
-            ("state", Kind::Str),
-            ("uniform", Kind::Bool),
-            ("runs", Kind::I64),
-            ("stable", Kind::I64),
-            ("growing", Kind::I64),
-            ("diverged", Kind::I64),
-            ("solver_failed", Kind::I64),
-            ("timeout", Kind::I64),
-            ("invalid", Kind::I64),
-            ("steps", Kind::I64),
-            ("message", Kind::Str),
-            ("run_id", Kind::Str),
+        &columns![
+            method: Str, x_axis: Str, y_axis: Str, x: F64, y: F64, state: Str, uniform: Bool,
+            runs: I64, stable: I64, growing: I64, diverged: I64, solver_failed: I64, timeout: I64,
+            invalid: I64, steps: I64, message: Str, run_id: Str,
         ]
         .map(|(n, k)| (n.to_string(), k)),
     );
@@ -162,9 +146,8 @@ pub(crate) fn section(runs: &Runs) -> Section {
                 .map(super::runs::float_key)
                 .collect()
         };
-        let mut axes: Vec<(&str, usize)> = AXES
-            .iter()
-            .map(|a| (*a, distinct(a).len()))
+        let mut axes: Vec<(&str, usize)> = axes()
+            .map(|a| (a, distinct(a).len()))
             .filter(|(_, n)| *n >= 2)
             .collect();
         let mesh: Vec<(&str, usize)> = axes

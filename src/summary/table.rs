@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use polars::prelude::*;
 
-use super::runs::Cell;
+use super::runs::{Cell, Run, Runs};
 
 /// The type of a declared column.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -21,6 +21,38 @@ pub(crate) enum Kind {
     I64,
     Str,
     Bool,
+}
+
+/// A table's declared columns, several to a line: `columns![run_id: Str, h: F64, …]` — each
+/// column's name with its [`Kind`] — as the `&[(&str, Kind)]` that [`Table::new`] and
+/// [`owned`] take.
+macro_rules! columns {
+    ($($name:ident : $kind:ident),* $(,)?) => {
+        [$((stringify!($name), $crate::summary::table::Kind::$kind)),*]
+    };
+}
+pub(crate) use columns;
+
+/// A text table's declared columns, several to a line: `text_columns!["#" => Right, "label" =>
+/// Left, …]` — each header with its [`Align`] — as [`TextTable::new`] takes them.
+macro_rules! text_columns {
+    ($($header:expr => $align:ident),* $(,)?) => {
+        [$(($header, $crate::summary::table::Align::$align)),*]
+    };
+}
+pub(crate) use text_columns;
+
+/// Declared columns with owned names (a table's own, before the parameter columns that vary
+/// by folder are appended).
+pub(crate) fn owned(list: &[(&str, Kind)]) -> Vec<(String, Kind)> {
+    list.iter().map(|(n, k)| (n.to_string(), *k)).collect()
+}
+
+/// A table's own columns, then the folder's parameter columns (every parameter that varies).
+pub(crate) fn with_params(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
+    let mut c = owned(list);
+    c.extend(runs.param_columns());
+    c
 }
 
 /// A text column without one allocation per cell: the cells' bytes in one buffer, each cell
@@ -164,6 +196,26 @@ impl Table {
             Values::Bool(v) => v.push(x),
             _ => panic!("summary table: column `{name}` is not bool"),
         }
+    }
+
+    /// A run's method group: `group` (numbered from 1) and `group_title`.
+    pub(crate) fn run_group(&mut self, runs: &Runs, r: &Run) {
+        self.i64("group", Some(r.group as i64 + 1));
+        self.str("group_title", Some(&runs.groups[r.group].title));
+    }
+
+    /// The cells every per-run table names a run by: `run_id`, `label`, `status`.
+    pub(crate) fn run_identity(&mut self, r: &Run) {
+        self.str("run_id", Some(&r.run_id));
+        self.str("label", Some(&r.label));
+        self.str("status", Some(&r.status));
+    }
+
+    /// A run's level: `h`, `dt`, `courant`.
+    pub(crate) fn run_level(&mut self, r: &Run) {
+        self.f64("h", r.h);
+        self.f64("dt", r.dt);
+        self.f64("courant", r.courant);
     }
 
     pub(crate) fn cell(&mut self, name: &str, c: &Cell) {

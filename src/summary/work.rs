@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::runs::{Fixed, Runs};
-use super::table::{self, Align, Kind, Table, TextTable};
+use super::table::{self, Align, Table, TextTable, columns};
 
 /// The Pareto front of (cost, error) points, both minimised: `true` where no other point is
 /// at least as good in both and strictly better in one. O(n log n): sort by cost, sweep.
@@ -62,12 +62,6 @@ pub(crate) struct Section {
     pub terminal: String,
 }
 
-fn cols(list: &[(&str, Kind)], runs: &Runs) -> Vec<(String, Kind)> {
-    let mut c: Vec<(String, Kind)> = list.iter().map(|(n, k)| (n.to_string(), *k)).collect();
-    c.extend(runs.param_columns());
-    c
-}
-
 /// An error value usable on a log scale.
 fn usable(v: Option<f64>) -> Option<f64> {
     v.filter(|v| v.is_finite() && *v > 0.0)
@@ -90,48 +84,20 @@ struct Crossing {
 
 /// Build the speed-against-error section.
 pub(crate) fn section(runs: &Runs) -> Section {
-    let mut t = Table::new(&cols(
-        &[
-            ("family", Kind::I64),
-            ("family_title", Kind::Str),
-            ("run_id", Kind::Str),
-            ("label", Kind::Str),
-            ("status", Kind::Str),
-            ("h", Kind::F64),
-            ("dt", Kind::F64),
-            ("courant", Kind::F64),
-            ("steps", Kind::I64),
-            ("dofs", Kind::I64),
-            ("work", Kind::I64),
-            ("wall_time_s", Kind::F64),
-            ("wall_time_min_s", Kind::F64),
-            ("wall_time_max_s", Kind::F64),
-            ("repeats", Kind::I64),
-            ("error", Kind::Str),
-            ("value", Kind::F64),
-            ("pareto_wall", Kind::Bool),
-            ("pareto_work", Kind::Bool),
+    let mut t = Table::new(&table::with_params(
+        &columns![
+            family: I64, family_title: Str, run_id: Str, label: Str, status: Str, h: F64, dt: F64,
+            courant: F64, steps: I64, dofs: I64, work: I64, wall_time_s: F64,
+            wall_time_min_s: F64, wall_time_max_s: F64, repeats: I64, error: Str, value: F64,
+            pareto_wall: Bool, pareto_work: Bool,
         ],
         runs,
     ));
-    let mut cost = Table::new(&cols(
-        &[
-            ("family", Kind::I64),
-            ("family_title", Kind::Str),
-            ("label", Kind::Str),
-            ("error", Kind::Str),
-            ("epsilon", Kind::F64),
-            ("reached", Kind::Str),
-            ("wall_time_s", Kind::F64),
-            ("work", Kind::F64),
-            ("cost_is_upper_bound", Kind::Bool),
-            ("path", Kind::I64),
-            ("fixed", Kind::Str),
-            ("fixed_value", Kind::F64),
-            ("run_coarse", Kind::Str),
-            ("run_fine", Kind::Str),
-            ("value_coarse", Kind::F64),
-            ("value_fine", Kind::F64),
+    let mut cost = Table::new(&table::with_params(
+        &columns![
+            family: I64, family_title: Str, label: Str, error: Str, epsilon: F64, reached: Str,
+            wall_time_s: F64, work: F64, cost_is_upper_bound: Bool, path: I64, fixed: Str,
+            fixed_value: F64, run_coarse: Str, run_fine: Str, value_coarse: F64, value_fine: F64,
         ],
         runs,
     ));
@@ -214,12 +180,8 @@ pub(crate) fn section(runs: &Runs) -> Section {
             let r = &runs.runs[i];
             t.i64("family", Some(r.group as i64 + 1));
             t.str("family_title", Some(&runs.groups[r.group].title));
-            t.str("run_id", Some(&r.run_id));
-            t.str("label", Some(&r.label));
-            t.str("status", Some(&r.status));
-            t.f64("h", r.h);
-            t.f64("dt", r.dt);
-            t.f64("courant", r.courant);
+            t.run_identity(r);
+            t.run_level(r);
             t.i64("steps", r.steps);
             t.i64("dofs", r.dofs);
             t.i64("work", work_of(r.steps, r.dofs));
