@@ -567,8 +567,9 @@ mod tests {
     /// The affine simplices' vertex solve is the inverse map: on the Gmsh Hertz half-disc (P2)
     /// the cells off the arc are marked affine and those with a mid-edge node on the arc
     /// (bulging by the sagitta, ~1e-3 of a cell) are not; for every affine cell and points
-    /// inside it, ξ from the vertices equals Newton's to 1e-14 (both exact up to round-off of
-    /// coordinates of size 1 — Newton converges in one step on an affine map).
+    /// inside it, ξ from the vertices equals Newton's and the ξ that made the point to 1e-12:
+    /// both are exact up to the rounding of coordinates of size 1 over cells of about the
+    /// grading's finest size hc = 0.03, ~2.2e-16/0.03 ≈ 1e-14 (measured ≤ 1.2e-14).
     #[test]
     fn affine_simplices_skip_newton_with_the_same_xi() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -597,7 +598,7 @@ mod tests {
                 let newton = loc.inverse_map(e, x).unwrap();
                 for k in 0..2 {
                     assert!(
-                        (fast[k] - newton[k]).abs() < 1e-14,
+                        (fast[k] - newton[k]).abs() < 1e-12,
                         "cell {e}: {fast:?} {newton:?}"
                     );
                     assert!((fast[k] - xi[k]).abs() < 1e-12, "cell {e}: {fast:?} {xi:?}");
