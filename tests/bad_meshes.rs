@@ -332,6 +332,23 @@ const SWEEP_CASES: &[(&str, &str, &[&str])] = &[
             "hybrid with nitsche or penalty",
         ],
     ),
+    // `obstacle` and `gap` are two names of one plane (SPEC §1.6): both given is refused,
+    // naming both keys.
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\ngap = 0.1\nobstacle = -0.1\n",
+        "fixed.obstacle",
+        &["`gap`", "`obstacle`", "not both", "fixed.gap"],
+    ),
+    // A plane above the lowest contact node (here y = 0): the body would start inside it.
+    (
+        "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\nobstacle = 0.05\n",
+        "fixed.obstacle",
+        &[
+            "obstacle = 0.05 lies above the lowest contact node",
+            "body.msh",
+            "inside the obstacle",
+        ],
+    ),
     // A reference on another mesh file is located node by node (SPEC §1.6), but it must be
     // at least as fine as the run's: this one's largest cell is larger (a node moved up).
     (

@@ -8,8 +8,10 @@
 //! - on bar2d, Nitsche (Θ = 1) with the hybrid scheme never increases E_Θ, and the discrete
 //!   gradient conserves E_Θ (Nitsche, Θ = 1) and E^h + Φ (penalty) per step;
 //! - the papers' question on the same 2D bar: mass redistribution (mixed, mod3) against
-//!   Nitsche (Θ = 1, small γ0), both measured against one common reference run;
-//! - the Gmsh copy of bar2d's box runs Nitsche and the penalty as bar2d does.
+//!   Nitsche (Θ = 1, small γ0), both measured against one common reference run.
+//!
+//! The Gmsh copies of the bars run Nitsche and the penalty as bar2d and bar3d do:
+//! `tests/mesh_scenes.rs` (with every other method).
 //!
 //! Meshes are small (bar2d h = 0.05: 42 nodes) so each test stays well under 10 s in release.
 
@@ -196,14 +198,7 @@ method = [
         assert_eq!(runs.len(), 4);
         for (k, (label, o)) in runs.iter().enumerate() {
             let scale = o.metrics.energy_scale.unwrap();
-            let conserved: Vec<f64> = if label.contains("nitsche") {
-                o.series
-                    .rows()
-                    .map(|r| r.energy_theta.expect("Nitsche has E_Θ"))
-                    .collect()
-            } else {
-                o.series.energy.clone()
-            };
+            let conserved = common::kept_energy(label, o);
             let (inc, change) = increase_and_change(&conserved, scale);
             let phases = o.metrics.contact_phases.unwrap();
             println!(
@@ -275,63 +270,5 @@ method = [
     }
     for ratio in ratios(&rows[2]) {
         assert!(ratio > 3.0, "Nitsche CN / mod3: {ratio}");
-    }
-}
-
-/// The Gmsh copy of bar2d's box at h = 0.05 (`sweeps/meshes/bar2d_quad.msh`, `contact` = its
-/// bottom lines) runs Nitsche and the penalty as bar2d does: the same points from the other
-/// path (`gmsh_contact_faces`: the faces matched to their cells, heights above the lowest
-/// contact node, the run's gap added). The dofs are numbered differently, so the factors and
-/// Newton iterates round differently (~1e-16 relative, carried through the impacts); 1e-10 in
-/// every compared column is `tests/mesh_scenes.rs`'s bound for the same meshes with mixed
-/// (measured: at most 1.1e-12, CN's energy_max_dev).
-#[test]
-fn gmsh_bar_reproduces_bar2d_with_nitsche_and_penalty() {
-    let methods = r#"
-[fixed]
-T = 1.5
-dt = 0.025
-[grid]
-method = [
-  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "hybrid" },
-  { space = "nitsche", nitsche_theta = -1.0, nitsche_gamma0 = 0.01, scheme = "crank-nicolson" },
-  { space = "penalty", penalty_gamma0 = 100.0, scheme = "backward-euler" },
-]
-"#;
-    let at = root().join("sweeps/test_nitsche_bars.toml");
-    let bar = common::run_sweep_text_at(
-        &at,
-        &format!("name = \"b\"\nscene = \"bar2d\"\n{methods}h = [0.05]\n"),
-    );
-    let mesh = common::run_sweep_text_at(
-        &at,
-        &format!(
-            "name = \"m\"\nscene = \"mesh2d\"\n{methods}mesh = [\"meshes/bar2d_quad.msh\"]\nvelocity = [-0.5]\n"
-        ),
-    );
-    assert_eq!((bar.len(), mesh.len()), (3, 3));
-    for (b, m) in bar.iter().zip(&mesh) {
-        assert_eq!(b.status, "ok", "{:?}", b.message);
-        assert_eq!(m.status, "ok", "{:?}", m.message);
-        assert_eq!(b.contact_dofs, m.contact_dofs);
-        assert!(b.contact_phases.unwrap() >= 1);
-        for (name, x, y) in [
-            ("energy_final", b.energy_final, m.energy_final),
-            ("energy_max_dev", b.energy_max_dev, m.energy_max_dev),
-            ("max_penetration", b.max_penetration, m.max_penetration),
-            (
-                "first_contact_time",
-                b.first_contact_time,
-                m.first_contact_time,
-            ),
-        ] {
-            let (x, y) = (x.unwrap(), y.unwrap());
-            println!("{} {name}: {x:e} vs {y:e}", b.scheme_label);
-            assert!(
-                (x - y).abs() < 1e-10,
-                "{} {name}: {x:e} vs {y:e}",
-                b.scheme_label
-            );
-        }
     }
 }

@@ -55,6 +55,10 @@ pub enum Key {
     /// The Gmsh mesh file of `mesh2d`/`mesh3d` (SPEC §1.6), relative to the sweep file; its
     /// canonical text (the run id's) is the file's content hash, not its path.
     Mesh,
+    /// The rigid plane x_d = `obstacle` of `mesh2d`/`mesh3d` (SPEC §1.6), exclusive with `gap`:
+    /// the planner turns it into the run's gap (lowest Γ_C node − obstacle), so it never enters
+    /// a run id (the same plane given by `gap` is the same run).
+    Obstacle,
 }
 
 /// What a key's value must look like.
@@ -140,7 +144,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 37] = [
+    pub const ALL: [Key; 38] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -178,6 +182,7 @@ impl Key {
         Key::Solver,
         Key::CgTol,
         Key::Mesh,
+        Key::Obstacle,
     ];
 
     pub fn name(self) -> &'static str {
@@ -219,6 +224,7 @@ impl Key {
             Key::Solver => "solver",
             Key::CgTol => "cg_tol",
             Key::Mesh => "mesh",
+            Key::Obstacle => "obstacle",
         }
     }
 
@@ -406,7 +412,11 @@ impl Key {
             }
             (Key::RhoInf, Value::Num(x)) => within(*x, 0.0, 1.0),
             (Key::HhtAlpha, Value::Num(x)) => within(*x, 0.0, 1.0 / 3.0),
-            (Key::NitscheTheta | Key::Gravity, Value::Num(x)) => finite(*x).map(|_| ()),
+            // A height: any finite value (the planner refuses one above the body's lowest Γ_C
+            // node, where the body would start inside the obstacle).
+            (Key::NitscheTheta | Key::Gravity | Key::Obstacle, Value::Num(x)) => {
+                finite(*x).map(|_| ())
+            }
             (Key::Degree, Value::Num(x)) => {
                 if *x == 1.0 || *x == 2.0 {
                     Ok(())

@@ -492,24 +492,15 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let group = mesh
         .group("contact")
         .ok_or_else(|| format!("{}: no physical group \"contact\"", mesh.file))?;
-    let cnodes: Vec<usize> = group
-        .nodes
-        .iter()
-        .copied()
-        .filter(|&n| !clamped[n])
-        .collect();
-    if cnodes.is_empty() {
+    let cnodes = mesh.contact_nodes();
+    let Some(lowest) = mesh.contact_floor() else {
         return Err(format!(
             "{}: every node of the group \"contact\" is clamped",
             mesh.file
         ));
-    }
+    };
     let free = |g: usize| dofs.free_index(g).expect("Γ_C nodes are not clamped here");
     let contact: Vec<usize> = cnodes.iter().map(|&n| free(n * d + d - 1)).collect();
-    let lowest = cnodes
-        .iter()
-        .map(|&n| mesh.coords[n][d - 1])
-        .fold(f64::INFINITY, f64::min);
     let contact_height = cnodes
         .iter()
         .map(|&n| mesh.coords[n][d - 1] - lowest)

@@ -107,48 +107,7 @@ impl Scene for BallScene {
         mass: &str,
         scheme: &str,
     ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "nitsche" | "penalty") {
-            return Err((
-                "space",
-                format!(
-                    "space = {space} is not implemented for scene {} (mixed, nitsche, penalty)",
-                    self.name()
-                ),
-            ));
-        }
-        if matches!(mass, "singular-dynamic" | "node-neighbour") {
-            return Err((
-                "mass",
-                format!(
-                    "mass = {mass} is defined for the 1D bar only (SPEC §2.2); scene {} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact",
-                    self.name()
-                ),
-            ));
-        }
-        // SPEC §3.2's methods ([`crate::run::fe`]'s methods module); the planner checks their
-        // contact methods and masses.
-        let comparison = matches!(
-            scheme,
-            "kane"
-                | "contact-stabilized-newmark"
-                | "generalized-alpha"
-                | "hht"
-                | "moreau-jean"
-                | "discrete-gradient"
-        );
-        if !(matches!(scheme, "newmark" | "theta")
-            || comparison
-            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
-        {
-            return Err((
-                "scheme",
-                format!(
-                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes, the SPEC §3.2 methods; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
-                    self.name()
-                ),
-            ));
-        }
-        Ok(())
+        super::fe_supports(self.name(), space, mass, scheme)
     }
     /// No closed form; a reference run on the same mesh with a finer step (the mapped meshes
     /// of different sizes are not nested, `run::fe::ball_ref_map`).

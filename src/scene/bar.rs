@@ -158,48 +158,7 @@ impl Scene for BarScene {
         mass: &str,
         scheme: &str,
     ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "nitsche" | "penalty") {
-            return Err((
-                "space",
-                format!(
-                    "space = {space} is not available for scene {} (mixed, nitsche, penalty)",
-                    self.name()
-                ),
-            ));
-        }
-        if matches!(mass, "singular-dynamic" | "node-neighbour") {
-            return Err((
-                "mass",
-                format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
-            ));
-        }
-        // The disc's schemes (SPEC §1.2: every contact method on every scene): newmark and
-        // theta, SPEC §3.2's methods ([`crate::run::fe`]'s methods module; the planner checks
-        // their contact methods and masses, and central difference's kinematic contact needs
-        // `lumped`), hybrid with Nitsche or the penalty (the bottom face's quadrature points,
-        // `space::fe::nitsche::face_contact_points`).
-        let comparison = matches!(
-            scheme,
-            "kane"
-                | "contact-stabilized-newmark"
-                | "generalized-alpha"
-                | "hht"
-                | "moreau-jean"
-                | "discrete-gradient"
-        );
-        if !(matches!(scheme, "newmark" | "theta")
-            || comparison
-            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
-        {
-            return Err((
-                "scheme",
-                format!(
-                    "scheme = {scheme} is not available for scene {} with space = {space} (newmark and theta schemes, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean, discrete-gradient; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)",
-                    self.name()
-                ),
-            ));
-        }
-        Ok(())
+        super::fe_supports(self.name(), space, mass, scheme)
     }
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)

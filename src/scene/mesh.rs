@@ -11,7 +11,9 @@
 //! Physics: physical group `clamped` (optional) has u = 0, `contact` is Γ_C, every other boundary
 //! is traction-free. The rigid plane is x_d = (lowest x_d of Γ_C) − `gap`, normal −e_d, gap
 //! function g(x) = x_d − obstacle (SPEC §1.3's conventions): the engine's contact rows are the
-//! vertical dofs of the Γ_C nodes (`mixed`), each with its own initial gap. Loads: `gravity`
+//! vertical dofs of the Γ_C nodes (`mixed`), each with its own initial gap. The plane may be
+//! given by its height instead, `obstacle` (exclusive with `gap`): the planner turns it into
+//! the gap it names, so both spellings of one plane are one run with one id. Loads: `gravity`
 //! (per unit mass, towards the obstacle, default 0) and the initial velocity `velocity` e_d on
 //! every node not clamped (default 0; negative moves towards the obstacle). Material defaults
 //! are the bars' (ρ = 1, λ = 0.25, μ = 0.5) and `gap` defaults to the bars' 0.2, so the 002 bar
@@ -21,7 +23,9 @@
 //! `elements` its number of cells. Methods: `mixed` contact with every mass variant of SPEC §2.2
 //! but the 1D-only two (layers by topology: layer 0 = the cells with a node on Γ_C, layer k + 1
 //! their neighbours by shared nodes), `nitsche` and `penalty` on the `contact` group's faces,
-//! and the schemes the bars take (Newmark, θ; hybrid with Nitsche or the penalty).
+//! and the schemes of every finite-element scene ([`super::fe_supports`]: Newmark, θ, SPEC
+//! §3.2's methods, hybrid with Nitsche or the penalty) — the engines act on the assembled
+//! operators and the Γ_C rows or quadrature points, whatever the mesh.
 //!
 //! Errors are measured against a reference run at least as fine (SPEC §1.6): on the same file
 //! with a finer step, on another (finer) mesh file of the same body, or — `reference = { scene
@@ -115,35 +119,7 @@ impl Scene for MeshScene {
         mass: &str,
         scheme: &str,
     ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "nitsche" | "penalty") {
-            return Err((
-                "space",
-                format!(
-                    "space = {space} is not available for scene {} (mixed, nitsche, penalty)",
-                    self.name()
-                ),
-            ));
-        }
-        if matches!(mass, "singular-dynamic" | "node-neighbour") {
-            return Err((
-                "mass",
-                format!("mass = {mass} is defined for the 1D bar only (SPEC §2.2)"),
-            ));
-        }
-        // Nitsche and the penalty integrate over the `contact` group's boundary faces
-        // (`space::fe::nitsche::gmsh_contact_faces`); hybrid needs their contact potential.
-        if !(matches!(scheme, "newmark" | "theta")
-            || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
-        {
-            return Err((
-                "scheme",
-                format!(
-                    "scheme = {scheme} is not available for scene {} with space = {space}; it takes the bars' newmark and theta schemes, and hybrid with nitsche or penalty",
-                    self.name()
-                ),
-            ));
-        }
-        Ok(())
+        super::fe_supports(self.name(), space, mass, scheme)
     }
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)
@@ -167,9 +143,7 @@ impl Scene for MeshScene {
             ));
         }
         let clamped = mesh.group("clamped").map_or(&[][..], |g| &g.nodes[..]);
-        let contact = mesh.group("contact").map_or(0, |g| {
-            g.nodes.iter().filter(|n| !clamped.contains(n)).count()
-        });
+        let contact = mesh.contact_nodes().len();
         if contact == 0 {
             return Err(format!(
                 "{}: every node of the group \"contact\" is in \"clamped\": no contact dof is left",

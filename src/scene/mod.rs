@@ -44,6 +44,16 @@ impl Physics {
             .map(|(_, v)| *v)
             .unwrap_or_else(|| panic!("physics key `{name}` is not declared by this scene"))
     }
+
+    /// Replace the value of a declared key (panics on an undeclared name, as [`Physics::get`]).
+    pub fn set(&mut self, name: &str, value: f64) {
+        let slot = self
+            .0
+            .iter_mut()
+            .find(|(n, _)| *n == name)
+            .unwrap_or_else(|| panic!("physics key `{name}` is not declared by this scene"));
+        slot.1 = value;
+    }
 }
 
 /// How a run's errors are measured.
@@ -144,6 +154,56 @@ pub trait Scene: Send + Sync {
             path.display()
         ))
     }
+}
+
+/// What every finite-element scene takes — the bars, the disc/ball and the mesh files alike
+/// (SPEC §1.2: every contact method on every scene): `mixed`, `nitsche`, `penalty`; every mass
+/// variant of SPEC §2.2 but the 1D-only two; the newmark and θ families (central difference's
+/// kinematic contact needs `lumped`, the planner checks it), SPEC §3.2's methods
+/// ([`crate::run::fe`]'s methods module, on any mesh: they act on the assembled M, K and the
+/// Γ_C rows or quadrature points; the planner checks their contact methods and masses), and
+/// hybrid with a contact potential (Nitsche or the penalty on Γ_C's quadrature points).
+pub(crate) fn fe_supports(
+    scene: &str,
+    space: &str,
+    mass: &str,
+    scheme: &str,
+) -> Result<(), (&'static str, String)> {
+    if !matches!(space, "mixed" | "nitsche" | "penalty") {
+        return Err((
+            "space",
+            format!("space = {space} is not available for scene {scene} (mixed, nitsche, penalty)"),
+        ));
+    }
+    if matches!(mass, "singular-dynamic" | "node-neighbour") {
+        return Err((
+            "mass",
+            format!(
+                "mass = {mass} is defined for the 1D bar only (SPEC §2.2); scene {scene} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact"
+            ),
+        ));
+    }
+    let comparison = matches!(
+        scheme,
+        "kane"
+            | "contact-stabilized-newmark"
+            | "generalized-alpha"
+            | "hht"
+            | "moreau-jean"
+            | "discrete-gradient"
+    );
+    if !(matches!(scheme, "newmark" | "theta")
+        || comparison
+        || (scheme == "hybrid" && matches!(space, "nitsche" | "penalty")))
+    {
+        return Err((
+            "scheme",
+            format!(
+                "scheme = {scheme} is not available for scene {scene} with space = {space} (newmark and theta schemes, the SPEC §3.2 methods kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean, discrete-gradient; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// The scenes the engine can run (the registry; SPEC §1).

@@ -526,7 +526,7 @@ fn reference_scene_of(own: SceneKind, name: &str) -> Result<SceneKind, String> {
 
 /// Whether `scene` accepts `key`: every discretisation and method key, and its own physics.
 pub fn accepted(scene: SceneKind, key: Key) -> bool {
-    if key == Key::Mesh {
+    if matches!(key, Key::Mesh | Key::Obstacle) {
         return scene.get().takes_mesh_file();
     }
     !key.is_physics() || scene.accepts_physics(key.name())

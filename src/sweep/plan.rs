@@ -167,6 +167,48 @@ type MeshFile = (
     std::sync::Arc<crate::space::fe::GmshMesh>,
 );
 
+/// `obstacle` (SPEC §1.6) as the gap it names: the plane x_d = obstacle lies
+/// g = (lowest contact node's x_d) − obstacle below the body ([`GmshMesh::contact_floor`], the
+/// engine's plane is that height minus the gap), so the run is the one `gap = g` gives, with
+/// the same id. Exclusive with `gap` (one plane given twice could disagree); a plane above the
+/// lowest contact node (g < 0: the body would start inside the obstacle) is refused. None when
+/// the sweep gives no `obstacle`.
+///
+/// [`GmshMesh::contact_floor`]: crate::space::fe::GmshMesh::contact_floor
+fn gap_from_obstacle(
+    mesh: &crate::space::fe::GmshMesh,
+    user: &BTreeMap<Key, (Value, Origin)>,
+) -> Result<Option<f64>, Issue> {
+    let Some((v, o)) = user.get(&Key::Obstacle) else {
+        return Ok(None);
+    };
+    let obstacle = v.as_f64().expect("obstacle is a checked number");
+    if let Some((_, g)) = user.get(&Key::Gap) {
+        return Err(Issue::at(
+            o,
+            format!(
+                "give either `gap` (the distance from the lowest contact node, set at `{}`) or `obstacle` (the height x_d of the plane), not both: they name the same plane",
+                g.path
+            ),
+        ));
+    }
+    let Some(floor) = mesh.contact_floor() else {
+        // The scene refuses such a file with its own reason.
+        return Ok(None);
+    };
+    let gap = floor - obstacle;
+    if gap < 0.0 {
+        return Err(Issue::at(
+            o,
+            format!(
+                "obstacle = {obstacle} lies above the lowest contact node of {} (x_d = {floor}): the body would start {:e} inside the obstacle; the plane must be at x_d ≤ {floor}",
+                mesh.file, -gap
+            ),
+        ));
+    }
+    Ok(Some(gap))
+}
+
 /// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
 /// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
 fn resolve(
@@ -446,7 +488,7 @@ fn resolve(
     }
 
     // Physics, mesh and time step: the scene's.
-    let physics = Physics(
+    let mut physics = Physics(
         scene
             .physics()
             .iter()
@@ -496,8 +538,17 @@ fn resolve(
                 // Absolute, so the runs find it from any working directory (a cluster job's).
                 let joined = sweep_dir.join(&written);
                 let path = std::path::absolute(&joined).unwrap_or(joined);
-                match crate::space::fe::GmshMesh::read_shared(&path) {
-                    Err(e) => issues.push(Issue::at(o, e.to_string())),
+                let read = crate::space::fe::GmshMesh::read_shared(&path)
+                    .map_err(|e| Issue::at(o, e.to_string()))
+                    .and_then(|m| {
+                        // `obstacle` is the gap under another name (SPEC §1.6).
+                        if let Some(gap) = gap_from_obstacle(&m, &user)? {
+                            physics.set("gap", gap);
+                        }
+                        Ok(m)
+                    });
+                match read {
+                    Err(issue) => issues.push(issue),
                     Ok(m) => match scene.setup_from_file(&physics, &path, &m) {
                         Err(why) => issues.push(Issue::at(o, why)),
                         Ok((choice, setup)) => {
@@ -786,7 +837,13 @@ fn resolve(
         canonical.insert(Key::Mesh, format!("sha256:{}", m.content_hash));
         params.insert(Key::Mesh, Value::Str(written.clone()));
     }
-    // Derived columns, not part of the identity.
+    // Derived columns, not part of the identity: a mesh run's plane x_d = `obstacle` whether the
+    // sweep gave it or `gap` (SPEC §1.6), so filters and the plan table see both.
+    if let Some((_, _, m)) = &mesh_file
+        && let Some(floor) = m.contact_floor()
+    {
+        params.insert(Key::Obstacle, Value::Num(floor - physics.get("gap")));
+    }
     params.insert(Key::H, Value::Num(h));
     params.insert(Key::Courant, Value::Num(courant));
 
@@ -853,7 +910,7 @@ fn gcd(a: usize, b: usize) -> usize {
 
 /// The reference run of one combination: its entries overridden by `reference = {…}` (keys not
 /// given are the run's; a reference giving h or elements replaces both, likewise dt or
-/// courant). Returns the reference's spec and the run's (space, time) refinement ratios; the
+/// courant, gap or obstacle). Returns the reference's spec and the run's (space, time) refinement ratios; the
 /// reference must be nested in time (dt_run/dt_ref whole) and last as long; in space nested
 /// (h_run/h_ref whole) where the scene's meshes are, otherwise at least as fine, stored whole
 /// and interpolated at the run's nodes (SPEC §1.6).
@@ -869,17 +926,23 @@ fn reference_of(
     over: &[Entry],
     run: &Resolved,
 ) -> Result<(RunSpec, usize, usize), Vec<Issue>> {
-    let sets = |keys: [Key; 2]| over.iter().any(|e| keys.contains(&e.key));
-    let (mesh_keys, step_keys) = ([Key::H, Key::Elements], [Key::Dt, Key::Courant]);
-    let (new_mesh, new_step) = (sets(mesh_keys), sets(step_keys));
+    // Keys that name one thing two ways: a reference giving either replaces both.
+    let pairs = [
+        [Key::H, Key::Elements],
+        [Key::Dt, Key::Courant],
+        [Key::Gap, Key::Obstacle],
+    ];
+    let step_keys = pairs[1];
+    let replaced = |k: Key| {
+        over.iter().any(|o| o.key == k)
+            || pairs
+                .iter()
+                .any(|p| p.contains(&k) && over.iter().any(|o| p.contains(&o.key)))
+    };
     let mut combined: Vec<&Entry> = entries
         .iter()
         .copied()
-        .filter(|e| {
-            !(new_mesh && mesh_keys.contains(&e.key)
-                || new_step && step_keys.contains(&e.key)
-                || over.iter().any(|o| o.key == e.key))
-        })
+        .filter(|e| !replaced(e.key))
         .collect();
     let ref_scene = sweep.reference_scene.unwrap_or(sweep.scene);
     let other_scene = ref_scene != sweep.scene;

@@ -13,6 +13,9 @@ g square_quad.geo -2 -order 2 -o square_quad_q2.msh
 g cube_tet.geo -3 -order 1 -bin -o cube_tet.msh
 g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
 g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
+# The 3D bar of bar3d at h = 0.05 in hexahedra (tests/mesh_scenes.rs: Nitsche, the penalty and
+# SPEC §3.2's methods reproduce bar3d's rows).
+g bar3d_hex.geo -3 -order 1 -o bar3d_hex.msh
 # The same bar at h/2 (N = 4, M = 40): a finer mesh file as the reference of bar2d_quad.msh
 # (tests/mesh_scenes.rs: the interpolating path equals bar2d's node-for-node one).
 bar() { # bar GEO N OUT: the 002 bar with N cells across, M = 10 N along

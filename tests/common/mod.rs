@@ -181,3 +181,17 @@ pub fn run_sweep_text_at(path: &Path, text: &str) -> Vec<contact_sweep::run::Run
     out.sort_by_key(|r| order.iter().position(|id| *id == r.run_id));
     out
 }
+
+/// The energy a contact potential's schemes keep, per step: E_Θ for Nitsche (the run's label
+/// names its space) and E^h for the others (with the penalty, E^h holds the penalty potential
+/// Φ: SPEC §3.2's E^h + Φ).
+pub fn kept_energy(label: &str, o: &Outcome) -> Vec<f64> {
+    if label.contains("nitsche") {
+        o.series
+            .rows()
+            .map(|r| r.energy_theta.expect("Nitsche has E_Θ"))
+            .collect()
+    } else {
+        o.series.energy.clone()
+    }
+}

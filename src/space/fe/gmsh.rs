@@ -923,6 +923,34 @@ impl GmshMesh {
         self.groups.iter().find(|g| g.name == name)
     }
 
+    /// The nodes that carry contact (SPEC §1.6): those of the `contact` group not in `clamped`
+    /// (a clamped node never moves towards the obstacle), increasing.
+    pub fn contact_nodes(&self) -> Vec<usize> {
+        let clamped = self.group("clamped").map_or(&[][..], |g| &g.nodes[..]);
+        self.group("contact").map_or_else(Vec::new, |g| {
+            // Both lists are increasing: a merge, not a search per node.
+            let mut c = clamped.iter().peekable();
+            g.nodes
+                .iter()
+                .copied()
+                .filter(|&n| {
+                    while c.next_if(|&&m| m < n).is_some() {}
+                    c.peek() != Some(&&n)
+                })
+                .collect()
+        })
+    }
+
+    /// The lowest x_d of the contact nodes ([`GmshMesh::contact_nodes`]), None without any: the
+    /// rigid plane x_d = this − gap (SPEC §1.6), so a run's `gap` and `obstacle` are two names
+    /// of one plane.
+    pub fn contact_floor(&self) -> Option<f64> {
+        self.contact_nodes()
+            .iter()
+            .map(|&n| self.coords[n][self.dim - 1])
+            .reduce(f64::min)
+    }
+
     /// |Ω_h| = Σ_K ∫_K̂ det J by [`ElementKind::quadrature`] (exact for affine cells).
     pub fn measure(&self) -> f64 {
         let q = self.kind.quadrature();
