@@ -16,7 +16,7 @@
 //!   isoparametric map) and its interpolation weights computed — what a coarse run does once
 //!   against its reference.
 //!
-//! `cargo bench --bench locate`; the README's Performance section has the medians.
+//! `cargo bench --bench locate`; docs/performance.md has the medians.
 
 use std::time::Duration;
 

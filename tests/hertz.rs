@@ -4,7 +4,7 @@
 //! - the sweep file plans as committed: the seeds' methods and SPEC §3.2's (17 runs) on one
 //!   mesh whose `h` and cell count come from the file;
 //! - a short version of it (T = 2: the impact at t = 0.2 and most of the contact, which lasts
-//!   until t ≈ 2.7) runs in well under a second in release and shows what the README reports:
+//!   until t ≈ 2.7) runs in well under a second in release and shows what docs/methods.md reports:
 //!   the total mass is ρ|Ω_h| with |Ω_h| below πR²/2 by no more than the P2 arcs' geometric
 //!   error, the consistent mass with Crank–Nicolson gains energy, the massless-Γ_C masses
 //!   conserve it, backward Euler dissipates it, and row-sum lumping (massless P2 vertices,
@@ -195,7 +195,7 @@ fn short_impact_energies() {
 
 /// The 3D counterpart, `sweeps/meshes/ball_tet.msh` (R = 1, 420 P2 tetrahedra, 821 nodes,
 /// Γ_C = the lower hemisphere, 257 nodes; nothing clamped) under the half-disc's material and
-/// impact (v = −0.1, gap 0.02), T = 1: the same split as in 2D. Measured over T = 3 (README):
+/// impact (v = −0.1, gap 0.02), T = 1: the same split as in 2D. Measured over T = 3 (docs/methods.md):
 /// consistent + CN E(T)/E⁰ = 66 with 50 contact phases, mod3 + CN within 1.1e-5 of E⁰.
 #[test]
 fn ball_of_tetrahedra_short_impact() {

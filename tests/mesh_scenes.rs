@@ -459,7 +459,7 @@ fn a_reference_of_another_scene_is_checked() {
 /// Issue 22 done-when 2, second half: the 002 bar meshed with P1 triangles at three sizes
 /// (`sweeps/bar2d_triangles.toml`: N × 10N squares cut in two, N = 2, 4, 8, τ = 0.05/N) against
 /// the bar2d reference of `bar2d_convergence.toml` (Q1 at h = 0.05/32, τ/32, mod3 + CN, a run
-/// of scene bar2d located node by node). Measured (README "The 002 bar in triangles"), LSQ
+/// of scene bar2d located node by node). Measured (docs/methods.md "The 002 bar in triangles"), LSQ
 /// slopes in h over the three levels, with bar2d's own on the same ladder in brackets:
 /// l2(τ;L2) mod1 0.85 [0.83], mod2 0.80 [0.82], mod3 0.71 [0.91]; l2(τ;H1) stagnates for both
 /// element kinds (|slope| ≤ 0.06 here, ≤ 0.15 for bar2d) — the impact's velocity jump.
@@ -498,12 +498,12 @@ fn triangles_converge_to_the_bar2d_reference() {
         let s = slope(mass, |r| r.err_u_l2l2);
         println!("{mass}: l2(τ;L2) slope {s:.4}");
         assert!((s - l2).abs() < 0.02, "{mass}: L2 slope {s}, measured {l2}");
-        // H1 does not converge at these sizes, as for bar2d (README): measured −0.04 … 0.05.
+        // H1 does not converge at these sizes, as for bar2d (docs/methods.md): measured −0.04 … 0.05.
         let s1 = slope(mass, |r| r.err_u_l2h1);
         println!("{mass}: l2(τ;H1) slope {s1:.4}");
         assert!(s1.abs() < 0.1, "{mass}: H1 slope {s1}");
     }
-    // The finest level's L2 error against bar2d's at h = 0.0125 (README): the triangles' is
+    // The finest level's L2 error against bar2d's at h = 0.0125 (docs/methods.md): the triangles' is
     // larger by 6 % (mod1), 9 % (mod2), 54 % (mod3) — one order, the same reference.
     let finest = |mass: &str| {
         rows.iter()

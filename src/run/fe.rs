@@ -861,7 +861,7 @@ fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatr
             // Row-sum lumping of P2 simplices gives the vertices no mass (triangles: their rows
             // of the P2 mass matrix sum to 0) or a negative one (tetrahedra): the step then
             // has massless or anti-inertial dofs and blows up at the contact (the Hertz
-            // half-disc, README). Refused rather than run.
+            // half-disc, docs/methods.md). Refused rather than run.
             if let Some((i, x)) = sums.iter().enumerate().find(|(_, x)| **x <= 0.0) {
                 return Err(format!(
                     "mass = lumped: row-sum lumping gives free dof {i} the mass {x:.3e} ≤ 0 (the vertices of P2 triangles and tetrahedra); use consistent or a modified mass, or degree-1 elements"

@@ -19,7 +19,7 @@
 //!   round-off (all but the boundary cells of a Gmsh mesh of a curved body) — needs no Newton:
 //!   F_K = F1, so ξ solves the d × d system x* − x_0 = Σ_k ξ_k (x_k − x_0) of its vertices, at a
 //!   third of the two Newton iterations' cost with six shape functions (measured on the Gmsh
-//!   half-disc, README Performance).
+//!   half-disc, docs/performance.md).
 //! - Inside: ξ in the reference element up to 1e-10 (cube [−1, 1]^d, simplex ξ_k ≥ 0,
 //!   Σ ξ_k ≤ 1). A point on a shared face is inside both neighbours; either gives the same value,
 //!   the field being continuous.
