@@ -184,15 +184,16 @@ fn imports_point_down_the_pipeline() {
             let mut refs = Vec::new();
             crate_refs(l, &mut group, &mut refs);
             for r in refs {
-                if let Some(theirs) = rank(&r) {
-                    if theirs >= own && r != top {
-                        up.push(format!(
-                            "{}:{}: {top} imports {r}: {}",
-                            rel.display(),
-                            i + 1,
-                            l.trim()
-                        ));
-                    }
+                if let Some(theirs) = rank(&r)
+                    && theirs >= own
+                    && r != top
+                {
+                    up.push(format!(
+                        "{}:{}: {top} imports {r}: {}",
+                        rel.display(),
+                        i + 1,
+                        l.trim()
+                    ));
                 }
             }
         }
