@@ -1405,8 +1405,13 @@ struct Stepper<'a> {
     mv: Vec<f64>,
     ma: Vec<f64>,
     pred: Vec<f64>,
-    /// The step's right-hand side, then (after the solve) its solution.
-    y: Vec<f64>,
+    /// K u^n (hybrid and Nitsche/penalty: the midpoint's right-hand side and the energy's
+    /// uᵀKu), made by the group with K read once for all members; empty otherwise.
+    ku: Vec<f64>,
+    /// vᵀMv and uᵀMa of the state just made, summed by the pass that made it (Newmark/θ's
+    /// [`Stepper::end_step`]) so the observation does not stream the vectors again; taken by
+    /// [`Stepper::observe`].
+    sums: Option<(f64, f64)>,
     tmp: Vec<f64>,
     err: Vec<f64>,
     q: Vec<f64>,
@@ -1574,6 +1579,8 @@ impl<'a> Stepper<'a> {
                     .map(|(&c, _)| c)
             })
             .flatten();
+        let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
+        let needs_ku = hybrid || nit.is_some();
         let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
         if let Some(sc) = energy_scale {
             obs = obs.with_energy_scale(sc);
@@ -1590,7 +1597,7 @@ impl<'a> Stepper<'a> {
             c1,
             gamma,
             c_tau2,
-            hybrid: matches!(cfg.scheme, Scheme::Hybrid),
+            hybrid,
             fall,
             force_vec,
             vertical_mass,
@@ -1604,7 +1611,8 @@ impl<'a> Stepper<'a> {
             mv,
             ma,
             pred: vec![0.0; n],
-            y: vec![0.0; n],
+            ku: vec![0.0; if needs_ku { n } else { 0 }],
+            sums: None,
             tmp: vec![0.0; n],
             err: vec![0.0; n],
             q: vec![0.0; nc],
@@ -1643,6 +1651,8 @@ impl<'a> Stepper<'a> {
             mu,
             mv,
             ma,
+            ku,
+            sums,
             tmp,
             err,
             lambda,
@@ -1654,12 +1664,14 @@ impl<'a> Stepper<'a> {
         } = self;
         let (g, nit, tau, fall) = (&**geo, fac.nitsche.as_ref(), *tau, *fall);
         // E = ½vᵀMv + ½uᵀKu − Fᵀu with Mv carried and Ku = F + Bᵀλ − Ma (module header).
-        // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is one product
-        // with K (into the scratch `tmp`) instead.
-        let kinetic: f64 = v.iter().zip(mv.iter()).map(|(x, y)| x * y).sum();
-        let fu: f64 = u.iter().zip(force_vec.iter()).map(|(x, y)| x * y).sum();
+        // Nitsche: the equation involves K_Θ and the nonlinear term, so uᵀKu is taken from the
+        // product K u the group made for the step ([`Stepper::k_pair`]). Without a load, Fᵀu
+        // is 0 and not summed.
+        let carried = sums.take();
+        let kinetic: f64 = carried.map_or_else(|| dot(v, mv), |c| c.0);
+        let fu: f64 = if fall != 0.0 { dot(u, force_vec) } else { 0.0 };
         let uku = if nit.is_some() {
-            quad(&g.k, u, tmp)
+            dot(u, ku)
         } else {
             let contact: f64 = g
                 .contact
@@ -1667,7 +1679,7 @@ impl<'a> Stepper<'a> {
                 .zip(lambda.iter())
                 .map(|(&c, l)| l * u[c])
                 .sum();
-            let uma: f64 = u.iter().zip(ma.iter()).map(|(x, y)| x * y).sum();
+            let uma: f64 = carried.map_or_else(|| dot(u, ma), |c| c.1);
             fu + contact - uma
         };
         let [kinetic, elastic, gravity] = [0.5 * kinetic, 0.5 * uku, -fu];
@@ -1735,31 +1747,34 @@ impl<'a> Stepper<'a> {
         )
     }
 
-    /// The right-hand side of step n into `y` (before the solve with A).
-    fn prepare(&mut self) {
-        let n = self.y.len();
+    /// The right-hand side of step n into `y` (the member's column of the group's block, solved
+    /// in place with A).
+    fn prepare(&mut self, y: &mut [f64]) {
+        let n = y.len();
         let (tau, c_tau2) = (self.tau, self.c_tau2);
         if self.hybrid {
             // Midpoint rule: (M + τ²/4 K_Θ) u^{n+1} = M(u + τv) − τ²/4 K_Θ u + τ²/2 F − τ²/2 N_Φ
-            // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u).
-            let tmp = &mut self.tmp;
-            self.geo.k.matvec_into(&self.u, tmp);
-            if let Some(ops) = self.fac.nitsche.as_ref()
-                && ops.theta != 0.0
-            {
-                for k in 0..ops.len() {
-                    let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &self.u);
-                    for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
-                        .iter()
-                        .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
-                    {
-                        tmp[gd] -= f * sk;
+            // (fe_nitsche header), K_Θ u = K u − Θ Σ w γ s (s·u); K u is the group's product.
+            let kt: &[f64] = match self.fac.nitsche.as_ref() {
+                Some(ops) if ops.theta != 0.0 => {
+                    let tmp = &mut self.tmp;
+                    tmp.copy_from_slice(&self.ku);
+                    for k in 0..ops.len() {
+                        let f = ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, &self.u);
+                        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
+                            .iter()
+                            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
+                        {
+                            tmp[gd] -= f * sk;
+                        }
                     }
+                    tmp
                 }
-            }
-            let (mu, mv, f) = (&self.mu, &self.mv, &self.force_vec);
+                _ => &self.ku,
+            };
+            let (mu, mv, f, kt) = (&self.mu[..n], &self.mv[..n], &self.force_vec[..n], &kt[..n]);
             for i in 0..n {
-                self.y[i] = mu[i] + tau * mv[i] - c_tau2 * tmp[i] + 2.0 * c_tau2 * f[i];
+                y[i] = mu[i] + tau * mv[i] - c_tau2 * kt[i] + 2.0 * c_tau2 * f[i];
             }
         } else {
             // p^n and M p^n (the right-hand side) from the carried products. M p^n is
@@ -1768,7 +1783,7 @@ impl<'a> Stepper<'a> {
             let ct2 = self.c1 * tau * tau;
             let (u, v, a) = (&self.u[..n], &self.v[..n], &self.a[..n]);
             let (mv, ma) = (&self.mv[..n], &self.ma[..n]);
-            let (pred, y, mu) = (&mut self.pred[..n], &mut self.y[..n], &mut self.mu[..n]);
+            let (pred, mu) = (&mut self.pred[..n], &mut self.mu[..n]);
             for i in 0..n {
                 pred[i] = u[i] + tau * v[i] + ct2 * a[i];
                 let mp = mu[i] + tau * mv[i] + ct2 * ma[i];
@@ -1776,7 +1791,7 @@ impl<'a> Stepper<'a> {
                 mu[i] = mp;
             }
             if self.fall != 0.0 {
-                for (yi, fi) in self.y.iter_mut().zip(&self.force_vec) {
+                for (yi, fi) in y.iter_mut().zip(&self.force_vec) {
                     *yi += c_tau2 * fi;
                 }
             }
@@ -1786,13 +1801,13 @@ impl<'a> Stepper<'a> {
     /// Step n's contact problem once `y` = A⁻¹(right-hand side): the forces λ (upward) from
     /// the exact LCP (mixed) or Newton (Nitsche/penalty). u^{n+1} = y + cτ² Z λ is then made by
     /// the group ([`lockstep`]), which reads each column of Z once for all its members.
-    fn contact(&mut self, step: usize) -> Result<(), Stop<String>> {
+    fn contact(&mut self, step: usize, y: &[f64]) -> Result<(), Stop<String>> {
         let c_tau2 = self.c_tau2;
         let fac = &*self.fac;
         if let Some(ops) = fac.nitsche.as_ref() {
             // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
             for (k, qk) in self.q.iter_mut().enumerate() {
-                *qk = ops.apply(&ops.p, k, &self.y);
+                *qk = ops.apply(&ops.p, k, y);
             }
             if self.hybrid {
                 // Kinks g − max(P̃ⁿ, 0) from u^n (fe_nitsche header).
@@ -1816,7 +1831,7 @@ impl<'a> Stepper<'a> {
         } else {
             let g = &*self.geo;
             for ((qi, &ci), gi) in self.q.iter_mut().zip(&g.contact).zip(&self.gaps) {
-                *qi = self.y[ci] + gi;
+                *qi = y[ci] + gi;
             }
             let it = self
                 .lcp
@@ -1829,18 +1844,24 @@ impl<'a> Stepper<'a> {
     }
 
     /// With `y` = u^{n+1}: the acceleration a^{n+1} = (u^{n+1} − p^n)/(cτ²) into `tmp`
-    /// (Newmark/θ), or v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n and u ← u^{n+1} (hybrid). The products
-    /// with M that follow are the group's ([`Stepper::mass_pairs`]).
-    fn accelerate(&mut self) {
+    /// (Newmark/θ), or v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n (hybrid); then u ← u^{n+1}, in the
+    /// same pass. The products with M (and K) that follow are the group's
+    /// ([`Stepper::mass_pairs`], [`Stepper::k_pair`]).
+    fn accelerate(&mut self, y: &[f64]) {
         let (tau, c_tau2) = (self.tau, self.c_tau2);
+        let n = y.len();
+        let u = &mut self.u[..n];
         if self.hybrid {
-            for ((vi, yi), ui) in self.v.iter_mut().zip(&self.y).zip(&self.u) {
-                *vi = 2.0 * (yi - ui) / tau - *vi;
+            let v = &mut self.v[..n];
+            for i in 0..n {
+                v[i] = 2.0 * (y[i] - u[i]) / tau - v[i];
+                u[i] = y[i];
             }
-            std::mem::swap(&mut self.u, &mut self.y);
         } else {
-            for ((ti, yi), pi) in self.tmp.iter_mut().zip(&self.y).zip(&self.pred) {
-                *ti = (yi - pi) / c_tau2;
+            let (t, p) = (&mut self.tmp[..n], &self.pred[..n]);
+            for i in 0..n {
+                t[i] = (y[i] - p[i]) / c_tau2;
+                u[i] = y[i];
             }
         }
     }
@@ -1858,22 +1879,34 @@ impl<'a> Stepper<'a> {
         }
     }
 
+    /// The product K u with the current u, as an (x, K x) pair, for the runs that need it
+    /// (hybrid: the next right-hand side; Nitsche/penalty: the energy's uᵀKu); one product
+    /// serves both, where each used to make its own.
+    fn k_pair(&mut self) -> Option<(&[f64], &mut [f64])> {
+        (!self.ku.is_empty()).then(|| (self.u.as_slice(), self.ku.as_mut_slice()))
+    }
+
     /// The end of step n after the products with M: v, M v, M u and a (Newmark/θ), the
-    /// observation, the clock.
+    /// observation, the clock. The same pass sums vᵀMv and uᵀMa for the observation (in the
+    /// order of [`dot`]: the same numbers).
     fn end_step(&mut self, step: usize) -> Result<(), Stop<String>> {
         if !self.hybrid {
             let (tau, gamma, c_tau2) = (self.tau, self.gamma, self.c_tau2);
-            let n = self.y.len();
+            let n = self.u.len();
             let (a, an, ma, man) = (&self.a[..n], &self.tmp[..n], &self.ma[..n], &self.pred[..n]);
             let (v, mv, mu) = (&mut self.v[..n], &mut self.mv[..n], &mut self.mu[..n]);
+            let u = &self.u[..n];
+            let (mut kinetic, mut uma) = (-0.0, -0.0);
             for i in 0..n {
                 v[i] += tau * ((1.0 - gamma) * a[i] + gamma * an[i]);
                 mv[i] += tau * ((1.0 - gamma) * ma[i] + gamma * man[i]);
                 mu[i] += c_tau2 * man[i];
+                kinetic += v[i] * mv[i];
+                uma += u[i] * man[i];
             }
+            self.sums = Some((kinetic, uma));
             std::mem::swap(&mut self.a, &mut self.tmp);
             std::mem::swap(&mut self.ma, &mut self.pred);
-            std::mem::swap(&mut self.u, &mut self.y);
         }
         let mut timer = self.observe_timer;
         let r = timer.time(step, || self.observe(step));
@@ -1924,7 +1957,13 @@ impl<'a> Stepper<'a> {
 /// xᵀAx with `tmp` as scratch.
 fn quad(a: &SymMatrix, x: &[f64], tmp: &mut [f64]) -> f64 {
     a.matvec_into(x, tmp);
-    x.iter().zip(tmp.iter()).map(|(p, q)| p * q).sum()
+    dot(x, tmp)
+}
+
+/// xᵀy summed in order from −0.0 (the iterator sum's arithmetic, which the fused passes of
+/// the time loop repeat).
+fn dot(x: &[f64], y: &[f64]) -> f64 {
+    x.iter().zip(y).map(|(p, q)| p * q).sum()
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@ use std::time::Instant;
 
 use super::{Factored, FeConfig, Stepper, methods};
 use crate::run::{Outcome, RunContext, RunOptions, Stop};
+use crate::space::fe::SymMatrix;
 use crate::space::step_solver::Solver;
 
 /// The key under which runs may share a lockstep group: equal keys mean the same step matrix
@@ -79,14 +80,14 @@ pub fn simulate_group(cfgs: &[&FeConfig], opts: &RunOptions, ctxs: &[RunContext]
         .collect()
 }
 
-/// Most vectors of one joint product with M (accumulators kept in registers).
-const MASS_CHUNK: usize = 8;
+/// Most vectors of one joint product with M or K (accumulators kept in registers).
+const PRODUCT_CHUNK: usize = 8;
 
 /// The time loop of runs sharing one factor (a run alone is a group of one). Per step: each
 /// member's right-hand side; one solve for all (alone: the member's own work, so CG
 /// warm-starts); each member's contact problem; u^{n+1} = y + cτ²Zλ with each column of Z read
 /// once for all; each member's acceleration; the products with M, the matrix read once per
-/// [`MASS_CHUNK`] vectors; each member's updates and observation. The shared operations do, for
+/// [`PRODUCT_CHUNK`] vectors; each member's updates and observation. The shared operations do, for
 /// each member, exactly the arithmetic of its run alone (same order of summation); only the
 /// blocked triangular solves may round differently.
 pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Outcome)> {
@@ -99,11 +100,8 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
     let n = fac.chol.n();
     let nz = fac.z.len().checked_div(n).unwrap_or(0);
     let c_tau2 = active[0].1.c_tau2;
-    let mut block = if members > 1 {
-        vec![0.0; n * members]
-    } else {
-        Vec::new()
-    };
+    // Column j: member j's right-hand side, solved in place, then its u^{n+1}.
+    let mut block = vec![0.0; n * members];
     let mut work = (members > 1).then(|| fac.chol.work_for(members));
     let loop_start = Instant::now();
     // A member that stops leaves with its outcome; the order of the others is kept.
@@ -114,7 +112,8 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
         let (idx, s) = active.remove(j);
         finished.push((idx, s.finish(stop)));
     };
-    // Step 0's observation; a member may already diverge there.
+    // Step 0's observation (with K u⁰ where it needs it); a member may already diverge there.
+    products(&fac, &mut active);
     let mut j = 0;
     while j < active.len() {
         active[j].1.loop_start = loop_start;
@@ -138,20 +137,13 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
         if k == 0 {
             break;
         }
-        for (_, s) in active.iter_mut() {
-            s.prepare();
+        for ((_, s), y) in active.iter_mut().zip(block.chunks_exact_mut(n)) {
+            s.prepare(y);
         }
         // The solve. The direct solve cannot fail; CG's failure is the member's (alone).
         if let (Some(work), true) = (work.as_mut(), k > 1) {
-            for (j, (_, s)) in active.iter().enumerate() {
-                block[j * n..(j + 1) * n].copy_from_slice(&s.y);
-            }
             fac.chol.solve_many_in_place(&mut block[..k * n], k, work);
-            let failed = work.check().err().map(|e| e.to_string());
-            for (j, (_, s)) in active.iter_mut().enumerate() {
-                s.y.copy_from_slice(&block[j * n..(j + 1) * n]);
-            }
-            if let Some(e) = failed {
+            if let Some(e) = work.check().err().map(|e| e.to_string()) {
                 while !active.is_empty() {
                     leave(
                         &mut active,
@@ -163,33 +155,35 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
                 break;
             }
         } else {
-            let mut j = 0;
-            while j < active.len() {
-                let s = &mut active[j].1;
-                fac.chol.solve_in_place(&mut s.y, &mut s.work);
-                match s.work.check() {
-                    Ok(()) => j += 1,
-                    Err(e) => leave(
-                        &mut active,
-                        &mut finished,
-                        j,
-                        Err(Stop::Solver(step, e.to_string())),
-                    ),
+            // k = 1: the member is alone in its group.
+            let s = &mut active[0].1;
+            fac.chol.solve_in_place(&mut block[..n], &mut s.work);
+            if let Err(e) = s.work.check() {
+                leave(
+                    &mut active,
+                    &mut finished,
+                    0,
+                    Err(Stop::Solver(step, e.to_string())),
+                );
+                break;
+            }
+        }
+        // Members leave by removing their column: the block is compacted with them.
+        let mut j = 0;
+        while j < active.len() {
+            match active[j].1.contact(step, &block[j * n..(j + 1) * n]) {
+                Ok(()) => j += 1,
+                Err(stop) => {
+                    leave(&mut active, &mut finished, j, Err(stop));
+                    block.copy_within((j + 1) * n..(active.len() + 1) * n, j * n);
                 }
             }
         }
-        let mut j = 0;
-        while j < active.len() {
-            match active[j].1.contact(step) {
-                Ok(()) => j += 1,
-                Err(stop) => leave(&mut active, &mut finished, j, Err(stop)),
-            }
+        add_contact(&fac, c_tau2, nz, &mut active, &mut block);
+        for ((_, s), y) in active.iter_mut().zip(block.chunks_exact(n)) {
+            s.accelerate(y);
         }
-        add_contact(&fac, c_tau2, nz, &mut active);
-        for (_, s) in active.iter_mut() {
-            s.accelerate();
-        }
-        mass_products(&fac, &mut active);
+        products(&fac, &mut active);
         let mut j = 0;
         while j < active.len() {
             match active[j].1.end_step(step) {
@@ -214,11 +208,18 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
 /// the L2 cache while the tile's columns are added.
 const TILE: usize = 2048;
 
-/// u^{n+1} = y + cτ² Σ_{λ_c > 0} λ_c z_c for every member, by tiles of rows: each tile of a
-/// column z_c is read once for all members while their tiles of y stay in cache (column by
-/// column over the whole vectors, a group of 8 would stream its y's from memory once per
-/// column). Each entry of y receives the columns' terms in ascending c, as in the run alone.
-fn add_contact(fac: &Factored, c_tau2: f64, nz: usize, active: &mut [(usize, Stepper)]) {
+/// u^{n+1} = y + cτ² Σ_{λ_c > 0} λ_c z_c for every member (column j of `block` is member j's
+/// y), by tiles of rows: each tile of a column z_c is read once for all members while their
+/// tiles of y stay in cache (column by column over the whole vectors, a group of 8 would stream
+/// its y's from memory once per column). Each entry of y receives the columns' terms in
+/// ascending c, as in the run alone.
+fn add_contact(
+    fac: &Factored,
+    c_tau2: f64,
+    nz: usize,
+    active: &mut [(usize, Stepper)],
+    block: &mut [f64],
+) {
     let n = fac.chol.n();
     let touched = active
         .iter()
@@ -230,11 +231,11 @@ fn add_contact(fac: &Factored, c_tau2: f64, nz: usize, active: &mut [(usize, Ste
         let hi = (lo + TILE).min(n);
         for c in 0..nz {
             let zc = &fac.z[c * n + lo..c * n + hi];
-            for (_, s) in active.iter_mut() {
+            for ((_, s), y) in active.iter().zip(block.chunks_exact_mut(n)) {
                 let l = s.lambda[c];
                 if l > 0.0 {
                     let f = c_tau2 * l;
-                    for (yi, zi) in s.y[lo..hi].iter_mut().zip(zc) {
+                    for (yi, zi) in y[lo..hi].iter_mut().zip(zc) {
                         *yi += f * zi;
                     }
                 }
@@ -243,24 +244,35 @@ fn add_contact(fac: &Factored, c_tau2: f64, nz: usize, active: &mut [(usize, Ste
     }
 }
 
-/// Every member's products with M ([`Stepper::mass_pairs`]), [`MASS_CHUNK`] vectors per pass
-/// over the matrix; no allocation (the pairs live in arrays on the stack).
-fn mass_products(fac: &Factored, active: &mut [(usize, Stepper)]) {
-    let mut xs: [&[f64]; MASS_CHUNK] = [&[]; MASS_CHUNK];
-    let mut ys: [&mut [f64]; MASS_CHUNK] = Default::default();
+/// Every member's products with M ([`Stepper::mass_pairs`]) and with K ([`Stepper::k_pair`]),
+/// each matrix read once per [`PRODUCT_CHUNK`] vectors.
+fn products(fac: &Factored, active: &mut [(usize, Stepper)]) {
+    let Some(geo) = active.first().map(|(_, s)| Arc::clone(&s.geo)) else {
+        return;
+    };
+    let pairs = active
+        .iter_mut()
+        .flat_map(|(_, s)| s.mass_pairs().into_iter().flatten());
+    batched(&fac.m_products, pairs);
+    batched(&geo.k, active.iter_mut().filter_map(|(_, s)| s.k_pair()));
+}
+
+/// The products y = A x of `pairs`, [`PRODUCT_CHUNK`] per pass over A; no allocation (the
+/// pairs of a pass live in arrays on the stack).
+fn batched<'a>(a: &SymMatrix, pairs: impl Iterator<Item = (&'a [f64], &'a mut [f64])>) {
+    let mut xs: [&[f64]; PRODUCT_CHUNK] = [&[]; PRODUCT_CHUNK];
+    let mut ys: [&mut [f64]; PRODUCT_CHUNK] = Default::default();
     let mut c = 0;
-    for (_, s) in active.iter_mut() {
-        for (x, y) in s.mass_pairs().into_iter().flatten() {
-            if c == MASS_CHUNK {
-                fac.m_products.matvec_many_into(&xs[..c], &mut ys[..c]);
-                c = 0;
-            }
-            xs[c] = x;
-            ys[c] = y;
-            c += 1;
+    for (x, y) in pairs {
+        if c == PRODUCT_CHUNK {
+            a.matvec_many_into(&xs[..c], &mut ys[..c]);
+            c = 0;
         }
+        xs[c] = x;
+        ys[c] = y;
+        c += 1;
     }
     if c > 0 {
-        fac.m_products.matvec_many_into(&xs[..c], &mut ys[..c]);
+        a.matvec_many_into(&xs[..c], &mut ys[..c]);
     }
 }
