@@ -1370,10 +1370,11 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
 
 /// One run of the engine between its setup and its outcome: the shared operators, the run's own
 /// workspace, observer and counters. A step is split around its one linear solve —
-/// [`Stepper::prepare`] leaves the right-hand side in `y`, the solve replaces it by A⁻¹y,
-/// [`Stepper::complete`] does the contact and the updates — so runs sharing A can make their
+/// [`Stepper::prepare`] writes the right-hand side into the member's column y of the group's
+/// block, the solve replaces it by A⁻¹y, [`Stepper::contact`], [`Stepper::accelerate`] and
+/// [`Stepper::end_step`] do the contact and the updates — so runs sharing A can make their
 /// solves together ([`lockstep`]), and also their other reads of shared operators: u^{n+1} =
-/// y + cτ²Zλ and the products with M. A run alone is a group of one.
+/// y + cτ²Zλ and the products with M and K. A run alone is a group of one.
 struct Stepper<'a> {
     cfg: &'a FeConfig,
     opts: &'a RunOptions,

@@ -8,10 +8,13 @@
 //! condensed contact set: the members of a round-off ensemble, runs differing only in the gap,
 //! the initial velocity, γ at fixed β or T.
 //!
-//! Each member keeps its own state, contact solve, observer and outcome ([`Stepper`]); only the
-//! solve is shared. Column j of the block solve is member j's right-hand side, and each
-//! column's arithmetic is that of a single solve up to the blocking of the triangular kernels,
-//! so a member's numbers equal its run alone to round-off (tested to 1e-12). A member that
+//! Each member keeps its own state, contact solve, observer and outcome ([`Stepper`]); what the
+//! members share is every read of a shared operator: the solve, Z's columns, and the products
+//! with M and K (each matrix read once per 8 vectors — in 3D the members' own products were
+//! most of a group's step: sphere3d Q2, 4 503 dofs, made K u twice and M u, M v per member and
+//! step). Column j of the block solve is member j's right-hand side, and each column's
+//! arithmetic is that of a single solve up to the blocking of the triangular kernels, so a
+//! member's numbers equal its run alone to round-off (tested to 1e-12). A member that
 //! fails, diverges or reaches its last step leaves the group; the others go on. Members whose
 //! factors are not the same shared object (a cache eviction between their setups) are stepped
 //! as separate groups: one solve must use one factor.
@@ -86,8 +89,10 @@ const PRODUCT_CHUNK: usize = 8;
 /// The time loop of runs sharing one factor (a run alone is a group of one). Per step: each
 /// member's right-hand side; one solve for all (alone: the member's own work, so CG
 /// warm-starts); each member's contact problem; u^{n+1} = y + cτ²Zλ with each column of Z read
-/// once for all; each member's acceleration; the products with M, the matrix read once per
-/// [`PRODUCT_CHUNK`] vectors; each member's updates and observation. The shared operations do, for
+/// once for all; each member's acceleration (u ← y in the same pass); the products with M and
+/// K, each matrix read once per [`PRODUCT_CHUNK`] vectors; each member's updates and
+/// observation. The right-hand sides are written into, and u^{n+1} read from, the block the
+/// solve works on (no copies). The shared operations do, for
 /// each member, exactly the arithmetic of its run alone (same order of summation); only the
 /// blocked triangular solves may round differently.
 pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Outcome)> {
