@@ -1884,7 +1884,7 @@ impl<'a> Stepper<'a> {
     /// (hybrid: the next right-hand side; Nitsche/penalty: the energy's uᵀKu); one product
     /// serves both, where each used to make its own.
     fn k_pair(&mut self) -> Option<(&[f64], &mut [f64])> {
-        (!self.ku.is_empty()).then(|| (self.u.as_slice(), self.ku.as_mut_slice()))
+        (!self.ku.is_empty()).then_some((self.u.as_slice(), self.ku.as_mut_slice()))
     }
 
     /// The end of step n after the products with M: v, M v, M u and a (Newmark/θ), the

@@ -14,7 +14,8 @@
 //! most of a group's step: sphere3d Q2, 4 503 dofs, made K u twice and M u, M v per member and
 //! step). Column j of the block solve is member j's right-hand side, and each column's
 //! arithmetic is that of a single solve up to the blocking of the triangular kernels, so a
-//! member's numbers equal its run alone to round-off (tested to 1e-12). A member that
+//! member's numbers equal its run alone to round-off (tested to 1e-12; a chattering contact
+//! can magnify that round-off: docs/performance.md, "Lockstep groups"). A member that
 //! fails, diverges or reaches its last step leaves the group; the others go on. Members whose
 //! factors are not the same shared object (a cache eviction between their setups) are stepped
 //! as separate groups: one solve must use one factor.

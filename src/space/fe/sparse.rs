@@ -220,8 +220,7 @@ impl SymMatrix {
             xs.iter().all(|x| x.len() == p.n) && ys.iter().all(|y| y.len() == p.n),
             "matvec_many_into: length vs n"
         );
-        // One kernel per count: the accumulators are then registers, not memory (measured on
-        // sphere3d's group of 8, the dynamic-count loop was most of the products' time).
+        // One kernel per count: the k accumulators of a row can then live in registers.
         match k {
             0 => {}
             1 => self.matvec_into(xs[0], ys[0]),
