@@ -1,6 +1,8 @@
 //! contact-sweep: parameter sweeps of dynamic Signorini-contact simulations.
 //!
-//! The modules form a pipeline and depend on each other in this order only:
+//! The modules form a pipeline, `space, time, contact < scene < model < run < sweep < sink <
+//! exec < summary < report < cli`, and a module imports only those below it
+//! (`tests/architecture.rs`). What each holds:
 //!
 //! - [`scene`] — the physical problems behind one trait ([`scene::Scene`]): the 1D bar with its
 //!   closed forms (clamped, and the flying bar with a free end), the 2D/3D bars dropped on an
