@@ -218,8 +218,8 @@ pub struct RunArgs {
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
     /// Most runs per lockstep group: runs sharing their step matrix (2D/3D, direct solver) make
-    /// one multi-column solve per step; 1 steps every run alone. Rows equal the runs alone to
-    /// round-off (only `lockstep` and the timings differ).
+    /// one multi-column solve per step; 1 steps every run alone. Rows equal the runs alone bit
+    /// for bit (only `lockstep` and the timings differ).
     #[arg(long, default_value_t = ExecOptions::LOCKSTEP_DEFAULT, value_name = "N",
           value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub lockstep: usize,

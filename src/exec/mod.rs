@@ -8,7 +8,7 @@
 //! Lockstep groups (issue 24): runs whose step matrix is the same ([`run::lockstep_key`]) are
 //! cut into groups of at most [`ExecOptions::lockstep`] members, each group one unit of work
 //! stepped together ([`run::simulate_group`]: one multi-column solve per step). A member's
-//! numbers equal its run alone to round-off; only its `lockstep` and timing columns differ.
+//! numbers equal its run alone bit for bit; only its `lockstep` and timing columns differ.
 //! Groups are cut to keep every thread busy: a key's runs are split into more, smaller groups
 //! when there are fewer units than threads.
 

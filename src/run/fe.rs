@@ -354,23 +354,21 @@ fn geometry_key(s: &FeSetup) -> String {
     )
 }
 
-/// From this many unknowns a 2D step matrix is factored with supernodes, below column by
-/// column. Measured with faer 0.24 on the 2D bar's A = M + τ²/4 K, AMD ordering, ms per
-/// right-hand side for k right-hand sides solved at once (medians of 15 solves on a quiet
-/// machine; README, Performance): 5 440 dofs simplicial 0.23 (k = 1) / 0.11 (k = 8), supernodal 0.24 /
-/// 0.09; 21 120 dofs 1.32 / 0.57 against 1.33 / 0.45; 83 200 dofs 7.6 / 3.6 against 6.4 / 2.3.
-/// A single solve costs the same from ≈ 2·10⁴ dofs, and only the supernodal factor's dense
-/// blocks keep gaining past k = 4 — the lockstep groups' case ([`lockstep`]), whose members
-/// must use the factor of their runs alone so that their numbers are the same bit for bit.
-const SUPERNODAL_2D_FROM: usize = 16_000;
-
-/// The factor kind of a 2D step matrix of `n` unknowns ([`SUPERNODAL_2D_FROM`]).
-fn kind_2d(n: usize) -> FactorKind {
-    if n >= SUPERNODAL_2D_FROM {
-        FactorKind::Supernodal
-    } else {
-        FactorKind::Simplicial
-    }
+/// The factor kind of a 2D step matrix: column by column (simplicial) at every size.
+///
+/// Why: faer's simplicial solve treats each right-hand side with the same scalar operations
+/// whatever the number of columns, so a lockstep member ([`lockstep`]) equals its run alone bit
+/// for bit through faer's own blocked solve; a supernodal factor needs the engine's
+/// column-by-column sweep ([`crate::space::linalg::Cholesky::solve_columns_in_place`]), which in
+/// 2D (thousands of supernodes of a few columns each) costs 1.3–1.7× faer's blocked solve. And
+/// the supernodal factor buys nothing here. `cargo bench --bench solves` (faer 0.24, AMD, ms for
+/// 8 right-hand sides: one at a time / faer's block / the column sweep, medians of 15
+/// interleaved): 21 120 dofs simplicial 15.9 / 6.4 / 7.3, supernodal 14.3 / 6.1 / 10.4;
+/// 83 200 dofs simplicial 59.0 / 26.3 / 26.2, supernodal 116.7 / 34.5 / 46.7. (An earlier
+/// series on a quiet machine had the supernodal factor ahead at 83 200 dofs, 6.4 against
+/// 7.6 ms for one solve: docs/performance.md.)
+fn kind_2d() -> FactorKind {
+    FactorKind::Simplicial
 }
 
 /// The engine's fill-reducing ordering and factor kind, measured on M + τ²/4 K of the bars (one
@@ -382,7 +380,7 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
     if d == 2 {
         CholeskyOptions {
             ordering: Ordering::Amd,
-            kind: kind_2d(dofs.n_free()),
+            kind: kind_2d(),
         }
     } else {
         CholeskyOptions {
@@ -483,7 +481,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            kind_2d(dofs.n_free())
+            kind_2d()
         } else {
             FactorKind::Supernodal
         },
@@ -619,7 +617,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            kind_2d(dofs.n_free())
+            kind_2d()
         } else {
             FactorKind::Supernodal
         },

@@ -14,6 +14,11 @@
 //! supernodal (dense-block) factorisation from the flop count of the symbolic analysis.
 //!
 //! Solves run in place with caller-owned scratch ([`SolveWork`]): a time step allocates nothing.
+//! Several right-hand sides are solved two ways: [`Cholesky::solve_many_in_place`], faer's
+//! blocked solve (setup: the condensation's columns), and
+//! [`Cholesky::solve_columns_in_place`], which gives every column the arithmetic of its solve
+//! alone (time loops: a lockstep member must write its run alone's numbers). A single solve is
+//! the latter with one column.
 //! A matrix that is not numerically positive definite is a [`LinalgError`], never a panic.
 
 use std::hash::{Hash, Hasher};
@@ -21,13 +26,26 @@ use std::sync::Arc;
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{LltError, LltRegularization};
+use faer::linalg::matmul::matmul_with_conj;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place_with_conj, solve_upper_triangular_in_place_with_conj,
+};
+use faer::reborrow::{Reborrow, ReborrowMut};
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky as FaerSymbolic, SymmetricOrdering,
     factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Accum, Conj, MatMut, MatRef, Par, Side};
+
+/// Column stride of [`Cholesky::solve_columns_in_place`]'s block: n rounded up to a whole
+/// number of 64-byte lines, so every column starts on one.
+fn padded(n: usize) -> usize {
+    n.next_multiple_of(8)
+}
 
 use super::fe::{Pattern, SymMatrix};
 
@@ -217,6 +235,33 @@ impl SymbolicCholesky {
 pub struct SolveWork {
     buf: MemBuffer,
     ncols: usize,
+    /// [`Cholesky::solve_columns_in_place`]'s permuted columns and supernode products, on
+    /// 64-byte boundaries (see there); empty for a simplicial factor.
+    cols: AlignedBuf,
+    tmp: AlignedBuf,
+}
+
+/// f64 storage whose first element sits on a 64-byte boundary, so that a kernel that peels
+/// to an alignment boundary treats every copy of a vector the same way.
+#[derive(Default)]
+struct AlignedBuf {
+    data: Vec<f64>,
+    offset: usize,
+}
+
+impl AlignedBuf {
+    fn new(len: usize) -> AlignedBuf {
+        if len == 0 {
+            return AlignedBuf::default();
+        }
+        let data = vec![0.0; len + 8];
+        let offset = data.as_ptr().align_offset(64);
+        AlignedBuf { data, offset }
+    }
+
+    fn get(&mut self, len: usize) -> &mut [f64] {
+        &mut self.data[self.offset..self.offset + len]
+    }
 }
 
 impl std::fmt::Debug for SolveWork {
@@ -316,13 +361,145 @@ impl Cholesky {
 
     /// Scratch for solves with up to `ncols` right-hand sides at once.
     pub fn work_for(&self, ncols: usize) -> SolveWork {
+        let ncols = ncols.max(1);
+        let (cols, tmp) = match self.symbolic.inner.raw() {
+            SymbolicCholeskyRaw::Supernodal(sn) => {
+                let llt = SupernodalLltRef::new(sn, &self.values);
+                let widest = (0..sn.n_supernodes())
+                    .map(|s| llt.supernode(s).pattern().len())
+                    .max()
+                    .unwrap_or(0);
+                (
+                    AlignedBuf::new(padded(self.n()) * ncols),
+                    AlignedBuf::new(widest.max(1)),
+                )
+            }
+            SymbolicCholeskyRaw::Simplicial(_) => (AlignedBuf::default(), AlignedBuf::default()),
+        };
         SolveWork {
             buf: MemBuffer::new(
                 self.symbolic
                     .inner
-                    .solve_in_place_scratch::<f64>(ncols.max(1), Par::Seq),
+                    .solve_in_place_scratch::<f64>(ncols, Par::Seq),
             ),
-            ncols: ncols.max(1),
+            ncols,
+            cols,
+            tmp,
+        }
+    }
+
+    /// Solve for `ncols` right-hand sides (column-major n × ncols) in place, each column with
+    /// exactly the arithmetic of a solve of that column alone — whatever `ncols` is.
+    ///
+    /// faer's blocked solve ([`Self::solve_many_in_place`]) hands each supernode's dense
+    /// products to a kernel chosen by the number of columns (matrix–vector for one, small or
+    /// packed GEMM for more), so column j of a k-column solve rounds differently from the same
+    /// column solved alone. Time loops whose runs may advance in lockstep (issue 24) need the
+    /// same numbers either way: a chattering contact magnifies a 1e-16 difference to 1e-10 in
+    /// the energy. Here the supernodal sweep visits each supernode once for all columns and
+    /// calls faer's dense kernels (triangular solve, matrix–vector product) on one column at a
+    /// time, so the factor still streams from memory once per step for the whole block while
+    /// every column sees the single-column kernels. The columns are copied (permuted) into
+    /// 64-byte-aligned storage so that alignment-dependent kernels treat them alike. A
+    /// simplicial factor's solve is already column by column: faer's own is used.
+    ///
+    /// # Panics
+    /// If `rhs.len() != n · ncols` or `work` was made for fewer columns.
+    pub fn solve_columns_in_place(&self, rhs: &mut [f64], ncols: usize, work: &mut SolveWork) {
+        let SymbolicCholeskyRaw::Supernodal(sn) = self.symbolic.inner.raw() else {
+            return self.solve_many_in_place(rhs, ncols, work);
+        };
+        let n = self.n();
+        assert_eq!(rhs.len(), n * ncols, "solve: rhs length vs n × ncols");
+        assert!(
+            ncols <= work.ncols,
+            "solve: scratch made for {} columns, {ncols} given",
+            work.ncols
+        );
+        let ld = padded(n);
+        let x = work.cols.get(ld * ncols);
+        let perm = self.symbolic.inner.perm();
+        for (j, col) in x.chunks_exact_mut(ld).enumerate() {
+            let b = &rhs[j * n..(j + 1) * n];
+            match perm {
+                Some(p) => {
+                    for (xi, &f) in col.iter_mut().zip(p.arrays().0) {
+                        *xi = b[f];
+                    }
+                }
+                None => col[..n].copy_from_slice(b),
+            }
+        }
+        let llt = SupernodalLltRef::new(sn, &self.values);
+        let widest = work.tmp.data.len().saturating_sub(8);
+        let tmp = work.tmp.get(widest);
+        for s in 0..sn.n_supernodes() {
+            let node = llt.supernode(s);
+            let ls = node.val();
+            let size = ls.ncols();
+            let (top, bot) = ls.split_at_row(size);
+            let (start, pattern) = (node.start(), node.pattern());
+            let t = &mut tmp[..pattern.len()];
+            for col in x.chunks_exact_mut(ld) {
+                let mut x_top =
+                    MatMut::from_column_major_slice_mut(&mut col[start..start + size], size, 1);
+                solve_lower_triangular_in_place_with_conj(top, Conj::No, x_top.rb_mut(), Par::Seq);
+                matmul_with_conj(
+                    MatMut::from_column_major_slice_mut(t, pattern.len(), 1),
+                    Accum::Replace,
+                    bot,
+                    Conj::No,
+                    x_top.rb(),
+                    Conj::No,
+                    1.0,
+                    Par::Seq,
+                );
+                for (&i, &v) in pattern.iter().zip(t.iter()) {
+                    col[i] -= v;
+                }
+            }
+        }
+        for s in (0..sn.n_supernodes()).rev() {
+            let node = llt.supernode(s);
+            let ls = node.val();
+            let size = ls.ncols();
+            let (top, bot) = ls.split_at_row(size);
+            let (start, pattern) = (node.start(), node.pattern());
+            let t = &mut tmp[..pattern.len()];
+            for col in x.chunks_exact_mut(ld) {
+                for (v, &i) in t.iter_mut().zip(pattern) {
+                    *v = col[i];
+                }
+                let mut x_top =
+                    MatMut::from_column_major_slice_mut(&mut col[start..start + size], size, 1);
+                matmul_with_conj(
+                    x_top.rb_mut(),
+                    Accum::Add,
+                    bot.transpose(),
+                    Conj::Yes,
+                    MatRef::from_column_major_slice(t, pattern.len(), 1),
+                    Conj::No,
+                    -1.0,
+                    Par::Seq,
+                );
+                solve_upper_triangular_in_place_with_conj(
+                    top.transpose(),
+                    Conj::Yes,
+                    x_top,
+                    Par::Seq,
+                );
+            }
+        }
+        for (j, col) in x.chunks_exact(ld).enumerate() {
+            let b = &mut rhs[j * n..(j + 1) * n];
+            match perm {
+                Some(p) => {
+                    for (bi, &v) in b.iter_mut().zip(p.arrays().1) {
+                        *bi = col[v];
+                    }
+                }
+                None => b.copy_from_slice(&col[..n]),
+            }
         }
     }
 
@@ -331,7 +508,10 @@ impl Cholesky {
     /// # Panics
     /// If `rhs.len() != n`.
     pub fn solve_in_place(&self, rhs: &mut [f64], work: &mut SolveWork) {
-        self.solve_many_in_place(rhs, 1, work);
+        // One column: faer's blocked solve would do the same arithmetic; going through the
+        // column-by-column sweep makes a run alone and a lockstep member (issue 24) the same
+        // code, not just the same numbers today.
+        self.solve_columns_in_place(rhs, 1, work);
     }
 
     /// Solve for `ncols` right-hand sides stored column-major in `rhs` (n × ncols), in place
@@ -449,6 +629,68 @@ mod tests {
             .map(|(u, v)| (u - v).abs())
             .fold(0.0, f64::max);
         assert!(d < 1e-14, "blocked vs single: {d}");
+    }
+
+    /// The lockstep groups' contract (issue 24): column j of a k-column
+    /// `solve_columns_in_place` is, bit for bit, the solve of that column alone, for both factor
+    /// kinds and every k (faer's blocked `solve_many_in_place` is not: its supernodal products
+    /// pick GEMM kernels by the number of columns).
+    #[test]
+    fn column_solves_equal_single_solves_bit_for_bit() {
+        use crate::space::fe::{BoxMesh, DofMap, ElementOp, assemble, fe_pattern};
+        // A 3D bar big enough for supernodes of several columns (nested dissection).
+        let mesh = BoxMesh::new(&[0.5, 0.5, 1.0], &[4, 4, 12]);
+        let d = mesh.dim;
+        let top = mesh.cells[d - 1];
+        let dofs = DofMap::for_nodes(mesh.num_nodes(), d, |n, _| mesh.node_index(n)[d - 1] == top);
+        let p = fe_pattern(&mesh, &dofs);
+        let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
+        let k = assemble(
+            &mesh,
+            &dofs,
+            &p,
+            ElementOp::Stiffness {
+                lambda: 0.25,
+                mu: 0.5,
+            },
+            &|_| 1.0,
+        );
+        let a = SymMatrix::lin_comb(1.0, &m, 0.01, &k);
+        let n = p.n;
+        let mut rng = fastrand::Rng::with_seed(24);
+        let b: Vec<f64> = (0..n * 8).map(|_| rng.f64() - 0.5).collect();
+        for kind in [FactorKind::Simplicial, FactorKind::Supernodal] {
+            let opts = CholeskyOptions {
+                ordering: Ordering::Custom(dofs.order_by_nodes(&mesh.nested_dissection(), d)),
+                kind,
+            };
+            let sym = SymbolicCholesky::with_options(&p, &opts).unwrap();
+            assert_eq!(sym.is_supernodal(), kind == FactorKind::Supernodal);
+            let ch = Cholesky::new(&sym, &a).unwrap();
+            let mut work = ch.work_for(8);
+            let mut singles = b.clone();
+            for col in singles.chunks_exact_mut(n) {
+                ch.solve_in_place(col, &mut ch.work());
+            }
+            for cols in [2, 3, 5, 8] {
+                let mut x = b[..n * cols].to_vec();
+                ch.solve_columns_in_place(&mut x, cols, &mut work);
+                let same = x
+                    .iter()
+                    .zip(&singles)
+                    .all(|(u, v)| u.to_bits() == v.to_bits());
+                assert!(
+                    same,
+                    "{kind:?}, {cols} columns differ from the single solves"
+                );
+            }
+            // And the single solve is faer's: the blocked solve of one column agrees to
+            // round-off of a backward-stable solve (cond(A) ≲ 10², |x| ≲ 10: 1e-12).
+            let mut faer_one = b[..n].to_vec();
+            ch.solve_many_in_place(&mut faer_one, 1, &mut work);
+            let d = faer_one.iter().zip(&singles).map(|(u, v)| (u - v).abs());
+            assert!(d.fold(0.0, f64::max) < 1e-12);
+        }
     }
 
     #[test]

@@ -224,6 +224,19 @@ impl StepSolver {
         }
     }
 
+    /// [`Self::solve_many_in_place`] with each column's arithmetic that of its solve alone
+    /// ([`Cholesky::solve_columns_in_place`]): the lockstep groups' solve, whose members must
+    /// write the numbers of their runs alone. CG columns are independent already.
+    ///
+    /// # Panics
+    /// As [`Self::solve_many_in_place`].
+    pub fn solve_columns_in_place(&self, rhs: &mut [f64], ncols: usize, work: &mut StepWork) {
+        match (self, &mut work.scratch) {
+            (StepSolver::Direct(c), Scratch::Direct(w)) => c.solve_columns_in_place(rhs, ncols, w),
+            _ => self.solve_many_in_place(rhs, ncols, work),
+        }
+    }
+
     /// [`Self::solve_many_in_place`], returning a CG failure.
     pub fn try_solve_many_in_place(
         &self,
