@@ -51,6 +51,15 @@ fn step_matrix(extent: &[f64], cells: &[usize]) -> (SymMatrix, CholeskyOptions) 
     )
 }
 
+/// A benchmark case: its name, the box's extent and cells, and the factor kind (`None`: the
+/// engine's choice).
+struct Case {
+    name: &'static str,
+    extent: Vec<f64>,
+    cells: Vec<usize>,
+    kind: Option<FactorKind>,
+}
+
 fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -63,44 +72,48 @@ fn main() {
         .find_map(|a| a.parse().ok())
         .unwrap_or(15);
     const K: usize = 8;
-    let cases: [(&str, Vec<f64>, Vec<usize>, Option<FactorKind>); 5] = [
-        (
-            "2D 21 120, simplicial",
-            vec![0.1, 1.0],
-            vec![32, 320],
-            Some(FactorKind::Simplicial),
-        ),
-        (
-            "2D 21 120, supernodal",
-            vec![0.1, 1.0],
-            vec![32, 320],
-            Some(FactorKind::Supernodal),
-        ),
-        (
-            "2D 83 200, simplicial",
-            vec![0.1, 1.0],
-            vec![64, 640],
-            Some(FactorKind::Simplicial),
-        ),
-        (
-            "2D 83 200, supernodal",
-            vec![0.1, 1.0],
-            vec![64, 640],
-            Some(FactorKind::Supernodal),
-        ),
-        (
-            "3D 19 440, supernodal",
-            vec![0.1, 0.1, 1.0],
-            vec![8, 8, 80],
-            None,
-        ),
+    let bar2d = |cells: usize, kind| Case {
+        name: "",
+        extent: vec![0.1, 1.0],
+        cells: vec![cells, 10 * cells],
+        kind: Some(kind),
+    };
+    let cases = [
+        Case {
+            name: "2D 21 120, simplicial",
+            ..bar2d(32, FactorKind::Simplicial)
+        },
+        Case {
+            name: "2D 21 120, supernodal",
+            ..bar2d(32, FactorKind::Supernodal)
+        },
+        Case {
+            name: "2D 83 200, simplicial",
+            ..bar2d(64, FactorKind::Simplicial)
+        },
+        Case {
+            name: "2D 83 200, supernodal",
+            ..bar2d(64, FactorKind::Supernodal)
+        },
+        Case {
+            name: "3D 19 440, supernodal",
+            extent: vec![0.1, 0.1, 1.0],
+            cells: vec![8, 8, 80],
+            kind: None,
+        },
     ];
     println!("ms for {K} right-hand sides, medians of {reps} interleaved repetitions");
     println!(
         "| case | entries of L | supernodes | {K} × one | faer block | columns | columns = {K} × one |"
     );
     println!("|---|---|---|---|---|---|---|");
-    for (name, extent, cells, kind) in cases {
+    for Case {
+        name,
+        extent,
+        cells,
+        kind,
+    } in cases
+    {
         let (a, mut opts) = step_matrix(&extent, &cells);
         if let Some(kind) = kind {
             opts.kind = kind;
