@@ -241,12 +241,13 @@ pub struct SolveWork {
     tmp: AlignedBuf,
 }
 
-/// f64 storage whose first element sits on a 64-byte boundary, so that a kernel that peels
-/// to an alignment boundary treats every copy of a vector the same way.
+/// `len` f64s whose first one sits on a 64-byte boundary, so that a kernel that peels to an
+/// alignment boundary treats every copy of a vector the same way.
 #[derive(Default)]
 struct AlignedBuf {
     data: Vec<f64>,
     offset: usize,
+    len: usize,
 }
 
 impl AlignedBuf {
@@ -254,12 +255,19 @@ impl AlignedBuf {
         if len == 0 {
             return AlignedBuf::default();
         }
+        // 8 f64s of slack: a Vec<f64> starts on an 8-byte boundary, at most 56 bytes short.
         let data = vec![0.0; len + 8];
         let offset = data.as_ptr().align_offset(64);
-        AlignedBuf { data, offset }
+        AlignedBuf { data, offset, len }
     }
 
+    /// The first `len` values (the buffer's own length at most).
     fn get(&mut self, len: usize) -> &mut [f64] {
+        assert!(
+            len <= self.len,
+            "aligned scratch of {} values, {len} asked",
+            self.len
+        );
         &mut self.data[self.offset..self.offset + len]
     }
 }
@@ -431,7 +439,7 @@ impl Cholesky {
             }
         }
         let llt = SupernodalLltRef::new(sn, &self.values);
-        let widest = work.tmp.data.len().saturating_sub(8);
+        let widest = work.tmp.len;
         let tmp = work.tmp.get(widest);
         for s in 0..sn.n_supernodes() {
             let node = llt.supernode(s);
