@@ -16,6 +16,12 @@
 //!   consistent mass; the discrete gradient with the penalty, central difference with the
 //!   lumped mass at ν = 0.9), timed in alternation, 5 rounds, medians; target ≤ 1.3×.
 //!
+//! - `lanes-ratio` (issue 24's 1D bullet: lockstep across SIMD lanes, "if it pays"): for
+//!   m = 10², 10³, 10⁴, eight Thomas solves one after another against the same eight solved
+//!   together, one run per lane of an `[f64; 8]` row (the compiler vectorises the lanes; each
+//!   lane does a single solve's arithmetic, checked bit for bit), next to one CN step per node.
+//!   The last column bounds what 1D lockstep could save: (Thomas − lanes) ÷ step.
+//!
 //! `cargo bench --bench bar1d`; compare medians, not single runs.
 //! `cargo bench --bench bar1d -- thomas-ratio` prints only the ratio table.
 
@@ -243,6 +249,114 @@ fn thomas_ratio(c: &mut Criterion) {
     }
 }
 
+/// Eight Thomas solves in the lanes of `[f64; 8]` rows: each lane does the arithmetic of
+/// `TridiagLu::solve_in_place` (same operations, same order), the eight chains interleaved.
+fn thomas_lanes(mult: &[f64], piv: &[f64], upper: &[f64], x: &mut [[f64; 8]]) {
+    let n = piv.len();
+    for i in 1..n {
+        let (m, prev) = (mult[i - 1], x[i - 1]);
+        for (xi, p) in x[i].iter_mut().zip(prev) {
+            *xi -= m * p;
+        }
+    }
+    for xi in x[n - 1].iter_mut() {
+        *xi *= piv[n - 1];
+    }
+    for i in (0..n - 1).rev() {
+        let (u, q, next) = (upper[i], piv[i], x[i + 1]);
+        for (xi, nx) in x[i].iter_mut().zip(next) {
+            *xi = (*xi - u * nx) * q;
+        }
+    }
+}
+
+/// 1D lockstep's ceiling (module header, `lanes-ratio`): the tridiagonal solve of 8 runs one by
+/// one against 8 in lanes, per node and run, against a whole CN step per node.
+fn lanes_ratio(c: &mut Criterion) {
+    let filter: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
+    if !filter.is_empty() && !filter.iter().any(|f| "lanes-ratio".contains(f.as_str())) {
+        return;
+    }
+    let _ = c;
+    println!("\nlanes-ratio: ns per node and run; 8 runs, their solves one by one or in lanes");
+    println!(
+        "{:>8} {:>12} {:>12} {:>12} {:>10} {:>16}",
+        "m", "CN step", "Thomas", "8 in lanes", "speed-up", "saving ≤ of step"
+    );
+    for m in [100usize, 1_000, 10_000] {
+        let steps = (10_000_000 / m).max(10);
+        let dt = 1.0 / m as f64;
+        let cfg = RunConfig::Bar1d(Bar1dConfig {
+            steps,
+            ..Bar1dConfig::new(
+                BarParams::default(),
+                m,
+                dt,
+                1.0,
+                ContactMethod::Mixed,
+                MassVariant::Mod3,
+                Scheme::Newmark(NewmarkParams::crank_nicolson()),
+            )
+        });
+        let no_series = RunOptions {
+            series_every: 0,
+            timeout: None,
+            cancel: None,
+        };
+        let sp = Bar1dSpace::new(
+            BarParams::default(),
+            m,
+            &MassVariant::Mod3,
+            ContactMethod::Mixed,
+        )
+        .expect("a valid space");
+        let a = sp.mass.axpy(0.25 * dt * dt, &sp.stiffness_lin);
+        let lu = a.factor().expect("M + cK is SPD");
+        let (mult, piv, upper) = lu.parts();
+        let rhs: Vec<Vec<f64>> = (0..8)
+            .map(|l| (0..m).map(|i| 1.0 + ((i + l) % 7) as f64).collect())
+            .collect();
+        let rows: Vec<[f64; 8]> = (0..m).map(|i| std::array::from_fn(|l| rhs[l][i])).collect();
+        let mut xs = rhs.clone();
+        let mut xl = rows.clone();
+        let (mut run_ns, mut one_ns, mut lanes_ns) = (Vec::new(), Vec::new(), Vec::new());
+        let per =
+            |t: Instant, runs: usize| t.elapsed().as_secs_f64() * 1e9 / (steps * m * runs) as f64;
+        for _ in 0..7 {
+            let t = Instant::now();
+            simulate(&cfg, &no_series);
+            run_ns.push(per(t, 1));
+            let t = Instant::now();
+            for _ in 0..steps {
+                for (x, b) in xs.iter_mut().zip(&rhs) {
+                    x.copy_from_slice(b);
+                    lu.solve_in_place(x);
+                }
+            }
+            std::hint::black_box(&xs);
+            one_ns.push(per(t, 8));
+            let t = Instant::now();
+            for _ in 0..steps {
+                xl.copy_from_slice(&rows);
+                thomas_lanes(mult, piv, upper, &mut xl);
+            }
+            std::hint::black_box(&xl);
+            lanes_ns.push(per(t, 8));
+        }
+        let same = (0..m).all(|i| (0..8).all(|l| xs[l][i].to_bits() == xl[i][l].to_bits()));
+        assert!(same, "each lane does a single solve's arithmetic");
+        let (r, o, l) = (median(run_ns), median(one_ns), median(lanes_ns));
+        println!(
+            "{m:>8} {r:>12.2} {o:>12.2} {l:>12.2} {:>10.1} {:>15.0} %",
+            o / l,
+            100.0 * (o - l) / r
+        );
+    }
+}
+
 /// Per-step cost of each SPEC §3.2 method against Crank–Nicolson, m = 10³ … 10⁵ (module header).
 fn scheme_ratio(c: &mut Criterion) {
     use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams};
@@ -336,5 +450,12 @@ fn scheme_ratio(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, steps, executor, thomas_ratio, scheme_ratio);
+criterion_group!(
+    benches,
+    steps,
+    executor,
+    thomas_ratio,
+    lanes_ratio,
+    scheme_ratio
+);
 criterion_main!(benches);

@@ -203,6 +203,12 @@ pub struct TridiagLu {
 }
 
 impl TridiagLu {
+    /// The factors: multipliers of the forward sweep, inverse pivots, the upper diagonal (for a
+    /// benchmark that solves several systems at once: `benches/bar1d.rs`, `lanes-ratio`).
+    pub fn parts(&self) -> (&[f64], &[f64], &[f64]) {
+        (&self.mult, &self.piv, &self.upper)
+    }
+
     /// Overwrite `x` (the right-hand side) with the solution.
     pub fn solve_in_place(&self, x: &mut [f64]) {
         let n = self.piv.len();
