@@ -175,3 +175,58 @@ fn energy_impacts_figure_of_a_short_disc_sweep() {
         "{stdout}"
     );
 }
+
+/// `analysis/sweepdata.py` mirrors the output schema in Python (it reads every part with one
+/// schema and casts what differs, so a renamed or retyped column would silently read as nulls
+/// there): every column it declares for the runs and series tables is in the engine's Parquet
+/// with the declared type, and its `ERROR_COLUMNS` are the engine's (`model::ERROR_COLUMNS`,
+/// in order).
+#[test]
+fn sweepdata_py_mirrors_the_engine_schema() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("qs");
+    let o = cli(
+        repo,
+        &[
+            "run",
+            "sweeps/quickstart.toml",
+            "--out",
+            out.to_str().unwrap(),
+            "--no-summary",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let check = r#"
+import sys, polars as pl
+sys.path.insert(0, sys.argv[1])
+import sweepdata as sd
+out, engine_errors = sys.argv[2], sys.argv[3].split(",")
+problems = []
+for table, declared in (("runs", sd.RUN_COLUMNS), ("series", sd.SERIES_COLUMNS)):
+    schema = pl.read_parquet_schema(sd.parquet_files(f"{out}/{table}")[0])
+    for name, dtype in declared.items():
+        if name not in schema:
+            problems.append(f"{table}.{name}: declared, not written")
+        elif schema[name] != dtype:
+            problems.append(f"{table}.{name}: declared {dtype}, written {schema[name]}")
+if sd.ERROR_COLUMNS != engine_errors:
+    problems.append(f"ERROR_COLUMNS {sd.ERROR_COLUMNS} != engine {engine_errors}")
+print("\n".join(problems))
+sys.exit(1 if problems else 0)
+"#;
+    let o = Command::new("python3")
+        .arg("-c")
+        .arg(check)
+        .arg(repo.join("analysis"))
+        .arg(&out)
+        .arg(contact_sweep::model::ERROR_COLUMNS.join(","))
+        .output()
+        .expect("python3 runs (pip install -r analysis/requirements.txt)");
+    assert!(
+        o.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
