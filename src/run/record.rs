@@ -207,7 +207,7 @@ schema! {
         cg_tol: Option<f64> => "", "CG's relative residual tolerance, ‖r‖ ≤ cg_tol·‖b‖ in the D⁻¹ norm, D = diag(A) (solver = cg)";
         solver_iterations: Option<i64> => "", "CG iterations of the step solves of the time loop, summed over the steps (solver = cg; null for direct)";
         solver_iterations_max_step: Option<i64> => "", "most CG iterations of one step's solve (solver = cg)";
-        lockstep: Option<i64> => "", "members of the lockstep group the run was stepped in (runs sharing the step matrix make one multi-column solve per step; its numbers equal the run alone to round-off, and its timings are the group's divided among the members); null: stepped alone";
+        lockstep: Option<i64> => "", "members of the lockstep group the run was stepped in (runs sharing the step matrix make one multi-column solve per step; its numbers equal the run alone bit for bit, and its timings are the group's divided among the members); null: stepped alone";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
