@@ -427,6 +427,7 @@ impl Cholesky {
         let ld = padded(n);
         let x = work.cols.get(ld * ncols);
         let perm = self.symbolic.inner.perm();
+        // P b, column by column into the aligned block.
         for (j, col) in x.chunks_exact_mut(ld).enumerate() {
             let b = &rhs[j * n..(j + 1) * n];
             match perm {
@@ -441,6 +442,9 @@ impl Cholesky {
         let llt = SupernodalLltRef::new(sn, &self.values);
         let widest = work.tmp.len;
         let tmp = work.tmp.get(widest);
+        // Forward, L y = P b in faer's supernode order: the diagonal block's triangular solve,
+        // then the rows below it (`pattern`) updated through the product with the block under
+        // the diagonal. Each supernode is read once; the columns take turns on it.
         for s in 0..sn.n_supernodes() {
             let node = llt.supernode(s);
             let ls = node.val();
@@ -467,6 +471,8 @@ impl Cholesky {
                 }
             }
         }
+        // Backward, Lᵀ z = y in reverse order: the rows below the block gathered, their
+        // contribution subtracted, then the diagonal block's transposed triangular solve.
         for s in (0..sn.n_supernodes()).rev() {
             let node = llt.supernode(s);
             let ls = node.val();
@@ -498,6 +504,7 @@ impl Cholesky {
                 );
             }
         }
+        // x = Pᵀ z.
         for (j, col) in x.chunks_exact(ld).enumerate() {
             let b = &mut rhs[j * n..(j + 1) * n];
             match perm {
