@@ -34,89 +34,23 @@
 
 use std::time::Duration;
 
+mod common;
+
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use contact_sweep::run::fe::{FeConfig, cholesky_options};
+use common::{config, step_matrix};
+use contact_sweep::run::fe::FeConfig;
 use contact_sweep::run::{RunOptions, simulate};
-use contact_sweep::scene::{BarScene, MeshChoice, Physics, Scene, SceneSetup};
+use contact_sweep::scene::{Physics, Scene, SceneSetup};
 use contact_sweep::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use contact_sweep::space::fe::nitsche::contact_points;
-use contact_sweep::space::fe::{
-    BallMesh, BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern,
-};
+use contact_sweep::space::fe::{BallMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern};
 use contact_sweep::space::linalg::{
     Cholesky, CholeskyOptions, FactorKind, Ordering, SymbolicCholesky,
 };
 use contact_sweep::space::step_solver::Solver;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
-
-fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
-    let scene = BarScene { dim };
-    let physics = Physics(
-        scene
-            .physics()
-            .iter()
-            .map(|k| (k.name, k.default))
-            .collect(),
-    );
-    let mesh: MeshChoice = scene.mesh_from_h(&physics, h).unwrap();
-    let SceneSetup::Fe(setup) = scene.setup(&physics, mesh) else {
-        unreachable!("the bars are FE scenes")
-    };
-    FeConfig {
-        setup,
-        method: ContactMethod::Mixed,
-        mass: MassVariant::Mod3,
-        scheme: Scheme::Newmark(NewmarkParams::crank_nicolson()),
-        dt: h / 2.0,
-        steps,
-        solver: Solver::Direct,
-        perturbation: None,
-    }
-}
-
-/// The step matrix A = M + τ²/4 K of `config` (mod3 mass), assembled outside the engine, and
-/// the engine's choice of ordering and factor kind for it.
-fn step_matrix(cfg: &FeConfig) -> (SymMatrix, usize, CholeskyOptions) {
-    let contact_sweep::scene::FeGeometry::Box { extent, cells } = &cfg.setup.geometry else {
-        panic!("the bench runs the bars");
-    };
-    let mesh = BoxMesh::new(extent, cells);
-    let d = mesh.dim;
-    let dofs = DofMap::new(mesh.num_nodes() * d, |g| {
-        mesh.node_index(g / d)[d - 1] == cells[d - 1]
-    });
-    let p = fe_pattern(&mesh, &dofs);
-    let k = assemble(
-        &mesh,
-        &dofs,
-        &p,
-        ElementOp::Stiffness {
-            lambda: 0.25,
-            mu: 0.5,
-        },
-        &|_| 1.0,
-    );
-    let m = assemble(
-        &mesh,
-        &dofs,
-        &p,
-        ElementOp::Mass { rho: 1.0 },
-        &|e| match mesh.element_layer(e) {
-            0 => 0.0,
-            1 => 2.0,
-            _ => 1.0,
-        },
-    );
-    let tau = cfg.dt;
-    let opts = cholesky_options(&mesh, &dofs);
-    (
-        SymMatrix::lin_comb(1.0, &m, tau * tau / 4.0, &k),
-        dofs.n_free(),
-        opts,
-    )
-}
 
 fn bench_bar(c: &mut Criterion, name: &str, dim: usize, h: f64) {
     let mut g = c.benchmark_group(name);

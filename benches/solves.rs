@@ -1,5 +1,5 @@
 //! The step solve with eight right-hand sides, three ways, on the bars' step matrices
-//! A = M + τ²/4 K (issue 24: lockstep groups):
+//! A = M + τ²/4 K (mod3, τ = h/2: `common::step_matrix`; issue 24: lockstep groups):
 //!
 //! - `8 × one`: eight single-column solves (eight runs alone);
 //! - `faer block`: faer's blocked solve of the 8 columns at once — not what a group may use on
@@ -18,45 +18,18 @@
 //!
 //!   cargo bench --bench solves [-- REPS]   (default 15)
 
+mod common;
+
 use std::time::Instant;
 
-use contact_sweep::run::fe::cholesky_options;
-use contact_sweep::space::fe::{BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern};
-use contact_sweep::space::linalg::{Cholesky, CholeskyOptions, FactorKind, SymbolicCholesky};
+use contact_sweep::space::linalg::{Cholesky, FactorKind, SymbolicCholesky};
 
-/// The bar's step matrix at `cells` (Q1, clamped top, consistent mass: a solve's cost depends
-/// on the pattern only), τ = h/2 with h the cell height, and the engine's options.
-fn step_matrix(extent: &[f64], cells: &[usize]) -> (SymMatrix, CholeskyOptions) {
-    let mesh = BoxMesh::new(extent, cells);
-    let d = mesh.dim;
-    let dofs = DofMap::new(mesh.num_nodes() * d, |g| {
-        mesh.node_index(g / d)[d - 1] == cells[d - 1]
-    });
-    let p = fe_pattern(&mesh, &dofs);
-    let k = assemble(
-        &mesh,
-        &dofs,
-        &p,
-        ElementOp::Stiffness {
-            lambda: 0.25,
-            mu: 0.5,
-        },
-        &|_| 1.0,
-    );
-    let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
-    let tau = extent[d - 1] / cells[d - 1] as f64 / 2.0;
-    (
-        SymMatrix::lin_comb(1.0, &m, tau * tau / 4.0, &k),
-        cholesky_options(&mesh, &dofs),
-    )
-}
-
-/// A benchmark case: its name, the box's extent and cells, and the factor kind (`None`: the
-/// engine's choice).
+/// A benchmark case: its name, the bar's dimension and mesh size, and the factor kind (`None`:
+/// the engine's choice).
 struct Case {
     name: &'static str,
-    extent: Vec<f64>,
-    cells: Vec<usize>,
+    dim: usize,
+    h: f64,
     kind: Option<FactorKind>,
 }
 
@@ -72,49 +45,41 @@ fn main() {
         .find_map(|a| a.parse().ok())
         .unwrap_or(15);
     const K: usize = 8;
-    let bar2d = |cells: usize, kind| Case {
-        name: "",
-        extent: vec![0.1, 1.0],
-        cells: vec![cells, 10 * cells],
-        kind: Some(kind),
-    };
+    let case = |name, dim, h, kind| Case { name, dim, h, kind };
     let cases = [
-        Case {
-            name: "2D 21 120, simplicial",
-            ..bar2d(32, FactorKind::Simplicial)
-        },
-        Case {
-            name: "2D 21 120, supernodal",
-            ..bar2d(32, FactorKind::Supernodal)
-        },
-        Case {
-            name: "2D 83 200, simplicial",
-            ..bar2d(64, FactorKind::Simplicial)
-        },
-        Case {
-            name: "2D 83 200, supernodal",
-            ..bar2d(64, FactorKind::Supernodal)
-        },
-        Case {
-            name: "3D 19 440, supernodal",
-            extent: vec![0.1, 0.1, 1.0],
-            cells: vec![8, 8, 80],
-            kind: None,
-        },
+        case(
+            "2D 21 120, simplicial",
+            2,
+            0.05 / 16.0,
+            Some(FactorKind::Simplicial),
+        ),
+        case(
+            "2D 21 120, supernodal",
+            2,
+            0.05 / 16.0,
+            Some(FactorKind::Supernodal),
+        ),
+        case(
+            "2D 83 200, simplicial",
+            2,
+            0.05 / 32.0,
+            Some(FactorKind::Simplicial),
+        ),
+        case(
+            "2D 83 200, supernodal",
+            2,
+            0.05 / 32.0,
+            Some(FactorKind::Supernodal),
+        ),
+        case("3D 19 440, supernodal", 3, 0.0125, None),
     ];
     println!("ms for {K} right-hand sides, medians of {reps} interleaved repetitions");
     println!(
         "| case | entries of L | supernodes | {K} × one | faer block | columns | columns = {K} × one |"
     );
     println!("|---|---|---|---|---|---|---|");
-    for Case {
-        name,
-        extent,
-        cells,
-        kind,
-    } in cases
-    {
-        let (a, mut opts) = step_matrix(&extent, &cells);
+    for Case { name, dim, h, kind } in cases {
+        let (a, _, mut opts) = common::step_matrix(&common::config(dim, h, 1));
         if let Some(kind) = kind {
             opts.kind = kind;
         }

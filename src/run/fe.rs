@@ -360,19 +360,17 @@ fn geometry_key(s: &FeSetup) -> String {
 /// whatever the number of columns, so a lockstep member ([`lockstep`]) equals its run alone bit
 /// for bit through faer's own blocked solve; a supernodal factor needs the engine's
 /// column-by-column sweep ([`crate::space::linalg::Cholesky::solve_columns_in_place`]), which in
-/// 2D (thousands of supernodes of a few columns each) costs 1.3–1.7× faer's blocked solve. And
+/// 2D (thousands of supernodes of a few columns each) costs 1.4–1.7× faer's blocked solve. And
 /// the supernodal factor buys nothing here. `cargo bench --bench solves` (faer 0.24, AMD, ms for
 /// 8 right-hand sides: one at a time / faer's block / the column sweep, medians of 15
-/// interleaved): 21 120 dofs simplicial 15.9 / 6.4 / 7.3, supernodal 14.3 / 6.1 / 10.4;
-/// 83 200 dofs simplicial 59.0 / 26.3 / 26.2, supernodal 116.7 / 34.5 / 46.7. (An earlier
+/// interleaved): 21 120 dofs simplicial 13.2 / 6.2 / 6.0, supernodal 23.3 / 8.5 / 13.9;
+/// 83 200 dofs simplicial 60.5 / 26.6 / 26.8, supernodal 117.7 / 33.6 / 46.1. (An earlier
 /// series on a quiet machine had the supernodal factor ahead at 83 200 dofs, 6.4 against
 /// 7.6 ms for one solve: docs/performance.md.)
-fn kind_2d() -> FactorKind {
-    FactorKind::Simplicial
-}
+const FACTOR_KIND_2D: FactorKind = FactorKind::Simplicial;
 
 /// The engine's fill-reducing ordering and factor kind, measured on M + τ²/4 K of the bars (one
-/// solve): 2D: AMD ([`kind_2d`]; nested dissection gives 5.3–6.9 M entries in L at 65 × 641
+/// solve): 2D: AMD ([`FACTOR_KIND_2D`]; nested dissection gives 5.3–6.9 M entries in L at 65 × 641
 /// nodes against AMD's 4.9–6.2 M); 3D 9 × 9 × 81: the geometric nested dissection of the box
 /// with supernodes, 6.6 M, 9.5 ms (AMD supernodal 10.0 M, 13.5 ms).
 pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
@@ -380,7 +378,7 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
     if d == 2 {
         CholeskyOptions {
             ordering: Ordering::Amd,
-            kind: kind_2d(),
+            kind: FACTOR_KIND_2D,
         }
     } else {
         CholeskyOptions {
@@ -481,7 +479,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            kind_2d()
+            FACTOR_KIND_2D
         } else {
             FactorKind::Supernodal
         },
@@ -617,7 +615,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
     let opts = CholeskyOptions {
         ordering: Ordering::Amd,
         kind: if d == 2 {
-            kind_2d()
+            FACTOR_KIND_2D
         } else {
             FactorKind::Supernodal
         },
