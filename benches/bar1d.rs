@@ -34,7 +34,7 @@ use contact_sweep::exec::{self, ExecOptions};
 use contact_sweep::run::bar1d::Bar1dConfig;
 use contact_sweep::run::{RunConfig, RunOptions, simulate};
 use contact_sweep::scene::BarParams;
-use contact_sweep::space::{Bar1dSpace, ContactMethod, MassVariant};
+use contact_sweep::space::{Bar1dSpace, ContactMethod, MassVariant, TridiagLu};
 use contact_sweep::sweep::{self, SweepFile};
 use contact_sweep::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
 
@@ -93,13 +93,8 @@ fn steps(c: &mut Criterion) {
     let mut g = c.benchmark_group("step");
     g.sample_size(20);
     g.throughput(Throughput::Elements(1000 * 3000));
-    let no_series = RunOptions {
-        series_every: 0,
-        timeout: None,
-        cancel: None,
-    };
     for (name, cfg) in &cases {
-        g.bench_function(*name, |b| b.iter(|| simulate(cfg, &no_series)));
+        g.bench_function(*name, |b| b.iter(|| simulate(cfg, &NO_SERIES)));
     }
     g.finish();
 
@@ -172,16 +167,60 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Per-step cost of a CN run against a bare Thomas solve, per node, for m = 10² … 10⁵.
-/// Not a criterion benchmark: the two sides are timed in alternation so that both see the same
-/// machine load, and their ratio is what is reported.
-fn thomas_ratio(c: &mut Criterion) {
-    // Honour criterion's name filter (`cargo bench --bench bar1d -- step` skips this).
+/// Whether the non-criterion table `name` is wanted: criterion's name filter, honoured by hand
+/// (`cargo bench --bench bar1d -- step` skips the tables).
+fn wanted(name: &str) -> bool {
     let filter: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with('-'))
         .collect();
-    if !filter.is_empty() && !filter.iter().any(|f| "thomas-ratio".contains(f.as_str())) {
+    filter.is_empty() || filter.iter().any(|f| name.contains(f.as_str()))
+}
+
+/// A CN run (mixed, mod3, errors against the closed form, ν = 1 on the unit bar: τ = 1/m) of
+/// `steps` steps on m elements, and its iteration matrix M + (τ²/4) K factored once — the
+/// Thomas side of the ratio tables.
+fn cn_run_and_factor(m: usize, steps: usize) -> (RunConfig, TridiagLu) {
+    let dt = 1.0 / m as f64;
+    let cfg = RunConfig::Bar1d(Bar1dConfig {
+        steps,
+        ..Bar1dConfig::new(
+            BarParams::default(),
+            m,
+            dt,
+            1.0,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            Scheme::Newmark(NewmarkParams::crank_nicolson()),
+        )
+    });
+    let sp = Bar1dSpace::new(
+        BarParams::default(),
+        m,
+        &MassVariant::Mod3,
+        ContactMethod::Mixed,
+    )
+    .expect("a valid space");
+    let lu = sp
+        .mass
+        .axpy(0.25 * dt * dt, &sp.stiffness_lin)
+        .factor()
+        .expect("M + cK is SPD");
+    (cfg, lu)
+}
+
+/// Series off, no timeout.
+const NO_SERIES: RunOptions = RunOptions {
+    series_every: 0,
+    timeout: None,
+    cancel: None,
+};
+
+/// Per-step cost of a CN run against a bare Thomas solve, per node, for m = 10² … 10⁵.
+/// Not a criterion benchmark: the two sides are timed in alternation so that both see the same
+/// machine load, and their ratio is what is reported.
+fn thomas_ratio(c: &mut Criterion) {
+    if !wanted("thomas-ratio") {
         return;
     }
     let _ = c;
@@ -195,43 +234,13 @@ fn thomas_ratio(c: &mut Criterion) {
     for m in [100usize, 1_000, 10_000, 100_000] {
         // About 3·10⁷ node-steps per sample: ≈ 0.25 s.
         let steps = (30_000_000 / m).max(10);
-        let dt = 1.0 / m as f64; // ν = 1 on the unit bar (c₀ = 1)
-        let cfg = RunConfig::Bar1d(Bar1dConfig {
-            steps,
-            ..Bar1dConfig::new(
-                BarParams::default(),
-                m,
-                dt,
-                1.0,
-                ContactMethod::Mixed,
-                MassVariant::Mod3,
-                Scheme::Newmark(NewmarkParams::crank_nicolson()),
-            )
-        });
-        let no_series = RunOptions {
-            series_every: 0,
-            timeout: None,
-            cancel: None,
-        };
-        // The Thomas side: the same iteration matrix M + (τ²/4) K, factored once.
-        let sp = Bar1dSpace::new(
-            BarParams::default(),
-            m,
-            &MassVariant::Mod3,
-            ContactMethod::Mixed,
-        )
-        .expect("a valid space");
-        let lu = sp
-            .mass
-            .axpy(0.25 * dt * dt, &sp.stiffness_lin)
-            .factor()
-            .expect("M + cK is SPD");
+        let (cfg, lu) = cn_run_and_factor(m, steps);
         let rhs: Vec<f64> = (0..m).map(|i| 1.0 + (i % 7) as f64).collect();
         let mut x = rhs.clone();
         let (mut run_ns, mut thomas_ns) = (Vec::new(), Vec::new());
         for _ in 0..9 {
             let t = Instant::now();
-            let out = simulate(&cfg, &no_series);
+            let out = simulate(&cfg, &NO_SERIES);
             run_ns.push(t.elapsed().as_secs_f64() * 1e9 / (steps * m) as f64);
             assert_eq!(out.metrics.steps as usize, steps);
             let t = Instant::now();
@@ -273,11 +282,7 @@ fn thomas_lanes(mult: &[f64], piv: &[f64], upper: &[f64], x: &mut [[f64; 8]]) {
 /// 1D lockstep's ceiling (module header, `lanes-ratio`): the tridiagonal solve of 8 runs one by
 /// one against 8 in lanes, per node and run, against a whole CN step per node.
 fn lanes_ratio(c: &mut Criterion) {
-    let filter: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with('-'))
-        .collect();
-    if !filter.is_empty() && !filter.iter().any(|f| "lanes-ratio".contains(f.as_str())) {
+    if !wanted("lanes-ratio") {
         return;
     }
     let _ = c;
@@ -288,33 +293,7 @@ fn lanes_ratio(c: &mut Criterion) {
     );
     for m in [100usize, 1_000, 10_000] {
         let steps = (10_000_000 / m).max(10);
-        let dt = 1.0 / m as f64;
-        let cfg = RunConfig::Bar1d(Bar1dConfig {
-            steps,
-            ..Bar1dConfig::new(
-                BarParams::default(),
-                m,
-                dt,
-                1.0,
-                ContactMethod::Mixed,
-                MassVariant::Mod3,
-                Scheme::Newmark(NewmarkParams::crank_nicolson()),
-            )
-        });
-        let no_series = RunOptions {
-            series_every: 0,
-            timeout: None,
-            cancel: None,
-        };
-        let sp = Bar1dSpace::new(
-            BarParams::default(),
-            m,
-            &MassVariant::Mod3,
-            ContactMethod::Mixed,
-        )
-        .expect("a valid space");
-        let a = sp.mass.axpy(0.25 * dt * dt, &sp.stiffness_lin);
-        let lu = a.factor().expect("M + cK is SPD");
+        let (cfg, lu) = cn_run_and_factor(m, steps);
         let (mult, piv, upper) = lu.parts();
         let rhs: Vec<Vec<f64>> = (0..8)
             .map(|l| (0..m).map(|i| 1.0 + ((i + l) % 7) as f64).collect())
@@ -327,7 +306,7 @@ fn lanes_ratio(c: &mut Criterion) {
             |t: Instant, runs: usize| t.elapsed().as_secs_f64() * 1e9 / (steps * m * runs) as f64;
         for _ in 0..7 {
             let t = Instant::now();
-            simulate(&cfg, &no_series);
+            simulate(&cfg, &NO_SERIES);
             run_ns.push(per(t, 1));
             let t = Instant::now();
             for _ in 0..steps {
@@ -360,11 +339,7 @@ fn lanes_ratio(c: &mut Criterion) {
 /// Per-step cost of each SPEC §3.2 method against Crank–Nicolson, m = 10³ … 10⁵ (module header).
 fn scheme_ratio(c: &mut Criterion) {
     use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams};
-    let filter: Vec<String> = std::env::args()
-        .skip(1)
-        .filter(|a| !a.starts_with('-'))
-        .collect();
-    if !filter.is_empty() && !filter.iter().any(|f| "scheme-ratio".contains(f.as_str())) {
+    if !wanted("scheme-ratio") {
         return;
     }
     let _ = c;
@@ -410,11 +385,6 @@ fn scheme_ratio(c: &mut Criterion) {
         "{:>8} {:>28} {:>10} {:>10} {:>8}",
         "m", "method", "method", "CN", "ratio"
     );
-    let no_series = RunOptions {
-        series_every: 0,
-        timeout: None,
-        cancel: None,
-    };
     for m in [1_000usize, 10_000, 100_000] {
         // About 2·10⁷ node-steps per sample, through the first impact (t ≥ 1.5 at ν ≤ 1).
         let steps = (20_000_000 / m).max(10);
@@ -439,7 +409,7 @@ fn scheme_ratio(c: &mut Criterion) {
             for _ in 0..5 {
                 for (cfg, out) in [(&a, &mut ta), (&b, &mut tb)] {
                     let t = Instant::now();
-                    let o = simulate(cfg, &no_series);
+                    let o = simulate(cfg, &NO_SERIES);
                     out.push(t.elapsed().as_secs_f64() * 1e9 / (steps * m) as f64);
                     assert_eq!(o.metrics.steps as usize, steps, "{name}: {:?}", o.message);
                 }
