@@ -5,16 +5,14 @@
 
 mod common;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::cli;
 
-#[test]
-fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
-    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("qs");
+/// The quickstart run into `dir/qs` (no summary), its path.
+fn quickstart(repo: &Path, dir: &Path) -> PathBuf {
+    let out = dir.join("qs");
     let o = cli(
         repo,
         &[
@@ -26,6 +24,14 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
         ],
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+#[test]
+fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let tmp = tempfile::tempdir().unwrap();
+    let out = quickstart(repo, tmp.path());
     // The stability maps are drawn from the summary's table.
     let o = cli(repo, &["summarize", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -185,18 +191,7 @@ fn energy_impacts_figure_of_a_short_disc_sweep() {
 fn sweepdata_py_mirrors_the_engine_schema() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
     let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("qs");
-    let o = cli(
-        repo,
-        &[
-            "run",
-            "sweeps/quickstart.toml",
-            "--out",
-            out.to_str().unwrap(),
-            "--no-summary",
-        ],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = quickstart(repo, tmp.path());
     let check = r#"
 import sys, polars as pl
 sys.path.insert(0, sys.argv[1])
