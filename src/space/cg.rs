@@ -387,7 +387,8 @@ pub fn pcg_many_into(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::space::fe::{BoxMesh, DofMap, ElementOp, assemble, fe_pattern};
+    use crate::space::fe::BoxMesh;
+    use crate::space::fe::test_bars::clamped_step_matrix;
     use crate::space::linalg::{Cholesky, SymbolicCholesky};
 
     /// M + cτ²K of a clamped Q1 bar (the engine's step matrix at Courant `nu`, c = ¼).
@@ -396,24 +397,9 @@ mod tests {
             &cells.iter().map(|&c| c as f64 * 0.1).collect::<Vec<_>>(),
             cells,
         );
-        let d = mesh.dim;
-        let top = mesh.cells[d - 1];
-        let dofs = DofMap::for_nodes(mesh.num_nodes(), d, |n, _| mesh.node_index(n)[d - 1] == top);
-        let p = fe_pattern(&mesh, &dofs);
-        let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
-        let k = assemble(
-            &mesh,
-            &dofs,
-            &p,
-            ElementOp::Stiffness {
-                lambda: 0.25,
-                mu: 0.5,
-            },
-            &|_| 1.0,
-        );
         // h = 0.1, c0 = √1.25: τ = ν h / c0.
         let tau = nu * 0.1 / 1.25f64.sqrt();
-        SymMatrix::lin_comb(1.0, &m, 0.25 * tau * tau, &k)
+        clamped_step_matrix(&mesh, 0.25 * tau * tau).1
     }
 
     fn direct(a: &SymMatrix, b: &[f64]) -> Vec<f64> {

@@ -652,25 +652,13 @@ mod tests {
     /// pick GEMM kernels by the number of columns).
     #[test]
     fn column_solves_equal_single_solves_bit_for_bit() {
-        use crate::space::fe::{BoxMesh, DofMap, ElementOp, assemble, fe_pattern};
+        use crate::space::fe::BoxMesh;
+        use crate::space::fe::test_bars::clamped_step_matrix;
         // A 3D bar big enough for supernodes of several columns (nested dissection).
         let mesh = BoxMesh::new(&[0.5, 0.5, 1.0], &[4, 4, 12]);
         let d = mesh.dim;
-        let top = mesh.cells[d - 1];
-        let dofs = DofMap::for_nodes(mesh.num_nodes(), d, |n, _| mesh.node_index(n)[d - 1] == top);
-        let p = fe_pattern(&mesh, &dofs);
-        let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
-        let k = assemble(
-            &mesh,
-            &dofs,
-            &p,
-            ElementOp::Stiffness {
-                lambda: 0.25,
-                mu: 0.5,
-            },
-            &|_| 1.0,
-        );
-        let a = SymMatrix::lin_comb(1.0, &m, 0.01, &k);
+        let (dofs, a) = clamped_step_matrix(&mesh, 0.01);
+        let p = &a.pattern;
         let n = p.n;
         let mut rng = fastrand::Rng::with_seed(24);
         let b: Vec<f64> = (0..n * 8).map(|_| rng.f64() - 0.5).collect();
@@ -679,7 +667,7 @@ mod tests {
                 ordering: Ordering::Custom(dofs.order_by_nodes(&mesh.nested_dissection(), d)),
                 kind,
             };
-            let sym = SymbolicCholesky::with_options(&p, &opts).unwrap();
+            let sym = SymbolicCholesky::with_options(p, &opts).unwrap();
             assert_eq!(sym.is_supernodal(), kind == FactorKind::Supernodal);
             let ch = Cholesky::new(&sym, &a).unwrap();
             let mut work = ch.work_for(8);
@@ -742,29 +730,16 @@ mod tests {
 
     #[test]
     fn orderings_and_kinds_agree() {
-        use crate::space::fe::{BoxMesh, DofMap, ElementOp, assemble, fe_pattern};
+        use crate::space::fe::BoxMesh;
+        use crate::space::fe::test_bars::clamped_step_matrix;
         // M + K of a clamped 2D and 3D bar: every (ordering, kind) pair solves the same system.
         for mesh in [
             BoxMesh::new(&[0.5, 1.0], &[5, 9]),
             BoxMesh::new(&[0.5, 0.5, 1.0], &[3, 3, 6]),
         ] {
             let d = mesh.dim;
-            let top = mesh.cells[d - 1];
-            let dofs =
-                DofMap::for_nodes(mesh.num_nodes(), d, |n, _| mesh.node_index(n)[d - 1] == top);
-            let p = fe_pattern(&mesh, &dofs);
-            let m = assemble(&mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
-            let k = assemble(
-                &mesh,
-                &dofs,
-                &p,
-                ElementOp::Stiffness {
-                    lambda: 0.25,
-                    mu: 0.5,
-                },
-                &|_| 1.0,
-            );
-            let a = SymMatrix::lin_comb(1.0, &m, 0.01, &k);
+            let (dofs, a) = clamped_step_matrix(&mesh, 0.01);
+            let p = &a.pattern;
             let b: Vec<f64> = (0..p.n).map(|i| ((i * 7 % 13) as f64) - 6.0).collect();
             let nd = dofs.order_by_nodes(&mesh.nested_dissection(), d);
             let mut reference: Option<Vec<f64>> = None;

@@ -143,6 +143,33 @@ impl DofMap {
     }
 }
 
+/// Test fixtures shared by the solver modules' unit tests.
+#[cfg(test)]
+pub(crate) mod test_bars {
+    use super::{BoxMesh, DofMap, ElementOp, SymMatrix, assemble, fe_pattern};
+
+    /// M + c K of the Q1 bar `mesh` clamped on its top face (ρ = 1, λ = 1/4, μ = 1/2: an SPD
+    /// step matrix of the engine's kind), and its dof map.
+    pub fn clamped_step_matrix(mesh: &BoxMesh, c: f64) -> (DofMap, SymMatrix) {
+        let d = mesh.dim;
+        let top = mesh.cells[d - 1];
+        let dofs = DofMap::for_nodes(mesh.num_nodes(), d, |n, _| mesh.node_index(n)[d - 1] == top);
+        let p = fe_pattern(mesh, &dofs);
+        let m = assemble(mesh, &dofs, &p, ElementOp::Mass { rho: 1.0 }, &|_| 1.0);
+        let k = assemble(
+            mesh,
+            &dofs,
+            &p,
+            ElementOp::Stiffness {
+                lambda: 0.25,
+                mu: 0.5,
+            },
+            &|_| 1.0,
+        );
+        (dofs, SymMatrix::lin_comb(1.0, &m, c, &k))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
