@@ -753,7 +753,7 @@ mod tests {
                         ordering: ordering.clone(),
                         kind,
                     };
-                    let sym = SymbolicCholesky::with_options(&p, &opts).unwrap();
+                    let sym = SymbolicCholesky::with_options(p, &opts).unwrap();
                     if kind != FactorKind::Auto {
                         assert_eq!(sym.is_supernodal(), kind == FactorKind::Supernodal);
                     }
