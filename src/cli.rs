@@ -284,7 +284,9 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         {
             return 2;
         }
-        if let Some(SinkError::ForeignSweep { .. }) = cause.downcast_ref::<SinkError>() {
+        if let Some(SinkError::ForeignSweep { .. } | SinkError::Superseded { .. }) =
+            cause.downcast_ref::<SinkError>()
+        {
             return 2;
         }
         if let Some(
@@ -514,6 +516,27 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
                 .collect()
         }
     };
+    // Rows of these runs under their ids of before a definition change (issue 34): their
+    // numbers are not this version's, and new rows beside them would make two answers to one
+    // question in every table.
+    let superseded: Vec<&sweep::RunSpec> = mine
+        .iter()
+        .copied()
+        .filter(|r| {
+            r.superseded_id
+                .as_ref()
+                .is_some_and(|old| done.contains(old))
+        })
+        .collect();
+    if let Some(first) = superseded.first() {
+        return Err(SinkError::Superseded {
+            path: dir.clone(),
+            count: superseded.len(),
+            example: first.superseded_id.clone().unwrap_or_default(),
+            now: first.run_id.clone(),
+        }
+        .into());
+    }
     let todo: Vec<&sweep::RunSpec> = mine
         .iter()
         .copied()

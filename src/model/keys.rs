@@ -59,6 +59,9 @@ pub enum Key {
     /// the planner turns it into the run's gap (lowest Γ_C node − obstacle), so it never enters
     /// a run id (the same plane given by `gap` is the same run).
     Obstacle,
+    /// How gravity enters the FE scenes (SPEC §1.3): `body` (default, F = ∫ρ f·φ whatever the
+    /// mass variant) or `inertial` (F = M_run f e_d, the load following the modified inertia).
+    Load,
 }
 
 /// What a key's value must look like.
@@ -144,7 +147,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 38] = [
+    pub const ALL: [Key; 39] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -183,6 +186,7 @@ impl Key {
         Key::CgTol,
         Key::Mesh,
         Key::Obstacle,
+        Key::Load,
     ];
 
     pub fn name(self) -> &'static str {
@@ -225,6 +229,7 @@ impl Key {
             Key::CgTol => "cg_tol",
             Key::Mesh => "mesh",
             Key::Obstacle => "obstacle",
+            Key::Load => "load",
         }
     }
 
@@ -247,6 +252,7 @@ impl Key {
                 | Key::Stiffness
                 | Key::Force
                 | Key::ImpactLaw
+                | Key::Load
         )
     }
 
@@ -256,6 +262,7 @@ impl Key {
     pub fn choices(self) -> Option<&'static [&'static str]> {
         match self {
             Key::RightEnd => Some(&["clamped", "free"]),
+            Key::Load => Some(&["body", "inertial"]),
             _ => None,
         }
     }
@@ -272,6 +279,7 @@ impl Key {
             | Key::Scheme
             | Key::ContactInit
             | Key::RightEnd
+            | Key::Load
             | Key::Solver
             | Key::Mesh => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
@@ -364,6 +372,12 @@ impl Key {
                 "clamped" | "free" => Ok(()),
                 _ => Err(format!(
                     "unknown right_end `{s}` (expected clamped or free: the bar's end x = L held at u = 0 or traction-free)"
+                )),
+            },
+            (Key::Load, Value::Str(s)) => match s.as_str() {
+                "body" | "inertial" => Ok(()),
+                _ => Err(format!(
+                    "unknown load `{s}` (expected body — the body force ∫ρ f·φ, SPEC §1.3 — or inertial — M_run f e_d, the weight following the run's modified mass)"
                 )),
             },
             (Key::PointMass | Key::Stiffness, Value::Num(x)) => positive(*x),

@@ -44,13 +44,15 @@ use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::contact::Lcp;
-use crate::scene::{FeGeometry, FeSetup};
+use crate::scene::{FeGeometry, FeSetup, LoadModel};
+use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
 use crate::space::fe::nitsche::{
     ContactPoint, box_contact_faces, contact_points, face_contact_points, gmsh_contact_faces,
 };
 use crate::space::fe::{
-    BallMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+    BallMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble,
+    assemble_load, fe_pattern,
 };
 use crate::space::linalg::{CholeskyOptions, FactorKind, LinalgError, Ordering, SymbolicCholesky};
 use crate::space::step_solver::{Solver, StepSolver, StepWork};
@@ -823,6 +825,120 @@ fn component_total(
     total
 }
 
+/// The volume load of a run with gravity (SPEC §1.3) and what its time loop needs of it.
+#[derive(Debug)]
+struct GravityLoad {
+    /// F on the free dofs: ∫ρ f·φ (`load = "body"`) or M_run f e_d (`"inertial"`).
+    force: Vec<f64>,
+    /// a⁰ with M a⁰ = F − K u⁰ = F on the dofs with inertia (u⁰ = 0, no contact at t = 0; 003
+    /// Remark 2.1), 0 on the massless ones (their rows are quasi-static: they never use it).
+    a0: Vec<f64>,
+    /// M e_d (the run's M), for the centre of mass e_dᵀ M u / e_dᵀ M e_d.
+    m_ed: Vec<f64>,
+    /// e_dᵀ M e_d.
+    vertical_mass: f64,
+    /// m·|f|·gap with m = ∫ρ the body's mass, the same for every mass variant (SPEC §1.3).
+    energy_scale: f64,
+}
+
+/// The load of `cfg`'s gravity on `g` with the run's mass matrix `m` (None without gravity).
+///
+/// With `load = "body"` (the papers' model) and a mass variant that keeps 1ᵀM = ∫ρφ
+/// (consistent, lumped), F = M f e_d in exact arithmetic and a⁰ = f e_d exactly: the body falls
+/// rigidly. A redistributed or removed mass keeps F but not M, so a⁰ = M⁻¹F is no longer
+/// uniform (the body strains in free fall, SPEC §1.3): it is solved on the dofs with inertia by
+/// conjugate gradients on M (κ = O(1), a few dozen iterations to round-off).
+fn gravity_load(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+) -> Result<Option<GravityLoad>, String> {
+    let s = &cfg.setup;
+    let fall = -s.gravity;
+    if fall == 0.0 {
+        return Ok(None);
+    }
+    if g.mesh.as_box().is_some() {
+        return Err(format!(
+            "scene {}: a volume load on the clamped bar is not supported",
+            s.scene
+        ));
+    }
+    let n = g.dofs.n_free();
+    let mesh = g.mesh.mesh();
+    let d = mesh.dim();
+    let mut ed = vec![0.0; n];
+    for &r in &g.vertical {
+        ed[r] = 1.0;
+    }
+    let mut m_ed = vec![0.0; n];
+    m.matvec_into(&ed, &mut m_ed);
+    let vertical_mass: f64 = g.vertical.iter().map(|&r| m_ed[r]).sum();
+    // The body force on every dof, clamped ones included: its vertical sum is f·∫ρ (Σφ = 1).
+    let mut f = [0.0; 3];
+    f[d - 1] = fall;
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let body = assemble_load(mesh, &all, s.density, f, &|_| 1.0);
+    let body_mass = body.iter().skip(d - 1).step_by(d).sum::<f64>() / fall;
+    let force: Vec<f64> = match s.load {
+        LoadModel::Body => g.dofs.free.iter().map(|&gd| body[gd]).collect(),
+        LoadModel::Inertial => m_ed.iter().map(|x| fall * x).collect(),
+    };
+    let keeps_row_sums = matches!(cfg.mass, MassVariant::Consistent | MassVariant::Lumped);
+    let a0 = if s.load == LoadModel::Inertial || keeps_row_sums {
+        ed.iter().map(|e| fall * e).collect()
+    } else {
+        // (M + I_massless) a = F with F = 0 on the massless rows: M's massless rows and
+        // columns are zero (module header of the mass variants), so a_f = M_ff⁻¹ F_f, a_c = 0.
+        let mut shifted = m.clone();
+        let diag = m.diagonal();
+        let mut rhs = force.clone();
+        for (j, &dj) in diag.iter().enumerate() {
+            if dj == 0.0 {
+                let k = shifted
+                    .pattern
+                    .position(j, j)
+                    .expect("the pattern holds the diagonal");
+                shifted.values[k] = 1.0;
+                rhs[j] = 0.0;
+            }
+        }
+        let inv = jacobi(&shifted).map_err(|e| format!("initial acceleration: {e}"))?;
+        let mut a: Vec<f64> = ed.iter().map(|e| fall * e).collect();
+        let mut work = CgWork::new(n);
+        pcg_into(
+            &shifted,
+            &inv,
+            &rhs,
+            &mut a,
+            CgOptions::new(1e-14),
+            &mut work,
+        )
+        .map_err(|e| format!("initial acceleration M a⁰ = F: {e}"))?;
+        a
+    };
+    Ok(Some(GravityLoad {
+        force,
+        a0,
+        m_ed,
+        vertical_mass,
+        energy_scale: body_mass * fall.abs() * s.gap,
+    }))
+}
+
+/// The Γ_C node nearest the plane, whose vertical dof gives `u_lowest` (the disc's and ball's
+/// lowest point; a mesh body's lowest Γ_C node). The bars' bottom face is flat: none.
+fn lowest_contact(g: &Geometry) -> Option<usize> {
+    if g.mesh.as_box().is_some() {
+        return None;
+    }
+    g.contact
+        .iter()
+        .zip(&g.contact_height)
+        .min_by(|a, b| a.1.total_cmp(b.1))
+        .map(|(&c, _)| c)
+}
+
 /// The run's mass matrix and 1ᵀM1 (per component: the total mass it represents).
 fn mass_matrix(g: &Geometry, s: &FeSetup, mass: &MassVariant) -> Result<(SymMatrix, f64), String> {
     let layers = g.mesh.num_layers();
@@ -1531,31 +1647,18 @@ impl<'a> Stepper<'a> {
             }
         }
         fac.m.matvec_into(&v, &mut mv);
-        // Gravity: F = M (f e_d) with the run's mass, f = −gravity — the load ∫ρ f·v of the
-        // consistent mass, whose row sums the lumped mass keeps. Then a⁰ = M⁻¹(F − Ku⁰) = f e_d
-        // exactly (u⁰ = 0): the rigid acceleration, and M a⁰ = F. The bars have no load (F = 0).
+        // Gravity (SPEC §1.3, [`gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
+        // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0).
         let fall = -cfg.setup.gravity;
-        let mut force_vec = vec![0.0; n];
-        if fall != 0.0 {
-            if g.mesh.as_box().is_some() {
-                return Err(fail(
-                    Status::Invalid,
-                    format!(
-                        "scene {}: a volume load on the clamped bar is not supported",
-                        cfg.setup.scene
-                    ),
-                    metrics,
-                ));
+        let (force_vec, vertical_mass, energy_scale) = match gravity_load(g, cfg, &fac.m) {
+            Err(e) => return Err(fail(Status::Invalid, e, metrics)),
+            Ok(None) => (vec![0.0; n], 0.0, None),
+            Ok(Some(load)) => {
+                a.copy_from_slice(&load.a0);
+                fac.m.matvec_into(&a, &mut ma);
+                (load.force, load.vertical_mass, Some(load.energy_scale))
             }
-            for &r in &g.vertical {
-                a[r] = fall;
-            }
-            fac.m.matvec_into(&a, &mut force_vec);
-            ma.copy_from_slice(&force_vec);
-        }
-        // Centre of mass height: x_G,d − x_G,d(0) = (e_dᵀ M u)/(e_dᵀ M e_d), with M u carried.
-        let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
-        let energy_scale = (fall != 0.0).then(|| fac.mass_total * fall.abs() * cfg.setup.gap);
+        };
         // The reference lattice this run records, if it is one.
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
@@ -1564,18 +1667,7 @@ impl<'a> Stepper<'a> {
         if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
             return Err(fail(status, msg, metrics));
         }
-        // The lowest point of the reference configuration (disc/ball): the Γ_C node nearest the
-        // plane, whose vertical dof gives `u_lowest`. The bars' bottom face is flat: none.
-        let lowest = g
-            .gap_in_geometry
-            .then(|| {
-                g.contact
-                    .iter()
-                    .zip(&g.contact_height)
-                    .min_by(|a, b| a.1.total_cmp(b.1))
-                    .map(|(&c, _)| c)
-            })
-            .flatten();
+        let lowest = lowest_contact(g);
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some();
         let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
@@ -1928,8 +2020,6 @@ impl<'a> Stepper<'a> {
         metrics.observe_time_s = self.observe_timer.estimate_s();
         let (status, message) = Stop::status(stop, self.tau, cfg.steps, self.start, metrics);
         self.obs.finish(metrics, status == Status::Ok);
-        metrics.first_contact_time = self.obs.first_contact();
-        metrics.contact_phases = Some(self.obs.contact_phases());
         metrics.free_fall_error = (self.fall != 0.0).then_some(self.fall_error);
         // The observer's pressure columns are the total force here; there is no midpoint
         // pressure.
@@ -1987,6 +2077,7 @@ mod tests {
             lame_mu: 1.0,
             gap: 1.0,
             gravity: 0.1,
+            load: LoadModel::Body,
             v0: 0.0,
         }
     }

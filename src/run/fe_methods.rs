@@ -65,8 +65,8 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, mass_matrix, ref_map,
-    reference_record,
+    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, gravity_load,
+    lowest_contact, mass_matrix, ref_map, reference_record,
 };
 use crate::contact::Lcp;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -580,31 +580,25 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
         }
     }
-    // Gravity F = M(f e_d) as in the engine; a⁰ = f e_d solves M a⁰ = F − Ku⁰ (u⁰ = 0, no
-    // contact at t = 0), the start of generalized-α and of central difference.
+    // Gravity as in the engine ([`gravity_load`]): F, and a⁰ with M a⁰ = F − Ku⁰ on the dofs
+    // with inertia (u⁰ = 0, no contact at t = 0), the start of generalized-α and of central
+    // difference.
     let fall = -cfg.setup.gravity;
-    let mut force_vec = vec![0.0; n];
-    if fall != 0.0 {
-        if g.mesh.as_box().is_some() {
-            return fail(
-                Status::Invalid,
-                format!(
-                    "scene {}: a volume load on the clamped bar is not supported",
-                    cfg.setup.scene
-                ),
-                metrics,
-            );
+    let (force_vec, m_ed, vertical_mass, energy_scale) = match gravity_load(g, cfg, m) {
+        Err(e) => return fail(Status::Invalid, e, metrics),
+        Ok(None) => (vec![0.0; n], vec![0.0; n], 0.0, None),
+        Ok(Some(load)) => {
+            a.copy_from_slice(&load.a0);
+            m.matvec_into(&a, &mut ma);
+            (
+                load.force,
+                load.m_ed,
+                load.vertical_mass,
+                Some(load.energy_scale),
+            )
         }
-        for &r in &g.vertical {
-            a[r] = fall;
-        }
-        m.matvec_into(&a, &mut force_vec);
-        ma.copy_from_slice(&force_vec);
-    }
+    };
     m.matvec_into(&v, &mut mv);
-    let vertical_mass: f64 = g.vertical.iter().map(|&r| force_vec[r]).sum::<f64>() / fall;
-    let energy_scale =
-        (fall != 0.0).then(|| metrics.mass_total.unwrap_or(0.0) * fall.abs() * cfg.setup.gap);
     let mut record = match reference_record(g, cfg, ctx) {
         Err(e) => return fail(Status::Invalid, e, metrics),
         Ok(r) => r,
@@ -619,16 +613,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     if let Some(sc) = energy_scale {
         obs = obs.with_energy_scale(sc);
     }
-    let lowest = g
-        .gap_in_geometry
-        .then(|| {
-            g.contact
-                .iter()
-                .zip(&g.contact_height)
-                .min_by(|a, b| a.1.total_cmp(b.1))
-                .map(|(&c, _)| c)
-        })
-        .flatten();
+    let lowest = lowest_contact(g);
     let mean = |x: &[f64]| -> f64 {
         g.contact
             .iter()
@@ -670,9 +655,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                 touched = true;
             } else {
                 let t = step as f64 * tau;
-                // e_dᵀ M u / e_dᵀ M e_d, M u from F = M f e_d: Fᵀu / (f·m_d).
-                let com: f64 = g.vertical.iter().map(|&r| force_vec[r] * u[r]).sum::<f64>()
-                    / (fall * vertical_mass);
+                // e_dᵀ M u / e_dᵀ M e_d.
+                let com: f64 =
+                    m_ed.iter().zip(u.iter()).map(|(x, y)| x * y).sum::<f64>() / vertical_mass;
                 fall_error = fall_error.max((com - 0.5 * fall * t * t).abs());
             }
         }
@@ -1055,8 +1040,6 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     metrics.observe_time_s = observe_timer.estimate_s();
     let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
     obs.finish(&mut metrics, status == Status::Ok);
-    metrics.first_contact_time = obs.first_contact();
-    metrics.contact_phases = Some(obs.contact_phases());
     metrics.free_fall_error = (fall != 0.0).then_some(fall_error);
     metrics.err_force_l2 = metrics.err_sigma_l2.take();
     metrics.err_sigma_mid_l2 = None;

@@ -552,6 +552,9 @@ impl Observer {
         }
 
         metrics.contact_switches = self.switches;
+        // Every scene where contact can happen (issue 34: bar1d and the oscillator too).
+        metrics.first_contact_time = self.first_contact;
+        metrics.contact_phases = Some(self.phases);
         metrics.impacts = Some(self.impacts.finish());
         metrics.pressure_oscillation = self.impacts.pressure_oscillation();
         metrics.energy_theta_initial = self.e0_theta;

@@ -179,8 +179,8 @@ schema! {
         setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
         stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
         observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
-        first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force (2D/3D; null if none)";
-        contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force switched on (2D/3D)";
+        first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force or pressure (every scene; null if none)";
+        contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force or pressure switched on (every scene)";
         impact_step_first: Option<Vec<i64>> => "", "contact phases found at every step (σ_C < 0; a one-step gap without pressure does not end a phase), one list element per phase: first contact step (null if no step ran; explode the impact_* lists together for one row per phase)";
         impact_step_last: Option<Vec<i64>> => "", "per phase: last contact step";
         impact_t_first: Option<Vec<f64>> => "s", "per phase: time of the first contact step";
@@ -207,6 +207,7 @@ schema! {
         cg_tol: Option<f64> => "", "CG's relative residual tolerance, ‖r‖ ≤ cg_tol·‖b‖ in the D⁻¹ norm, D = diag(A) (solver = cg)";
         solver_iterations: Option<i64> => "", "CG iterations of the step solves of the time loop, summed over the steps (solver = cg; null for direct)";
         solver_iterations_max_step: Option<i64> => "", "most CG iterations of one step's solve (solver = cg)";
+        load: Option<String> => "", "how gravity enters (SPEC §1.3): body (F = ∫ρ f·φ whatever the mass variant, the papers' model) or inertial (F = M_run f e_d, the weight following the modified mass); null without gravity";
         lockstep: Option<i64> => "", "members of the lockstep group the run was stepped in (runs sharing the step matrix make one multi-column solve per step; its numbers equal the run alone bit for bit, and its timings are the group's divided among the members); null: stepped alone";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
@@ -416,6 +417,7 @@ impl RunRecord {
             cg_tol: f(Key::CgTol),
             solver_iterations: m.solver_iterations,
             solver_iterations_max_step: m.solver_iterations_max_step,
+            load: p.get(&Key::Load).map(|v| v.to_string()),
             lockstep: m.lockstep,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }

@@ -31,4 +31,9 @@ pub struct RunSpec {
     pub reference: Option<String>,
     /// The `[search]` this run is a probe of ([`crate::sweep::plan::search_tag`]); None for grid runs.
     pub search: Option<String>,
+    /// The id this run had before a definition change moved its numbers (issue 34: the body
+    /// load, exact quadrature on curved cells; or a change to its reference run): a folder
+    /// holding a row under it holds the old numbers, and `--resume` refuses to add this run's
+    /// new ones beside them. None for runs no change touched (their ids never changed).
+    pub superseded_id: Option<String>,
 }

@@ -29,7 +29,9 @@
 //! nodes start at rest at u = 0, which is their quasi-static state (no contact at t = 0), so
 //! `contact_init` changes nothing here.
 
-use super::{ErrorSource, FeGeometry, FeSetup, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup,
+};
 use crate::space::fe::BallMesh;
 
 /// Radius of the disc and the ball (diameter 40, SPEC §1.3).
@@ -41,7 +43,7 @@ pub struct BallScene {
     pub dim: usize,
 }
 
-const BALL_PHYSICS: [PhysicsKey; 6] = [
+const BALL_PHYSICS: [PhysicsKey; 7] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -65,6 +67,11 @@ const BALL_PHYSICS: [PhysicsKey; 6] = [
     PhysicsKey {
         name: "degree",
         default: 2.0,
+    },
+    // A choice key: the index into `Key::Load.choices()`, 0 = body (SPEC §1.3).
+    PhysicsKey {
+        name: "load",
+        default: 0.0,
     },
 ];
 
@@ -138,6 +145,7 @@ impl Scene for BallScene {
             lame_mu: p.get("lame_mu"),
             gap,
             gravity: p.get("gravity"),
+            load: LoadModel::from_index(p.get("load")),
             v0: 0.0,
         })
     }

@@ -61,6 +61,61 @@ impl FeGeometry {
     }
 }
 
+/// How a volume load (gravity) enters the FE scenes (SPEC §1.3, key `load`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LoadModel {
+    /// The body force F = ∫ρ f·φ, whatever the mass variant: the papers' model (GetFEM
+    /// assembles the source term apart from the mass), the body's full weight.
+    Body,
+    /// F = M_run f e_d: the weight follows the run's (modified) inertia, so every mass variant
+    /// falls rigidly — an option to measure what the choice does, the engine's load before
+    /// issue 34.
+    Inertial,
+}
+
+impl LoadModel {
+    /// From the `load` physics key's index into [`crate::model::Key::Load`]'s choices.
+    pub fn from_index(x: f64) -> LoadModel {
+        if x == 1.0 {
+            LoadModel::Inertial
+        } else {
+            LoadModel::Body
+        }
+    }
+}
+
+impl FeSetup {
+    /// Lines added to the run id of a run whose numbers a definition change moved (issue 34),
+    /// so a resumed folder never holds the numbers of two definitions under one id:
+    /// - the load of SPEC §1.3 (F = ∫ρ f·φ, `energy_scale` with the body's mass): every run
+    ///   with gravity;
+    /// - exact quadrature on curved cells (SPEC §1.6): every run whose cells can be curved or
+    ///   distorted — degree-2 cells and hexahedra of the mapped ball and of mesh files (the
+    ///   bars' boxes are affine: their matrices did not change).
+    pub fn id_revision(&self) -> String {
+        let mut out = String::new();
+        if self.gravity != 0.0 {
+            out.push_str("revision=body-load\n");
+        }
+        let curved_cells = match &self.geometry {
+            FeGeometry::Box { .. } => false,
+            FeGeometry::Ball { dim, degree, .. } => *degree == 2 || *dim == 3,
+            FeGeometry::Mesh {
+                dim,
+                nodes_per_element,
+                ..
+            } => {
+                matches!(nodes_per_element, 6 | 9 | 10 | 27)
+                    || (*dim == 3 && *nodes_per_element == 8)
+            }
+        };
+        if curved_cells {
+            out.push_str("revision=curved-quadrature\n");
+        }
+        out
+    }
+}
+
 /// A finite-element scene as the sparse engine runs it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FeSetup {
@@ -78,6 +133,8 @@ pub struct FeSetup {
     pub gap: f64,
     /// Volume load per unit mass towards the obstacle (−gravity e_d).
     pub gravity: f64,
+    /// How that load enters the equations (SPEC §1.3, key `load`).
+    pub load: LoadModel,
     /// Initial vertical velocity of every node not on a clamped face.
     pub v0: f64,
 }
@@ -183,6 +240,7 @@ impl Scene for BarScene {
             lame_mu: p.get("lame_mu"),
             gap: p.get("gap"),
             gravity: 0.0,
+            load: LoadModel::Body,
             v0: -0.5,
         })
     }

@@ -37,7 +37,9 @@
 
 use std::path::Path;
 
-use super::{ErrorSource, FeGeometry, FeSetup, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup,
+};
 use crate::space::fe::{GmshMesh, Mesh};
 
 /// The scenes `mesh2d` (dim 2) and `mesh3d` (dim 3).
@@ -46,7 +48,7 @@ pub struct MeshScene {
     pub dim: usize,
 }
 
-const MESH_PHYSICS: [PhysicsKey; 6] = [
+const MESH_PHYSICS: [PhysicsKey; 7] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -69,6 +71,12 @@ const MESH_PHYSICS: [PhysicsKey; 6] = [
     },
     PhysicsKey {
         name: "velocity",
+        default: 0.0,
+    },
+    // A choice key: the index into `Key::Load.choices()`, 0 = body (SPEC §1.3); it applies
+    // only with gravity (the planner drops it otherwise).
+    PhysicsKey {
+        name: "load",
         default: 0.0,
     },
 ];
@@ -179,6 +187,7 @@ impl Scene for MeshScene {
                 lame_mu: p.get("lame_mu"),
                 gap: p.get("gap"),
                 gravity: p.get("gravity"),
+                load: LoadModel::from_index(p.get("load")),
                 v0: p.get("velocity"),
             }),
         ))

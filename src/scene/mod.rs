@@ -19,7 +19,7 @@ pub mod mesh;
 pub mod oscillator;
 
 pub use ball::BallScene;
-pub use bar::{BarScene, FeGeometry, FeSetup};
+pub use bar::{BarScene, FeGeometry, FeSetup, LoadModel};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
 pub use mesh::MeshScene;
 pub use oscillator::{OscillatorExact, OscillatorParams, OscillatorScene};
@@ -84,6 +84,17 @@ pub enum SceneSetup {
     Fe(FeSetup),
     /// The impact oscillator: one mass, one spring, one obstacle (SPEC §1.5).
     Oscillator(OscillatorParams),
+}
+
+impl SceneSetup {
+    /// Lines every id of this run carries for definition changes that moved its numbers
+    /// ([`FeSetup::id_revision`]); empty for the runs no change touched, whose ids stay.
+    pub fn id_revision(&self) -> String {
+        match self {
+            SceneSetup::Fe(s) => s.id_revision(),
+            SceneSetup::Bar1d { .. } | SceneSetup::Oscillator(_) => String::new(),
+        }
+    }
 }
 
 /// A physical problem, as the planner sees it.

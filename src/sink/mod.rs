@@ -77,6 +77,15 @@ pub enum SinkError {
         found: String,
         expected: String,
     },
+    #[error(
+        "{path}: holds {count} row(s) of this sweep's runs computed before a change of definition moved their numbers (the body load of SPEC §1.3 and exact quadrature on curved cells, issue 34; e.g. run {example}, now {now}); resuming would put both numbers in one folder's tables — run into a new --out"
+    )]
+    Superseded {
+        path: PathBuf,
+        count: usize,
+        example: String,
+        now: String,
+    },
     #[error("{path}: manifest is not valid JSON: {message}")]
     Manifest { path: PathBuf, message: String },
 }

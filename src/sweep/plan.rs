@@ -100,6 +100,9 @@ pub fn search_tag(s: &super::Search, base: usize) -> String {
 struct Resolved {
     params: BTreeMap<Key, Value>,
     canonical: BTreeMap<Key, String>,
+    /// Lines of the id for definition changes that moved this run's numbers
+    /// ([`crate::scene::SceneSetup::id_revision`]).
+    revision: String,
     config: RunConfig,
     label: String,
     scheme_label: String,
@@ -646,6 +649,7 @@ fn resolve(
         Some((_, setup)) => setup,
         None => scene.setup(&physics, mesh),
     };
+    let revision = setup.id_revision();
     let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps).with_contact_init(
         if massless && scene.contact_init_matters() {
             contact_init
@@ -818,8 +822,17 @@ fn resolve(
             put(Key::Restitution, Value::Num(p.restitution), true);
         }
     }
+    // `load` says how gravity enters (SPEC §1.3): without gravity it changes nothing, so it is
+    // no parameter of the run (null column, never in the id) and both values are one run.
+    let weightless = physics.0.iter().any(|(n, g)| *n == "gravity" && *g == 0.0);
     for (name, value) in &physics.0 {
         let key = Key::from_name(name).unwrap();
+        if key == Key::Load && weightless {
+            if user.contains_key(&Key::Load) {
+                dropped.push("load applies only with gravity ≠ 0".into());
+            }
+            continue;
+        }
         put(key, physics_value(key, *value), false);
     }
     // `direct` is the default: its runs keep the ids they had before the key existed.
@@ -870,6 +883,7 @@ fn resolve(
     Outcome::Run(Box::new(Resolved {
         params,
         canonical,
+        revision,
         label: format!("{space_label} · {mass_label} · {scheme_label}"),
         scheme_names: [scheme.family().to_string(), scheme_label.clone()],
         scheme_label,
@@ -1054,9 +1068,10 @@ fn reference_of(
             ),
         )]);
     }
-    let id = run_id(ref_scene, &r.canonical, "");
+    let id = r.id(ref_scene, "");
     let spec = RunSpec {
         run_id: id,
+        superseded_id: r.superseded_id(ref_scene, "", false),
         label: if other_scene {
             format!("reference: {} {}", ref_scene.name(), r.label)
         } else {
@@ -1072,6 +1087,27 @@ fn reference_of(
         search: None,
     };
     Ok((spec, sx, st))
+}
+
+impl Resolved {
+    /// The run's id: its canonical parameters, its definition revisions, then `extra`
+    /// (ensemble member, reference).
+    fn id(&self, scene: SceneKind, extra: &str) -> String {
+        run_id(scene, &self.canonical, &format!("{}{extra}", self.revision))
+    }
+
+    /// The id before the definition changes of its revision lines (with `old_extra`, whose
+    /// reference is the reference's own superseded id); None when neither the run nor its
+    /// reference changed.
+    fn superseded_id(
+        &self,
+        scene: SceneKind,
+        old_extra: &str,
+        reference_changed: bool,
+    ) -> Option<String> {
+        (!self.revision.is_empty() || reference_changed)
+            .then(|| run_id(scene, &self.canonical, old_extra))
+    }
 }
 
 /// Hash of the canonical text.
@@ -1316,6 +1352,7 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                         Some(over) => match reference_of(sweep, limits, &entries, over, &r) {
                             Ok((spec, sx, st)) => {
                                 let id = spec.run_id.clone();
+                                let old = spec.superseded_id.clone();
                                 match references.iter_mut().find(|p| p.spec.run_id == id) {
                                     Some(p) => {
                                         p.space_stride = gcd(p.space_stride, sx);
@@ -1327,7 +1364,7 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                                         time_stride: st,
                                     }),
                                 }
-                                Some(id)
+                                Some((id, old))
                             }
                             Err(mut is) => {
                                 issues.append(&mut is);
@@ -1346,12 +1383,20 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                             }
                             _ => String::new(),
                         };
+                        let mut old_extra = extra.clone();
                         // The errors depend on the reference: a run measured against another
                         // reference is another run.
-                        if let Some(rid) = &reference {
+                        if let Some((rid, old)) = &reference {
                             let _ = writeln!(extra, "reference={rid}");
+                            let _ =
+                                writeln!(old_extra, "reference={}", old.as_ref().unwrap_or(rid));
                         }
-                        let id = run_id(sweep.scene, &r.canonical, &extra);
+                        let id = r.id(sweep.scene, &extra);
+                        let superseded_id = r.superseded_id(
+                            sweep.scene,
+                            &old_extra,
+                            reference.as_ref().is_some_and(|(_, old)| old.is_some()),
+                        );
                         if seen.contains_key(&id) {
                             let why = if r.dropped.is_empty() {
                                 "identical parameters after alias resolution".to_string()
@@ -1376,8 +1421,9 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
                             repeats: sweep.repeats,
                             sample,
                             scene: sweep.scene,
-                            reference: reference.clone(),
+                            reference: reference.as_ref().map(|(rid, _)| rid.clone()),
                             search: search.clone(),
+                            superseded_id,
                         });
                     }
                 }
@@ -1455,19 +1501,26 @@ pub fn probe(plan: &Plan, base: &SearchBase, value: f64) -> Result<RunSpec, Swee
         Outcome::Run(r) => {
             let reference = match &sweep.reference {
                 None => None,
-                Some(over) => Some(
-                    reference_of(sweep, &plan.limits, &entries, over, &r)
+                Some(over) => {
+                    let spec = reference_of(sweep, &plan.limits, &entries, over, &r)
                         .map_err(invalid)?
-                        .0
-                        .run_id,
-                ),
+                        .0;
+                    Some((spec.run_id, spec.superseded_id))
+                }
             };
             let extra = reference
                 .as_ref()
-                .map(|rid| format!("reference={rid}\n"))
+                .map(|(rid, _)| format!("reference={rid}\n"))
                 .unwrap_or_default();
+            let old_extra = reference
+                .as_ref()
+                .map(|(rid, old)| format!("reference={}\n", old.as_ref().unwrap_or(rid)))
+                .unwrap_or_default();
+            let changed = reference.as_ref().is_some_and(|(_, old)| old.is_some());
+            let reference = reference.map(|(rid, _)| rid);
             Ok(RunSpec {
-                run_id: run_id(sweep.scene, &r.canonical, &extra),
+                run_id: r.id(sweep.scene, &extra),
+                superseded_id: r.superseded_id(sweep.scene, &old_extra, changed),
                 label: r.label.clone(),
                 params: r.params.clone(),
                 scheme_label: r.scheme_label.clone(),

@@ -37,6 +37,8 @@ g cube_hex.geo -3 -order 2 -o cube_hex_q2.msh
 g hertz_halfdisc.geo -2 -order 2 -o hertz_halfdisc.msh
 # A ball of P2 tetrahedra for mesh3d (tests/hertz.rs).
 g ball_tet.geo -3 -order 2 -o ball_tet.msh
+# The 003 disc in P2 triangles (tests/getfem_disc.rs: the engine against GetFEM on this file).
+g disc_p2.geo -2 -order 2 -o disc_p2.msh
 # Refinement families of the unit square and cube for the manufactured convergence test
 # (tests/fe_convergence.rs): the same .geo files with N overridden (M = N for the quadrilaterals).
 conv() { # conv GEO N DIM ORDER OUT [extra gmsh args]

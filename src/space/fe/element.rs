@@ -17,17 +17,14 @@
 //! - grad-grad   G_{ai,bj} = δ_ij ∫ ∇N_a·∇N_b (full vector gradient, for H1 error norms),
 //! - load        F_{ai} = ∫ ρ f_i N_a.
 //!
-//! Quadrature (Q2): Gauss–Legendre with 3 points per direction (exact to degree 5): exact for
-//! the Q2 matrices on affine elements; on mapped Q2 elements it still integrates det J (degree
-//! ≤ 3 per variable in 2D, ≤ 5 in 3D) and cof(J)ᵀ∇_ξN_a (degree ≤ 3 / ≤ 5) exactly, so the
-//! total mass is the mapped mesh's measure and linear fields pass the patch test to round-off.
-//!
-//! Quadrature (Q1): Gauss–Legendre with 2 points per direction. It is exact for the Q1 mass and
-//! stiffness on squares, rectangles and boxes (integrands of degree ≤ 2 per variable, the rule is
-//! exact to degree 3) — the matrices of SPEC §1.2, never a reduced integration. On distorted
-//! elements the stiffness integrand is rational and the rule is the usual approximation; it still
-//! integrates ∫ ∇N_a exactly (cofactor of J is polynomial of degree ≤ 2 per variable), which is
-//! what the patch test needs.
+//! Quadrature: Gauss–Legendre with p + 1 points per direction (2 for Q1, 3 for Q2) on affine
+//! cells (parallelograms, parallelepipeds), where it is exact for the mass, stiffness and load —
+//! the matrices of SPEC §1.2, never a reduced integration. On a mapped (curved or distorted)
+//! cell det J is a polynomial too and the mass integrand N_a N_b det J has degree 7 per variable
+//! (Q2, 2D), 9 (Q2, 3D), 4 (Q1, 3D) or 3 (Q1, 2D): such cells take 4, 5, 3 or 2 points per
+//! direction, exact for their mass and load ([`super::quadrature`], SPEC §1.6). The stiffness
+//! integrand of a mapped cell is rational; the same rule still integrates ∫ ∇N_a exactly (the
+//! cofactor of J is polynomial), which is what the patch test needs.
 //!
 //! The kernels are generic over the dimension `D`, the node count `NN` and the dof count
 //! `ND = D·NN` (checked at compile time), so the 2D and 3D paths share one code; the concrete
@@ -35,6 +32,8 @@
 //! The `q1_*` names are historical: every kernel takes Q1 or Q2 by its node count NN.
 
 use nalgebra::{SMatrix, SVector};
+
+use super::quadrature::{curved_tensor_points, is_affine};
 
 /// The 2D Q1 element matrix (4 nodes × 2 components).
 pub type Q1Mat2 = SMatrix<f64, 8, 8>;
@@ -220,14 +219,45 @@ pub fn map_at<const D: usize, const NN: usize>(
 }
 
 /// Calls `f(N, ∇N, w·det J)` at each Gauss point of the element with node coordinates `x`: the
-/// element's own rule, n1 points per direction (2 for Q1 — exact on boxes, SPEC §1.2 — and 3 for
-/// Q2, which integrates the Q2 mass and stiffness exactly on affine elements and, on mapped
-/// ones, ∫ det J and ∫ cof(J)ᵀ∇_ξN_a exactly: total mass and the patch test hold to round-off).
+/// element's own rule, n1 points per direction on an affine cell (2 for Q1 — exact on boxes,
+/// SPEC §1.2 — and 3 for Q2), more on a mapped one so that its mass is exact (module header).
 fn for_each_point<const D: usize, const NN: usize>(
     x: &[[f64; D]; NN],
     f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),
 ) {
-    for_each_point_with(x, const { nodes_per_axis(D, NN) }, f)
+    let n1 = const { nodes_per_axis(D, NN) };
+    let points = if is_affine(tensor_node_jacobians(x)) {
+        n1
+    } else {
+        curved_tensor_points(D, n1)
+    };
+    for_each_point_with(x, points, f)
+}
+
+/// The Jacobian of the cell's map at each of its reference nodes (tensor order), which
+/// determine it ([`is_affine`]).
+fn tensor_node_jacobians<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+) -> impl Iterator<Item = [[f64; D]; D]> + '_ {
+    let n1 = const { nodes_per_axis(D, NN) };
+    (0..NN).map(move |b| {
+        let mut xi = [0.0; D];
+        let mut r = b;
+        for xk in xi.iter_mut() {
+            *xk = -1.0 + 2.0 * (r % n1) as f64 / (n1 - 1) as f64;
+            r /= n1;
+        }
+        let (_, dn) = shape::<D, NN>(xi);
+        let mut jac = [[0.0; D]; D];
+        for a in 0..NN {
+            for i in 0..D {
+                for j in 0..D {
+                    jac[i][j] += x[a][i] * dn[a][j];
+                }
+            }
+        }
+        jac
+    })
 }
 
 /// Calls `f(N, ∇N, w·det J)` at each point of the tensor Gauss rule with `points` points per

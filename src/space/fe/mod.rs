@@ -30,6 +30,7 @@ pub mod gmsh;
 pub mod locate;
 pub mod mesh;
 pub mod nitsche;
+pub mod quadrature;
 pub mod simplex;
 pub mod sparse;
 

@@ -10,17 +10,23 @@
 //! [`super::element`]: mass ρ ∫ N_a N_b δ_ij, elasticity ∫ λ div u div v + 2μ ε(u):ε(v) (plane
 //! strain in 2D), grad-grad ∫ ∇u:∇v, load ∫ ρ f·v.
 //!
-//! Quadrature, never a reduced integration: the P2 mass has degree 4, the P2 stiffness degree 2
-//! on affine cells, so the rules must be exact to degree 4 —
+//! Quadrature, never a reduced integration: on an affine cell the P2 mass has degree 4, the P2
+//! stiffness degree 2, so the rules are exact to degree 4 —
 //! - triangles: Dunavant's 6-point rule of degree 4;
 //! - tetrahedra: Walkington's 14-point rule of degree 5 (positive weights, unlike Keast's
 //!   11-point degree-4 rule whose negative weight would make a lumped or layer-weighted mass
-//!   indefinite at a point). On curved P2 tetrahedra det J has degree 3, so ρ ∫ det J is still
-//!   exact and the total mass is the curved mesh's measure.
+//!   indefinite at a point).
+//!
+//! A curved P2 cell (midside nodes off the straight edges, e.g. on a Gmsh disc's arc) has det J
+//! of degree 2 (triangle) or 3 (tetrahedron), and a mass integrand of degree 6 or 7: it takes
+//! the conical-product rule of degree 7 of [`super::quadrature`] (16 or 64 positive weights), so
+//! its mass and load are exact on its own geometry (SPEC §1.6) — a degree-4 rule left a curved
+//! boundary triangle's mass entries off by up to 2e-4 (issue 34).
 
 use nalgebra::{SMatrix, SVector};
 
 use super::element::{ElementOp, det_inv};
+use super::quadrature::{curved_simplex_rule, is_affine};
 
 /// The P1 triangle matrix (3 nodes × 2 components).
 pub type P1Mat2 = SMatrix<f64, 6, 6>;
@@ -171,12 +177,42 @@ pub fn simplex_for_each_point<const D: usize, const NN: usize>(
     x: &[[f64; D]; NN],
     mut f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),
 ) {
-    for &(p, w) in simplex_rule(D) {
+    // Curved P2 cells take the rule exact for their mass (det J quadratic/cubic); affine ones
+    // keep the cheaper rule, exact there ([`super::quadrature`]).
+    let rule = if NN > D + 1 && !is_affine(vertex_jacobians(x)) {
+        curved_simplex_rule(D)
+    } else {
+        simplex_rule(D)
+    };
+    for &(p, w) in rule {
         let mut xi = [0.0; D];
         xi.copy_from_slice(&p[..D]);
         let (n, g, det) = simplex_map_at(x, xi);
         f(&n, &g, w * det);
     }
+}
+
+/// The Jacobian of the simplex's map at its vertices: a P2 map's Jacobian is linear, so these
+/// determine it ([`is_affine`]).
+fn vertex_jacobians<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+) -> impl Iterator<Item = [[f64; D]; D]> + '_ {
+    (0..=D).map(move |v| {
+        let mut xi = [0.0; D];
+        if v > 0 {
+            xi[v - 1] = 1.0;
+        }
+        let (_, dn) = simplex_shape::<D, NN>(xi);
+        let mut j = [[0.0; D]; D];
+        for a in 0..NN {
+            for i in 0..D {
+                for k in 0..D {
+                    j[i][k] += x[a][i] * dn[a][k];
+                }
+            }
+        }
+        j
+    })
 }
 
 /// The element matrix of `op` for the simplex with node coordinates `x`.

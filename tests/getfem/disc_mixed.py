@@ -1,0 +1,188 @@
+#!/usr/bin/python3
+"""The 003 disc on a Gmsh P2 mesh, assembled by GetFEM 5.4 (Debian's python3-getfem), stepped by
+Crank–Nicolson with nodal Signorini contact on the vertical dofs of Γ_C — an implementation of
+SPEC §1.3/§2.1/§2.2/§3 that shares no code with the engine, for tests/getfem_disc.rs (issue 34).
+
+What GetFEM computes: the isoparametric P2 mesh of the file (curved boundary triangles, GT_PK(2,2)),
+the P2 vector FEM, and on it, with a degree-13 triangle rule (exact for the curved cells' mass,
+whose integrand has degree 6):
+- K: isotropic linearized elasticity (plane strain), λ = μ = 20;
+- M: ρ ∫ w φ_a·φ_b with w the mass variant's element weight (layers by topology: layer 0 the
+  cells with a node on Γ_C, layer k + 1 their neighbours; mod1 w₀ = 0; mod2 w₀ = 0, w_k =
+  m/(m − m₀); mod3 w₀ = 0, w₁ = 1 + m₀/m₁; zero-contact: the Γ_C nodes' rows and columns of M
+  zeroed);
+- F: the body force ∫ρ f·φ, f = −0.1 e_y (SPEC §1.3: whatever the mass variant).
+Time stepping in numpy: Newmark β = ¼, γ = ½ (Crank–Nicolson), u⁰ = v⁰ = 0, a⁰ from M a⁰ = F on
+the dofs with inertia; each step (M + τ²/4 K) u = M(u + τv + τ²/4 a) + τ²/4 (F + Bᵀλ) with the
+LCP 0 ≤ λ ⊥ u_y + g ≥ 0 on the Γ_C nodes (g = the node's height above the plane y = −gap),
+condensed onto Γ_C and solved exactly (active set, Murty's least-index rule). Energy
+E = ½vᵀMv + ½uᵀKu − Fᵀu, contact force Σλ.
+
+Usage: disc_mixed.py MESH OUT.json [T dt gap]
+"""
+import json
+import sys
+
+import getfem as gf
+import numpy as np
+import scipy.linalg as sla
+
+RHO, LAM, MU, GRAV = 1.0, 20.0, 20.0, 0.1
+mesh_path, out_path = sys.argv[1], sys.argv[2]
+T = float(sys.argv[3]) if len(sys.argv) > 3 else 40.0
+TAU = float(sys.argv[4]) if len(sys.argv) > 4 else 0.1
+GAP = float(sys.argv[5]) if len(sys.argv) > 5 else 5.0
+STEPS = int(round(T / TAU))
+
+m = gf.Mesh('import', 'gmsh', mesh_path)
+mfu = gf.MeshFem(m, 2)
+mfu.set_classical_fem(2)
+mim = gf.MeshIm(m, gf.Integ('IM_TRIANGLE(13)'))
+n = mfu.nbdof()
+pts = m.pts()
+
+# Γ_C: the boundary faces below the centre's height (all their nodes at y ≤ y_centre).
+ymin, ymax = pts[1].min(), pts[1].max()
+ycentre = 0.5 * (ymin + ymax)
+outer = m.outer_faces()
+contact_pids = set()
+for k in range(outer.shape[1]):
+    pid = m.pid_in_faces(outer[:, k:k + 1])
+    if all(pts[1][p] <= ycentre + 1e-9 for p in pid):
+        contact_pids.update(int(p) for p in pid)
+contact_pids = sorted(contact_pids)
+
+# Layers by topology over the cells' points (midside nodes included, as the engine's).
+cv_pids = [set(int(p) for p in m.pid_from_cvid(cv)[0]) for cv in range(m.nbcvs())]
+layer = [None] * m.nbcvs()
+reached = set(contact_pids)
+k = 0
+while any(l is None for l in layer):
+    now = [cv for cv in range(m.nbcvs()) if layer[cv] is None and cv_pids[cv] & reached]
+    if not now:
+        break
+    for cv in now:
+        layer[cv] = k
+    for cv in now:
+        reached |= cv_pids[cv]
+    k += 1
+layer = [k if l is None else l for l in layer]
+
+# The dofs of each point: the vector dof 2i + c is component c of basic dof i.
+dof_xy = mfu.basic_dof_nodes()
+
+
+def dofs_at(p):
+    x = pts[:, p]
+    return [d for d in range(n) if abs(dof_xy[0, d] - x[0]) < 1e-9 and abs(dof_xy[1, d] - x[1]) < 1e-9]
+
+
+contact_dofs = [dofs_at(p) for p in contact_pids]
+vertical = [sorted(ds)[1] for ds in contact_dofs]
+gaps = np.array([pts[1][p] - ymin + GAP for p in contact_pids])
+
+mf0 = gf.MeshFem(m, 1)
+mf0.set_classical_discontinuous_fem(0)
+U0 = np.zeros(n)
+
+
+def mass(weights):
+    """ρ ∫ w φ_a·φ_b with the element weights `weights` (one per convex)."""
+    w = np.zeros(mf0.nbdof())
+    for cv in range(m.nbcvs()):
+        w[mf0.basic_dof_from_cv(cv)[0]] = weights[cv]
+    M = gf.asm('generic', mim, 2, f'{RHO}*w*(Test_u.Test2_u)', -1, 'u', 1, mfu, U0, 'w', 0, mf0, w)
+    return M.full()
+
+
+md = gf.Model('real')
+md.add_fem_variable('u', mfu)
+md.add_initialized_data('lambda', [LAM])
+md.add_initialized_data('mu', [MU])
+md.add_isotropic_linearized_elasticity_brick(mim, 'u', 'lambda', 'mu')
+md.assembly('build_matrix')
+K = md.tangent_matrix().full()
+K = 0.5 * (K + K.T)
+F = gf.asm('generic', mim, 1, f'{RHO}*[0,{-GRAV}].Test_u', -1, 'u', 1, mfu, U0)
+F = np.asarray(F).ravel()
+
+one = np.ones(m.nbcvs())
+M_full = mass(one)
+layer_mass = lambda l: mass(np.array([1.0 if x == l else 0.0 for x in layer]))[0::2, 0::2].sum()
+total = M_full[0::2, 0::2].sum()
+m0, m1 = layer_mass(0), layer_mass(1)
+
+
+def variant(name):
+    if name == 'consistent':
+        return M_full.copy()
+    if name == 'zero-contact':
+        M = M_full.copy()
+        for ds in contact_dofs:
+            M[ds, :] = 0.0
+            M[:, ds] = 0.0
+        return M
+    w = {'mod1': lambda l: 0.0 if l == 0 else 1.0,
+         'mod2': lambda l: 0.0 if l == 0 else total / (total - m0),
+         'mod3': lambda l: 0.0 if l == 0 else (1.0 + m0 / m1 if l == 1 else 1.0)}[name]
+    return mass(np.array([w(l) for l in layer]))
+
+
+def lcp(H, q, active, tol):
+    """0 ≤ λ ⊥ q + Hλ ≥ 0 for symmetric positive definite H: Murty's least-index principal
+    pivoting from the previous step's active set (finite for P-matrices)."""
+    A = set(active)
+    for _ in range(10000):
+        lam = np.zeros(len(q))
+        idx = sorted(A)
+        if idx:
+            lam[idx] = np.linalg.solve(H[np.ix_(idx, idx)], -q[idx])
+        w = q + H @ lam
+        bad = [i for i in range(len(q)) if (i in A and lam[i] < -tol) or (i not in A and w[i] < -tol)]
+        if not bad:
+            return lam, sorted(A)
+        j = bad[0]
+        A.symmetric_difference_update({j})
+    raise RuntimeError('LCP: no convergence')
+
+
+def run(name):
+    M = variant(name)
+    beta = 0.25
+    A = M + beta * TAU**2 * K
+    cho = sla.cho_factor(A)
+    B = np.zeros((len(vertical), n))
+    for i, d in enumerate(vertical):
+        B[i, d] = 1.0
+    Z = sla.cho_solve(cho, B.T)
+    H = beta * TAU**2 * (B @ Z)
+    diag = np.diag(M)
+    free = np.where(diag != 0.0)[0]
+    u = np.zeros(n)
+    v = np.zeros(n)
+    a = np.zeros(n)
+    a[free] = np.linalg.solve(M[np.ix_(free, free)], F[free])
+    energy = [0.0]
+    force = [0.0]
+    active = []
+    for _ in range(STEPS):
+        p = u + TAU * v + TAU**2 * (0.5 - beta) * a
+        ufree = sla.cho_solve(cho, M @ p + beta * TAU**2 * F)
+        q = B @ ufree + gaps
+        lam, active = lcp(H, q, active, 1e-13 * max(1.0, np.abs(q).max()))
+        un = ufree + beta * TAU**2 * (Z @ lam)
+        an = (un - p) / (beta * TAU**2)
+        v = v + TAU * (0.5 * a + 0.5 * an)
+        u, a = un, an
+        energy.append(0.5 * v @ M @ v + 0.5 * u @ K @ u - F @ u)
+        force.append(float(lam.sum()))
+    return {'mass_total': float(M[0::2, 0::2].sum()), 'energy': energy, 'force': force}
+
+
+out = {'body_mass': float(total), 'dofs': n, 'contact_nodes': len(contact_pids),
+       'layers': int(max(layer)) + 1, 'variants': {}}
+for name in (sys.argv[6].split(',') if len(sys.argv) > 6 else
+             ['consistent', 'zero-contact', 'mod1', 'mod2', 'mod3']):
+    out['variants'][name] = run(name)
+with open(out_path, 'w') as f:
+    json.dump(out, f)

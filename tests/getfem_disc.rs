@@ -1,0 +1,174 @@
+//! The engine against GetFEM on the same Gmsh file (issue 34): the 003 disc as P2 triangles
+//! (`sweeps/meshes/disc_p2.msh`, curved boundary cells), `mesh2d` with gravity 0.1, gap 5,
+//! λ = μ = 20, mixed contact + Crank–Nicolson, τ = 0.1, T = 40, five masses — against
+//! `tests/getfem/disc_mixed.py`, which assembles K, M (the layer weights of SPEC §2.2) and the
+//! body force with GetFEM 5.4 (Debian's python3-getfem, installed by `tests/install_getfem.sh`)
+//! on the same file and steps the same scheme in numpy, sharing no code with the engine.
+//!
+//! What must agree, and why to these digits:
+//! - `mass_total` (1ᵀM1 of each variant) to 1e-12: both integrate the curved cells' mass
+//!   exactly (degree 6; the engine's degree-7 conical rule, GetFEM's IM_TRIANGLE(13)), so only
+//!   round-off of ~10⁴ summed entries remains.
+//! - the energy (in units of `energy_scale` = m|f|·5 ≈ 628) and the total contact force (in
+//!   units of its maximum) at every step, to 1e-8: the matrices agree to round-off in the mass
+//!   and the load, and to ~1e-11 in the stiffness of the curved cells (a rational integrand that
+//!   neither rule integrates exactly; rules of degree 6 to 14 agree to 1e-11 on the first
+//!   contact force), the LCPs are solved exactly by both; 400 stable steps amplify that by no
+//!   more than a few hundred. Over the whole T = 40 for the massless-Γ_C masses (one clean
+//!   contact phase), and through the first contact phase for the consistent mass, whose
+//!   Crank–Nicolson is chaotic afterwards (SPEC §2.1: ill-posed in practice, 1e-14 moves it).
+//! - `energy_scale` = ρ|Ω_h|·|f|·gap with GetFEM's body mass, whatever the variant (SPEC §1.3).
+//!
+//! Before issue 34 the engine missed by far more: its load followed the modified mass (mod1's
+//! body 16.5 % lighter than the paper's, the first contact force 460 → 402) and its degree-4
+//! rule left the curved cells' mass 2e-4 off.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use contact_sweep::run::{Outcome, RunOptions, simulate};
+use contact_sweep::sweep::{SweepFile, expand};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+const MASSES: [&str; 5] = ["consistent", "zero-contact", "mod1", "mod2", "mod3"];
+
+/// GetFEM's run of every mass variant: (body mass, per variant (mass_total, energy, force)).
+fn getfem_runs() -> (f64, Vec<(f64, Vec<f64>, Vec<f64>)>) {
+    let install = Command::new("bash")
+        .arg(root().join("tests/install_getfem.sh"))
+        .status()
+        .expect("bash");
+    assert!(install.success(), "tests/install_getfem.sh failed");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("getfem.json");
+    let o = Command::new("/usr/bin/python3")
+        .arg(root().join("tests/getfem/disc_mixed.py"))
+        .arg(root().join("sweeps/meshes/disc_p2.msh"))
+        .arg(&out)
+        .args(["40", "0.1", "5", &MASSES.join(",")])
+        .output()
+        .expect("python3");
+    assert!(
+        o.status.success(),
+        "disc_mixed.py: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let list = |x: &serde_json::Value| -> Vec<f64> {
+        x.as_array()
+            .unwrap()
+            .iter()
+            .map(|y| y.as_f64().unwrap())
+            .collect()
+    };
+    let runs = MASSES
+        .iter()
+        .map(|m| {
+            let r = &v["variants"][m];
+            (
+                r["mass_total"].as_f64().unwrap(),
+                list(&r["energy"]),
+                list(&r["force"]),
+            )
+        })
+        .collect();
+    (v["body_mass"].as_f64().unwrap(), runs)
+}
+
+fn engine_runs(path: &Path) -> Vec<(String, Outcome)> {
+    let text = format!(
+        r#"
+name = "getfem-disc"
+scene = "mesh2d"
+[fixed]
+mesh = "{}"
+density = 1.0
+lame_lambda = 20.0
+lame_mu = 20.0
+gravity = 0.1
+gap = 5.0
+T = 40.0
+dt = 0.1
+space = "mixed"
+scheme = "crank-nicolson"
+[grid]
+mass = {:?}
+"#,
+        path.display(),
+        MASSES
+    );
+    let plan = expand(&SweepFile::parse(&root().join("t.toml"), &text).unwrap()).unwrap();
+    assert_eq!(plan.runs.len(), MASSES.len());
+    plan.runs
+        .iter()
+        .map(|spec| {
+            let o = simulate(
+                &spec.config,
+                &RunOptions {
+                    series_every: 1,
+                    ..RunOptions::default()
+                },
+            );
+            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
+            (spec.label.clone(), o)
+        })
+        .collect()
+}
+
+#[test]
+fn engine_equals_getfem_on_the_p2_disc_for_every_mass() {
+    let (body_mass, getfem) = getfem_runs();
+    let engine = engine_runs(&root().join("sweeps/meshes/disc_p2.msh"));
+    let scale = body_mass * 0.1 * 5.0;
+    for ((mass, (label, o)), (gf_mass, gf_energy, gf_force)) in
+        MASSES.iter().zip(&engine).zip(&getfem)
+    {
+        let m = &o.metrics;
+        let mt = m.mass_total.unwrap();
+        assert!(
+            (mt - gf_mass).abs() <= 1e-12 * gf_mass,
+            "{label}: mass_total {mt} against GetFEM's {gf_mass}"
+        );
+        let es = m.energy_scale.unwrap();
+        assert!(
+            (es - scale).abs() <= 1e-12 * scale,
+            "{label}: energy_scale {es} against m|f|·5 = {scale} with GetFEM's body mass"
+        );
+        let energy = &o.series.energy;
+        // The engine reports σ_C = minus the total contact force.
+        let force: Vec<f64> = o.series.sigma_contact.iter().map(|s| -s).collect();
+        assert_eq!(energy.len(), gf_energy.len(), "{label}: steps");
+        let fmax = gf_force.iter().cloned().fold(0.0, f64::max);
+        assert!(fmax > 0.0, "{label}: GetFEM's disc never touches");
+        // The steps compared: all of them, or through the first contact phase (consistent).
+        let first = gf_force.iter().position(|f| *f > 0.0).unwrap();
+        let end = if *mass == "consistent" {
+            first
+                + gf_force[first..]
+                    .iter()
+                    .position(|f| *f == 0.0)
+                    .unwrap_or(gf_force.len() - first)
+        } else {
+            gf_force.len()
+        };
+        let (mut de, mut df) = (0.0f64, 0.0f64);
+        for n in 0..end {
+            de = de.max((energy[n] - gf_energy[n]).abs() / scale);
+            df = df.max((force[n] - gf_force[n]).abs() / fmax);
+        }
+        eprintln!(
+            "{mass}: steps 0..{end}, max |ΔE|/scale = {de:.2e}, max |Δforce|/max = {df:.2e}, first contact step {first}, max force {fmax:.4}"
+        );
+        assert!(
+            de <= 1e-8,
+            "{label}: energy off GetFEM's by {de:.3e} scales"
+        );
+        assert!(
+            df <= 1e-8,
+            "{label}: contact force off GetFEM's by {df:.3e} of its max"
+        );
+    }
+}
