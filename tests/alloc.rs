@@ -81,13 +81,22 @@ fn assert_loop_allocates_nothing_with(text: &str, t_final: f64, min_switches: i6
         assert_eq!(out.status, Status::Ok, "{}: {:?}", a.label, out.message);
         let mut counts = [0u64; 2];
         let mut steps = [0i64; 2];
-        for (k, spec) in [a, b].into_iter().enumerate() {
-            let before = allocations();
-            let out = simulate(&spec.config, &opts);
-            counts[k] = allocations() - before;
-            assert_eq!(out.status, Status::Ok, "{}: {:?}", spec.label, out.message);
-            steps[k] = out.metrics.steps;
-            drop(out);
+        // The FE caches (geometry, factors) are process-wide and this binary's other tests run
+        // in parallel: one of them may evict this run's entries between the two measured runs,
+        // and the second then rebuilds them (set-up allocations, seen once under load). Up to
+        // three attempts; an allocation in the time loop differs at every one.
+        for _attempt in 0..3 {
+            for (k, spec) in [a, b].into_iter().enumerate() {
+                let before = allocations();
+                let out = simulate(&spec.config, &opts);
+                counts[k] = allocations() - before;
+                assert_eq!(out.status, Status::Ok, "{}: {:?}", spec.label, out.message);
+                steps[k] = out.metrics.steps;
+                drop(out);
+            }
+            if counts[0] == counts[1] {
+                break;
+            }
         }
         assert_eq!(steps[1], 2 * steps[0], "{}: steps {steps:?}", a.label);
         // The contact solve must have run in both states: the short run already switches

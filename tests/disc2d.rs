@@ -153,8 +153,14 @@ fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
     for r in [&mixed, &nitsche, &hybrid, &modified] {
         assert_eq!(r.status, "ok", "{scene} {}: {:?}", r.label, r.message);
         assert_eq!(r.degree, Some(2));
-        // All fall freely until t = 10 (Nitsche's P_γ = −u_d while σ_n(rigid) = 0).
-        assert!(r.free_fall_error.unwrap() < 1e-10 * GAP);
+        // The consistent mass falls freely until t = 10 (Nitsche's P_γ = −u_d while
+        // σ_n(rigid) = 0); the modified mass carries the body's weight on less inertia and
+        // runs ahead (`check_mass_variants`), touching at 9.9 (2D) / 9.4 (3D).
+        if r.mass == "consistent" {
+            assert!(r.free_fall_error.unwrap() < 1e-10 * GAP);
+        } else {
+            assert!(r.first_contact_time.unwrap() < 10.05);
+        }
         println!(
             "{scene} {} {} {}: energy drift {:.3e}, max dev {:.3e} (× energy_scale), contact phases {:?}, iterations {} (max {:?}/step), setup {:.2} s, steps {:.2} s",
             r.space,
@@ -170,14 +176,14 @@ fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
         );
     }
     // Nitsche + CN: E^h back to its initial value within 1 % of energy_scale at T (measured
-    // 3e-5 in 2D, 2e-4 in 3D); during the contact E^h rises by the energy of the Nitsche
+    // 2.4e-5 in 2D, 6.7e-5 in 3D); during the contact E^h rises by the energy of the Nitsche
     // term (E_Θ holds it): measured 2.3 % (2D), 14.5 % (3D) — bounded by
     // `max_dev_bound`. The semismooth Newton takes ≤ 3 iterations per step (measured 2).
     assert!(nitsche.energy_drift.unwrap().abs() < 0.01, "{scene}");
     assert!(nitsche.energy_max_dev.unwrap() < max_dev_bound, "{scene}");
     assert!(nitsche.iterations_max_step.unwrap() <= 3, "{scene}");
     assert!(nitsche.energy_theta_max_increase.is_some());
-    // Nitsche-Hybrid: the same E^h within 1 % at T (measured −6.4e-4 in 2D, 2.3e-5 in 3D: E^h
+    // Nitsche-Hybrid: the same E^h within 1 % at T (measured −6.4e-4 in 2D, −6.8e-5 in 3D: E^h
     // may rise slightly, E_Θ may not) and the same excursion during the contact; E_Θ never
     // increases (003 Cor 3.8; rounding bound of the property test, 1e-12).
     assert!(hybrid.energy_drift.unwrap().abs() < 0.01, "{scene}");
@@ -188,12 +194,12 @@ fn check_impacts(scene: &str, h: f64, max_dev_bound: f64) {
     );
     // Modified mass + CN: the massless Γ_C nodes make the semi-discrete problem well posed and
     // energy conserving (003 §1, [18]); what remains is CN's error at the impacts and
-    // releases: within 1 % of energy_scale at every step (measured max deviation 5.2e-4 in
-    // 2D, 2.7e-4 in 3D), and no chatter: one contact phase (t ≈ 10.1–28 in 2D, then the
-    // flight beyond T) where mixed + CN has 24.
+    // releases: within 1 % of energy_scale at every step (measured max deviation 9.1e-4 in
+    // 2D, 4.9e-4 in 3D), and no chatter: one contact phase (t ≈ 9.9–27.3 in 2D, 9.4–27.5 in
+    // 3D, then the flight beyond T) where mixed + CN has 24 (2D) / 21 (3D).
     assert!(modified.energy_max_dev.unwrap() < 0.01, "{scene}");
     assert!(modified.contact_phases.unwrap() <= 2, "{scene}");
-    // Mixed + CN: the spurious energy growth of 003 §4.2 — measured E(T) = 100 (2D) and 66
+    // Mixed + CN: the spurious energy growth of 003 §4.2 — measured E(T) = 93 (2D) and 61
     // (3D) times energy_scale; asserted as behaviour: more than ten times.
     assert!(mixed.energy_drift.unwrap() > 10.0, "{scene}");
 }
@@ -407,9 +413,21 @@ scheme = ["crank-nicolson", "hybrid"]
 
 /// The mass variants of SPEC §2.2 on the disc and the ball (scene module header): `mod2` and
 /// `mod3` conserve the total mass (their weights come from the measured layer masses), `mod1`
-/// and `weights = [1]` (the same matrix) remove layer 0's, `zero-contact` the Γ_C nodes' rows;
-/// with the load F = M_run f e_d the rigid fall solves every variant, so the centre of mass
-/// still follows −½|f|t² to round-off with Crank–Nicolson until the contact at t = 10.
+/// and `weights = [1]` (the same matrix) remove layer 0's, `zero-contact` the Γ_C nodes' rows.
+/// `energy_scale` is m·|f|·gap with m = ∫ρ the body's mass for every variant and load (SPEC
+/// §1.3). Free fall until the contact at t ≈ 10, Crank–Nicolson, both loads (issue 34):
+/// - `load = "inertial"` (F = M_run f e_d): the rigid fall solves every variant, so the centre
+///   of mass follows −½|f|t² to round-off;
+/// - `load = "body"` (F = ∫ρ f·φ, the default): the consistent mass falls rigidly as well
+///   (1ᵀM = ∫ρφ), but a modified mass carries the body's whole weight on less inertia. K kills
+///   translations, so once the massless rows are in equilibrium e_dᵀM a = f·m and the M-weighted
+///   centre falls as ½ f t²·m/mass_total: mod1 (and weights = [1]) and zero-contact run ahead by
+///   ½|f|t²(m/mass_total − 1) — within 5 %: the first step, where the massless rows jump from
+///   u⁰ = 0 to their quasi-static place, misses their share of the weight once (measured ≤ 1.3 %)
+///   — and touch before the rigid fall's 10.1; mod2/mod3 keep mass_total = m, so only that
+///   first-step transient remains: an impulse of at most ½τ·w₀ m|f| (w₀ the layer-0 mass
+///   fraction, which bounds the massless rows' weight), i.e. a lag of at most ½τ|f|w₀·t, asserted
+///   with a factor 2 (measured 0.0036 (Q1), 0.0062 (Q2) on the disc, 0.022 on the ball).
 fn check_mass_variants(scene: &str, h: f64, degrees: &str) {
     let rows = run_sweep_text(&format!(
         r#"
@@ -420,56 +438,86 @@ T = 10.5
 h = {h}
 dt = {TAU}
 [grid]
+load = ["inertial", "body"]
 degree = [{degrees}]
 mass = ["consistent", "mod1", "mod2", "mod3", {{ mass = "weights", mass_weights = [1.0] }}, "zero-contact"]
 "#
     ));
     let ndeg = degrees.split(',').count();
-    assert_eq!(rows.len(), 6 * ndeg);
+    assert_eq!(rows.len(), 12 * ndeg);
     for r in &rows {
         assert_eq!(r.status, "ok", "{scene} {}: {:?}", r.mass, r.message);
     }
     for degree in degrees.split(',').map(|d| d.trim().parse::<i64>().unwrap()) {
-        let of = |mass: &str| {
+        let of = |mass: &str, load: &str| {
             rows.iter()
-                .find(|r| r.degree == Some(degree) && r.mass == mass)
-                .unwrap_or_else(|| panic!("no {mass} run"))
+                .find(|r| {
+                    r.degree == Some(degree) && r.mass == mass && r.load.as_deref() == Some(load)
+                })
+                .unwrap_or_else(|| panic!("no {mass} {load} run"))
         };
-        let m = of("consistent").mass_total.unwrap();
+        let m = of("consistent", "body").mass_total.unwrap();
+        let w0 = 1.0 - of("mod1", "body").mass_total.unwrap() / m;
         for r in rows.iter().filter(|r| r.degree == Some(degree)) {
             let mt = r.mass_total.unwrap();
             let err = r.free_fall_error.unwrap();
             let t_fc = r.first_contact_time.unwrap();
+            let load = r.load.as_deref().unwrap();
             println!(
-                "{scene} Q{degree} {}: mass {mt:.6} ({:.4} of consistent), free-fall error {err:.2e}, first contact {t_fc}, energy max dev {:.2e}",
+                "{scene} Q{degree} {} {load}: mass {mt:.6} ({:.4} of consistent), free-fall error {err:.4e}, first contact {t_fc}, energy max dev {:.2e}",
                 r.mass,
                 mt / m,
                 r.energy_max_dev.unwrap()
             );
-            // As with the consistent mass (free-fall test above): round-off only.
-            assert!(err < 1e-10 * GAP, "{scene} Q{degree} {}: {err:e}", r.mass);
-            assert!(
-                (t_fc - 10.0).abs() < 1e-9 || (t_fc - 10.1).abs() < 1e-9,
-                "{scene} Q{degree} {}: {t_fc}",
-                r.mass
-            );
-            // energy_scale follows the run's mass.
-            assert!((r.energy_scale.unwrap() - mt * GRAVITY * GAP).abs() < 1e-12 * m);
+            // energy_scale: the body's mass, whatever the variant and the load.
+            assert!((r.energy_scale.unwrap() - m * GRAVITY * GAP).abs() < 1e-12 * m);
+            let rigid = load == "inertial" || r.mass == "consistent";
+            if rigid {
+                // As with the consistent mass (free-fall test above): round-off only.
+                assert!(
+                    err < 1e-10 * GAP,
+                    "{scene} Q{degree} {} {load}: {err:e}",
+                    r.mass
+                );
+                assert!(
+                    (t_fc - 10.0).abs() < 1e-9 || (t_fc - 10.1).abs() < 1e-9,
+                    "{scene} Q{degree} {} {load}: {t_fc}",
+                    r.mass
+                );
+                continue;
+            }
+            let t_last = t_fc - TAU;
+            let ahead = 0.5 * GRAVITY * t_last * t_last * (m / mt - 1.0);
+            let transient = 0.5 * TAU * GRAVITY * w0 * t_last;
+            if matches!(r.mass.as_str(), "mod2" | "mod3") {
+                assert!(
+                    err <= 2.0 * transient,
+                    "{scene} Q{degree} {}: {err:e} against {transient:e}",
+                    r.mass
+                );
+            } else {
+                assert!(
+                    (err - ahead).abs() <= 0.05 * ahead,
+                    "{scene} Q{degree} {}: {err:e} against ½|f|t²(m/mass_total − 1) = {ahead:e}",
+                    r.mass
+                );
+                assert!(t_fc < 10.05, "{scene} Q{degree} {}: {t_fc}", r.mass);
+            }
         }
         // Conservation: the weights are ratios of sums of the same element masses, so only
         // rounding of ~10³ terms remains: 1e-12.
         for mass in ["mod2", "mod3"] {
-            let mt = of(mass).mass_total.unwrap();
+            let mt = of(mass, "body").mass_total.unwrap();
             assert!(
                 (mt - m).abs() < 1e-12 * m,
                 "{scene} Q{degree} {mass}: {mt} vs {m}"
             );
         }
         // mod1 and weights = [1] are the same matrix; layer 0 has mass, so less than m.
-        let m1 = of("mod1").mass_total.unwrap();
-        assert_eq!(of("weights").mass_total.unwrap(), m1);
+        let m1 = of("mod1", "body").mass_total.unwrap();
+        assert_eq!(of("weights", "body").mass_total.unwrap(), m1);
         assert!(m1 < m);
-        let mz = of("zero-contact").mass_total.unwrap();
+        let mz = of("zero-contact", "body").mass_total.unwrap();
         assert!(
             mz < m && mz > m1,
             "{scene} Q{degree}: zero-contact {mz}, mod1 {m1}, {m}"

@@ -277,6 +277,11 @@ fn siconos_impacting_bar_from_its_sweep_file() {
         "contact starts at {}",
         first[0]
     );
+    // The impact columns every scene fills (issue 34; null on bar1d before): the first contact
+    // is the phase's first step (5.01e-4 s) and there is one phase.
+    assert_eq!(r.first_contact_time, Some(first[0]));
+    assert!((r.first_contact_time.unwrap() - 5.01e-4).abs() < 1e-12);
+    assert_eq!(r.contact_phases, Some(1));
     let lasted = last[0] - first[0] + dt;
     assert!(
         (lasted - dur).abs() <= 2.0 * dt,

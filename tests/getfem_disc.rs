@@ -3,7 +3,10 @@
 //! λ = μ = 20, mixed contact + Crank–Nicolson, τ = 0.1, T = 40, five masses — against
 //! `tests/getfem/disc_mixed.py`, which assembles K, M (the layer weights of SPEC §2.2) and the
 //! body force with GetFEM 5.4 (Debian's python3-getfem, installed by `tests/install_getfem.sh`)
-//! on the same file and steps the same scheme in numpy, sharing no code with the engine.
+//! on the same file and steps the same scheme in numpy, sharing no code with the engine; and
+//! Nitsche's contact (Θ = 1, γ0 = 1e-3, consistent mass, 003 §4.2's setting) with the Nitsche
+//! terms in GetFEM's weak form language on Γ_C's faces (the same 3 Gauss points per face as the
+//! engine's rule) and each step solved by GetFEM's Newton method.
 //!
 //! What must agree, and why to these digits:
 //! - `mass_total` (1ᵀM1 of each variant) to 1e-12: both integrate the curved cells' mass
@@ -15,7 +18,9 @@
 //!   neither rule integrates exactly; rules of degree 6 to 14 agree to 1e-11 on the first
 //!   contact force), the LCPs are solved exactly by both; 400 stable steps amplify that by no
 //!   more than a few hundred. Over the whole T = 40 for the massless-Γ_C masses (one clean
-//!   contact phase), and through the first contact phase for the consistent mass, whose
+//!   contact phase) and for Nitsche (its Newton solves to a residual of 1e-10 against a
+//!   right-hand side of ~10³: u to ~1e-10, the energy to ~1e-10 of its scale), and through the
+//!   first contact phase for the consistent mass with mixed contact, whose
 //!   Crank–Nicolson is chaotic afterwards (SPEC §2.1: ill-posed in practice, 1e-14 moves it).
 //! - `energy_scale` = ρ|Ω_h|·|f|·gap with GetFEM's body mass, whatever the variant (SPEC §1.3).
 //!
@@ -34,6 +39,15 @@ fn root() -> PathBuf {
 }
 
 const MASSES: [&str; 5] = ["consistent", "zero-contact", "mod1", "mod2", "mod3"];
+/// The variants of the GetFEM script: the five masses with mixed contact, then Nitsche.
+const VARIANTS: [&str; 6] = [
+    "consistent",
+    "zero-contact",
+    "mod1",
+    "mod2",
+    "mod3",
+    "nitsche",
+];
 
 /// GetFEM's run of every mass variant: (body mass, per variant (mass_total, energy, force)).
 fn getfem_runs() -> (f64, Vec<(f64, Vec<f64>, Vec<f64>)>) {
@@ -48,7 +62,7 @@ fn getfem_runs() -> (f64, Vec<(f64, Vec<f64>, Vec<f64>)>) {
         .arg(root().join("tests/getfem/disc_mixed.py"))
         .arg(root().join("sweeps/meshes/disc_p2.msh"))
         .arg(&out)
-        .args(["40", "0.1", "5", &MASSES.join(",")])
+        .args(["40", "0.1", "5", &VARIANTS.join(",")])
         .output()
         .expect("python3");
     assert!(
@@ -64,7 +78,7 @@ fn getfem_runs() -> (f64, Vec<(f64, Vec<f64>, Vec<f64>)>) {
             .map(|y| y.as_f64().unwrap())
             .collect()
     };
-    let runs = MASSES
+    let runs = VARIANTS
         .iter()
         .map(|m| {
             let r = &v["variants"][m];
@@ -92,16 +106,20 @@ gravity = 0.1
 gap = 5.0
 T = 40.0
 dt = 0.1
-space = "mixed"
 scheme = "crank-nicolson"
 [grid]
-mass = {:?}
+method = [{}
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 }},
+]
 "#,
         path.display(),
         MASSES
+            .iter()
+            .map(|m| format!("{{ mass = \"{m}\" }},"))
+            .collect::<String>()
     );
     let plan = expand(&SweepFile::parse(&root().join("t.toml"), &text).unwrap()).unwrap();
-    assert_eq!(plan.runs.len(), MASSES.len());
+    assert_eq!(plan.runs.len(), VARIANTS.len());
     plan.runs
         .iter()
         .map(|spec| {
@@ -119,12 +137,12 @@ mass = {:?}
 }
 
 #[test]
-fn engine_equals_getfem_on_the_p2_disc_for_every_mass() {
+fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
     let (body_mass, getfem) = getfem_runs();
     let engine = engine_runs(&root().join("sweeps/meshes/disc_p2.msh"));
     let scale = body_mass * 0.1 * 5.0;
     for ((mass, (label, o)), (gf_mass, gf_energy, gf_force)) in
-        MASSES.iter().zip(&engine).zip(&getfem)
+        VARIANTS.iter().zip(&engine).zip(&getfem)
     {
         let m = &o.metrics;
         let mt = m.mass_total.unwrap();
@@ -145,7 +163,7 @@ fn engine_equals_getfem_on_the_p2_disc_for_every_mass() {
         assert!(fmax > 0.0, "{label}: GetFEM's disc never touches");
         // The steps compared: all of them, or through the first contact phase (consistent).
         let first = gf_force.iter().position(|f| *f > 0.0).unwrap();
-        let end = if *mass == "consistent" {
+        let end = if *mass == "consistent" && !label.contains("nitsche") {
             first
                 + gf_force[first..]
                     .iter()
@@ -154,6 +172,25 @@ fn engine_equals_getfem_on_the_p2_disc_for_every_mass() {
         } else {
             gf_force.len()
         };
+        // `u_lowest` on a mesh scene (issue 34; was null): the lowest Γ_C node, (0, 0) here.
+        // The consistent mass falls rigidly before the contact (1ᵀM = ∫ρφ), so its u_d there is
+        // −½|f|t² to round-off (1e-10 of the gap).
+        let rows: Vec<_> = o.series.rows().collect();
+        assert!(
+            rows.iter().all(|r| r.u_lowest.is_some()),
+            "{label}: u_lowest"
+        );
+        if *mass == "consistent" {
+            for r in rows.iter().take(first) {
+                let exact = -0.5 * 0.1 * r.t * r.t;
+                let u = r.u_lowest.unwrap();
+                assert!(
+                    (u - exact).abs() <= 1e-10 * 5.0,
+                    "{label}: u_lowest({}) = {u}",
+                    r.t
+                );
+            }
+        }
         let (mut de, mut df) = (0.0f64, 0.0f64);
         for n in 0..end {
             de = de.max((energy[n] - gf_energy[n]).abs() / scale);

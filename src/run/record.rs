@@ -276,13 +276,13 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "energy_gravity",
         "Option<f64>",
         "J",
-        "gravity potential −Fᵀu of E^h, zero at the initial position (disc2d, sphere3d; null without a load). kinetic + elastic + gravity = energy (penalty: plus its potential)",
+        "gravity potential −Fᵀu of E^h, zero at the initial position (scenes with gravity: disc2d, sphere3d, mesh2d/mesh3d with `gravity`; null without a load). kinetic + elastic + gravity = energy (penalty: plus its potential)",
     ),
     (
         "u_lowest",
         "Option<f64>",
         "m",
-        "vertical displacement u_d of the lowest point of the reference configuration (disc2d, sphere3d)",
+        "vertical displacement u_d of the lowest point of the reference configuration, the lowest Γ_C node (disc2d, sphere3d, mesh2d, mesh3d; null on the bars, whose Γ_C is flat)",
     ),
 ];
 
