@@ -133,11 +133,11 @@ fn curved_quad9() -> [[f64; 2]; 9] {
 fn curved_hex<const NN: usize>() -> [[f64; 3]; NN] {
     let n1 = if NN == 8 { 2 } else { 3 };
     let mut x = [[0.0; 3]; NN];
-    for a in 0..NN {
+    for (a, xa) in x.iter_mut().enumerate() {
         let (i, j, k) = (a % n1, (a / n1) % n1, a / (n1 * n1));
         let h = (n1 - 1) as f64;
         let (s, t, r) = (i as f64 / h, j as f64 / h, k as f64 / h);
-        x[a] = [
+        *xa = [
             s + 0.15 * t * r + 0.1 * s * r,
             t + 0.2 * s * r - 0.05 * s * t,
             r + 0.2 * r * s * (1.0 - s) + 0.1 * t * s + 0.05 * s * t * r,

@@ -49,8 +49,11 @@ const VARIANTS: [&str; 6] = [
     "nitsche",
 ];
 
-/// GetFEM's run of every mass variant: (body mass, per variant (mass_total, energy, force)).
-fn getfem_runs() -> (f64, Vec<(f64, Vec<f64>, Vec<f64>)>) {
+/// One variant as GetFEM ran it: mass_total, and per step the energy and the contact force.
+type GetfemRun = (f64, Vec<f64>, Vec<f64>);
+
+/// GetFEM's run of every variant, with the body's mass.
+fn getfem_runs() -> (f64, Vec<GetfemRun>) {
     let install = Command::new("bash")
         .arg(root().join("tests/install_getfem.sh"))
         .status()
