@@ -99,6 +99,13 @@ impl Scene for OscillatorScene {
             h: 1.0,
         })
     }
+    /// The mass meets the obstacle along its one dof: a friction law at the contact has no
+    /// direction to act in. Dry friction on the mass is SPEC §1.5's physics key
+    /// `friction_force` (not implemented yet), not the friction axis.
+    fn supports_friction(&self) -> Result<(), String> {
+        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is SPEC §1.5's `friction_force` (not implemented yet), not a friction law at the contact".into())
+    }
+
     fn supports(
         &self,
         space: &str,
