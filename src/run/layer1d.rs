@@ -320,6 +320,7 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
     let loop_start = Instant::now();
     let mut observe_timer = SampledTimer::default();
     let stop = (|| -> Result<(), Stop<ContactSolveError>> {
+        obs.set_friction(0.0, tang.st.v[0], 0.0);
         observe(&mut obs, 0, &normal, &tang, sigma0).map_err(Stop::Diverged)?;
         for n in 1..=cfg.steps {
             let phi_n = normal
@@ -374,6 +375,7 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
                 let d = sigma_t - ex.base_sigma_t(time);
                 sum_st += d * d;
             }
+            obs.set_friction(sigma_t, tang.st.v[0], work);
             observe_timer
                 .time(n, || observe(&mut obs, n, &normal, &tang, sigma_n))
                 .map_err(Stop::Diverged)?;
@@ -406,6 +408,21 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
             Some((stats.tangential_velocity_final - ex.mean_tangential_velocity(t_end)).abs());
     }
     metrics.exit_velocity = Some(stats.normal_velocity_final);
+    metrics.tangential_velocity_final = Some(stats.tangential_velocity_final);
+    metrics.normal_velocity_final = Some(stats.normal_velocity_final);
+    if status == Status::Ok {
+        metrics.err_sigma_t_l2 = stats.err_sigma_t_l2;
+        metrics.err_vt_final = stats.err_vt_final;
+    }
+    // The friction columns belong to a friction law (null for `none`, SPEC §5).
+    if !law.is_none() {
+        metrics.friction_work = Some(stats.friction_work);
+        metrics.energy_balance_drift = Some(stats.energy_balance_drift);
+        metrics.energy_balance_max_increase = Some(stats.energy_balance_max_increase);
+        metrics.stick_steps = Some(stats.stick_steps);
+        metrics.slip_steps = Some(stats.slip_steps);
+        metrics.friction_ratio_max = stats.friction_ratio_max;
+    }
     (
         Outcome {
             status,

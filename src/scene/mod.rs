@@ -24,7 +24,7 @@ pub use bar::{BarScene, FeGeometry, FeSetup};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
-pub use oscillator::{OscillatorExact, OscillatorParams, OscillatorScene};
+pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
 
 /// A physics parameter of a scene: its key name (SPEC §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
