@@ -38,12 +38,15 @@ const MJ1: Scheme = Scheme::MoreauJean(MoreauJeanParams {
     restitution: 1.0,
 });
 
+/// A row of SPEC §6's friction table: (V_t, μ_f, mass, scheme, [(value, tolerance); 5]).
+type Row = (f64, f64, MassVariant, Scheme, [(f64, f64); 5]);
+
 /// SPEC §6: defaults, 80 elements, c_p τ/h = ½ (τ = 1/320), T = 2.5, Coulomb. Each value must
 /// round to the printed digits: the tolerance is half a unit of the last printed digit.
 #[test]
 fn spec_friction_table() {
     // (V_t, μ_f, mass, scheme, v̄_t⁺, E(T)/E⁰, W_f/E⁰, l2(τ;L2), l2(τ;H1))
-    let rows: [(f64, f64, MassVariant, Scheme, [(f64, f64); 5]); 4] = [
+    let rows: [Row; 4] = [
         (
             1.0,
             0.1,

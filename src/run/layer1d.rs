@@ -156,9 +156,9 @@ pub struct FrictionStats {
 
 /// How the tangential force enters the scheme's momentum equation over a step: f̄ = (1 − c)fⁿ
 /// + c f^{n+1} (SPEC §2.5's W_f).
-fn work_weight(scheme: Scheme) -> f64 {
-    match scheme {
-        Scheme::Newmark(NewmarkParams { gamma, .. }) if !is_kinematic(scheme) => gamma,
+fn work_weight(cfg: &Layer1dConfig) -> f64 {
+    match cfg.scheme {
+        Scheme::Newmark(NewmarkParams { gamma, .. }) if !is_kinematic(cfg) => gamma,
         Scheme::Theta(th) => th.theta,
         Scheme::GeneralizedAlpha(ga) => 1.0 - ga.alpha_f,
         // kane, contact-stabilized-newmark, moreau-jean, kinematic central difference: the
@@ -167,8 +167,12 @@ fn work_weight(scheme: Scheme) -> f64 {
     }
 }
 
-fn is_kinematic(scheme: Scheme) -> bool {
-    scheme == Scheme::Newmark(NewmarkParams::central_difference())
+/// Central difference with `mixed` and the lumped mass: kinematic contact and friction, an
+/// impulse on the half-step velocity (SPEC §3.2); with the penalty it is a Newmark scheme.
+fn is_kinematic(cfg: &Layer1dConfig) -> bool {
+    cfg.scheme == Scheme::Newmark(NewmarkParams::central_difference())
+        && cfg.method == ContactMethod::Mixed
+        && cfg.mass == MassVariant::Lumped
 }
 
 /// One chain: its engine, state and work vectors.
@@ -264,7 +268,7 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
         Scheme::MoreauJean(p) => p.restitution,
         _ => 0.0,
     };
-    let weight = work_weight(cfg.scheme);
+    let weight = work_weight(cfg);
     let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
     let e0 = normal.energy() + tang.energy();
     let scale = e0;
