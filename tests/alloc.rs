@@ -384,3 +384,38 @@ scheme = "contact-stabilized-newmark"
         1,
     );
 }
+
+/// The frictional layer (SPEC §1.7, issue 32): every method that defines friction, stick and
+/// slip, Coulomb and Tresca — two chains and the friction law's local solve per step,
+/// nothing allocated.
+#[test]
+fn layer1d_frictional_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-layer"
+scene = "layer1d"
+[fixed]
+T = T_FINAL
+elements = 40
+courant = 0.5
+velocity_tangential = 1.0
+[grid]
+law = [
+  { friction = "coulomb", friction_coefficient = 0.1 },
+  { friction = "coulomb", friction_coefficient = 2.0 },
+  { friction = "tresca", tresca_threshold = 0.3 },
+]
+method = [
+  { space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" },
+  { space = "mixed", mass = "consistent", scheme = "theta", theta_scheme = 0.7 },
+  { space = "mixed", mass = "lumped", scheme = "central-difference" },
+  { space = "mixed", scheme = "kane" },
+  { space = "mixed", scheme = "contact-stabilized-newmark" },
+  { space = "mixed", scheme = "generalized-alpha", rho_inf = 0.5 },
+  { space = "mixed", scheme = "moreau-jean" },
+  { space = "penalty", penalty_gamma0 = 10.0, scheme = "crank-nicolson" },
+]
+"#,
+        1.25,
+    );
+}

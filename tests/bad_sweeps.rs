@@ -234,6 +234,83 @@ const CASES: &[(&str, &str, &str)] = &[
         "summary",
         "expected a table",
     ),
+    // Friction (SPEC §2.5): bounds, a law without its parameter, a bound without a law, and
+    // the scenes and methods that cannot take one.
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"coulomb\"\nfriction_coefficient = -0.1\n",
+        "fixed.friction_coefficient",
+        "must be ≥ 0 (a friction bound",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"coulomb\"\n[grid]\nfriction_coefficient = [0.1, nan]\n",
+        "grid.friction_coefficient[1]",
+        "must be a finite number",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"tresca\"\ntresca_threshold = -2.0\n",
+        "fixed.tresca_threshold",
+        "must be ≥ 0 (a friction bound",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"tresca\"\n",
+        "fixed.friction",
+        "friction = tresca needs tresca_threshold",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"coulomb\"\n",
+        "fixed.friction",
+        "friction = coulomb needs friction_coefficient",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nfriction_coefficient = [0.1, 0.3]\n",
+        "grid.friction_coefficient[0]",
+        "sets a friction bound but friction = \"none\" (the default) for this run",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"none\"\ntresca_threshold = 1.0\n",
+        "fixed.tresca_threshold",
+        "sets a friction bound but friction = \"none\" for this run",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"dry\"\n",
+        "fixed.friction",
+        "unknown friction `dry` (expected none, tresca",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+        "fixed.friction",
+        "scene bar1d has no tangential direction",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+        "fixed.friction",
+        "the oscillator's one dof is normal to the obstacle",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nfriction = \"tresca\"\ntresca_threshold = 0.1\n",
+        "fixed.friction",
+        "friction on FE scenes is not implemented yet (issue 33)",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"paoli-schatzman\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+        "fixed.scheme",
+        "paoli-schatzman has no frictional version in the literature (SPEC §2.5)",
+    ),
+    (
+        "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nfriction_coefficient = 0.3\n",
+        "fixed.friction_coefficient",
+        "sets a friction bound but friction = \"none\" (the default) for this run",
+    ),
+    (
+        "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nspace = \"penalty\"\npenalty_gamma0 = 10.0\nscheme = \"discrete-gradient\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+        "fixed.scheme",
+        "scheme = discrete-gradient has no frictional version in the literature (SPEC §2.5)",
+    ),
+    (
+        "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nfriction = \"tresca\"\ntresca_threshold = inf\n",
+        "fixed.tresca_threshold",
+        "must be a finite number",
+    ),
 ];
 
 #[test]

@@ -475,3 +475,97 @@ fn comparison_sweep_plans_every_method_on_its_ladder() {
     assert!(p.inapplicable.is_empty() && p.collapsed.is_empty());
     assert!(ids(&p).contains(&"35050bcfa8862a8f".to_string()));
 }
+
+/// SPEC §2.5: `friction = "none"` is today's engine. Given explicitly (as `--set` puts it on
+/// top of a file), it keeps every run id of every 1D and 2D sweep file — the key's default
+/// never enters the canonical text — and the 003 CN run keeps its frozen id.
+#[test]
+fn friction_none_keeps_every_run_id() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&path).unwrap();
+        // The 3D and large-mesh files plan slowly and name the same keys.
+        if !["bar1d", "oscillator", "bar2d"]
+            .iter()
+            .any(|s| text.contains(&format!("scene = \"{s}\"")))
+        {
+            continue;
+        }
+        let base = SweepFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let with = SweepFile::load_with(&path, &["friction=\"none\"".to_string()])
+            .unwrap_or_else(|e| panic!("{e}"));
+        let a = sweep::expand(&base).unwrap_or_else(|e| panic!("{e}"));
+        let b = sweep::expand(&with).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(ids(&a), ids(&b), "{}", path.display());
+        assert!(
+            a.runs
+                .iter()
+                .all(|r| !r.params.contains_key(&Key::FrictionCoefficient)),
+            "{}",
+            path.display()
+        );
+        checked += 1;
+    }
+    assert!(checked >= 10, "only {checked} sweep files checked");
+    let p = plan(&format!(
+        "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\nfriction = \"none\"\n[grid]\nmass = [\"consistent\"]\n"
+    ));
+    assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
+}
+
+/// The friction keys on the layer (SPEC §2.5, §7): a bound applies to its own law only, so
+/// across a `friction` axis the frictionless runs (and Tresca's runs crossed with Coulomb's
+/// coefficients) collapse, with the reason; `none` never enters an id, each bound does.
+#[test]
+fn friction_keys_apply_to_their_law_and_collapse() {
+    let p = plan(
+        "name = \"t\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\n[grid]\nfriction = [\"none\", \"coulomb\", \"tresca\"]\nfriction_coefficient = [0.1, 0.3]\ntresca_threshold = [0.5]\n",
+    );
+    assert_eq!(p.runs.len(), 4);
+    let labels: Vec<&str> = p.runs.iter().map(|r| r.label.as_str()).collect();
+    assert!(labels[1].ends_with("coulomb(μ_f=0.1)"), "{labels:?}");
+    assert!(labels[3].ends_with("tresca(s=0.5)"), "{labels:?}");
+    assert!(
+        p.collapsed
+            .keys()
+            .any(|k| k.contains("friction_coefficient applies to friction = coulomb only")),
+        "{:?}",
+        p.collapsed
+    );
+    assert!(
+        p.collapsed
+            .keys()
+            .any(|k| k.contains("tresca_threshold applies to friction = tresca only")),
+        "{:?}",
+        p.collapsed
+    );
+    assert_eq!(p.runs[0].params[&Key::Friction].as_str(), Some("none"));
+    assert!(!p.runs[0].params.contains_key(&Key::FrictionCoefficient));
+    assert_eq!(
+        p.runs[2].params[&Key::FrictionCoefficient].as_f64(),
+        Some(0.3)
+    );
+    // The frictionless layer run is the one without the axis, with the same id.
+    let bare = plan("name = \"u\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\n");
+    assert_eq!(bare.runs[0].run_id, p.runs[0].run_id);
+    let mut all = ids(&p);
+    all.sort();
+    all.dedup();
+    assert_eq!(all.len(), 4);
+    // Hybrid across a friction axis: refused by the scene with the literature's reason.
+    let sf = SweepFile::parse(
+        Path::new("t.toml"),
+        "name = \"t\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nmass = \"mod3\"\nscheme = \"hybrid\"\n",
+    )
+    .unwrap();
+    let err = sweep::expand(&sf).unwrap_err().to_string();
+    assert!(
+        err.contains("has no frictional version in the literature"),
+        "{err}"
+    );
+}

@@ -16,7 +16,12 @@
 //! small dense complementarity problem exactly by an active-set method. The discrete-gradient
 //! scheme's contact force is a difference quotient, not a piecewise-linear law: [`gradient`]
 //! solves its scalar equation by a safeguarded semismooth Newton iteration.
+//!
+//! Friction (SPEC §2.5) is a law of its own, [`friction`]: the law as data (none, Tresca,
+//! Coulomb) and the exact case analysis of one point's normal and tangential rows, which every
+//! stepper calls with its condensed rows — the same local solve for every scheme.
 
+pub mod friction;
 pub mod gradient;
 pub mod lcp;
 

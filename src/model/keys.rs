@@ -62,6 +62,17 @@ pub enum Key {
     /// How gravity enters the FE scenes (SPEC §1.3): `body` (default, F = ∫ρ f·φ whatever the
     /// mass variant) or `inertial` (F = M_run f e_d, the load following the modified inertia).
     Load,
+    /// The friction law at the contact points (SPEC §2.5): `none` (default: today's engine,
+    /// every id unchanged), `tresca` or `coulomb`.
+    Friction,
+    /// Coulomb's coefficient μ_f ≥ 0 (`friction = "coulomb"` only).
+    FrictionCoefficient,
+    /// Tresca's threshold s ≥ 0, a traction (`friction = "tresca"` only).
+    TrescaThreshold,
+    /// The layer's height H (SPEC §1.7).
+    Height,
+    /// The initial tangential velocity V_t (layer1d, SPEC §1.7).
+    VelocityTangential,
 }
 
 /// What a key's value must look like.
@@ -147,7 +158,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 39] = [
+    pub const ALL: [Key; 44] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -187,6 +198,11 @@ impl Key {
         Key::Mesh,
         Key::Obstacle,
         Key::Load,
+        Key::Friction,
+        Key::FrictionCoefficient,
+        Key::TrescaThreshold,
+        Key::Height,
+        Key::VelocityTangential,
     ];
 
     pub fn name(self) -> &'static str {
@@ -230,6 +246,11 @@ impl Key {
             Key::Mesh => "mesh",
             Key::Obstacle => "obstacle",
             Key::Load => "load",
+            Key::Friction => "friction",
+            Key::FrictionCoefficient => "friction_coefficient",
+            Key::TrescaThreshold => "tresca_threshold",
+            Key::Height => "height",
+            Key::VelocityTangential => "velocity_tangential",
         }
     }
 
@@ -253,6 +274,8 @@ impl Key {
                 | Key::Force
                 | Key::ImpactLaw
                 | Key::Load
+                | Key::Height
+                | Key::VelocityTangential
         )
     }
 
@@ -281,7 +304,8 @@ impl Key {
             | Key::RightEnd
             | Key::Load
             | Key::Solver
-            | Key::Mesh => ValueType::Str,
+            | Key::Mesh
+            | Key::Friction => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -366,7 +390,8 @@ impl Key {
             }
             (Key::T | Key::H | Key::Dt | Key::Courant, Value::Num(x)) => positive(*x),
             (Key::NitscheGamma0 | Key::PenaltyGamma0, Value::Num(x)) => positive(*x),
-            (Key::Length | Key::Young | Key::Density, Value::Num(x)) => positive(*x),
+            (Key::Length | Key::Young | Key::Density | Key::Height, Value::Num(x)) => positive(*x),
+            (Key::VelocityTangential, Value::Num(x)) => finite(*x).map(|_| ()),
             (Key::LameLambda | Key::LameMu, Value::Num(x)) => positive(*x),
             (Key::RightEnd, Value::Str(s)) => match s.as_str() {
                 "clamped" | "free" => Ok(()),
@@ -410,6 +435,27 @@ impl Key {
                 }
             }
             (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),
+            (Key::Friction, Value::Str(s)) => {
+                if crate::contact::friction::FrictionKind::from_name(s).is_some() {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown friction `{s}` (expected none, tresca — a fixed threshold — or coulomb — proportional to the normal force)"
+                    ))
+                }
+            }
+            // A coefficient and a traction: zero is frictionless (the same numbers as none),
+            // a negative bound would push the body along its slip.
+            (Key::FrictionCoefficient | Key::TrescaThreshold, Value::Num(x)) => {
+                finite(*x)?;
+                if *x >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "must be ≥ 0 (a friction bound; a negative one would drive the slip), got {x}"
+                    ))
+                }
+            }
             (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
             // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).
             (Key::Gap | Key::Amplitude, Value::Num(x)) => {

@@ -40,6 +40,7 @@ use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Series, Status, Stop};
+use crate::contact::friction;
 use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{BarExact, BarParams};
 use crate::space::bar1d::Pair;
@@ -134,8 +135,21 @@ fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
     free.max(active.max_generalized_eigenvalue(&sp.mass))
 }
 
+/// The contact node of a tangential chain (the layer's S-wave chain, SPEC §1.7): held by the
+/// friction law instead of the obstacle. Before each step the layer's driver
+/// ([`super::layer1d`]) sets the bound b of the step (from the normal chain's force of the same
+/// step) and the slip's reference value: the step's scalar s is then u₀^{n+1} (position-level
+/// schemes, s_ref = u₀ⁿ) or v₀^{n+1} + e v₀ⁿ (Moreau–Jean, s_ref = e v₀ⁿ), and the slip is
+/// s − s_ref. `kappa` is the penalty's tangential stiffness (f_t = proj_[−b,b](−κ·slip)).
+#[derive(Debug, Default)]
+pub(super) struct Tangential {
+    pub bound: std::cell::Cell<f64>,
+    pub s_ref: std::cell::Cell<f64>,
+    pub kappa: Option<f64>,
+}
+
 /// The per-run constant part: operators, factorisations, condensed contact.
-struct Engine {
+pub(super) struct Engine {
     sp: Bar1dSpace,
     scheme: Scheme,
     tau: f64,
@@ -158,18 +172,20 @@ struct Engine {
     /// Contact-solver iterations beyond one per step (the discrete gradient's Newton
     /// iterations, the contact-stabilized predictor's second solve), for `iterations`.
     extra_iterations: std::cell::Cell<i64>,
+    /// A tangential chain's friction (None: the obstacle's contact, every bar1d run).
+    pub(super) tangential: Option<Tangential>,
 }
 
 /// Vectors reused by every step.
-struct Work {
-    b: Vec<f64>,
-    y: Vec<f64>,
-    pred: Vec<f64>,
+pub(super) struct Work {
+    pub b: Vec<f64>,
+    pub y: Vec<f64>,
+    pub pred: Vec<f64>,
 }
 
-struct State {
-    u: Vec<f64>,
-    v: Vec<f64>,
+pub(super) struct State {
+    pub u: Vec<f64>,
+    pub v: Vec<f64>,
     a: Vec<f64>,
     /// Contact argument at t^n (hybrid switches).
     s_prev: f64,
@@ -220,7 +236,7 @@ fn gen_alpha_rhs_into(
 }
 
 impl Engine {
-    fn new(sp: Bar1dSpace, scheme: Scheme, tau: f64) -> Result<Self, String> {
+    pub(super) fn new(sp: Bar1dSpace, scheme: Scheme, tau: f64) -> Result<Self, String> {
         let m = sp.m;
         let (c, cf) = scheme.coefficients(tau);
         let reduced = matches!(scheme, Scheme::Hybrid) && sp.method == ContactMethod::Mixed;
@@ -327,7 +343,32 @@ impl Engine {
             wm,
             kinematic,
             extra_iterations: std::cell::Cell::new(0),
+            tangential: None,
         })
+    }
+
+    /// The space of the chain.
+    pub(super) fn space(&self) -> &Bar1dSpace {
+        &self.sp
+    }
+
+    /// Iterations beyond one per step (see the field).
+    pub(super) fn extra_iterations(&self) -> i64 {
+        self.extra_iterations.get()
+    }
+
+    /// The tangential chain's friction solve of s = s_free + w φ (the force on the node is
+    /// φ q = −φ e₀, so f_t = −φ and slip = (s_free − s_ref) + (−w) f_t): the law's exact
+    /// case analysis ([`friction`]). Returns (s, φ).
+    fn tangential_solve(&self, t: &Tangential, s_free: f64) -> (f64, f64) {
+        let s_ref = t.s_ref.get();
+        let (f_t, slip, _) = match t.kappa {
+            None => friction::solve_tangential(s_free - s_ref, -self.w, t.bound.get()),
+            Some(kappa) => {
+                friction::solve_tangential_penalized(s_free - s_ref, -self.w, kappa, t.bound.get())
+            }
+        };
+        (s_ref + slip, -f_t)
     }
 
     /// φ(s) of the state (not the step): σ_C for Nitsche and penalty, the multiplier graph for
@@ -378,7 +419,7 @@ impl Engine {
     }
 
     /// Contact pressure to report for a state whose step returned `phi`.
-    fn sigma(&self, u: &[f64], phi: f64) -> f64 {
+    pub(super) fn sigma(&self, u: &[f64], phi: f64) -> f64 {
         if let Scheme::MoreauJean(_) = self.scheme {
             // φ is the impulse p^{n+1} of the step: the force is p/τ (SPEC §3.2).
             return phi / self.tau;
@@ -414,7 +455,13 @@ impl Engine {
         self.a_lu.solve_in_place(&mut wk.b);
         std::mem::swap(&mut wk.b, &mut wk.y);
         let s_free = self.p.dot(&wk.y) + p0;
-        let sol = contact::solve(law, s_free, self.w)?;
+        let sol = match &self.tangential {
+            None => contact::solve(law, s_free, self.w)?,
+            Some(t) => {
+                let (s, phi) = self.tangential_solve(t, s_free);
+                contact::ContactSolution { s, phi }
+            }
+        };
         if sol.phi != 0.0 {
             for (y, z) in wk.y.iter_mut().zip(&self.z) {
                 *y += sol.phi * z;
@@ -424,7 +471,7 @@ impl Engine {
     }
 
     /// One step of a one-step scheme; returns φ of the step.
-    fn step(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
+    pub(super) fn step(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
         if self.kinematic || self.scheme.is_comparison() {
             return self.step_comparison(st, wk);
         }
@@ -560,8 +607,23 @@ impl Engine {
                     st.v[i] += 0.5 * tau * st.a[i];
                     st.u[i] += tau * st.v[i];
                 }
-                let (u0, dv, lambda) =
-                    crate::time::kinematic_impulse(st.u[0], -sp.bar.gap, sp.mass.diag[0], tau);
+                let (u0, dv, lambda) = match &self.tangential {
+                    None => {
+                        crate::time::kinematic_impulse(st.u[0], -sp.bar.gap, sp.mass.diag[0], tau)
+                    }
+                    // Kinematic friction: the tangential impulse that stops the node's slip
+                    // increment, limited by the bound (μ_f times the normal impulse's force).
+                    Some(t) => {
+                        let m0 = sp.mass.diag[0];
+                        let s_ref = t.s_ref.get();
+                        let (f_t, slip, _) = friction::solve_tangential(
+                            st.u[0] - s_ref,
+                            tau * tau / m0,
+                            t.bound.get(),
+                        );
+                        (s_ref + slip, tau * f_t / m0, f_t)
+                    }
+                };
                 st.u[0] = u0;
                 st.v[0] += dv;
                 self.acceleration_into(&st.u, 0.0, &mut st.a);
@@ -607,7 +669,15 @@ impl Engine {
                     wk.pred[i] = st.u[i] + tau * st.v[i];
                 }
                 let s_free = self.p.dot(&wk.pred) + self.p0;
-                let pred = contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?;
+                // The admissible set constrains the normal rows only: a tangential chain's
+                // predictor is the free flight.
+                let pred = match self.tangential {
+                    None => contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?,
+                    Some(_) => contact::ContactSolution {
+                        s: s_free,
+                        phi: 0.0,
+                    },
+                };
                 self.extra_iterations.set(self.extra_iterations.get() + 1);
                 if pred.phi != 0.0 {
                     for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
@@ -705,7 +775,10 @@ impl Engine {
 /// initial velocity (0 but for the flying bar, SPEC §1.4), a massless
 /// node at its quasi-static value (or left at the interpolant, `contact_init = interpolant`),
 /// a⁰ from the equation at t = 0 on the free nodes. Returns the state and σ_C⁰.
-fn initial_state(eng: &Engine, cfg: &Bar1dConfig) -> Result<(State, f64), ContactSolveError> {
+pub(super) fn initial_state(
+    eng: &Engine,
+    cfg: &Bar1dConfig,
+) -> Result<(State, f64), ContactSolveError> {
     let sp = &eng.sp;
     let m = sp.m;
     let mut u: Vec<f64> = (0..m)

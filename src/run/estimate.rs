@@ -60,6 +60,7 @@ impl RunConfig {
             RunConfig::Bar1d(c) => c.steps,
             RunConfig::Fe(c) => c.steps,
             RunConfig::Oscillator(c) => c.steps,
+            RunConfig::Layer1d(c) => c.steps,
         }
     }
 
@@ -84,6 +85,11 @@ impl RunConfig {
             }
             // One dof: a few scalars and the exact solution's events (one per impact).
             RunConfig::Oscillator(_) => (1.0, 4096.0),
+            // Two chains of the bar's engine.
+            RunConfig::Layer1d(c) => {
+                let m = c.elements as f64;
+                (2.0 * m, 2.0 * m * BAR1D_BYTES_PER_ELEMENT)
+            }
             RunConfig::Fe(c) => {
                 // (unknowns, dimension, matrix entries per row, contact columns of Z), in f64.
                 let (n, d, per_row, contact) = match &c.setup.geometry {

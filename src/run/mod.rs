@@ -11,6 +11,7 @@ pub mod estimate;
 pub mod fe;
 mod fe_nitsche;
 pub mod impacts;
+pub mod layer1d;
 pub mod observe;
 pub mod oscillator;
 pub mod record;
@@ -141,6 +142,7 @@ pub enum RunConfig {
     Bar1d(bar1d::Bar1dConfig),
     Fe(fe::FeConfig),
     Oscillator(oscillator::OscillatorConfig),
+    Layer1d(layer1d::Layer1dConfig),
 }
 
 impl RunConfig {
@@ -184,7 +186,27 @@ impl RunConfig {
                 steps,
                 perturbation: None,
             }),
+            SceneSetup::Layer1d { layer, elements } => RunConfig::Layer1d(layer1d::Layer1dConfig {
+                layer,
+                elements,
+                dt,
+                steps,
+                method,
+                mass,
+                scheme,
+                perturbation: None,
+            }),
         }
+    }
+
+    /// The friction law at the contact (SPEC §2.5). Only the layer has a tangential direction
+    /// today; the planner refuses a law ≠ none on every other scene before a config is built,
+    /// so for them the law is none and nothing changes.
+    pub fn with_friction(mut self, law: crate::contact::friction::FrictionLaw) -> RunConfig {
+        if let RunConfig::Layer1d(c) = &mut self {
+            c.layer.friction = law;
+        }
+        self
     }
 
     /// The initial value of a massless contact node (SPEC §2.2). The FE scenes start from
@@ -212,6 +234,7 @@ impl RunConfig {
             RunConfig::Bar1d(c) => c.perturbation = p,
             RunConfig::Fe(c) => c.perturbation = p,
             RunConfig::Oscillator(c) => c.perturbation = p,
+            RunConfig::Layer1d(c) => c.perturbation = p,
         }
     }
 
@@ -223,6 +246,7 @@ impl RunConfig {
             RunConfig::Bar1d(c) => c.explicit_dt_limit(),
             RunConfig::Fe(c) => c.explicit_dt_limit(),
             RunConfig::Oscillator(c) => c.explicit_dt_limit(),
+            RunConfig::Layer1d(c) => c.explicit_dt_limit(),
         }
     }
 
@@ -232,6 +256,7 @@ impl RunConfig {
             RunConfig::Bar1d(c) => (c.steps, c.elements),
             RunConfig::Fe(c) => (c.steps, c.unknowns()),
             RunConfig::Oscillator(c) => (c.steps, 1),
+            RunConfig::Layer1d(c) => (c.steps, 2 * c.elements),
         };
         (steps as u64).saturating_mul(unknowns as u64)
     }
@@ -309,6 +334,7 @@ pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext)
         RunConfig::Bar1d(c) => bar1d::simulate(c, options),
         RunConfig::Fe(c) => fe::simulate(c, options, ctx),
         RunConfig::Oscillator(c) => oscillator::simulate(c, options),
+        RunConfig::Layer1d(c) => layer1d::simulate(c, options),
     }
 }
 
@@ -319,7 +345,7 @@ pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext)
 pub fn lockstep_key(config: &RunConfig) -> Option<String> {
     match config {
         RunConfig::Fe(c) => fe::lockstep_key(c),
-        RunConfig::Bar1d(_) | RunConfig::Oscillator(_) => None,
+        RunConfig::Bar1d(_) | RunConfig::Oscillator(_) | RunConfig::Layer1d(_) => None,
     }
 }
 

@@ -87,6 +87,22 @@ pub struct Metrics {
     pub exit_velocity: Option<f64>,
     /// max over the contact phases of TV(σ_C)/(2·max|σ_C|) (SPEC §3.2), from the phases.
     pub pressure_oscillation: Option<f64>,
+    /// Friction (SPEC §5; null without a friction law): W_f(T), E^N + W_f^N − E⁰ and the
+    /// largest one-step rise of E + W_f, all over energy_scale; contact node-steps in stick
+    /// and in slip; max |f_t|/f_n over the contact steps.
+    pub friction_work: Option<f64>,
+    pub energy_balance_drift: Option<f64>,
+    pub energy_balance_max_increase: Option<f64>,
+    pub stick_steps: Option<i64>,
+    pub slip_steps: Option<i64>,
+    pub friction_ratio_max: Option<f64>,
+    /// Mean tangential and normal velocities 1ᵀMv/1ᵀM1 at T (scenes with a tangential
+    /// direction).
+    pub tangential_velocity_final: Option<f64>,
+    pub normal_velocity_final: Option<f64>,
+    /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, SPEC §1.7).
+    pub err_sigma_t_l2: Option<f64>,
+    pub err_vt_final: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].
@@ -143,10 +159,14 @@ pub struct SeriesRow {
     pub energy_elastic: Option<f64>,
     pub energy_gravity: Option<f64>,
     pub u_lowest: Option<f64>,
+    /// Friction (SPEC §5): the base's σ_t (1D), the contact node's slip velocity, W_f.
+    pub sigma_t_contact: Option<f64>,
+    pub v_t_contact: Option<f64>,
+    pub friction_work: Option<f64>,
 }
 
 /// The optional series columns, in schema order (null where a run has no such quantity).
-pub const OPTIONAL_SERIES: [&str; 7] = [
+pub const OPTIONAL_SERIES: [&str; 10] = [
     "energy_theta",
     "u_contact_exact",
     "sigma_contact_exact",
@@ -154,6 +174,9 @@ pub const OPTIONAL_SERIES: [&str; 7] = [
     "energy_elastic",
     "energy_gravity",
     "u_lowest",
+    "sigma_t_contact",
+    "v_t_contact",
+    "friction_work",
 ];
 
 /// A run's time series, stored by column: the sink hands each column to the Parquet encoder
@@ -171,9 +194,9 @@ pub struct Series {
     pub sigma_contact: Vec<f64>,
     pub energy: Vec<f64>,
     /// Values of the optional columns (0 where null); empty for a column never given.
-    pub optional: [Vec<f64>; 7],
+    pub optional: [Vec<f64>; 10],
     /// Whether each value of an optional column is given; empty for a column never given.
-    pub valid: [Vec<bool>; 7],
+    pub valid: [Vec<bool>; 10],
     cap: usize,
 }
 
@@ -248,6 +271,9 @@ impl Series {
             energy_elastic: opt(4),
             energy_gravity: opt(5),
             u_lowest: opt(6),
+            sigma_t_contact: opt(7),
+            v_t_contact: opt(8),
+            friction_work: opt(9),
         }
     }
 
@@ -274,7 +300,7 @@ impl FromIterator<SeriesRow> for Series {
 
 impl SeriesRow {
     /// The optional columns' values, in [`OPTIONAL_SERIES`] order.
-    pub fn optional(&self) -> [Option<f64>; 7] {
+    pub fn optional(&self) -> [Option<f64>; 10] {
         [
             self.energy_theta,
             self.u_contact_exact,
@@ -283,6 +309,9 @@ impl SeriesRow {
             self.energy_elastic,
             self.energy_gravity,
             self.u_lowest,
+            self.sigma_t_contact,
+            self.v_t_contact,
+            self.friction_work,
         ]
     }
 }
@@ -362,6 +391,9 @@ pub struct Observer {
     /// Contact phases at full resolution (issue 12), independent of `every`.
     impacts: super::impacts::PhaseTracker,
     max_penetration: Option<f64>,
+    /// The friction values of the next observed step (σ_t, slip velocity, W_f), set by a
+    /// frictional engine before [`Observer::observe`] ([`Observer::set_friction`]).
+    friction: Option<[f64; 3]>,
     pub series: Series,
 }
 
@@ -401,6 +433,7 @@ impl Observer {
             phases: 0,
             impacts: super::impacts::PhaseTracker::new(),
             max_penetration: None,
+            friction: None,
             series: Series::with_capacity(cap),
         }
     }
@@ -410,6 +443,12 @@ impl Observer {
     pub fn with_energy_scale(mut self, scale: f64) -> Self {
         self.scale = Some(scale);
         self
+    }
+
+    /// The friction series values (σ_t at the contact, its slip velocity, W_f) of the step
+    /// observed next.
+    pub fn set_friction(&mut self, sigma_t: f64, v_t: f64, work: f64) {
+        self.friction = Some([sigma_t, v_t, work]);
     }
 
     /// First observed time with a negative contact pressure (a non-zero contact force).
@@ -505,8 +544,12 @@ impl Observer {
                 energy_elastic: v.energy_elastic,
                 energy_gravity: v.energy_gravity,
                 u_lowest: v.u_lowest,
+                sigma_t_contact: self.friction.map(|f| f[0]),
+                v_t_contact: self.friction.map(|f| f[1]),
+                friction_work: self.friction.map(|f| f[2]),
             });
         }
+        self.friction = None;
         let scale = self.energy_unit().abs().max(f64::MIN_POSITIVE);
         if v.energy > DIVERGENCE_FACTOR * scale {
             return Err(Divergence(format!(
@@ -591,6 +634,9 @@ mod tests {
             energy_elastic: None,
             energy_gravity: None,
             u_lowest: None,
+            sigma_t_contact: None,
+            v_t_contact: None,
+            friction_work: None,
         }
     }
 
@@ -610,6 +656,6 @@ mod tests {
         assert_eq!(s.rows().collect::<Vec<_>>(), rows);
         assert!(s.has(0));
         assert_eq!(s.valid[0], [false, false, true, false, true]);
-        assert!((1..7).all(|k| !s.has(k) && s.optional[k].is_empty()));
+        assert!((1..10).all(|k| !s.has(k) && s.optional[k].is_empty()));
     }
 }

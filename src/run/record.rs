@@ -209,6 +209,21 @@ schema! {
         solver_iterations_max_step: Option<i64> => "", "most CG iterations of one step's solve (solver = cg)";
         load: Option<String> => "", "how gravity enters (SPEC §1.3): body (F = ∫ρ f·φ whatever the mass variant, the papers' model) or inertial (F = M_run f e_d, the weight following the modified mass); null without gravity";
         lockstep: Option<i64> => "", "members of the lockstep group the run was stepped in (runs sharing the step matrix make one multi-column solve per step; its numbers equal the run alone bit for bit, and its timings are the group's divided among the members); null: stepped alone";
+        friction: Option<String> => "", "friction law at the contact (SPEC §2.5): none | tresca | coulomb (null on scenes without a tangential direction)";
+        friction_coefficient: Option<f64> => "", "Coulomb's μ_f (friction = coulomb)";
+        tresca_threshold: Option<f64> => "Pa", "Tresca's threshold s, a traction (friction = tresca)";
+        height: Option<f64> => "m", "layer1d: the layer's height H";
+        velocity_tangential: Option<f64> => "m/s", "layer1d: the initial tangential velocity V_t";
+        friction_work: Option<f64> => "", "friction: W_f(T)/energy_scale, the work the friction force took from the body (SPEC §5; null without friction)";
+        energy_balance_drift: Option<f64> => "", "friction: (E^N + W_f^N − E⁰)/energy_scale — the normal contact's work over the run";
+        energy_balance_max_increase: Option<f64> => "", "friction: max_n of the one-step rise of E + W_f, over energy_scale (≤ 0 up to round-off for kane and moreau-jean θ = ½)";
+        stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
+        slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
+        friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |f_t|/f_n, the apparent friction coefficient";
+        tangential_velocity_final: Option<f64> => "m/s", "the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d)";
+        normal_velocity_final: Option<f64> => "m/s", "the normal component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d)";
+        err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
+        err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -283,6 +298,24 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "Option<f64>",
         "m",
         "vertical displacement u_d of the lowest point of the reference configuration, the lowest Γ_C node (disc2d, sphere3d, mesh2d, mesh3d; null on the bars, whose Γ_C is flat)",
+    ),
+    (
+        "sigma_t_contact",
+        "Option<f64>",
+        "Pa",
+        "friction (SPEC §2.5): the base's tangential stress σ_t (layer1d; the force the scheme applied at t^n, impulses over τ); null without a tangential direction",
+    ),
+    (
+        "v_t_contact",
+        "Option<f64>",
+        "m/s",
+        "friction: the contact node's tangential velocity (its slip velocity while in contact)",
+    ),
+    (
+        "friction_work",
+        "Option<f64>",
+        "J",
+        "friction: the frictional work W_f^n = −Σ f̄_t·Δu_t so far (SPEC §2.5); energy + friction_work − its initial value is the normal contact's work",
     ),
 ];
 
@@ -419,6 +452,21 @@ impl RunRecord {
             solver_iterations_max_step: m.solver_iterations_max_step,
             load: p.get(&Key::Load).map(|v| v.to_string()),
             lockstep: m.lockstep,
+            friction: p.get(&Key::Friction).map(|v| v.to_string()),
+            friction_coefficient: f(Key::FrictionCoefficient),
+            tresca_threshold: f(Key::TrescaThreshold),
+            height: f(Key::Height),
+            velocity_tangential: f(Key::VelocityTangential),
+            friction_work: m.friction_work,
+            energy_balance_drift: m.energy_balance_drift,
+            energy_balance_max_increase: m.energy_balance_max_increase,
+            stick_steps: m.stick_steps,
+            slip_steps: m.slip_steps,
+            friction_ratio_max: m.friction_ratio_max,
+            tangential_velocity_final: m.tangential_velocity_final,
+            normal_velocity_final: m.normal_velocity_final,
+            err_sigma_t_l2: m.err_sigma_t_l2,
+            err_vt_final: m.err_vt_final,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

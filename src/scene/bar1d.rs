@@ -320,7 +320,13 @@ impl BarExact {
             let (a, b) = (c * s, 2.0 * self.p.length - c * s);
             let kinks = if a <= b { (a, b) } else { (b, a) };
             let m = nodal.len() - 1;
-            return integrate_error(m, |i| nodal[i], h, kinks, |x| self.flying(x, s).u);
+            return integrate_error(
+                m,
+                |i| nodal[i],
+                h,
+                &[kinks.0, kinks.1],
+                |x| self.flying(x, s).u,
+            );
         }
         let l = self.p.length;
         let inv_l = 1.0 / l;
@@ -334,20 +340,21 @@ impl BarExact {
         };
         let m = nodal.len();
         let node = |i: usize| if i < m { nodal[i] } else { 0.0 };
-        integrate_error(m, node, h, kinks, exact)
+        integrate_error(m, node, h, &[kinks.0, kinks.1], exact)
     }
 }
 
 /// ∫(u_h − u)² and ∫(u_h' − u')² over `elements` P1 elements of size h with nodal values
 /// `node(i)`, i = 0 … elements, against a continuous field `exact` that is affine between the
-/// kinks k1 ≤ k2 (only those inside an element matter). On each affine piece the error is
-/// affine, so its values at the piece ends determine both integrals: ∫ e² over a piece of
-/// length d is d (e_a² + e_a e_b + e_b²)/3, ∫ e'² is (e_b − e_a)²/d.
-fn integrate_error(
+/// kinks, sorted ascending (only those inside an element matter; the layer of SPEC §1.7 has up
+/// to four per component). On each affine piece the error is affine, so its values at the piece
+/// ends determine both integrals: ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3,
+/// ∫ e'² is (e_b − e_a)²/d.
+pub(crate) fn integrate_error(
     elements: usize,
     node: impl Fn(usize) -> f64,
     h: f64,
-    (k1, k2): (f64, f64),
+    kinks: &[f64],
     exact: impl Fn(f64) -> f64,
 ) -> (f64, f64) {
     let (h3, inv_h) = (h / 3.0, 1.0 / h);
@@ -360,7 +367,7 @@ fn integrate_error(
         let ua = node(i);
         let ub = node(i + 1);
         let er_node = ub - exact(xb);
-        if !((k1 > xa && k1 < xb) || (k2 > xa && k2 < xb)) {
+        if !kinks.iter().any(|k| *k > xa && *k < xb) {
             // No kink inside (all elements but at most two): one affine piece.
             l2 += h3 * (el * el + el * er_node + er_node * er_node);
             let de = er_node - el;
@@ -368,8 +375,9 @@ fn integrate_error(
         } else {
             let slope = (ub - ua) * inv_h;
             let (mut xl, mut e_l) = (xa, el);
-            for (xr, er) in [k1, k2]
-                .into_iter()
+            for (xr, er) in kinks
+                .iter()
+                .copied()
                 .filter(|k| *k > xa && *k < xb)
                 .map(|k| (k, ua + slope * (k - xa) - exact(k)))
                 .chain(std::iter::once((xb, er_node)))

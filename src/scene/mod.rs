@@ -15,14 +15,16 @@
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod layer1d;
 pub mod mesh;
 pub mod oscillator;
 
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup, LoadModel};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
+pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
-pub use oscillator::{OscillatorExact, OscillatorParams, OscillatorScene};
+pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
 
 /// A physics parameter of a scene: its key name (SPEC §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,6 +86,8 @@ pub enum SceneSetup {
     Fe(FeSetup),
     /// The impact oscillator: one mass, one spring, one obstacle (SPEC §1.5).
     Oscillator(OscillatorParams),
+    /// The frictional layer: two P1 chains on the same nodes (SPEC §1.7).
+    Layer1d { layer: LayerParams, elements: usize },
 }
 
 impl SceneSetup {
@@ -92,7 +96,9 @@ impl SceneSetup {
     pub fn id_revision(&self) -> String {
         match self {
             SceneSetup::Fe(s) => s.id_revision(),
-            SceneSetup::Bar1d { .. } | SceneSetup::Oscillator(_) => String::new(),
+            SceneSetup::Bar1d { .. } | SceneSetup::Layer1d { .. } | SceneSetup::Oscillator(_) => {
+                String::new()
+            }
         }
     }
 }
@@ -143,6 +149,22 @@ pub trait Scene: Send + Sync {
     /// scene of the same dimension (SPEC §1.6, `reference = { scene = … }`).
     fn fe_dim(&self) -> Option<usize> {
         None
+    }
+    /// Whether the scene takes a friction law (SPEC §2.5, `friction` ≠ `none`); `Err` says
+    /// why not. A friction law needs a tangential direction at the contact: the 1D bar has
+    /// none (its one displacement is normal to the obstacle); the finite-element scenes have
+    /// one, but their frictional steps are part 2 (issue 33).
+    fn supports_friction(&self) -> Result<(), String> {
+        if self.fe_dim().is_some() {
+            return Err(format!(
+                "friction on FE scenes is not implemented yet (issue 33); scene {} takes friction = \"none\" only",
+                self.name()
+            ));
+        }
+        Err(format!(
+            "scene {} has no tangential direction at its contact (its one displacement is normal to the obstacle): friction needs layer1d (SPEC §1.7)",
+            self.name()
+        ))
     }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
@@ -236,6 +258,8 @@ pub enum SceneKind {
     Mesh2d,
     /// The user's own 3D body, a Gmsh mesh (SPEC §1.6).
     Mesh3d,
+    /// The frictional layer with its exact solution (SPEC §1.7).
+    Layer1d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -246,10 +270,11 @@ static SPHERE3D: BallScene = BallScene { dim: 3 };
 static OSCILLATOR: OscillatorScene = OscillatorScene;
 static MESH2D: MeshScene = MeshScene { dim: 2 };
 static MESH3D: MeshScene = MeshScene { dim: 3 };
+static LAYER1D: Layer1dScene = Layer1dScene;
 
 impl SceneKind {
     /// Every scene name of SPEC §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 8] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 9] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
@@ -258,6 +283,7 @@ impl SceneKind {
         ("oscillator", Some(SceneKind::Oscillator)),
         ("mesh2d", Some(SceneKind::Mesh2d)),
         ("mesh3d", Some(SceneKind::Mesh3d)),
+        ("layer1d", Some(SceneKind::Layer1d)),
     ];
 
     /// The scene behind this name.
@@ -271,6 +297,7 @@ impl SceneKind {
             SceneKind::Oscillator => &OSCILLATOR,
             SceneKind::Mesh2d => &MESH2D,
             SceneKind::Mesh3d => &MESH3D,
+            SceneKind::Layer1d => &LAYER1D,
         }
     }
 

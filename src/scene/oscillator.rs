@@ -99,6 +99,13 @@ impl Scene for OscillatorScene {
             h: 1.0,
         })
     }
+    /// The mass meets the obstacle along its one dof: a friction law at the contact has no
+    /// direction to act in. Dry friction on the mass is SPEC §1.5's physics key
+    /// `friction_force` (not implemented yet), not the friction axis.
+    fn supports_friction(&self) -> Result<(), String> {
+        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is SPEC §1.5's `friction_force` (not implemented yet), not a friction law at the contact".into())
+    }
+
     fn supports(
         &self,
         space: &str,
@@ -222,6 +229,148 @@ impl OscillatorParams {
     /// The exact solution over [0, t_final].
     pub fn exact(&self, t_final: f64) -> OscillatorExact {
         OscillatorExact::new(*self, t_final)
+    }
+}
+
+/// The oscillator with dry (Coulomb) friction on the mass (SPEC §1.5, Siconos'
+/// FrictionOscillator): m ẍ + k x = f − F·sign(ẋ) while it moves, at rest where |k x − f| ≤ F.
+///
+/// Exact, piece by piece: while the mass moves in the direction s = ±1 the friction is the
+/// constant −sF, so the motion is a free oscillation about the shifted centre c = (f − sF)/k,
+/// x = c + R cos(ω(t − t₀) + φ). It runs until the velocity vanishes — a turning point
+/// x_j = c + sR, whence x_{j+1} = 2f/k + 2(F/k)·sign(x_j − f/k) − x_j — or, moving down, until
+/// it meets the obstacle x = −g (the impact angle in closed form as for the frictionless
+/// oscillator, about c instead of f/k), where Newton's law reverses the velocity. At a turning
+/// point the mass stays for good if the spring and the load cannot overcome the friction,
+/// |k x_j − f| ≤ F: that instant is `stop_time_exact`. The whole history is a handful of
+/// segments (the amplitude drops by 2F/k per half period), built once.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DryFrictionExact {
+    p: OscillatorParams,
+    friction: f64,
+    /// (t₀, x₀, v₀, centre; at rest).
+    segments: Vec<(f64, f64, f64, f64, bool)>,
+    turning_points: Vec<(f64, f64)>,
+    impacts: Vec<f64>,
+    stop: Option<(f64, f64)>,
+}
+
+impl DryFrictionExact {
+    /// The exact motion over [0, t_final] with the friction force `friction` = F ≥ 0.
+    pub fn new(p: OscillatorParams, friction: f64, t_final: f64) -> Self {
+        let (w, k, f, g) = (p.omega(), p.stiffness, p.force, p.gap);
+        let tau2 = std::f64::consts::TAU;
+        let v_scale =
+            p.v0.abs()
+                .max(w * (p.x0 - f / k).abs())
+                .max(f64::MIN_POSITIVE);
+        let slow = 1e-14 * v_scale;
+        let mut out = Self {
+            p,
+            friction,
+            segments: Vec::new(),
+            turning_points: Vec::new(),
+            impacts: Vec::new(),
+            stop: None,
+        };
+        let (mut t0, mut x0, mut v0) = (0.0, p.x0, p.v0);
+        // Each pass is one half oscillation or one flight to the obstacle; the amplitude about
+        // f/k drops by 2F/k per half period, so the loop ends (the cap guards F = 0).
+        for _ in 0..1_000_000 {
+            let s = if v0 != 0.0 {
+                v0.signum()
+            } else {
+                let net = f - k * x0;
+                // On the obstacle the obstacle holds a mass pushed into it.
+                if net.abs() <= friction || (x0 <= -g && net < 0.0) {
+                    out.segments.push((t0, x0, 0.0, x0, true));
+                    out.stop = Some((t0, x0));
+                    break;
+                }
+                net.signum()
+            };
+            let c = (f - s * friction) / k;
+            out.segments.push((t0, x0, v0, c, false));
+            let dx = x0 - c;
+            let r = (dx * dx + (v0 / w).powi(2)).sqrt();
+            let phi = (-v0 / w).atan2(dx);
+            let turn = if s > 0.0 {
+                -phi
+            } else {
+                std::f64::consts::PI - phi
+            };
+            let mut theta = turn.rem_euclid(tau2);
+            if theta == 0.0 {
+                theta = tau2;
+            }
+            if s < 0.0 && c - r < -g {
+                // The flight meets the obstacle before its turning point.
+                let speed = (v0 * v0 + w * w * (x0 + g) * (x0 - g - 2.0 * c))
+                    .max(0.0)
+                    .sqrt();
+                let alpha = (speed / w).atan2(-g - c);
+                let t_hit = t0 + (alpha - phi).rem_euclid(tau2) / w;
+                if t_hit > t_final {
+                    break;
+                }
+                let rebound = p.impact_law * speed;
+                if speed > slow {
+                    out.impacts.push(t_hit);
+                }
+                (t0, x0, v0) = (t_hit, -g, if rebound > slow { rebound } else { 0.0 });
+                continue;
+            }
+            let t_turn = t0 + theta / w;
+            if t_turn > t_final {
+                break;
+            }
+            let x_turn = c + s * r;
+            out.turning_points.push((t_turn, x_turn));
+            (t0, x0, v0) = (t_turn, x_turn, 0.0);
+        }
+        out
+    }
+
+    /// The friction force F.
+    pub fn friction(&self) -> f64 {
+        self.friction
+    }
+    /// The turning points (t_j, x_j) in [0, T], in order.
+    pub fn turning_points(&self) -> &[(f64, f64)] {
+        &self.turning_points
+    }
+    /// The impact times in [0, T].
+    pub fn impacts(&self) -> &[f64] {
+        &self.impacts
+    }
+    /// Where and when the mass comes to rest for good (`stop_time_exact`), if before T.
+    pub fn stop(&self) -> Option<(f64, f64)> {
+        self.stop
+    }
+
+    /// (x, v) at t.
+    pub fn state(&self, t: f64) -> (f64, f64) {
+        let k = self
+            .segments
+            .partition_point(|s| s.0 <= t)
+            .saturating_sub(1);
+        let (t0, x0, v0, c, rest) = self.segments[k];
+        if rest {
+            return (x0, 0.0);
+        }
+        let w = self.p.omega();
+        let (sin, cos) = (w * (t - t0)).sin_cos();
+        (
+            c + (x0 - c) * cos + v0 / w * sin,
+            -(x0 - c) * w * sin + v0 * cos,
+        )
+    }
+
+    /// Mechanical energy ½mv² + ½kx² − fx at t: it falls by F·|x_{j+1} − x_j| from one
+    /// turning point to the next (the friction's work), the identity a test checks.
+    pub fn energy(&self, t: f64) -> f64 {
+        let (x, v) = self.state(t);
+        self.p.energy(x, v)
     }
 }
 

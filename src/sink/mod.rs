@@ -877,6 +877,9 @@ mod tests {
             energy_elastic: Some(0.5 - step as f64),
             energy_gravity: None,
             u_lowest: theta.map(|t| -t),
+            sigma_t_contact: None,
+            v_t_contact: None,
+            friction_work: exact.map(|e| 2.0 * e),
         }
     }
 

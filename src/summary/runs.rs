@@ -25,7 +25,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &columns![
     hht_alpha: F64, length: F64, young: F64, density: F64, amplitude: F64, gap: F64,
     lame_lambda: F64, lame_mu: F64, gravity: F64, degree: I64, right_end: Str, velocity: F64,
     point_mass: F64, stiffness: F64, force: F64, impact_law: F64, solver: Str, cg_tol: F64,
-    T: F64, ensemble_sample: I64, ensemble_perturbation: F64,
+    T: F64, ensemble_sample: I64, ensemble_perturbation: F64, friction: Str,
+    friction_coefficient: F64, tresca_threshold: F64, height: F64, velocity_tangential: F64,
 ];
 
 /// The parameters already spelled out in a run's `label` (contact method · mass · scheme);
@@ -37,6 +38,9 @@ const IN_LABEL: &[&str] = &[
     "contact_init",
     "scheme",
     "scheme_label",
+    "friction",
+    "friction_coefficient",
+    "tresca_threshold",
 ];
 
 /// The contact methods' and schemes' numeric parameters: spelled out in a run's label too,

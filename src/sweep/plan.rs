@@ -20,6 +20,7 @@ use sha2::{Digest, Sha256};
 
 use super::keys::canonical_number;
 use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
+use crate::contact::friction::{FrictionKind, FrictionLaw};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
 use crate::scene::{Physics, Scene, SceneKind};
@@ -135,6 +136,7 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
         Key::RhoInf => Value::Num(1.0),
         Key::ContactInit => Value::Str(ContactInit::Consistent.name().into()),
         Key::Solver => Value::Str(Solver::Direct.name().into()),
+        Key::Friction => Value::Str(FrictionKind::None.name().into()),
         Key::CgTol => Value::Num(Solver::DEFAULT_CG_TOL),
         k if k.is_physics() => physics_value(
             k,
@@ -382,9 +384,82 @@ fn resolve(
         return Outcome::Invalid(vec![Issue::at(&origin(k), why)]);
     }
 
+    // Friction (SPEC §2.5): the law and its parameter; `none` is today's engine (no key of
+    // it enters the id). A bound given while friction is fixed at `none` (by default or in
+    // [fixed]) is a mistake, refused; across a `friction` axis it applies to its law only and
+    // the frictionless runs collapse, as every other key.
+    let friction_kind = get(Key::Friction)
+        .and_then(|v| v.as_str().and_then(FrictionKind::from_name))
+        .expect("checked");
+    let friction_fixed = user
+        .get(&Key::Friction)
+        .is_none_or(|(_, o)| !(o.path.starts_with("grid") || o.path.starts_with("zip")));
+    let friction = match friction_kind {
+        FrictionKind::None => {
+            for k in [Key::FrictionCoefficient, Key::TrescaThreshold] {
+                if user.contains_key(&k) && friction_fixed {
+                    issues.push(Issue::at(
+                        &origin(k),
+                        format!(
+                            "{} sets a friction bound but friction = \"none\"{} for this run: set friction = \"coulomb\" (with friction_coefficient) or \"tresca\" (with tresca_threshold)",
+                            k.name(),
+                            if user.contains_key(&Key::Friction) { "" } else { " (the default)" }
+                        ),
+                    ));
+                }
+            }
+            FrictionLaw::None
+        }
+        FrictionKind::Coulomb => match num(Key::FrictionCoefficient) {
+            Some(coefficient) => FrictionLaw::Coulomb { coefficient },
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Friction),
+                    "friction = coulomb needs friction_coefficient (μ_f ≥ 0: |f_t| ≤ μ_f f_n)",
+                ));
+                FrictionLaw::None
+            }
+        },
+        FrictionKind::Tresca => match num(Key::TrescaThreshold) {
+            Some(threshold) => FrictionLaw::Tresca { threshold },
+            None => {
+                issues.push(Issue::at(
+                    &origin(Key::Friction),
+                    "friction = tresca needs tresca_threshold (s ≥ 0, a traction: |f_t| ≤ s while in contact)",
+                ));
+                FrictionLaw::None
+            }
+        },
+    };
+    if friction_kind != FrictionKind::None {
+        if let Err(why) = scene.supports_friction() {
+            issues.push(Issue::at(&origin(Key::Friction), why));
+        }
+        // Where the literature defines no frictional version (SPEC §2.5).
+        let undefined = match scheme {
+            Scheme::PaoliSchatzman(_) => Some("paoli-schatzman"),
+            Scheme::Hybrid => Some("the hybrid schemes"),
+            Scheme::DiscreteGradient => Some("discrete-gradient"),
+            _ => None,
+        };
+        if let Some(what) = undefined {
+            let why = format!(
+                "{what} has no frictional version in the literature (SPEC §2.5): friction = {} runs with the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean and central-difference",
+                friction_kind.name()
+            );
+            if friction_fixed {
+                issues.push(Issue::at(&origin(Key::Scheme), why));
+            } else {
+                return Outcome::Inapplicable(why);
+            }
+        }
+    }
+
     // Applicability (SPEC §3): which keys this run uses.
     let applies = |k: Key| -> Result<(), &'static str> {
         let ok = match k {
+            Key::FrictionCoefficient => friction_kind == FrictionKind::Coulomb,
+            Key::TrescaThreshold => friction_kind == FrictionKind::Tresca,
             Key::NitscheTheta | Key::NitscheGamma0 => space_name == "nitsche",
             Key::PenaltyGamma0 => space_name == "penalty",
             Key::NewmarkBeta => matches!(scheme, Scheme::Newmark(_) | Scheme::PaoliSchatzman(_)),
@@ -423,6 +498,8 @@ fn resolve(
             Key::Restitution => "applies to paoli-schatzman (and moreau-jean) only",
             Key::RhoInf => "applies to generalized-alpha only",
             Key::HhtAlpha => "applies to hht only",
+            Key::FrictionCoefficient => "applies to friction = coulomb only",
+            Key::TrescaThreshold => "applies to friction = tresca only",
             Key::ContactInit => {
                 if scene.contact_init_matters() {
                     "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
@@ -650,13 +727,13 @@ fn resolve(
         None => scene.setup(&physics, mesh),
     };
     let revision = setup.id_revision();
-    let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps).with_contact_init(
-        if massless && scene.contact_init_matters() {
+    let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps)
+        .with_friction(friction)
+        .with_contact_init(if massless && scene.contact_init_matters() {
             contact_init
         } else {
             ContactInit::Consistent
-        },
-    );
+        });
     // The step solver (SPEC §4) is the finite-element engine's choice; the 1D engines solve
     // tridiagonal systems, and drop the keys.
     let fe = matches!(config, RunConfig::Fe(_));
@@ -835,6 +912,22 @@ fn resolve(
         }
         put(key, physics_value(key, *value), false);
     }
+    // The friction column where a law can act (null on the scenes that take none); `none`
+    // is the default and never enters the id.
+    if scene.supports_friction().is_ok() {
+        put(
+            Key::Friction,
+            Value::Str(friction_kind.name().into()),
+            false,
+        );
+    }
+    match friction {
+        FrictionLaw::None => {}
+        FrictionLaw::Coulomb { coefficient } => {
+            put(Key::FrictionCoefficient, Value::Num(coefficient), true)
+        }
+        FrictionLaw::Tresca { threshold } => put(Key::TrescaThreshold, Value::Num(threshold), true),
+    }
     // `direct` is the default: its runs keep the ids they had before the key existed.
     match solver {
         Solver::Cg { tol } => {
@@ -880,11 +973,16 @@ fn resolve(
         _ => mass_label,
     };
     let scheme_label = scheme.label();
+    let friction_label = match friction {
+        FrictionLaw::None => String::new(),
+        FrictionLaw::Coulomb { coefficient } => format!(" · coulomb(μ_f={coefficient})"),
+        FrictionLaw::Tresca { threshold } => format!(" · tresca(s={threshold})"),
+    };
     Outcome::Run(Box::new(Resolved {
         params,
         canonical,
         revision,
-        label: format!("{space_label} · {mass_label} · {scheme_label}"),
+        label: format!("{space_label} · {mass_label} · {scheme_label}{friction_label}"),
         scheme_names: [scheme.family().to_string(), scheme_label.clone()],
         scheme_label,
         config,
