@@ -895,20 +895,10 @@ fn encode_batch(dirs: &PartDirs, batch: Batch) -> Result<Encoded, SinkError> {
     let Batch { name, rows, series } = batch;
     let series_rows: u64 = series.iter().map(|(_, s)| s.len() as u64).sum();
     let series_tmp = dirs.tmp.join(format!("{name}.series"));
-    let series_bytes = write_file(&series_tmp, Durability::Derived, |out| {
-        parquet::write_series(out, series).map_err(|source| SinkError::Format {
-            path: series_tmp.clone(),
-            source,
-        })
-    })?;
+    let series_bytes = encode_to_file(&series_tmp, |out| parquet::write_series(out, series))?;
     let runs_tmp = dirs.tmp.join(format!("{name}.runs"));
-    write_file(&runs_tmp, Durability::Derived, |out| {
-        parquet::record_batch(RunRecord::to_columns(&rows))
-            .and_then(|b| parquet::write_runs(out, &b))
-            .map_err(|source| SinkError::Format {
-                path: runs_tmp.clone(),
-                source,
-            })
+    encode_to_file(&runs_tmp, |out| {
+        parquet::write_runs(out, &parquet::record_batch(RunRecord::to_columns(&rows))?)
     })?;
     let encode_cpu_seconds = match (cpu_start, thread_cpu_seconds()) {
         (Some(a), Some(b)) => Some(b - a),
@@ -922,6 +912,42 @@ fn encode_batch(dirs: &PartDirs, batch: Batch) -> Result<Encoded, SinkError> {
         series_bytes,
         encode_seconds: start.elapsed().as_secs_f64(),
         encode_cpu_seconds,
+    })
+}
+
+/// Most bytes an encoding thread keeps of its part buffer between batches: a part of the
+/// overhead sweep is ≈ 1.5 MB; a larger one is written from a buffer that is then freed.
+const KEPT_PART_BUFFER: usize = 8 << 20;
+
+thread_local! {
+    /// The part buffer of an encoding thread, kept from batch to batch: a fresh buffer per part
+    /// (the 1 MB `BufWriter` of [`write_file`]) is fresh pages each time. Measured on the
+    /// overhead sweep (`--threads 1`, 4 interleaved pairs): 12 500–14 500 page faults a
+    /// command against 16 000–18 500 for the writer thread before, and the encoding's CPU
+    /// back to the writer's (0.30 against 0.32 s), where fresh buffers on the workers took
+    /// 7 % more.
+    static PART_BUFFER: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Encode a part into this thread's buffer, then write it to `path` in one call (not synced);
+/// returns its size.
+fn encode_to_file(
+    path: &Path,
+    encode: impl FnOnce(&mut Vec<u8>) -> Result<(), ::parquet::errors::ParquetError>,
+) -> Result<u64, SinkError> {
+    PART_BUFFER.with_borrow_mut(|buf| {
+        buf.clear();
+        let written = encode(buf)
+            .map_err(|source| SinkError::Format {
+                path: path.to_path_buf(),
+                source,
+            })
+            .and_then(|()| fs::write(path, &buf[..]).map_err(io(path)));
+        let bytes = buf.len() as u64;
+        if buf.capacity() > KEPT_PART_BUFFER {
+            *buf = Vec::new();
+        }
+        written.map(|()| bytes)
     })
 }
 
