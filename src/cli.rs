@@ -487,7 +487,7 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    let (mut sink, done) = Sink::open(dir, cfg.batch)?;
+    let (sink, done) = Sink::open(dir, cfg.batch)?;
     for d in &sink.damaged {
         eprintln!("warning: {}", d.warning());
     }
@@ -607,7 +607,9 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     }
     let (mut failed, mut diverged) = (0usize, 0usize);
     let refs = exec::references::ensure(dir, plan, &todo, &cfg.exec.run)?;
-    let result = exec::execute(
+    // Each run's output is encoded by the worker that ran it (`Sink::push`); this thread
+    // only counts and draws the bar.
+    let result = exec::execute_with(
         &plan.sweep.name,
         &todo,
         &refs,
@@ -616,7 +618,11 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             ..cfg.exec
         },
         |res| {
-            match res.record.status.as_str() {
+            let seen = (res.record.status.clone(), res.record.run_id.clone());
+            sink.push(res).map(|()| seen)
+        },
+        |(status, run_id)| {
+            match status.as_str() {
                 "ok" => {}
                 "diverged" => diverged += 1,
                 _ => failed += 1,
@@ -625,8 +631,8 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             bar.set_message(format!(
                 "{done_runs}/{total_runs} runs, failed {failed}, diverged {diverged}"
             ));
-            bar.inc(works.get(res.record.run_id.as_str()).copied().unwrap_or(1));
-            sink.push(res)
+            bar.inc(works.get(run_id.as_str()).copied().unwrap_or(1));
+            Ok::<(), SinkError>(())
         },
     );
     let mut flushed = sink.flush();
@@ -638,7 +644,7 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
                 "(a shard runs only the bracket ends of the [search]; run the sweep without --shard to bisect)"
             );
         } else {
-            searched = bisect(dir, plan, &refs, &cfg.exec, threads, &mut sink);
+            searched = bisect(dir, plan, &refs, &cfg.exec, threads, &sink);
             if searched.is_ok() {
                 flushed = sink.flush();
             }
@@ -735,18 +741,33 @@ fn say(text: &str) {
 }
 
 /// Where the session's time and bytes went: the runs' own time (summed over workers) against
-/// the wall time since the command started, the writer thread's time, and the size of the
-/// time series per stored step.
+/// the wall time since the command started, the output's encoding (CPU summed over the
+/// workers that did it) and the committer thread's CPU — the one serial part of the output,
+/// which bounds how many workers a node can use — and the size of the time series per stored
+/// step.
 fn cost_line(stats: &crate::sink::SinkStats, wall_s: f64) -> String {
+    // "NAME N s CPU (…)": the CPU is the figure that matters (it is what the part takes from
+    // the cores); wall time where the platform has no per-thread clock.
+    let part = |name: &str, cpu: Option<f64>, wall: f64, where_: &str| match cpu {
+        Some(c) => format!("{name} {c:.3} s CPU ({where_}, {wall:.3} s wall)"),
+        None => format!("{name} {wall:.3} s wall ({where_})"),
+    };
     let mut s = format!(
-        "time: runs {:.3} s (summed), command {:.3} s wall so far, Parquet writer {:.3} s (own thread{})",
+        "time: runs {:.3} s (summed), command {:.3} s wall so far, {}, {}",
         stats.run_seconds,
         wall_s,
-        stats.write_seconds,
-        stats
-            .write_cpu_seconds
-            .map(|c| format!(", {c:.3} s CPU"))
-            .unwrap_or_default()
+        part(
+            "encoding",
+            stats.encode_cpu_seconds,
+            stats.encode_seconds,
+            "on the workers"
+        ),
+        part(
+            "committer",
+            stats.commit_cpu_seconds,
+            stats.commit_seconds,
+            "own thread"
+        ),
     );
     if stats.series_rows > 0 {
         s.push_str(&format!(
@@ -1048,7 +1069,7 @@ fn bisect(
     refs: &exec::References,
     opts: &ExecOptions,
     threads: usize,
-    sink: &mut Sink,
+    sink: &Sink,
 ) -> Result<()> {
     let search = plan
         .sweep
@@ -1072,12 +1093,13 @@ fn bisect(
             break;
         }
         let specs: Vec<&sweep::RunSpec> = todo.iter().collect();
-        exec::execute(
+        exec::execute_with(
             &plan.sweep.name,
             &specs,
             refs,
             &ExecOptions { threads, ..*opts },
             |res| sink.push(res),
+            |()| Ok::<(), SinkError>(()),
         )?;
         sink.flush()?;
     }

@@ -1,5 +1,6 @@
 //! End to end: the binary on sweep files, the Parquet it writes, determinism across thread
-//! counts, crash safety (SIGKILL mid-sweep, then resume), timeouts, foreign output folders.
+//! counts, crash safety (SIGKILL mid-sweep and while workers encode, then resume), timeouts,
+//! foreign output folders.
 
 mod common;
 
@@ -8,7 +9,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use common::{assert_complete, bin, cli, write};
-use contact_sweep::sink::{parquet_parts, read_runs, read_series};
+use contact_sweep::sink::{committed_run_ids, parquet_parts, part_problem, read_runs, read_series};
 use polars::prelude::*;
 
 fn repo() -> &'static Path {
@@ -244,6 +245,92 @@ fn sigkill_mid_sweep_then_resume_loses_nothing_and_duplicates_nothing() {
     );
     assert!(String::from_utf8_lossy(&o.stderr).contains("240 of 240 runs already done"));
     assert_eq!(read_runs(&out).unwrap().height(), 240);
+}
+
+/// Batches of `.tmp/` (encoded or being encoded, not yet committed): their names, without the
+/// `.series`/`.runs` suffix of each file.
+fn batches_in_flight(out: &Path) -> std::collections::HashSet<String> {
+    std::fs::read_dir(out.join(".tmp"))
+        .map(|entries| {
+            entries
+                .flatten()
+                .filter_map(|e| {
+                    let name = e.file_name().to_string_lossy().into_owned();
+                    name.rsplit_once('.').map(|(batch, _)| batch.to_string())
+                })
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Issue 35: each worker encodes its batch into `.tmp/`, one thread commits. A SIGKILL while
+/// several batches are in `.tmp/` (workers encoding, or waiting for the committer) leaves only
+/// complete parts in `runs/` and `series/`; the resume keeps every committed run, computes
+/// exactly the others again (its "already done" count is the committed rows at the kill), and
+/// no row is there twice.
+#[test]
+fn sigkill_while_workers_encode_loses_only_runs_in_flight() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Every step stored, so that encoding a batch takes a while; 4 workers on batches of 2.
+    let sweep = write(
+        tmp.path(),
+        "long.toml",
+        &LONG.replace("series_every = 50", "series_every = 1"),
+    );
+    let out = tmp.path().join("out");
+    let mut child = spawn_long(&sweep, &out, &["--threads", "4", "--batch", "2"]);
+    let start = Instant::now();
+    loop {
+        let committed = parquet_parts(&out.join("runs"))
+            .map(|p| p.len())
+            .unwrap_or(0);
+        if committed >= 3 && batches_in_flight(&out).len() >= 2 {
+            break;
+        }
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the sweep finished before two batches were seen in flight"
+        );
+        assert!(start.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    child.kill().unwrap(); // SIGKILL
+    child.wait().unwrap();
+    // Only complete parts are visible: every one reads (runs whole, series by their footer).
+    let runs_parts = parquet_parts(&out.join("runs")).unwrap();
+    for (sub, whole) in [("runs", true), ("series", false)] {
+        for part in parquet_parts(&out.join(sub)).unwrap() {
+            assert_eq!(part_problem(&part, whole), None, "{}", part.display());
+        }
+    }
+    let committed = committed_run_ids(&out.join("runs")).unwrap();
+    assert_eq!(
+        read_runs(&out).unwrap().height(),
+        committed.len(),
+        "a run committed twice before the kill"
+    );
+    assert!(committed.len() < 240);
+    // The resume recomputes the uncommitted runs, and only them.
+    let o = cli(
+        tmp.path(),
+        &["run", "long.toml", "--out", "out", "--no-summary"],
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("{} of 240 runs already done", committed.len())),
+        "{err}"
+    );
+    // The parts committed before the kill are still there, untouched; every run once.
+    let after = parquet_parts(&out.join("runs")).unwrap();
+    assert!(runs_parts.iter().all(|p| after.contains(p)));
+    let ids = assert_complete(&out, 240);
+    assert!(committed.is_subset(&ids));
+    assert_eq!(
+        batches_in_flight(&out).len(),
+        0,
+        "temporaries left in .tmp/"
+    );
 }
 
 #[test]

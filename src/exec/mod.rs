@@ -1,5 +1,7 @@
 //! The executor: runs a plan's runs, serially (the reference path, a plain loop) or on a rayon
-//! pool, and hands each finished run to a callback in the calling thread (the sink).
+//! pool, and hands each finished run to a callback in the thread that ran it (the sink, which
+//! encodes its output there so that the output's CPU grows with the workers), then what that
+//! returns to a callback in the calling thread (progress).
 //!
 //! A run that panics becomes a row (`solver-failed`, "internal error: …"); the sweep goes on.
 //! Rows do not depend on the thread count: every run is a pure function of its spec, so the
@@ -240,7 +242,23 @@ pub fn execute<E: Send>(
     runs: &[&RunSpec],
     refs: &References,
     opts: &ExecOptions,
-    mut on_result: impl FnMut(RunResult) -> Result<(), E>,
+    on_result: impl FnMut(RunResult) -> Result<(), E>,
+) -> Result<(), E> {
+    execute_with(sweep, runs, refs, opts, |r| Ok(r), on_result)
+}
+
+/// [`execute`], with each finished run first handed to `on_worker` in the thread that ran it
+/// (a worker of the pool; the calling thread on the serial path), and what it returns to
+/// `on_result` in the calling thread. Work that grows with the runs (encoding their output)
+/// goes in `on_worker`, so it runs in parallel; `on_result` is serial. An error from either
+/// stops the sweep as [`execute`] does.
+pub fn execute_with<M: Send, E: Send>(
+    sweep: &str,
+    runs: &[&RunSpec],
+    refs: &References,
+    opts: &ExecOptions,
+    on_worker: impl Fn(RunResult) -> Result<M, E> + Sync,
+    mut on_result: impl FnMut(M) -> Result<(), E>,
 ) -> Result<(), E> {
     let keep = |r: &RunResult| r.record.status != Status::Cancelled.as_str();
     let threads = if opts.threads == 0 {
@@ -256,7 +274,7 @@ pub fn execute<E: Send>(
             }
             for r in run_unit(sweep, unit, &opts.run, refs) {
                 if keep(&r) {
-                    on_result(r)?;
+                    on_result(on_worker(r)?)?;
                 }
             }
         }
@@ -266,11 +284,11 @@ pub fn execute<E: Send>(
         .num_threads(opts.threads)
         .build()
         .expect("a rayon pool of N threads can be built");
-    let (tx, rx) = mpsc::channel::<RunResult>();
+    let (tx, rx) = mpsc::channel::<Result<M, E>>();
     let run_opts = opts.run;
     let cancel = AtomicBool::new(false);
     std::thread::scope(|scope| {
-        let cancel = &cancel;
+        let (cancel, on_worker) = (&cancel, &on_worker);
         scope.spawn(move || {
             pool.install(|| {
                 units.par_iter().for_each_with(tx, |tx, unit| {
@@ -279,7 +297,11 @@ pub fn execute<E: Send>(
                     if !cancel.load(Ordering::Relaxed) && !run_opts.cancelled() {
                         for r in run_unit(sweep, unit, &run_opts, refs) {
                             if keep(&r) {
-                                let _ = tx.send(r);
+                                let out = on_worker(r);
+                                if out.is_err() {
+                                    cancel.store(true, Ordering::Relaxed);
+                                }
+                                let _ = tx.send(out);
                             }
                         }
                     }
@@ -288,7 +310,7 @@ pub fn execute<E: Send>(
         });
         let mut result = Ok(());
         for res in rx.iter() {
-            if let Err(e) = on_result(res) {
+            if let Err(e) = res.and_then(&mut on_result) {
                 cancel.store(true, Ordering::Relaxed);
                 result = Err(e);
                 break;

@@ -178,7 +178,7 @@ schema! {
         factor_cache_hits: Option<i64> => "", "factorisations reused from an earlier run of the sweep with the same matrix (2D/3D; null with solver = cg)";
         setup_time_s: Option<f64> => "s", "setup: assembly, factorisation, condensation onto the contact set, initial state (first repeat)";
         stepping_time_s: Option<f64> => "s", "time loop, observables included (first repeat)";
-        observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (a writer thread; its total is in the end-of-sweep line)";
+        observe_time_s: Option<f64> => "s", "part of stepping_time_s spent on energies and error norms (timed on one step in 64, extrapolated); the Parquet output is not in any run's time (encoded once the run is done; its total is in the end-of-sweep line)";
         first_contact_time: Option<f64> => "s", "first t^n with a non-zero contact force or pressure (every scene; null if none)";
         contact_phases: Option<i64> => "", "number of contact intervals, i.e. times the contact force or pressure switched on (every scene)";
         impact_step_first: Option<Vec<i64>> => "", "contact phases found at every step (σ_C < 0; a one-step gap without pressure does not end a phase), one list element per phase: first contact step (null if no step ran; explode the impact_* lists together for one row per phase)";
