@@ -43,14 +43,14 @@ impl W {
         if self.binary {
             self.out.extend_from_slice(&v.to_le_bytes());
         } else {
-            write!(self, "{v} ");
+            let _ = write!(self, "{v} ");
         }
     }
     fn int(&mut self, v: i32) {
         if self.binary {
             self.out.extend_from_slice(&v.to_le_bytes());
         } else {
-            write!(self, "{v} ");
+            let _ = write!(self, "{v} ");
         }
     }
     fn double(&mut self, v: f64) {
@@ -58,7 +58,7 @@ impl W {
             self.out.extend_from_slice(&v.to_le_bytes());
         } else {
             // Debug prints the shortest decimal that reads back to the same double.
-            write!(self, "{v:?} ");
+            let _ = write!(self, "{v:?} ");
         }
     }
     fn eol(&mut self) {

@@ -697,6 +697,9 @@ fn elements(c: &mut Cur) -> Result<Vec<ElementBlock>, MshError> {
             "block {} of {nb} (entity {entity_tag} of dimension {entity_dim})",
             b + 1
         );
+        if !(0..=3).contains(&entity_dim) {
+            return Err(c.err(format!("entity dimension {entity_dim}, expected 0 to 3")));
+        }
         let element_type = c.int("the element type")?;
         let n = c.size("the number of elements in the block")?;
         let Some(k) = nodes_of_type(element_type) else {
@@ -710,7 +713,7 @@ fn elements(c: &mut Cur) -> Result<Vec<ElementBlock>, MshError> {
                 String::new()
             };
             return Err(c.err(format!(
-                "{first} has Gmsh type {element_type} ({}), not supported (cells: 3/6-node triangles, 4/9-node quadrilaterals, 4/10-node tetrahedra, 8/27-node hexahedra; their boundary lines and faces; points)",
+                "{first} has Gmsh type {element_type} ({}), not supported (P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, their faces, points)",
                 type_name(element_type)
             )
             .trim_start()
