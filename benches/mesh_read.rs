@@ -17,6 +17,12 @@
 //! - `…/factorization`: the numeric factorisation of A with the engine's choice for a 2D mesh
 //!   file (AMD, simplicial: `run::fe`'s `build_gmsh`) — made by every run whose matrix differs.
 //!
+//! - `parse/…` (issue 36): the engine's MSH parser alone ([`msh::parse`]) and the whole read with
+//!   validation ([`GmshMesh::from_bytes`]) on the Hertz half-disc (`sweeps/meshes/`, 97 KB
+//!   ASCII, and its binary rewrite) and on the unit square of 10⁶ nodes (n = 999, P1) — the
+//!   files are written into cargo's target temporary folder so that the parser the engine used
+//!   before (`mshio`) can be timed on the same bytes.
+//!
 //! `cargo bench --bench mesh_read`; docs/performance.md has the medians.
 
 use std::fmt::Write as _;
@@ -25,9 +31,13 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
+use contact_sweep::space::fe::msh;
 use contact_sweep::space::fe::{
     DofMap, ElementOp, GmshMesh, Mesh, SymMatrix, assemble, fe_pattern,
 };
+
+#[path = "../tests/msh_io/mod.rs"]
+mod msh_io;
 use contact_sweep::space::linalg::{
     Cholesky, CholeskyOptions, FactorKind, Ordering, SymbolicCholesky,
 };
@@ -195,7 +205,47 @@ fn bench_square(c: &mut Criterion, name: &str, n: usize, p: usize) {
     g.finish();
 }
 
+/// The parser and the whole read on the Hertz mesh (ASCII, binary) and a 10⁶-node square.
+fn parse_files(c: &mut Criterion) {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mesh_parse");
+    std::fs::create_dir_all(&dir).expect("the target folder is writable");
+    let hertz = std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/meshes/hertz_halfdisc.msh"),
+    )
+    .expect("the committed Hertz mesh");
+    let bin = msh_io::write(
+        &msh::parse(&hertz).expect("a valid file"),
+        &msh_io::Style {
+            binary: true,
+            ..Default::default()
+        },
+    );
+    std::fs::write(dir.join("hertz_bin.msh"), &bin).expect("written");
+    std::fs::write(dir.join("hertz.msh"), &hertz).expect("written");
+    let big_path = dir.join("square_1e6.msh");
+    if !big_path.exists() {
+        std::fs::write(&big_path, square_msh(999, 1)).expect("written");
+    }
+    let big = std::fs::read(&big_path).expect("read back");
+    let mut g = c.benchmark_group("parse");
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    for (name, bytes) in [
+        ("hertz-ascii", &hertz),
+        ("hertz-binary", &bin),
+        ("square-1e6", &big),
+    ] {
+        g.bench_function(format!("{name}/parse"), |b| {
+            b.iter(|| msh::parse(bytes).expect("a valid file"))
+        });
+        g.bench_function(format!("{name}/read"), |b| {
+            b.iter(|| GmshMesh::from_bytes(name, bytes).expect("a valid mesh"))
+        });
+    }
+    g.finish();
+}
+
 fn mesh_read(c: &mut Criterion) {
+    parse_files(c);
     bench_square(c, "mesh-p1-1e5", 223, 1);
     bench_square(c, "mesh-p2-1e5", 112, 2);
 }

@@ -497,6 +497,12 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             sink.migrated.len()
         );
     }
+    if !sink.migrated_series.is_empty() {
+        eprintln!(
+            "note: {} series part(s) written by an older version given this version's columns (new columns null)",
+            sink.migrated_series.len()
+        );
+    }
     for p in &sink.legacy_damaged {
         eprintln!(
             "note: moved {} (a damaged part set aside by an older version) out of the parts' folder",

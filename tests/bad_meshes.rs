@@ -3,9 +3,11 @@
 //! names the file. The meshes are hand-written MSH 4.1 (ASCII) variations of one good file: the
 //! unit square as two counter-clockwise triangles, `contact` = the bottom line.
 
-use std::path::PathBuf;
+mod msh_io;
 
-use contact_sweep::space::fe::{GmshError, GmshMesh};
+use std::path::{Path, PathBuf};
+
+use contact_sweep::space::fe::{ElementKind, GmshError, GmshMesh};
 
 /// The good file; each test edits one thing in it.
 const GOOD: &str = "$MeshFormat
@@ -118,13 +120,21 @@ fn contact_group_of_the_wrong_dimension() {
 
 #[test]
 fn unsupported_element_type() {
-    // Element 1 becomes a 4-node (cubic) line, Gmsh type 26.
+    // Element 1 becomes a 4-node (cubic) line, Gmsh type 26: refused by the parser, naming the
+    // section, the block and the element.
     let e = refused(&edit("1 1 1 1\n1 1 2\n", "1 1 26 1\n1 1 2 3 4\n"));
     match e {
-        GmshError::UnsupportedElement {
-            element, type_id, ..
-        } => assert_eq!((element, type_id), (1, 26)),
-        other => panic!("expected UnsupportedElement, got {other:?}"),
+        GmshError::Parse { error, .. } => {
+            assert_eq!(error.section, "$Elements");
+            assert!(error.at.contains("block 1 of 2"), "{error}");
+            assert!(
+                error
+                    .reason
+                    .contains("element 1 has Gmsh type 26 (4-node line)"),
+                "{error}"
+            );
+        }
+        other => panic!("expected Parse, got {other:?}"),
     }
 }
 
@@ -428,4 +438,432 @@ fn bad_mesh_sweeps_are_refused_with_the_file_key_and_exit_2() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Issue 36: the user's mesh under fire. Each class the issue found is refused at read time (so
+// at plan time: the planner reads every mesh file) with one line naming the file and the
+// reason, or — for valid rewrites — read as the same mesh.
+
+/// Every refusal's message: one line, under 300 characters, naming the file.
+fn one_line(e: &GmshError, path: &Path) {
+    let msg = e.to_string();
+    assert!(!msg.contains('\n'), "more than one line: {msg}");
+    assert!(msg.chars().count() < 300, "{} chars: {msg}", msg.len());
+    assert!(msg.contains(&path.display().to_string()), "{msg}");
+}
+
+/// The error of `bytes`, checked by [`one_line`].
+fn refused_bytes(bytes: &[u8]) -> GmshError {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("body.msh");
+    std::fs::write(&path, bytes).unwrap();
+    let e = GmshMesh::read(&path).expect_err("the mesh must be refused");
+    one_line(&e, &path);
+    e
+}
+
+/// `plan` and `run` of a mesh2d sweep on `mesh`: exit 2, no panic, no output folder, and the
+/// stderr line naming the mesh file under 300 characters and holding `reason`.
+fn refused_by_the_binary(mesh: &[u8], scene: &str, reason: &str) {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    std::fs::write(dir.join("body.msh"), mesh).unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        format!(
+            "name = \"x\"\nscene = \"{scene}\"\n[fixed]\ndt = 0.1\nT = 0.2\nmesh = \"body.msh\"\n"
+        ),
+    )
+    .unwrap();
+    for cmd in ["plan", "run"] {
+        let mut args = vec![cmd, "s.toml"];
+        if cmd == "run" {
+            args.extend(["--out", "out"]);
+        }
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_contact-sweep"))
+            .args(&args)
+            .current_dir(dir)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{cmd}:\n{err}");
+        assert!(!err.contains("panicked"), "{cmd}: panic\n{err}");
+        let line = err
+            .lines()
+            .find(|l| l.contains("body.msh"))
+            .unwrap_or_else(|| panic!("{cmd}: the mesh file is not named\n{err}"));
+        assert!(
+            line.chars().count() < 300,
+            "{cmd}: {} chars: {line}",
+            line.len()
+        );
+        assert!(line.contains(reason), "{cmd}: `{reason}` missing: {line}");
+        assert!(!dir.join("out").exists(), "{cmd}: output written");
+    }
+}
+
+fn committed(name: &str) -> Vec<u8> {
+    std::fs::read(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("sweeps/meshes")
+            .join(name),
+    )
+    .unwrap()
+}
+
+#[test]
+fn nodes_listed_out_of_tag_order_are_read_by_tag() {
+    // Issue 36's misread: the bottom row listed last under a `$Nodes` header whose tag range is
+    // contiguous (1..4 for 4 nodes). mshio numbered the nodes by position, so the square was
+    // read mirrored (contact on top) or refused as inverted. Read by tag, it is the same mesh.
+    let swapped = edit(
+        "1 1 0 2\n1\n2\n0 0 0\n1 0 0\n2 1 0 2\n3\n4\n1 1 0\n0 1 0\n",
+        "2 1 0 2\n3\n4\n1 1 0\n0 1 0\n1 1 0 2\n1\n2\n0 0 0\n1 0 0\n",
+    );
+    let (a, _, _d1) = read(GOOD);
+    let (b, _, _d2) = read(&swapped);
+    let (a, b) = (a.unwrap(), b.unwrap_or_else(|e| panic!("{e}")));
+    // Equal in everything but the bytes' hash: coordinates, numbering, cells, groups, h.
+    assert_eq!(a.coords, b.coords);
+    assert_eq!(a.node_tags, b.node_tags);
+    assert_eq!(a.elements, b.elements);
+    assert_eq!(a.groups, b.groups);
+    assert_eq!((a.h, a.reoriented), (b.h, b.reoriented));
+    // Γ_C is the bottom y = 0, not the top.
+    for &n in &b.group("contact").unwrap().nodes {
+        assert_eq!(b.coords[n][1], 0.0);
+    }
+}
+
+#[test]
+fn physical_names_count_of_1e9_and_1e18_is_refused_not_aborted() {
+    // 10⁹ aborted the process (40 GB asked of the allocator), 10¹⁸ panicked ("capacity
+    // overflow"): the count is checked against the bytes left first.
+    for count in ["1000000000", "1000000000000000000", "18446744073709551615"] {
+        let text = edit("$PhysicalNames\n2\n", &format!("$PhysicalNames\n{count}\n"));
+        match refused_bytes(text.as_bytes()) {
+            GmshError::Parse { error, .. } => {
+                assert_eq!(error.section, "$PhysicalNames");
+                assert!(
+                    error
+                        .reason
+                        .contains(&format!("{count} physical names announced")),
+                    "{error}"
+                );
+            }
+            other => panic!("expected Parse, got {other:?}"),
+        }
+        refused_by_the_binary(text.as_bytes(), "mesh2d", "$PhysicalNames");
+    }
+    // A count past u64 is no integer.
+    let text = edit(
+        "$PhysicalNames\n2\n",
+        "$PhysicalNames\n99999999999999999999999\n",
+    );
+    assert!(matches!(
+        refused_bytes(text.as_bytes()),
+        GmshError::Parse { .. }
+    ));
+}
+
+#[test]
+fn binary_data_size_of_0_3_or_25_digits_is_refused() {
+    // mshio panicked on these (`not implemented`, an unwrap on PosOverflow).
+    let good = committed("square_tri_p1_bin.msh");
+    let head = b"$MeshFormat\n4.1 1 8\n";
+    assert!(good.starts_with(head));
+    for size in ["", "3", "1234567890123456789012345"] {
+        let mut bytes = format!("$MeshFormat\n4.1 1 {size}\n").into_bytes();
+        bytes.extend_from_slice(&good[head.len()..]);
+        match refused_bytes(&bytes) {
+            GmshError::Parse { error, .. } => {
+                assert_eq!(error.section, "$MeshFormat", "{error}");
+                assert!(error.reason.contains("data size"), "{error}");
+            }
+            other => panic!("expected Parse, got {other:?}"),
+        }
+        refused_by_the_binary(&bytes, "mesh2d", "data size");
+    }
+}
+
+#[test]
+fn point_element_in_a_contact_curve_is_refused_at_read() {
+    // A point (Gmsh type 15) in the contact curve's block panicked inside every run
+    // (src/run/fe.rs, an index out of bounds on the face's second node).
+    let text = edit("1 1 1 1\n1 1 2\n", "1 1 15 1\n1 1\n");
+    match refused(&text) {
+        GmshError::Parse { error, .. } => {
+            assert_eq!(error.section, "$Elements");
+            assert!(
+                error
+                    .reason
+                    .contains("points (dimension 0) in a block of an entity of dimension 1"),
+                "{error}"
+            );
+        }
+        other => panic!("expected Parse, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "point");
+}
+
+#[test]
+fn cell_listed_twice_is_refused() {
+    // E(T)/E⁰ went from 1.326 to 1.366 on a mesh with a cell listed twice.
+    let text = edit("2 3 1 3\n", "2 4 1 4\n")
+        .replacen("2 1 2 2\n", "2 1 2 3\n", 1)
+        .replacen("3 1 3 4\n", "3 1 3 4\n4 3 4 1\n", 1);
+    match refused(&text) {
+        GmshError::DuplicateCell { element, first, .. } => assert_eq!((element, first), (4, 3)),
+        other => panic!("expected DuplicateCell, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "a cell listed twice");
+}
+
+#[test]
+fn overlapping_cells_are_refused() {
+    // A third triangle (1, 2, 4) over the square: it shares edge 1–2 with element 2 on the same
+    // side (both traverse it 1 → 2).
+    let text = edit("2 3 1 3\n", "2 4 1 4\n")
+        .replacen("2 1 2 2\n", "2 1 2 3\n", 1)
+        .replacen("3 1 3 4\n", "3 1 3 4\n4 1 2 4\n", 1);
+    match refused(&text) {
+        GmshError::SameSide { a, b, nodes, .. } => {
+            assert_eq!((a, b, nodes), (2, 4, vec![1, 2]));
+        }
+        other => panic!("expected SameSide, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "overlap");
+    // Both diagonals' triangles: the square covered twice, every side shared on one side.
+    let text = edit("2 3 1 3\n", "2 5 1 5\n")
+        .replacen("2 1 2 2\n", "2 1 2 4\n", 1)
+        .replacen("3 1 3 4\n", "3 1 3 4\n4 1 2 4\n5 2 3 4\n", 1);
+    assert!(matches!(refused(&text), GmshError::SameSide { .. }));
+}
+
+#[test]
+fn crack_of_coincident_nodes_is_refused() {
+    // Element 3 uses node 5, a copy of node 1 at (0, 0): the two triangles share only node 3, so
+    // the diagonal is a crack (two boundary edges on one line).
+    let text = edit("2 4 1 4\n", "2 5 1 5\n")
+        .replacen(
+            "2 1 0 2\n3\n4\n1 1 0\n0 1 0\n",
+            "2 1 0 3\n3\n4\n5\n1 1 0\n0 1 0\n0 0 0\n",
+            1,
+        )
+        .replacen("3 1 3 4\n", "3 5 3 4\n", 1);
+    match refused(&text) {
+        GmshError::CoincidentNodes { a, b, distance, .. } => {
+            assert_eq!((a, b, distance), (1, 5, 0.0));
+        }
+        other => panic!("expected CoincidentNodes, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "coincide");
+}
+
+#[test]
+fn contact_on_an_interior_face_is_refused() {
+    // The diagonal 1–3 is shared by both triangles: the plane inside the body.
+    let text = edit("1 1 1 1\n1 1 2\n", "1 1 1 1\n1 1 3\n");
+    match refused(&text) {
+        GmshError::GroupElement {
+            group,
+            element,
+            reason,
+            ..
+        } => {
+            assert_eq!((group.as_str(), element), ("contact", 1));
+            assert!(
+                reason.contains("interior face (between elements 2 and 3)"),
+                "{reason}"
+            );
+        }
+        other => panic!("expected GroupElement, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "interior face");
+}
+
+#[test]
+fn contact_elements_of_the_wrong_type_or_no_face_are_refused() {
+    // A 3-node line on P1 triangles.
+    let text = edit("1 1 1 1\n1 1 2\n", "1 1 8 1\n1 1 2 3\n");
+    match refused(&text) {
+        GmshError::GroupElement { reason, .. } => assert!(
+            reason.contains(
+                "a 3-node line, but the faces of the mesh's 3-node triangles are 2-node lines"
+            ),
+            "{reason}"
+        ),
+        other => panic!("expected GroupElement, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "3-node line");
+    // The line 2–4 crosses the square: no cell has it as an edge ("no face of any cell" failed
+    // inside every Nitsche run, after planning accepted the file).
+    let text = edit("1 1 1 1\n1 1 2\n", "1 1 1 1\n1 2 4\n");
+    match refused(&text) {
+        GmshError::GroupElement { reason, .. } => {
+            assert!(
+                reason.contains("vertices [2, 4] are no face of any cell"),
+                "{reason}"
+            )
+        }
+        other => panic!("expected GroupElement, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "no face of any cell");
+}
+
+/// One 6-node triangle, corners (0,0), (1,0), (0,1), midside nodes as given (Gmsh order: edges
+/// 01, 12, 20), `contact` = edge 01.
+fn p2_triangle(m: [[f64; 2]; 3]) -> String {
+    format!(
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 1 \"contact\"\n$EndPhysicalNames\n\
+         $Entities\n0 1 1 0\n1 0 0 0 1 0 0 1 1 0\n1 0 0 0 1 1 0 0 1 1\n$EndEntities\n\
+         $Nodes\n1 6 1 6\n2 1 0 6\n1\n2\n3\n4\n5\n6\n0 0 0\n1 0 0\n0 1 0\n{} {} 0\n{} {} 0\n{} {} 0\n$EndNodes\n\
+         $Elements\n2 2 1 2\n1 1 8 1\n1 1 2 4\n2 1 9 1\n2 1 2 3 4 5 6\n$EndElements\n",
+        m[0][0], m[0][1], m[1][0], m[1][1], m[2][0], m[2][1]
+    )
+}
+
+#[test]
+fn folded_p2_triangle_positive_at_the_points_checked_is_refused() {
+    // Midside nodes (0.82, 0.07), (0.8, 0.25), (0.08, 0.54): det J (a degree-2 polynomial) is
+    // positive at the 9 points the reader sampled (vertices, edge midpoints, the 3 quadrature
+    // points; smallest 0.056 at vertex 1) but negative on about 7 % of the cell (a 400 × 400
+    // grid), e.g. −0.058 at (0.772, 0.206). Its Bernstein coefficients are not all positive, and
+    // subdivision finds a negative value.
+    let m = [[0.82, 0.07], [0.8, 0.25], [0.08, 0.54]];
+    let mut x = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    x.extend(m.iter().map(|p| [p[0], p[1], 0.0]));
+    let det = |xi: [f64; 3]| {
+        let g = ElementKind::Tri6.shape_gradients(xi);
+        let mut j = [[0.0; 2]; 2];
+        for (xa, ga) in x.iter().zip(&g) {
+            for r in 0..2 {
+                for c in 0..2 {
+                    j[r][c] += xa[r] * ga[c];
+                }
+            }
+        }
+        j[0][0] * j[1][1] - j[0][1] * j[1][0]
+    };
+    // The premise: positive where the old check looked, negative inside.
+    let (a, b) = (1.0 / 6.0, 2.0 / 3.0);
+    for p in [
+        [0.0, 0.0],
+        [1.0, 0.0],
+        [0.0, 1.0],
+        [0.5, 0.0],
+        [0.5, 0.5],
+        [0.0, 0.5],
+        [a, a],
+        [b, a],
+        [a, b],
+    ] {
+        assert!(det([p[0], p[1], 0.0]) > 0.05, "{p:?}");
+    }
+    assert!(det([0.772, 0.2055, 0.0]) < -0.05);
+    let text = p2_triangle(m);
+    match refused(&text) {
+        GmshError::Inverted {
+            element,
+            det: d,
+            xi,
+            ..
+        } => {
+            assert_eq!(element, 2);
+            // A value of det J itself, at the reported point.
+            assert!(d < 0.0 && (d - det(xi)).abs() < 1e-12, "{d} at {xi:?}");
+        }
+        other => panic!("expected Inverted, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "inverted");
+    // The straight cell and a gently curved one are certified (det J = 1, and 1 − 0.4 η … > 0).
+    let (r, _, _d) = read(&p2_triangle([[0.5, 0.0], [0.5, 0.5], [0.0, 0.5]]));
+    r.unwrap_or_else(|e| panic!("{e}"));
+    let (r, _, _d) = read(&p2_triangle([[0.5, 0.0], [0.55, 0.55], [0.0, 0.5]]));
+    r.unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn p2_midside_node_not_shared_is_refused() {
+    // Two 6-node triangles on the unit square sharing the diagonal 1–3, each with its own
+    // midside node on it (7 at (0.5, 0.5), 10 at (0.45, 0.55)): the field is cut along it.
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 1 \"contact\"\n$EndPhysicalNames\n\
+         $Entities\n0 1 1 0\n1 0 0 0 1 0 0 1 1 0\n1 0 0 0 1 1 0 0 1 1\n$EndEntities\n\
+         $Nodes\n1 10 1 10\n2 1 0 10\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n\
+         0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0 0\n1 0.5 0\n0.5 0.5 0\n0.5 1 0\n0 0.5 0\n0.45 0.55 0\n$EndNodes\n\
+         $Elements\n2 3 1 3\n1 1 8 1\n1 1 2 5\n2 1 9 2\n2 1 2 3 5 6 7\n3 1 3 4 10 8 9\n$EndElements\n";
+    match refused(text) {
+        GmshError::NotConforming {
+            a,
+            b,
+            vertices,
+            na,
+            nb,
+            ..
+        } => {
+            assert_eq!((a, b, vertices), (2, 3, vec![1, 3]));
+            let mut both = [na, nb].concat();
+            both.sort_unstable();
+            assert_eq!(both, vec![7, 10]);
+        }
+        other => panic!("expected NotConforming, got {other:?}"),
+    }
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "not conforming");
+}
+
+#[test]
+fn nan_z_in_a_2d_mesh_is_refused() {
+    for v in ["nan", "NaN", "inf", "-inf"] {
+        let text = edit("0 1 0\n$EndNodes", &format!("0 1 {v}\n$EndNodes"));
+        match refused(&text) {
+            GmshError::NonFinite { node, axis, .. } => assert_eq!((node, axis), (4, "z")),
+            other => panic!("expected NonFinite, got {other:?}"),
+        }
+    }
+    let text = edit("0 1 0\n$EndNodes", "0 1 nan\n$EndNodes");
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "every coordinate must be finite");
+}
+
+#[test]
+fn node_tag_given_twice_is_refused() {
+    let text = edit("2 1 0 2\n3\n4\n", "2 1 0 2\n3\n2\n");
+    match refused(&text) {
+        GmshError::DuplicateNodeTag { node, .. } => assert_eq!(node, 2),
+        other => panic!("expected DuplicateNodeTag, got {other:?}"),
+    }
+}
+
+#[test]
+fn messages_are_one_line_without_dumps() {
+    // mshio answered "Unknown error occurred" with a hex dump of the rest of the file (450 KB
+    // for the Hertz mesh). Truncated, damaged and lying files, ASCII and binary: one line each.
+    let hertz = committed("hertz_halfdisc.msh");
+    let bin = committed("square_tri_p1_bin.msh");
+    let mut cases: Vec<Vec<u8>> = vec![
+        hertz[..hertz.len() / 2].to_vec(),
+        bin[..bin.len() / 2].to_vec(),
+        bin[..bin.len() - 12].to_vec(),
+    ];
+    let mut flipped = hertz.clone();
+    let at = flipped.windows(6).position(|w| w == b"$Nodes").unwrap() + 9;
+    flipped[at] = b'x';
+    cases.push(flipped);
+    let mut lying = bin.clone();
+    let at = lying.windows(7).position(|w| w == b"$Nodes\n").unwrap() + 7;
+    lying[at..at + 8].copy_from_slice(&u64::MAX.to_le_bytes());
+    cases.push(lying);
+    for c in &cases {
+        match refused_bytes(c) {
+            GmshError::Parse { error, .. } => {
+                assert!(
+                    error.section.starts_with('$') || error.section == "file",
+                    "{error}"
+                )
+            }
+            other => panic!("expected Parse, got {other:?}"),
+        }
+    }
+    // The section is named right after the file.
+    refused_by_the_binary(&cases[0], "mesh2d", "body.msh: $");
 }

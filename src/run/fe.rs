@@ -47,6 +47,7 @@ use crate::contact::Lcp;
 use crate::scene::{FeGeometry, FeSetup, LoadModel};
 use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
+use crate::space::fe::mesh::mesh_layers;
 use crate::space::fe::nitsche::{
     ContactPoint, box_contact_faces, contact_points, face_contact_points, gmsh_contact_faces,
 };
@@ -424,47 +425,10 @@ fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     }
 }
 
-/// Mass layers of a mesh (SPEC §2.2, §1.6): layer 0 = the cells with a node in `seed`, layer
-/// k + 1 the cells not yet layered that share a node with layer k (breadth-first over shared
-/// nodes, as the disc/ball). Cells of a part never reached (a body not connected to Γ_C) take
-/// one layer past the last.
-fn node_layers(mesh: &dyn Mesh, seed: &[usize]) -> Vec<usize> {
-    let ne = mesh.num_elements();
-    let mut layers = vec![usize::MAX; ne];
-    let mut reached = vec![false; mesh.num_nodes()];
-    for &n in seed {
-        reached[n] = true;
-    }
-    let mut k = 0;
-    loop {
-        let now: Vec<usize> = (0..ne)
-            .filter(|&e| {
-                layers[e] == usize::MAX && mesh.element_nodes(e).iter().any(|&n| reached[n])
-            })
-            .collect();
-        if now.is_empty() {
-            break;
-        }
-        for &e in &now {
-            layers[e] = k;
-        }
-        for &e in &now {
-            for &n in mesh.element_nodes(e) {
-                reached[n] = true;
-            }
-        }
-        k += 1;
-    }
-    for l in layers.iter_mut().filter(|l| **l == usize::MAX) {
-        *l = k;
-    }
-    layers
-}
-
 /// A Gmsh mesh (SPEC §1.6): the `clamped` group's nodes fixed (every component), contact on the
 /// vertical dofs of the other `contact` nodes, each with its height above the lowest of them
 /// (the run's `gap` is added: the plane is x_d = lowest − gap), Γ_C's mean weighting each node
-/// by its faces' measures, mass layers by topology ([`node_layers`]).
+/// by its faces' measures, mass layers by topology ([`mesh_layers`]).
 fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let d = mesh.dim;
     let nn = mesh.num_nodes();
@@ -555,7 +519,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let vertical = (0..dofs.n_free())
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
-    let layers = node_layers(&*mesh, &group.nodes);
+    let layers = mesh_layers(&*mesh, &group.nodes);
     // Heights above the lowest Γ_C node, as the nodes' (the run adds its gap, [`factor`]).
     let points = gmsh_contact_faces(&mesh, group).map(|faces| {
         reduce_points(

@@ -397,9 +397,35 @@ pub fn conform_runs_parts(tmp_dir: &Path, runs_dir: &Path) -> Result<Vec<PathBuf
             source,
         })?
         .schema();
+    conform_parts(
+        tmp_dir,
+        runs_dir,
+        &current,
+        ::parquet::basic::Compression::UNCOMPRESSED,
+    )
+}
+
+/// [`conform_runs_parts`] for the series parts: the columns of [`parquet::series_schema`]
+/// (a folder resumed by a version with new series columns — issue 32's friction series —
+/// must hold one schema there too, or polars' glob refuses the folder's series).
+pub fn conform_series_parts(tmp_dir: &Path, series_dir: &Path) -> Result<Vec<PathBuf>, SinkError> {
+    conform_parts(
+        tmp_dir,
+        series_dir,
+        &parquet::series_schema(),
+        parquet::codec(),
+    )
+}
+
+fn conform_parts(
+    tmp_dir: &Path,
+    runs_dir: &Path,
+    current: &arrow_schema::Schema,
+    compression: ::parquet::basic::Compression,
+) -> Result<Vec<PathBuf>, SinkError> {
     let mut rewritten = Vec::new();
     for part in parquet_parts(runs_dir)? {
-        match parquet::runs_part_is_current(&part, &current) {
+        match parquet::part_is_current(&part, current) {
             Ok(true) | Err(_) => continue,
             Ok(false) => {}
         }
@@ -409,7 +435,7 @@ pub fn conform_runs_parts(tmp_dir: &Path, runs_dir: &Path) -> Result<Vec<PathBuf
             .unwrap_or("part")
             .to_string();
         match write_part_atomic(tmp_dir, runs_dir, &name, "conform", |out| {
-            parquet::conform_runs_part(&part, &current, out)
+            parquet::conform_part(&part, current, compression, out)
         }) {
             Ok(_) => rewritten.push(part),
             // A page that cannot be decoded: the part stays as it is, for `quarantine`.
@@ -610,6 +636,8 @@ pub struct Sink {
     /// Runs parts of an older version rewritten with the current columns when the folder was
     /// opened ([`conform_runs_parts`]).
     pub migrated: Vec<PathBuf>,
+    /// Series parts rewritten likewise ([`conform_series_parts`]).
+    pub migrated_series: Vec<PathBuf>,
     shared_with_others: bool,
     shared: Arc<Mutex<Shared>>,
     jobs: Option<mpsc::Sender<Job>>,
@@ -641,10 +669,12 @@ impl Sink {
         };
         let tmp_dir = dir.join(".tmp");
         let mut migrated = Vec::new();
+        let mut migrated_series = Vec::new();
         if alone {
             Self::clean(&tmp_dir, &runs_dir, &series_dir)?;
             fs::create_dir_all(&tmp_dir).map_err(io(&tmp_dir))?;
             migrated = conform_runs_parts(&tmp_dir, &runs_dir)?;
+            migrated_series = conform_series_parts(&tmp_dir, &series_dir)?;
             lock.unlock().map_err(io(&lock_path))?;
         }
         fs::create_dir_all(&tmp_dir).map_err(io(&tmp_dir))?;
@@ -687,6 +717,7 @@ impl Sink {
                 damaged,
                 legacy_damaged,
                 migrated,
+                migrated_series,
                 shared_with_others: !alone,
                 shared,
                 jobs: Some(jobs),

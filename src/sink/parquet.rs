@@ -156,7 +156,7 @@ pub fn write_runs<W: Write + Send>(out: W, batch: &RecordBatch) -> Result<(), Pa
 
 /// The schema of a series part: every series column, all nullable (as the parts have always
 /// been).
-fn series_schema() -> Arc<Schema> {
+pub fn series_schema() -> Arc<Schema> {
     let mut fields = vec![
         Field::new("run_id", DataType::Utf8, true),
         Field::new("step", DataType::Int64, true),
@@ -210,16 +210,16 @@ pub fn write_series<W: Write + Send>(
     Ok(())
 }
 
-/// Whether a runs part already has exactly the columns of `current` (the current
-/// [`RunRecord`](crate::run::RunRecord) schema), in order.
-pub fn runs_part_is_current(path: &Path, current: &Schema) -> Result<bool, ParquetError> {
+/// Whether a part already has exactly the columns of `current` (the current
+/// [`RunRecord`](crate::run::RunRecord) schema, or [`series_schema`]), in order.
+pub fn part_is_current(path: &Path, current: &Schema) -> Result<bool, ParquetError> {
     let b = builder(path)?;
     let names =
         |s: &Schema| -> Vec<String> { s.fields().iter().map(|f| f.name().clone()).collect() };
     Ok(names(b.schema()) == names(current))
 }
 
-/// Rewrite a runs part written by an older version into `out` with the columns of `current`:
+/// Rewrite a part written by an older version into `out` with the columns of `current`:
 /// its own columns as stored (read by their Parquet logical types, as every reader reads
 /// them), a column it lacks as nulls of the current type, in the current order; a column the
 /// current schema no longer has is kept, after the others (nothing computed is dropped).
@@ -227,10 +227,13 @@ pub fn runs_part_is_current(path: &Path, current: &Schema) -> Result<bool, Parqu
 /// Why: readers of a folder glob take the first part's columns as the folder's. Polars
 /// refuses a later part with a column the first lacks ("extra column in file outside of
 /// expected schema"), pyarrow's dataset (pandas) silently drops it — so a folder resumed by a
-/// version with new columns (`rho_inf`, `pressure_oscillation`, …) must hold one schema.
-pub fn conform_runs_part<W: Write + Send>(
+/// version with new columns (`rho_inf`, `pressure_oscillation`, …; the series' friction columns
+/// of issue 32) must hold one schema. `compression`: the parts' own (none for runs parts,
+/// [`codec`] for series parts, whose size it keeps).
+pub fn conform_part<W: Write + Send>(
     path: &Path,
     current: &Schema,
+    compression: Compression,
     out: W,
 ) -> Result<(), ParquetError> {
     let file = File::open(path).map_err(|e| ParquetError::External(Box::new(e)))?;
@@ -262,7 +265,7 @@ pub fn conform_runs_part<W: Write + Send>(
     }
     let schema = Arc::new(Schema::new(fields));
     let options = ArrowWriterOptions::new()
-        .with_properties(properties(&schema, Compression::UNCOMPRESSED))
+        .with_properties(properties(&schema, compression))
         .with_skip_arrow_metadata(true);
     let mut writer = ArrowWriter::try_new_with_options(out, Arc::clone(&schema), options)?;
     for batch in batches {

@@ -279,29 +279,9 @@ impl BallMesh {
         }
         self.contact_nodes = (0..self.coords.len()).filter(|&n| on_contact[n]).collect();
         // Layers: breadth-first over shared nodes from the elements touching Γ_C.
+        self.layers = super::mesh::mesh_layers(&*self, &self.contact_nodes);
         let ne = self.num_elements();
         let npe = self.nodes_per_element();
-        let mut layers = vec![usize::MAX; ne];
-        let mut reached = on_contact;
-        let mut k = 0;
-        while layers.contains(&usize::MAX) {
-            let now: Vec<usize> = (0..ne)
-                .filter(|&e| {
-                    layers[e] == usize::MAX && self.element_nodes(e).iter().any(|&n| reached[n])
-                })
-                .collect();
-            assert!(!now.is_empty(), "the ball mesh is connected");
-            for &e in &now {
-                layers[e] = k;
-            }
-            for &e in &now {
-                for &n in &self.elements[e * npe..(e + 1) * npe] {
-                    reached[n] = true;
-                }
-            }
-            k += 1;
-        }
-        self.layers = layers;
         let p = self.degree;
         let corners: Vec<usize> = (0..npe)
             .filter(|&l| {

@@ -5,8 +5,10 @@
 //! its node ids + its node coordinates"), so a Gmsh mesh is one more implementation of that trait
 //! ([`GmshMesh`]), not a parallel mesh type.
 //!
-//! What is read (with the `mshio` crate, which parses MSH 4.1 nodes, elements and entities; the
-//! `$PhysicalNames` section, which `mshio` skips, is read here — it is ASCII in binary files too):
+//! What is read (by [`super::msh`], the engine's own MSH 4.1 parser, which cannot panic and
+//! checks every count against the bytes left before allocating):
+//! - the nodes, numbered by increasing tag whatever order or block header the file has (a
+//!   rewrite listing them otherwise is the same mesh, to the bit);
 //! - the cells: the elements of the highest dimension present, one type per mesh among 3- and
 //!   6-node triangles, 4- and 9-node quadrilaterals, 4- and 10-node tetrahedra, 8- and 27-node
 //!   hexahedra ([`ElementKind`]);
@@ -19,11 +21,17 @@
 //! along axis k), so the Q1/Q2 kernels apply unchanged.
 //!
 //! Validation (each failure a [`GmshError`] naming the file, the element/node/group and the
-//! reason): a file that is not MSH 4.1, an unsupported element type, mixed cell types, no
+//! reason, on one line): a file that is not MSH 4.1 or not well formed (the section, the block
+//! and why), a node tag given twice, a coordinate that is not finite, mixed cell types, no
 //! cells, a missing `contact` group, a 2D mesh whose nodes do not share one z, unreferenced
-//! nodes (not in any cell), and inverted or degenerate cells — det J is evaluated at every
-//! reference node of the cell and at its quadrature points ([`ElementKind::quadrature`]). A 2D
-//! mesh whose cells are all clockwise in the (x, y) plane (a surface oriented towards −z) is
+//! nodes (not in any cell), inverted or degenerate cells — det J is evaluated at every
+//! reference node of the cell and at its quadrature points ([`ElementKind::quadrature`]), then
+//! certified positive over the whole cell by its Bernstein coefficients — and the whole-mesh
+//! checks of [`super::check`]: cells listed twice, faces shared by more than two cells or by
+//! two on one side (overlaps), neighbours not sharing their midside nodes, coincident distinct
+//! nodes (a crack), and `contact`/`clamped` elements that are not boundary faces of the cells'
+//! type. A 2D mesh whose cells are all clockwise in the (x, y) plane (a surface oriented
+//! towards −z) is
 //! reoriented rather than refused; a cell of the other orientation is then inverted.
 //!
 //! Also returned: `h` = the largest cell diameter (largest distance between two nodes of a
@@ -35,11 +43,11 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::SystemTime;
 
-use mshio::mshfile::ElementType;
 use sha2::{Digest, Sha256};
 
 use super::element::{gauss_legendre, shape};
 use super::mesh::Mesh;
+use super::{check, msh};
 
 /// The cell types of a Gmsh mesh the engine supports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -91,17 +99,17 @@ const HEX_FACES: [[usize; 4]; 6] = [
 ];
 
 impl ElementKind {
-    /// The supported cell kind of a Gmsh element type, if any.
-    pub fn from_gmsh(t: ElementType) -> Option<ElementKind> {
+    /// The supported cell kind of a Gmsh element type id, if any.
+    pub fn from_gmsh(t: i32) -> Option<ElementKind> {
         Some(match t {
-            ElementType::Tri3 => ElementKind::Tri3,
-            ElementType::Tri6 => ElementKind::Tri6,
-            ElementType::Qua4 => ElementKind::Quad4,
-            ElementType::Qua9 => ElementKind::Quad9,
-            ElementType::Tet4 => ElementKind::Tet4,
-            ElementType::Tet10 => ElementKind::Tet10,
-            ElementType::Hex8 => ElementKind::Hex8,
-            ElementType::Hex27 => ElementKind::Hex27,
+            2 => ElementKind::Tri3,
+            9 => ElementKind::Tri6,
+            3 => ElementKind::Quad4,
+            10 => ElementKind::Quad9,
+            4 => ElementKind::Tet4,
+            11 => ElementKind::Tet10,
+            5 => ElementKind::Hex8,
+            12 => ElementKind::Hex27,
             _ => return None,
         })
     }
@@ -368,7 +376,7 @@ fn jacobian_det(kind: ElementKind, x: &[[f64; 3]], xi: [f64; 3]) -> f64 {
 
 /// det J of the cell with node coordinates `x` from the reference shape gradients at one point
 /// (computed once per point for every cell of a mesh by the validation).
-fn det_from_gradients(d: usize, x: &[[f64; 3]], grads: &[[f64; 3]]) -> f64 {
+pub(crate) fn det_from_gradients(d: usize, x: &[[f64; 3]], grads: &[[f64; 3]]) -> f64 {
     let mut j = [[0.0; 3]; 3];
     for (xa, ga) in x.iter().zip(grads) {
         for i in 0..d {
@@ -397,8 +405,9 @@ pub enum GmshError {
     },
     #[error("{file}: not a Gmsh MSH 4.1 file ({reason}); save it with Gmsh's -format msh41")]
     NotMsh41 { file: String, reason: String },
-    #[error("{file}: MSH 4.1 file could not be parsed: {reason}")]
-    Parse { file: String, reason: String },
+    /// The file's structure: the section, the entity or block, and why (one line, no dump).
+    #[error("{file}: {error}")]
+    Parse { file: String, error: msh::MshError },
     #[error(
         "{file}: no physical group named \"{group}\" (found: {found}); tag the boundary with \
          Physical Curve(\"{group}\") in 2D or Physical Surface(\"{group}\") in 3D"
@@ -418,17 +427,6 @@ pub enum GmshError {
         found: usize,
         expected: usize,
         mesh_dim: usize,
-    },
-    #[error(
-        "{file}: element {element} has Gmsh type {type_name} (id {type_id}), not supported \
-         (cells: 3/6-node triangles, 4/9-node quadrilaterals, 4/10-node tetrahedra, 8/27-node \
-         hexahedra; their boundary lines and faces; points)"
-    )]
-    UnsupportedElement {
-        file: String,
-        element: u64,
-        type_name: String,
-        type_id: i32,
     },
     #[error(
         "{file}: element {element} is a {found} but the mesh's cells are {first}s; one cell type per mesh"
@@ -476,6 +474,74 @@ pub enum GmshError {
         file: String,
         node: u64,
         cell: &'static str,
+    },
+    #[error("{file}: node {node} is defined twice")]
+    DuplicateNodeTag { file: String, node: u64 },
+    #[error("{file}: node {node} has {axis} = {value}; every coordinate must be finite")]
+    NonFinite {
+        file: String,
+        node: u64,
+        axis: &'static str,
+        value: f64,
+    },
+    #[error("{file}: element {element} has the nodes of element {first}: a cell listed twice")]
+    DuplicateCell {
+        file: String,
+        element: u64,
+        first: u64,
+    },
+    #[error(
+        "{file}: the face with nodes {nodes:?} is shared by elements {cells:?}; a face belongs to at most two cells (overlapping cells)"
+    )]
+    FaceOverShared {
+        file: String,
+        nodes: Vec<u64>,
+        cells: Vec<u64>,
+    },
+    #[error(
+        "{file}: elements {a} and {b} lie on the same side of their common face (nodes {nodes:?}): the cells overlap"
+    )]
+    SameSide {
+        file: String,
+        a: u64,
+        b: u64,
+        nodes: Vec<u64>,
+    },
+    #[error(
+        "{file}: elements {a} and {b} share the vertices {vertices:?} but not the nodes between them ({na:?} against {nb:?}): the mesh is not conforming"
+    )]
+    NotConforming {
+        file: String,
+        a: u64,
+        b: u64,
+        vertices: Vec<u64>,
+        na: Vec<u64>,
+        nb: Vec<u64>,
+    },
+    #[error(
+        "{file}: nodes {a} and {b} coincide (distance {distance:e}): a crack or duplicated nodes; merge them (e.g. Gmsh's Coherence Mesh)"
+    )]
+    CoincidentNodes {
+        file: String,
+        a: u64,
+        b: u64,
+        distance: f64,
+    },
+    #[error(
+        "{file}: element {element}: det J could not be certified positive over the cell (smallest Bernstein coefficient {min:e} after {pieces} subdivisions); straighten or refine it"
+    )]
+    NotCertified {
+        file: String,
+        element: u64,
+        min: f64,
+        pieces: usize,
+    },
+    #[error("{file}: group \"{group}\", element {element}: {reason}")]
+    GroupElement {
+        file: String,
+        group: String,
+        element: u64,
+        reason: String,
     },
     #[error("{file}: element {element} refers to node {node}, which the file does not define")]
     UnknownNode {
@@ -541,78 +607,75 @@ impl GmshMesh {
     pub fn from_bytes(file: &str, bytes: &[u8]) -> Result<GmshMesh, GmshError> {
         let f = || file.to_string();
         check_version(file, bytes)?;
-        let names = physical_names(file, bytes)?;
-        let msh = mshio::parse_msh_bytes(bytes).map_err(|e| GmshError::Parse {
-            file: f(),
-            reason: e.to_string(),
-        })?;
+        let msh = msh::parse(bytes).map_err(|error| GmshError::Parse { file: f(), error })?;
 
-        // Nodes: tag → index. mshio drops the tags of blocks when the file's tags are
-        // contiguous; they are then min_node_tag + position in the file.
-        let mut coords = Vec::new();
-        let mut node_tags = Vec::new();
-        if let Some(nodes) = &msh.data.nodes {
-            let mut next = nodes.min_node_tag;
-            for block in &nodes.node_blocks {
-                let mut tags = vec![0u64; block.nodes.len()];
-                match &block.node_tags {
-                    Some(map) => {
-                        for (&t, &i) in map {
-                            tags[i] = t;
-                        }
-                    }
-                    None => {
-                        for t in tags.iter_mut() {
-                            *t = next;
-                            next += 1;
-                        }
-                    }
-                }
-                node_tags.extend(tags);
-                coords.extend(block.nodes.iter().map(|n| [n.x, n.y, n.z]));
+        // Nodes: the tags of every block, kept whatever the section's header says about their
+        // range (issue 36: a file listing its nodes out of tag order is read as written).
+        let total: usize = msh.node_blocks.iter().map(|b| b.tags.len()).sum();
+        let mut coords = Vec::with_capacity(total);
+        let mut node_tags = Vec::with_capacity(total);
+        for block in &msh.node_blocks {
+            node_tags.extend_from_slice(&block.tags);
+            coords.extend_from_slice(&block.coords);
+        }
+        // Nodes are numbered in increasing tag order, not in the order the file lists them: a
+        // file and its rewrite with the nodes listed otherwise (another writer's block order)
+        // are then one mesh, and run to the same numbers to the bit (the assembly and the
+        // factor's ordering follow the node numbering). Gmsh lists its nodes in tag order, so
+        // its files keep their numbering.
+        if node_tags.windows(2).any(|w| w[0] >= w[1]) {
+            let mut order: Vec<usize> = (0..node_tags.len()).collect();
+            order.sort_by_key(|&i| node_tags[i]);
+            node_tags = order.iter().map(|&i| node_tags[i]).collect();
+            coords = order.iter().map(|&i| coords[i]).collect();
+        }
+        for (i, c) in coords.iter().enumerate() {
+            if let Some(k) = (0..3).find(|&k| !c[k].is_finite()) {
+                return Err(GmshError::NonFinite {
+                    file: f(),
+                    node: node_tags[i],
+                    axis: ["x", "y", "z"][k],
+                    value: c[k],
+                });
             }
         }
         // Tag → index: a table when the tags are dense (Gmsh numbers nodes 1..n; a 10⁵-node
-        // file spent 5 % of its reading in SipHash), a map otherwise. A tag given twice keeps
-        // its last position, as the map's collect did.
+        // file spent 5 % of its reading in SipHash), a map otherwise. A tag given twice is
+        // refused: its elements would be ambiguous.
         let index_of = {
             let (lo, hi) = node_tags
                 .iter()
                 .fold((u64::MAX, 0), |(lo, hi), &t| (lo.min(t), hi.max(t)));
+            let twice = |t: u64| GmshError::DuplicateNodeTag { file: f(), node: t };
             if !node_tags.is_empty() && hi - lo <= 2 * node_tags.len() as u64 + 16 {
                 let mut table = vec![usize::MAX; (hi - lo + 1) as usize];
                 for (i, &t) in node_tags.iter().enumerate() {
-                    table[(t - lo) as usize] = i;
+                    let slot = &mut table[(t - lo) as usize];
+                    if *slot != usize::MAX {
+                        return Err(twice(t));
+                    }
+                    *slot = i;
                 }
                 TagIndex::Dense { lo, table }
             } else {
-                TagIndex::Map(node_tags.iter().enumerate().map(|(i, &t)| (t, i)).collect())
+                let mut m = HashMap::with_capacity(node_tags.len());
+                for (i, &t) in node_tags.iter().enumerate() {
+                    if m.insert(t, i).is_some() {
+                        return Err(twice(t));
+                    }
+                }
+                TagIndex::Map(m)
             }
         };
 
-        // Element types: every block supported; the cells are the highest dimension.
-        let blocks = msh
-            .data
-            .elements
-            .as_ref()
-            .map(|e| e.element_blocks.as_slice())
-            .unwrap_or(&[]);
-        let mut dim = 0usize;
-        for b in blocks {
-            let ok = matches!(
-                b.element_type,
-                ElementType::Pnt | ElementType::Lin2 | ElementType::Lin3
-            ) || ElementKind::from_gmsh(b.element_type).is_some();
-            if !ok {
-                return Err(GmshError::UnsupportedElement {
-                    file: f(),
-                    element: b.elements.first().map_or(0, |e| e.element_tag),
-                    type_name: format!("{:?}", b.element_type),
-                    type_id: b.element_type as i32,
-                });
-            }
-            dim = dim.max(b.entity_dim.max(0) as usize);
-        }
+        // The cells are the elements of the highest dimension (the parser checked that each
+        // block's type has its entity's dimension).
+        let blocks = &msh.element_blocks;
+        let dim = blocks
+            .iter()
+            .map(|b| b.entity_dim.max(0) as usize)
+            .max()
+            .unwrap_or(0);
         if dim < 2 {
             return Err(GmshError::NoCells { file: f() });
         }
@@ -624,12 +687,21 @@ impl GmshMesh {
             })
         };
 
+        // Every element's nodes are defined, those of blocks no group names included.
+        for b in blocks {
+            for (i, &t) in b.tags.iter().enumerate() {
+                for &n in b.element(i) {
+                    node_index(t, n)?;
+                }
+            }
+        }
+
         // Cells.
         let mut kind: Option<ElementKind> = None;
         let mut elements = Vec::new();
         let mut element_tags = Vec::new();
         for b in blocks.iter().filter(|b| b.entity_dim as usize == dim) {
-            let element = b.elements.first().map_or(0, |e| e.element_tag);
+            let element = b.tags.first().copied().unwrap_or(0);
             let Some(k) = ElementKind::from_gmsh(b.element_type).filter(|k| k.dim() == dim) else {
                 return Err(GmshError::MixedElements {
                     file: f(),
@@ -652,11 +724,13 @@ impl GmshMesh {
                 });
             }
             let perm = k.gmsh_local_order();
-            for e in &b.elements {
+            elements.reserve(b.tags.len() * perm.len());
+            for (i, &t) in b.tags.iter().enumerate() {
+                let nodes = b.element(i);
                 for &g in &perm {
-                    elements.push(node_index(e.element_tag, e.nodes[g])?);
+                    elements.push(node_index(t, nodes[g])?);
                 }
-                element_tags.push(e.element_tag);
+                element_tags.push(t);
             }
         }
         let kind = kind.ok_or_else(|| GmshError::NoCells { file: f() })?;
@@ -780,39 +854,44 @@ impl GmshMesh {
             }
         }
 
+        // Topology (issue 36): no cell twice, every face shared by at most two cells lying on
+        // either side of it with the same midside nodes, no distinct nodes at one point, and
+        // det J certified positive on the whole of every curved cell.
+        let topo = check::Topology::new(kind, &elements, &node_tags, &element_tags);
+        topo.check(file)?;
+        check::coincident_nodes(dim, &coords).map_err(|(a, b, distance)| {
+            GmshError::CoincidentNodes {
+                file: f(),
+                a: node_tags[a],
+                b: node_tags[b],
+                distance,
+            }
+        })?;
+        check::certify_jacobians(kind, &coords, &elements)
+            .map_err(|e| e.into_gmsh(f(), &element_tags))?;
+
         // Physical groups: entities by (dim, physical tag), then their elements.
         let mut groups = Vec::new();
-        let entities = msh.data.entities.as_ref();
-        for (gdim, tag, name) in names {
+        let entities = msh.entities.as_ref();
+        for (gdim, tag, name) in msh.names {
             let mut ents: Vec<i32> = Vec::new();
             if let Some(en) = entities {
-                let has = |p: &[i32]| p.iter().any(|&t| t.abs() == tag);
-                match gdim {
-                    0 => ents.extend(
-                        en.points
-                            .iter()
-                            .filter(|x| has(&x.physical_tags))
-                            .map(|x| x.tag),
-                    ),
-                    1 => ents.extend(
-                        en.curves
-                            .iter()
-                            .filter(|x| has(&x.physical_tags))
-                            .map(|x| x.tag),
-                    ),
-                    2 => ents.extend(
-                        en.surfaces
-                            .iter()
-                            .filter(|x| has(&x.physical_tags))
-                            .map(|x| x.tag),
-                    ),
-                    _ => ents.extend(
-                        en.volumes
-                            .iter()
-                            .filter(|x| has(&x.physical_tags))
-                            .map(|x| x.tag),
-                    ),
-                }
+                ents.extend(
+                    en[gdim.min(3)]
+                        .iter()
+                        .filter(|x| x.physical_tags.iter().any(|&t| t.abs() == tag))
+                        .map(|x| x.tag),
+                );
+            }
+            let boundary = name == "contact" || name == "clamped";
+            if boundary && gdim + 1 != dim {
+                return Err(GmshError::GroupDimension {
+                    file: f(),
+                    group: name,
+                    found: gdim,
+                    expected: dim - 1,
+                    mesh_dim: dim,
+                });
             }
             let mut els = Vec::new();
             let mut nodes = Vec::new();
@@ -820,12 +899,25 @@ impl GmshMesh {
                 .iter()
                 .filter(|b| b.entity_dim as usize == gdim && ents.contains(&b.entity_tag))
             {
-                for e in &b.elements {
-                    let ids = e
-                        .nodes
+                for (i, &t) in b.tags.iter().enumerate() {
+                    let ids = b
+                        .element(i)
                         .iter()
-                        .map(|&t| node_index(e.element_tag, t))
+                        .map(|&n| node_index(t, n))
                         .collect::<Result<Vec<_>, _>>()?;
+                    // `contact` and `clamped` are boundary faces of the cells' degree: Γ_C's
+                    // quadrature and the clamped nodes act on them (a point or an interior face
+                    // would fail or silently cut the body inside the runs).
+                    if boundary {
+                        topo.boundary_face(b.element_type, &ids).map_err(|reason| {
+                            GmshError::GroupElement {
+                                file: f(),
+                                group: name.clone(),
+                                element: t,
+                                reason,
+                            }
+                        })?;
+                    }
                     nodes.extend_from_slice(&ids);
                     els.push(ids);
                 }
@@ -841,34 +933,21 @@ impl GmshMesh {
                 nodes,
             });
         }
-        match groups.iter().find(|g| g.name == "contact") {
-            None => {
-                return Err(GmshError::MissingGroup {
-                    file: f(),
-                    group: "contact".into(),
-                    found: if groups.is_empty() {
-                        "none".into()
-                    } else {
-                        groups
-                            .iter()
-                            .map(|g| format!("\"{}\"", g.name))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    },
-                });
-            }
-            Some(g) if g.dim + 1 != dim => {
-                return Err(GmshError::GroupDimension {
-                    file: f(),
-                    group: g.name.clone(),
-                    found: g.dim,
-                    expected: dim - 1,
-                    mesh_dim: dim,
-                });
-            }
-            _ => {}
+        if !groups.iter().any(|g| g.name == "contact") {
+            return Err(GmshError::MissingGroup {
+                file: f(),
+                group: "contact".into(),
+                found: if groups.is_empty() {
+                    "none".into()
+                } else {
+                    groups
+                        .iter()
+                        .map(|g| format!("\"{}\"", g.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                },
+            });
         }
-
         let content_hash = Sha256::digest(bytes)
             .iter()
             .map(|b| format!("{b:02x}"))
@@ -1024,47 +1103,4 @@ fn check_version(file: &str, bytes: &[u8]) -> Result<(), GmshError> {
         return Err(bad(format!("format version \"{version}\"")));
     }
     Ok(())
-}
-
-/// The `$PhysicalNames` section (ASCII in both encodings): (dimension, tag, name) per group.
-fn physical_names(file: &str, bytes: &[u8]) -> Result<Vec<(usize, i32, String)>, GmshError> {
-    const START: &[u8] = b"$PhysicalNames";
-    let Some(pos) = bytes.windows(START.len()).position(|w| w == START) else {
-        return Ok(Vec::new());
-    };
-    let bad = |reason: String| GmshError::Parse {
-        file: file.to_string(),
-        reason: format!("$PhysicalNames: {reason}"),
-    };
-    let rest = &bytes[pos + START.len()..];
-    let end = rest
-        .windows(17)
-        .position(|w| w == b"$EndPhysicalNames")
-        .ok_or_else(|| bad("no $EndPhysicalNames".into()))?;
-    let text = std::str::from_utf8(&rest[..end]).map_err(|e| bad(e.to_string()))?;
-    let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
-    let count: usize = lines
-        .next()
-        .and_then(|l| l.parse().ok())
-        .ok_or_else(|| bad("no group count".into()))?;
-    let mut out = Vec::with_capacity(count);
-    for line in lines.take(count) {
-        out.push(name_line(line).ok_or_else(|| bad(format!("bad line \"{line}\"")))?);
-    }
-    if out.len() != count {
-        return Err(bad(format!(
-            "{count} groups announced, {} found",
-            out.len()
-        )));
-    }
-    Ok(out)
-}
-
-/// One `$PhysicalNames` line: `dim tag "name"`.
-fn name_line(line: &str) -> Option<(usize, i32, String)> {
-    let mut it = line.splitn(3, char::is_whitespace);
-    let d: usize = it.next()?.parse().ok()?;
-    let t: i32 = it.next()?.parse().ok()?;
-    let name = it.next()?.trim().trim_matches('"').to_string();
-    Some((d, t, name))
 }

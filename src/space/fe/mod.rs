@@ -8,9 +8,11 @@
 //!   quadrature;
 //! - [`nitsche`]: the Γ_C quadrature points of the disc/ball with the linear functionals u_n and
 //!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
-//! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, via `mshio`) of the `mesh2d`/`mesh3d` scenes:
-//!   P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, physical groups by name,
-//!   validated (typed [`GmshError`]s), with `h` and the file's content hash;
+//! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, parsed by [`msh`], the engine's own parser
+//!   that cannot panic) of the `mesh2d`/`mesh3d` scenes: P1/P2 triangles and tetrahedra, Q1/Q2
+//!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s;
+//!   the whole-mesh checks — conformity, coincident nodes, boundary groups, certified det J —
+//!   in `check`), with `h` and the file's content hash;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`simplex`]: vector P1/P2 triangle and tetrahedron mass, elasticity stiffness, grad-grad
@@ -25,10 +27,12 @@
 //! the factorisation of the assembled matrices is [`crate::space::linalg`].
 
 pub mod ball;
+mod check;
 pub mod element;
 pub mod gmsh;
 pub mod locate;
 pub mod mesh;
+pub mod msh;
 pub mod nitsche;
 pub mod quadrature;
 pub mod simplex;
