@@ -336,3 +336,34 @@ fn the_friction_oscillator_sweep_plans() {
         assert_eq!(r.params[&Key::Velocity], Value::Num(6.0));
     }
 }
+
+/// The relay combined with the contact (the obstacle in reach, SPEC §1.5's defaults: gap ½,
+/// x0 = 0, v0 = −1; F = 0.05): Moreau–Jean θ = ½ with e = 1 makes the normal impulse do no
+/// work (v^{n+1} = −vⁿ where it acts), so every step's energy change is the relay's,
+/// p_t(vⁿ + v^{n+1})/2 = −ΔW_f: E^n + W_f^n = E⁰ at every step, to the round-off of 1000 steps
+/// on energies ≤ ½ (1e-13 absolute). The mass does hit the obstacle (contact phases > 0), and
+/// the friction takes energy (W_f > 0). (`optional[9]` is the `friction_work` series column.)
+#[test]
+fn moreau_jean_e1_with_impacts_balances_energy_and_friction_work() {
+    let p = OscillatorParams {
+        friction: 0.05,
+        ..OscillatorParams::default()
+    };
+    let mj1 = Scheme::MoreauJean(MoreauJeanParams {
+        theta: 0.5,
+        restitution: 1.0,
+    });
+    let o = run(p, 1e-2, 10.0, mj1);
+    assert!(o.metrics.contact_phases.unwrap() > 0);
+    let e0 = o.series.energy[0];
+    let w = &o.series.optional[9];
+    assert_eq!(w.len(), o.series.energy.len());
+    for (n, (e, wf)) in o.series.energy.iter().zip(w).enumerate() {
+        assert!(
+            (e + wf - e0).abs() < 1e-13,
+            "step {n}: E + W_f − E⁰ = {}",
+            e + wf - e0
+        );
+    }
+    assert!(w.last().unwrap() > &0.0);
+}
