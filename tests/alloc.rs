@@ -419,3 +419,67 @@ method = [
         1.25,
     );
 }
+
+/// The dry-friction oscillator (SPEC §1.5, `friction_force`): the relay of every scheme that
+/// takes it, with impacts (the obstacle in reach: the relay combined with the contact) and with
+/// a stop (SPEC's setting, the mass at rest after t ≈ 22.4) — the exact solution's segments
+/// are built at setup, the stop watch and the work are scalars.
+#[test]
+fn dry_friction_oscillator_time_loops_allocate_nothing() {
+    assert_loop_allocates_nothing(
+        r#"
+name = "alloc-osc-dry"
+scene = "oscillator"
+[fixed]
+T = T_FINAL
+courant = 0.02
+impact_law = 0.5
+friction_force = 0.1
+[grid]
+method = [
+  { space = "mixed", scheme = "crank-nicolson" },
+  { space = "mixed", scheme = "backward-euler" },
+  { space = "penalty", penalty_gamma0 = 100.0, scheme = "crank-nicolson" },
+  { space = "mixed", scheme = "kane" },
+  { space = "mixed", scheme = "generalized-alpha", rho_inf = 0.5 },
+  { space = "mixed", scheme = "moreau-jean", theta_scheme = 0.5, restitution = 0.5 },
+]
+"#,
+        5.0,
+    );
+    // Contact-stabilized Newmark reports contact only where the net force holds the mass on
+    // the obstacle (as in `oscillator_time_loops_allocate_nothing`): f = −2, one switch.
+    assert_loop_allocates_nothing_with(
+        r#"
+name = "alloc-osc-dry-csn"
+scene = "oscillator"
+[fixed]
+T = T_FINAL
+courant = 0.02
+force = -2.0
+impact_law = 0.5
+friction_force = 0.1
+space = "mixed"
+scheme = "contact-stabilized-newmark"
+"#,
+        5.0,
+        1,
+    );
+    // No contact at all here (the obstacle 1e3 away): no switch to count.
+    assert_loop_allocates_nothing_with(
+        r#"
+name = "alloc-osc-stop"
+scene = "oscillator"
+[fixed]
+T = T_FINAL
+dt = 0.02
+amplitude = 12.0
+velocity = 6.0
+gap = 1e3
+friction_force = 1.0
+scheme = "moreau-jean"
+"#,
+        15.0,
+        0,
+    );
+}

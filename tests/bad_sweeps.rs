@@ -311,6 +311,33 @@ const CASES: &[(&str, &str, &str)] = &[
         "fixed.tresca_threshold",
         "must be a finite number",
     ),
+    // The oscillator's dry friction (SPEC §1.5): F ≥ 0 and finite, the oscillator's key only,
+    // and only with a scheme that has a frictional step.
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nfriction_force = -1.0\n",
+        "fixed.friction_force",
+        "must be ≥ 0 (a friction bound",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nfriction_force = inf\n",
+        "fixed.friction_force",
+        "must be a finite number, got inf",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\n[grid]\nfriction_force = [1.0, nan]\n",
+        "grid.friction_force[1]",
+        "must be a finite number, got NaN",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction_force = 1.0\n",
+        "fixed.friction_force",
+        "`friction_force` is not a parameter of scene bar1d",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nfriction_force = 1.0\nscheme = \"paoli-schatzman\"\n",
+        "fixed.friction_force",
+        "paoli-schatzman has no frictional version in the literature",
+    ),
 ];
 
 #[test]

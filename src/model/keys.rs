@@ -73,6 +73,9 @@ pub enum Key {
     Height,
     /// The initial tangential velocity V_t (layer1d, SPEC §1.7).
     VelocityTangential,
+    /// Dry (Coulomb) friction on the oscillator's mass, F ≥ 0 (SPEC §1.5; default 0, so the
+    /// frictionless runs keep their ids).
+    FrictionForce,
 }
 
 /// What a key's value must look like.
@@ -158,7 +161,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 44] = [
+    pub const ALL: [Key; 45] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -203,6 +206,7 @@ impl Key {
         Key::TrescaThreshold,
         Key::Height,
         Key::VelocityTangential,
+        Key::FrictionForce,
     ];
 
     pub fn name(self) -> &'static str {
@@ -251,6 +255,7 @@ impl Key {
             Key::TrescaThreshold => "tresca_threshold",
             Key::Height => "height",
             Key::VelocityTangential => "velocity_tangential",
+            Key::FrictionForce => "friction_force",
         }
     }
 
@@ -276,6 +281,7 @@ impl Key {
                 | Key::Load
                 | Key::Height
                 | Key::VelocityTangential
+                | Key::FrictionForce
         )
     }
 
@@ -446,7 +452,10 @@ impl Key {
             }
             // A coefficient and a traction: zero is frictionless (the same numbers as none),
             // a negative bound would push the body along its slip.
-            (Key::FrictionCoefficient | Key::TrescaThreshold, Value::Num(x)) => {
+            (
+                Key::FrictionCoefficient | Key::TrescaThreshold | Key::FrictionForce,
+                Value::Num(x),
+            ) => {
                 finite(*x)?;
                 if *x >= 0.0 {
                     Ok(())

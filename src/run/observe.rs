@@ -103,6 +103,10 @@ pub struct Metrics {
     /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, SPEC §1.7).
     pub err_sigma_t_l2: Option<f64>,
     pub err_vt_final: Option<f64>,
+    /// Dry friction on the oscillator (SPEC §1.5): the time after which the mass never moves
+    /// again (null while it moves at T), and the exact rest time (null if after T).
+    pub stop_time: Option<f64>,
+    pub stop_time_exact: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].

@@ -51,8 +51,9 @@ use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
+use crate::contact::friction::{PointState, solve_tangential};
 use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
-use crate::scene::{OscillatorExact, OscillatorParams};
+use crate::scene::{DryFrictionExact, OscillatorExact, OscillatorParams};
 use crate::space::ContactMethod;
 use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
 
@@ -160,6 +161,14 @@ struct Osc {
     /// z = c_f q / A and w = p_x z: the contact condensed (q = −1).
     z: f64,
     w: f64,
+    /// Dry friction (SPEC §1.5): the relay's bound on the force as it enters the step (F, or
+    /// the impulse τF for Moreau–Jean), 0 without friction; the step's slip is
+    /// (x − slip_ref)·slip_scale of the solved unknown x (module header).
+    bound: f64,
+    slip_scale: f64,
+    /// Weight of f_t^{n+1} in the force that does the step's work, f̄ = ω f^{n+1} + (1 − ω) fⁿ
+    /// (SPEC §2.5: γ for Newmark, θ for the θ-scheme, 1 − α_f for generalized-α, 1 else).
+    work_weight: f64,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -170,6 +179,9 @@ struct State {
     s_prev: f64,
     /// φⁿ, the contact force of the previous step (generalized-α carries α_f of it).
     phi_prev: f64,
+    /// The friction force f_tⁿ as it entered the previous step (impulse / τ for Moreau–Jean):
+    /// generalized-α carries α_f of it, and the work weighs it by 1 − ω.
+    ft_prev: f64,
 }
 
 /// Direction of the contact force: up (q = −1 with φ ≤ 0).
@@ -193,6 +205,18 @@ impl Osc {
             _ => (1.0, p.gap, ContactLaw::Complementarity),
         };
         let z = k.cf * Q / k.a;
+        let (bound, slip_scale) = match scheme {
+            // The relay on v^{n+1} with the impulse p_t ∈ −τF·Sign(v^{n+1}).
+            Scheme::MoreauJean(_) => (tau * p.friction, 1.0),
+            // The relay on the increment (x^{n+1} − xⁿ)/τ with the force f_t ∈ −F·Sign(·).
+            _ => (p.friction, 1.0 / tau),
+        };
+        let work_weight = match scheme {
+            Scheme::Newmark(NewmarkParams { gamma, .. }) => gamma,
+            Scheme::Theta(th) => th.theta,
+            Scheme::GeneralizedAlpha(ga) => 1.0 - ga.alpha_f,
+            _ => 1.0,
+        };
         Self {
             p,
             scheme,
@@ -204,7 +228,85 @@ impl Osc {
             kappa,
             z,
             w: px * z,
+            bound,
+            slip_scale,
+            work_weight,
         }
+    }
+
+    /// The friction force at the start, at rest or moving: −F·sign(v⁰) while moving; at rest
+    /// the force that holds the mass against the net force N = f − k x⁰ + φ⁰q, within ±F
+    /// (the schemes that carry an acceleration start from the equation at t⁰).
+    fn initial_friction(&self, x: f64, v: f64, phi: f64) -> f64 {
+        let f = self.p.friction;
+        if f == 0.0 {
+            0.0
+        } else if v != 0.0 {
+            -f * v.signum()
+        } else {
+            (-(self.p.force - self.p.stiffness * x + phi * Q)).clamp(-f, f)
+        }
+    }
+
+    /// The step's solve with dry friction (SPEC §1.5): A x = b + c_f(φq + f_t), the contact
+    /// law on p_x x + p0 and the relay f_t ∈ −bound·Sign(slip), slip = (x − x_ref)·scale,
+    /// both on the one dof. Returns (x, s, φ, f_t). The problem is the minimum of a strictly
+    /// convex function of x (the quadratic, the relay's bound·|slip|, the contact's
+    /// potential), so it has one x, found exactly by its cases:
+    /// 1. the relay with the contact open — [`solve_tangential`], the law's own local solver
+    ///    with the fixed bound — kept if the contact then exerts no force (always, far from
+    ///    the obstacle);
+    /// 2. otherwise the contact active with the mass slipping forward or backward
+    ///    (f_t = ∓bound, the contact solved exactly by [`contact::solve`]), kept if the slip
+    ///    has that sign;
+    /// 3. otherwise stick, x = x_ref, the friction taking what the contact does not, within
+    ///    its bound (on the obstacle the split is not unique: the friction takes the most).
+    ///
+    /// Without friction this is [`Osc::solve`] itself (the frictionless runs bit for bit).
+    fn solve_dry(
+        &self,
+        b: f64,
+        law: &ContactLaw,
+        p0: f64,
+        x_ref: f64,
+    ) -> Result<(f64, f64, f64, f64), ContactSolveError> {
+        if self.bound == 0.0 {
+            let (x, s, phi) = self.solve(b, law, p0)?;
+            return Ok((x, s, phi, 0.0));
+        }
+        // x per unit friction force: c_f/A (the friction pushes along +x, the contact along q).
+        let zt = self.k.cf / self.k.a;
+        let y = b / self.k.a;
+        let sc = self.slip_scale;
+        let (ft, _, state) = solve_tangential((y - x_ref) * sc, zt * sc, self.bound);
+        // Stick holds the mass exactly where it was (the relay's slip is 0 exactly).
+        let x1 = if state == PointState::Stick {
+            x_ref
+        } else {
+            y + zt * ft
+        };
+        let open = contact::solve(law, self.px * x1 + p0, self.w)?;
+        if open.phi == 0.0 {
+            return Ok((x1, open.s, 0.0, ft));
+        }
+        for ft in [-self.bound, self.bound] {
+            let yy = y + zt * ft;
+            let sol = contact::solve(law, self.px * yy + p0, self.w)?;
+            let x = yy + sol.phi * self.z;
+            // f_t = −bound goes with a forward slip, +bound with a backward one.
+            if -ft * (x - x_ref) > 0.0 {
+                return Ok((x, sol.s, sol.phi, ft));
+            }
+        }
+        // Stick in contact: the total force φq + f_t = (x_ref − y)/z_t.
+        let s = self.px * x_ref + p0;
+        let total = (x_ref - y) / zt;
+        let phi = match *law {
+            ContactLaw::PositivePart { k } => k * s.max(0.0),
+            _ if s > 0.0 => 0.0,
+            _ => (total - total.clamp(-self.bound, self.bound)) / Q,
+        };
+        Ok((x_ref, s, phi, total - phi * Q))
     }
 
     /// The state's contact force φ(x) (penalty), 0 for a multiplier not yet known.
@@ -239,14 +341,16 @@ impl Osc {
         Ok((y + sol.phi * self.z, sol.s, sol.phi))
     }
 
-    /// One step of a one-step scheme; returns φ of the step and whether its contact is active.
-    fn step(&self, st: &mut State) -> Result<(f64, bool), ContactSolveError> {
+    /// One step of a one-step scheme; returns φ of the step, the friction force f_t^{n+1}
+    /// (impulse / τ for Moreau–Jean) and whether its contact is active.
+    fn step(&self, st: &mut State) -> Result<(f64, f64, bool), ContactSolveError> {
         let (tau, m, f) = (self.tau, self.p.mass, self.p.force);
         let load = self.k.c * f;
-        let (phi, x_new) = match self.scheme {
+        let (phi, ft, x_new) = match self.scheme {
             Scheme::Newmark(NewmarkParams { beta, gamma }) => {
                 let pred = st.x + tau * st.v + tau * tau / 2.0 * (1.0 - 2.0 * beta) * st.a;
-                let (x, s, phi) = self.solve(m * pred + load, &self.law, self.p0)?;
+                let (x, s, phi, ft) = self.solve_dry(m * pred + load, &self.law, self.p0, st.x)?;
+                // Explicit with friction is refused by the scene: there f_t = 0.
                 let a = if beta > 0.0 {
                     (x - pred) / (beta * tau * tau)
                 } else {
@@ -255,18 +359,18 @@ impl Osc {
                 st.v += tau * ((1.0 - gamma) * st.a + gamma * a);
                 st.a = a;
                 st.s_prev = s;
-                (phi, x)
+                (phi, ft, x)
             }
             Scheme::Theta(th) => {
                 let t = th.theta;
                 let pred = st.x + tau * st.v + tau * tau * t * (1.0 - t) * st.a;
-                let (x, s, phi) = self.solve(m * pred + load, &self.law, self.p0)?;
+                let (x, s, phi, ft) = self.solve_dry(m * pred + load, &self.law, self.p0, st.x)?;
                 let it = 1.0 / (tau * t);
                 let v = (x - st.x - tau * (1.0 - t) * st.v) * it;
                 st.a = (v - st.v - tau * (1.0 - t) * st.a) * it;
                 st.v = v;
                 st.s_prev = s;
-                (phi, x)
+                (phi, ft, x)
             }
             Scheme::Hybrid => {
                 // Δx from A Δx = τ m v − (τ²/2)(k x − f) + c_f φ q, the contact switched on the
@@ -282,16 +386,18 @@ impl Osc {
                 let (dx, s, phi) = self.solve(b, &law, self.p0 + self.px * st.x)?;
                 st.v = 2.0 * dx / tau - st.v;
                 st.s_prev = s;
-                (phi, st.x + dx)
+                (phi, 0.0, st.x + dx)
             }
             Scheme::Kane => {
                 // S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q, complementarity on
                 // xⁿ + Δx + g; v^{n+1} = 2Δx/τ − vⁿ. No force is carried to the next step.
+                // The unknown is Δx: the slip Δx/τ is relative to 0.
                 let b = tau * m * st.v - tau * tau / 2.0 * self.p.stiffness * st.x + load;
-                let (dx, s, phi) = self.solve(b, &self.law, self.p0 + self.px * st.x)?;
+                let (dx, s, phi, ft) =
+                    self.solve_dry(b, &self.law, self.p0 + self.px * st.x, 0.0)?;
                 st.v = 2.0 * dx / tau - st.v;
                 st.s_prev = s;
-                (phi, st.x + dx)
+                (phi, ft, st.x + dx)
             }
             Scheme::ContactStabilizedNewmark => {
                 // Predictor: the M-projection of xⁿ + τvⁿ onto x ≥ −g — for one dof the
@@ -301,14 +407,17 @@ impl Osc {
                 let constrained = pred != free;
                 // kane from x^pred: S Δ = −τ²/4 k (xⁿ + x^pred) + τ²/2 f + τ²/2 φ q,
                 // Δ = x^{n+1} − x^pred; v^{n+1} = vⁿ + (2/τ) Δ.
+                // The unknown is Δ = x^{n+1} − x^pred: the slip (x^pred + Δ − xⁿ)/τ.
                 let b = -tau * tau / 4.0 * self.p.stiffness * (st.x + pred) + load;
-                let (dx, s, phi) = self.solve(b, &self.law, self.p0 + self.px * pred)?;
+                let (dx, s, phi, ft) =
+                    self.solve_dry(b, &self.law, self.p0 + self.px * pred, st.x - pred)?;
                 st.v += 2.0 * dx / tau;
                 st.a = 0.0;
                 st.s_prev = s;
                 st.x = pred + dx;
+                st.ft_prev = ft;
                 // SPEC §1.5: a step whose predictor is constrained is in contact.
-                return Ok((phi, constrained || phi != 0.0));
+                return Ok((phi, ft, constrained || phi != 0.0));
             }
             Scheme::GeneralizedAlpha(ga @ GeneralizedAlphaParams { beta, gamma, .. }) => {
                 // x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (x^{n+1} − x̃)/(βτ²); the equation at
@@ -317,15 +426,17 @@ impl Osc {
                 let bt2 = beta * tau * tau;
                 let (km, kf) = ga.history_coefficients(tau);
                 let pred = st.x + tau * st.v + tau * tau * (0.5 - beta) * st.a;
+                // The friction force is carried as the contact force is: κ_f f_tⁿ.
                 let b = m * (pred - km * st.a) - kf * self.p.stiffness * st.x
                     + kf * st.phi_prev * Q
+                    + kf * st.ft_prev
                     + load;
-                let (x, s, phi) = self.solve(b, &self.law, self.p0)?;
+                let (x, s, phi, ft) = self.solve_dry(b, &self.law, self.p0, st.x)?;
                 let a = (x - pred) / bt2;
                 st.v += tau * ((1.0 - gamma) * st.a + gamma * a);
                 st.a = a;
                 st.s_prev = s;
-                (phi, x)
+                (phi, ft, x)
             }
             Scheme::MoreauJean(MoreauJeanParams { theta, restitution }) => {
                 // (m + θ²τ²k)Δv = −τk(xⁿ + θτvⁿ) + τf + p q; active when the predicted gap
@@ -337,13 +448,16 @@ impl Osc {
                 } else {
                     ContactLaw::PositivePart { k: 0.0 }
                 };
-                let (dv, _, impulse) = self.solve(b, &law, (1.0 + restitution) * st.v)?;
+                // Dry friction: the relay p_t ∈ −τF·Sign(v^{n+1}), v^{n+1} = vⁿ + Δv, combined
+                // with the normal impulse on the same dof (`solve_dry`).
+                let (dv, _, impulse, pt) =
+                    self.solve_dry(b, &law, (1.0 + restitution) * st.v, -st.v)?;
                 let x = st.x + tau * (st.v + theta * dv);
                 st.v += dv;
                 st.a = dv / tau;
                 st.s_prev = x + self.p.gap;
-                // Reported force: the impulse over the step (SPEC §3.2).
-                (impulse / tau, x)
+                // Reported forces: the impulses over the step (SPEC §3.2).
+                (impulse / tau, pt / tau, x)
             }
             Scheme::DiscreteGradient => {
                 // The midpoint rule with the force the difference quotient D of the penalty
@@ -360,7 +474,7 @@ impl Osc {
                 let dx = y + phi * self.z;
                 st.v = 2.0 * dx / tau - st.v;
                 st.s_prev = sol.s;
-                (phi, st.x + dx)
+                (phi, 0.0, st.x + dx)
             }
             // Paoli–Schatzman is two-step (its loop is in `simulate`); a family the scene does
             // not list in `supports` never reaches the engine.
@@ -368,13 +482,61 @@ impl Osc {
         };
         st.x = x_new;
         st.phi_prev = phi;
-        Ok((phi, phi != 0.0))
+        st.ft_prev = ft;
+        Ok((phi, ft, phi != 0.0))
+    }
+}
+
+/// The exact solution the run is measured against: the frictionless one event by event, or
+/// with dry friction on the mass its turning points, impacts and rest ([`DryFrictionExact`]).
+enum Exact {
+    Free(OscillatorExact),
+    Dry(DryFrictionExact),
+}
+
+impl Exact {
+    fn state(&self, t: f64, cursor: &mut usize) -> (f64, f64) {
+        match self {
+            Exact::Free(e) => e.state(t, cursor),
+            Exact::Dry(e) => e.state(t),
+        }
+    }
+    fn impacts(&self) -> &[f64] {
+        match self {
+            Exact::Free(e) => e.impacts(),
+            Exact::Dry(e) => e.impacts(),
+        }
+    }
+}
+
+/// When the mass stops for good (SPEC §1.5 `stop_time`): the time of the last step that moved
+/// it by more than `tol` — after it the mass never moves again. `None` while it still moves
+/// at the last step.
+struct StopWatch {
+    tol: f64,
+    last_move: Option<usize>,
+    last_step: usize,
+}
+
+impl StopWatch {
+    fn observe(&mut self, n: usize, dx: f64) {
+        if dx.abs() > self.tol {
+            self.last_move = Some(n);
+        }
+        self.last_step = n;
+    }
+    fn stop_time(&self, tau: f64) -> Option<f64> {
+        match self.last_move {
+            Some(n) if n == self.last_step => None,
+            Some(n) => Some(n as f64 * tau),
+            None => Some(0.0),
+        }
     }
 }
 
 /// Error sums against the exact solution, and the discrete contact starts.
 struct Errors<'a> {
-    exact: &'a OscillatorExact,
+    exact: &'a Exact,
     cursor: usize,
     sum_v: f64,
     was_active: bool,
@@ -397,7 +559,12 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         factorizations: 0,
         ..Metrics::default()
     };
-    let exact = p.exact(t_final);
+    let dry = p.friction > 0.0;
+    let exact = if dry {
+        Exact::Dry(DryFrictionExact::new(p, p.friction, t_final))
+    } else {
+        Exact::Free(p.exact(t_final))
+    };
     let eng = Osc::new(cfg, cfg.scheme);
     let mut x0 = p.x0;
     if let Some((delta, seed)) = cfg.perturbation {
@@ -405,12 +572,26 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         x0 += delta * (2.0 * rng.f64() - 1.0) * x0.abs().max(p.gap);
     }
     let phi0 = eng.state_force(x0);
+    let ft0 = eng.initial_friction(x0, p.v0, phi0);
     let mut st = State {
         x: x0,
         v: p.v0,
-        a: eng.accel(x0, phi0),
+        // The equation at t⁰, the friction included where there is one.
+        a: if dry {
+            eng.accel(x0, phi0) + ft0 / p.mass
+        } else {
+            eng.accel(x0, phi0)
+        },
         s_prev: eng.px * x0 + eng.p0,
         phi_prev: phi0,
+        ft_prev: ft0,
+    };
+    // Dry friction's columns: the work W_f = −Σ f̄_t (x^{n+1} − xⁿ) and the stop (SPEC §1.5).
+    let mut work = 0.0;
+    let mut watch = StopWatch {
+        tol: 1e-12 * x0.abs().max(p.gap),
+        last_move: None,
+        last_step: 0,
     };
     let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
     let mut err = Errors {
@@ -420,8 +601,19 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         was_active: phi0 != 0.0,
         starts: Vec::with_capacity(cfg.steps + 1),
     };
-    let mut record = |n: usize, x: f64, v: f64, phi: f64, active: bool| -> Result<(), Divergence> {
+    let mut record = |n: usize,
+                      x: f64,
+                      v: f64,
+                      phi: f64,
+                      active: bool,
+                      friction: Option<(f64, f64)>|
+     -> Result<(), Divergence> {
         let t = n as f64 * tau;
+        // With dry friction, the friction series: f_t as it entered the step, the mass's
+        // velocity (its slip), W_f so far.
+        if let Some((ft, w)) = friction {
+            obs.set_friction(ft, v, w);
+        }
         let (xe, ve) = err.exact.state(t, &mut err.cursor);
         let dv = v - ve;
         err.sum_v += dv * dv;
@@ -478,7 +670,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
                         gamma: 0.5,
                     }),
                 );
-                record(0, st.x, st.v, phi0, phi0 != 0.0).map_err(Stop::Diverged)?;
+                record(0, st.x, st.v, phi0, phi0 != 0.0, None).map_err(Stop::Diverged)?;
                 let mut prev = st.x;
                 starter.step(&mut st).map_err(|e| Stop::Solver(1, e))?;
                 metrics.iterations += 1;
@@ -494,7 +686,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
                         .map_err(|err| Stop::Solver(n, err))?;
                     metrics.iterations += 1;
                     let v = (next - prev) / (2.0 * tau);
-                    record(n, st.x, v, lambda, lambda != 0.0).map_err(Stop::Diverged)?;
+                    record(n, st.x, v, lambda, lambda != 0.0, None).map_err(Stop::Diverged)?;
                     done = n;
                     prev = st.x;
                     st.x = next;
@@ -502,11 +694,22 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
                 }
             }
             _ => {
-                record(0, st.x, st.v, phi0, phi0 != 0.0).map_err(Stop::Diverged)?;
+                record(0, st.x, st.v, phi0, phi0 != 0.0, dry.then_some((ft0, 0.0)))
+                    .map_err(Stop::Diverged)?;
                 for n in 1..=cfg.steps {
-                    let (phi, active) = eng.step(&mut st).map_err(|e| Stop::Solver(n, e))?;
+                    let (x_old, ft_old) = (st.x, st.ft_prev);
+                    let (phi, ft, active) = eng.step(&mut st).map_err(|e| Stop::Solver(n, e))?;
                     metrics.iterations += 1;
-                    record(n, st.x, st.v, phi, active).map_err(Stop::Diverged)?;
+                    let friction = if dry {
+                        let dx = st.x - x_old;
+                        let w = eng.work_weight;
+                        work -= (w * ft + (1.0 - w) * ft_old) * dx;
+                        watch.observe(n, dx);
+                        Some((ft, work))
+                    } else {
+                        None
+                    };
+                    record(n, st.x, st.v, phi, active, friction).map_err(Stop::Diverged)?;
                     done = n;
                     interrupted(n)?;
                 }
@@ -523,6 +726,13 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
     metrics.err_u_l2h1 = None;
     metrics.err_sigma_l2 = None;
     metrics.err_sigma_mid_l2 = None;
+    if complete && dry {
+        metrics.friction_work = Some(work / p.energy(x0, p.v0).abs().max(f64::MIN_POSITIVE));
+        metrics.stop_time = watch.stop_time(tau);
+        if let Exact::Dry(e) = &exact {
+            metrics.stop_time_exact = e.stop().map(|(t, _)| t);
+        }
+    }
     if complete {
         metrics.err_v_l2 = Some((tau * err.sum_v).sqrt());
         metrics.err_impact_time = (!exact.impacts().is_empty()).then(|| {

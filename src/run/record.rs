@@ -224,6 +224,9 @@ schema! {
         normal_velocity_final: Option<f64> => "m/s", "the normal component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
         err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
+        friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (SPEC §1.5; 0: frictionless)";
+        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); null if it still moves at T";
+        stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -467,6 +470,9 @@ impl RunRecord {
             normal_velocity_final: m.normal_velocity_final,
             err_sigma_t_l2: m.err_sigma_t_l2,
             err_vt_final: m.err_vt_final,
+            friction_force: f(Key::FrictionForce),
+            stop_time: m.stop_time,
+            stop_time_exact: m.stop_time_exact,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

@@ -166,6 +166,15 @@ pub trait Scene: Send + Sync {
             self.name()
         ))
     }
+    /// Whether a physics value rules out a scheme (e.g. the oscillator's dry friction with a
+    /// scheme that has no frictional step); `Err` names the key and says why.
+    fn supports_physics(
+        &self,
+        _physics: &Physics,
+        _scheme: &crate::time::Scheme,
+    ) -> Result<(), (&'static str, String)> {
+        Ok(())
+    }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
     /// Whether the body comes from a mesh file (the `mesh` key, SPEC §1.6) rather than from

@@ -22,12 +22,13 @@
 //! `courant` reads as the dimensionless step ω·τ.
 
 use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use crate::time::Scheme;
 
 /// The scene `oscillator` (SPEC §1.5).
 #[derive(Debug, Clone, Copy)]
 pub struct OscillatorScene;
 
-const OSCILLATOR_PHYSICS: [PhysicsKey; 7] = [
+const OSCILLATOR_PHYSICS: [PhysicsKey; 8] = [
     PhysicsKey {
         name: "point_mass",
         default: 1.0,
@@ -56,6 +57,12 @@ const OSCILLATOR_PHYSICS: [PhysicsKey; 7] = [
         name: "impact_law",
         default: 1.0,
     },
+    // Dry friction on the mass (SPEC §1.5): 0 is the frictionless oscillator, and being the
+    // default it enters no run id.
+    PhysicsKey {
+        name: "friction_force",
+        default: 0.0,
+    },
 ];
 
 impl OscillatorScene {
@@ -68,6 +75,7 @@ impl OscillatorScene {
             x0: p.get("amplitude"),
             v0: p.get("velocity"),
             impact_law: p.get("impact_law"),
+            friction: p.get("friction_force"),
         }
     }
 }
@@ -101,9 +109,47 @@ impl Scene for OscillatorScene {
     }
     /// The mass meets the obstacle along its one dof: a friction law at the contact has no
     /// direction to act in. Dry friction on the mass is SPEC §1.5's physics key
-    /// `friction_force` (not implemented yet), not the friction axis.
+    /// `friction_force`, not the friction axis.
     fn supports_friction(&self) -> Result<(), String> {
-        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is SPEC §1.5's `friction_force` (not implemented yet), not a friction law at the contact".into())
+        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is SPEC §1.5's `friction_force` key, not a friction law at the contact".into())
+    }
+
+    /// Dry friction enters a step as a relay on the step's slip (SPEC §1.5): the increment
+    /// (x^{n+1} − xⁿ)/τ of an implicit position-level step, Moreau–Jean's v^{n+1}. An explicit
+    /// step's increment does not depend on the step's own force, so the relay has nothing to
+    /// solve; and the schemes SPEC §2.5 gives no frictional version (Paoli–Schatzman's two-step
+    /// contact argument, the hybrid and discrete-gradient energy splittings) are not invented
+    /// here.
+    fn supports_physics(
+        &self,
+        physics: &Physics,
+        scheme: &Scheme,
+    ) -> Result<(), (&'static str, String)> {
+        if physics.get("friction_force") == 0.0 {
+            return Ok(());
+        }
+        let why = match scheme {
+            Scheme::PaoliSchatzman(_) => {
+                "paoli-schatzman has no frictional version in the literature (SPEC §2.5)"
+            }
+            Scheme::Hybrid => {
+                "the hybrid scheme has no frictional version in the literature (SPEC §2.5)"
+            }
+            Scheme::DiscreteGradient => {
+                "discrete-gradient has no frictional version in the literature (SPEC §2.5)"
+            }
+            s if s.is_explicit() => {
+                "an explicit step's increment does not depend on the step's friction force: the relay on (x^{n+1} − xⁿ)/τ is undetermined"
+            }
+            _ => return Ok(()),
+        };
+        Err((
+            "friction_force",
+            format!(
+                "friction_force > 0 with scheme = {}: {why}; dry friction runs with the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht and moreau-jean",
+                scheme.family()
+            ),
+        ))
     }
 
     fn supports(
@@ -194,6 +240,8 @@ pub struct OscillatorParams {
     pub v0: f64,
     /// Newton's restitution coefficient e_x of the exact solution.
     pub impact_law: f64,
+    /// Dry (Coulomb) friction force F ≥ 0 on the mass (`friction_force`; 0: frictionless).
+    pub friction: f64,
 }
 
 impl Default for OscillatorParams {
@@ -206,6 +254,7 @@ impl Default for OscillatorParams {
             x0: 0.0,
             v0: -1.0,
             impact_law: 1.0,
+            friction: 0.0,
         }
     }
 }
@@ -265,12 +314,17 @@ impl DryFrictionExact {
                 .max(w * (p.x0 - f / k).abs())
                 .max(f64::MIN_POSITIVE);
         let slow = 1e-14 * v_scale;
+        // Sized once for the usual history — a half oscillation per π/ω, plus room for a
+        // Zeno sequence (rebound speeds falling by e_x to 1e-14 of the first: 47 impacts at
+        // e_x = ½) — so that the set-up's allocations do not grow with T (a longer sequence,
+        // e_x near 1, may still outgrow it: correct, only less tidy).
+        let cap = (2.0 * w * t_final.max(0.0) / std::f64::consts::PI).min(1e5) as usize + 128;
         let mut out = Self {
             p,
             friction,
-            segments: Vec::new(),
-            turning_points: Vec::new(),
-            impacts: Vec::new(),
+            segments: Vec::with_capacity(cap),
+            turning_points: Vec::with_capacity(cap),
+            impacts: Vec::with_capacity(cap),
             stop: None,
         };
         let (mut t0, mut x0, mut v0) = (0.0, p.x0, p.v0);

@@ -587,6 +587,17 @@ fn resolve(
             })
             .collect(),
     );
+    // A physics value that rules out this scheme (the oscillator's dry friction): refused
+    // where the value is fixed, skipped as a meaningless combination across an axis.
+    if let Err((key, why)) = scene.supports_physics(&physics, &scheme) {
+        let k = Key::from_name(key).expect("scenes name sweep keys");
+        match user.get(&k) {
+            Some((_, o)) if o.path.starts_with("grid") || o.path.starts_with("zip") => {
+                return Outcome::Inapplicable(why);
+            }
+            _ => return Outcome::Invalid(vec![Issue::at(&origin(k), why)]),
+        }
+    }
     let c0 = scene.wave_speed(&physics);
     // A mesh scene's body: the file of the `mesh` key, read and validated before any run.
     let mut mesh_file: Option<MeshFile> = None;
