@@ -77,6 +77,8 @@ ERROR_COLUMNS = [
     "err_sigma_mid_l2",
     "err_energy_l2",
     "err_u_contact_max",
+    "err_sigma_t_l2",
+    "err_vt_final",
 ]
 
 RESULT_COLUMNS = {

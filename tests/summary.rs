@@ -852,6 +852,94 @@ fn energy_classes_and_impact_losses() {
     );
 }
 
+/// Frictional rows are judged by the balance E + W_f against δ (energy.rs's header): within δ
+/// while E falls by more than δ is "dissipative with friction accounted", below −δ dissipative,
+/// above δ growing; a frictionless row with the same E is judged by E as before. h = dt = 0.25,
+/// L = 1: δ = 0.25, the values straddle it by at least 0.05.
+#[test]
+fn frictional_rows_are_judged_by_energy_plus_friction_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    // (scheme label, friction, E drift, W_f, balance drift, expected class)
+    let cases = [
+        (
+            "fa",
+            "coulomb",
+            -0.5,
+            0.49,
+            -0.01,
+            "dissipative with friction accounted",
+        ),
+        ("fb", "coulomb", -0.6, 0.2, -0.4, "dissipative"),
+        ("fc", "coulomb", 0.1, 0.2, 0.3, "growing"),
+        ("fd", "coulomb", -0.1, 0.1, 0.0, "conservative"),
+        ("fe", "none", -0.5, f64::NAN, f64::NAN, "dissipative"),
+    ];
+    let mut rows: Vec<R> = cases
+        .iter()
+        .map(|c| run(c.0, c.0, 0.25, 0.25, [None; 4]))
+        .collect();
+    for (r, c) in rows.iter_mut().zip(&cases) {
+        r.drift = Some(c.2);
+    }
+    let mut df = runs_frame(&rows);
+    let opt = |x: f64| (!x.is_nan()).then_some(x);
+    let n = cases.len();
+    for col in [
+        Column::new(
+            "friction".into(),
+            cases.iter().map(|c| Some(c.1)).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "friction_work".into(),
+            cases.iter().map(|c| opt(c.3)).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "energy_balance_drift".into(),
+            cases.iter().map(|c| opt(c.4)).collect::<Vec<_>>(),
+        ),
+        Column::new(
+            "energy_balance_max_increase".into(),
+            cases
+                .iter()
+                .map(|c| opt(c.4).map(|_| 1e-3))
+                .collect::<Vec<_>>(),
+        ),
+    ] {
+        assert_eq!(col.len(), n);
+        df.with_column(col).unwrap();
+    }
+    write_runs(tmp.path(), "part-0.parquet", &mut df);
+    summary::summarize(tmp.path()).unwrap();
+    let e = read(&tmp.path().join("summary/energy.parquet"));
+    let (labels, classes, functional) = (
+        strs(&e, "label"),
+        strs(&e, "energy_class"),
+        strs(&e, "energy_functional"),
+    );
+    let m = read(&tmp.path().join("summary/methods.parquet"));
+    let (methods, energy) = (strs(&m, "method"), strs(&m, "energy"));
+    for c in &cases {
+        let k = labels
+            .iter()
+            .position(|l| l.as_deref() == Some(c.0))
+            .unwrap();
+        assert_eq!(classes[k].as_deref(), Some(c.5), "{}", c.0);
+        let want = if c.1 == "none" { "E^h" } else { "E^h + W_f" };
+        assert_eq!(functional[k].as_deref(), Some(want), "{}", c.0);
+        // The method-class table's word for the same class (one run per group).
+        let j = methods
+            .iter()
+            .position(|l| l.as_deref() == Some(c.0))
+            .unwrap();
+        let word = if c.5 == "conservative" {
+            "conserving"
+        } else {
+            c.5
+        };
+        assert_eq!(energy[j].as_deref(), Some(word), "{}", c.0);
+    }
+}
+
 #[test]
 fn pareto_front_and_cost_to_reach_an_error() {
     // (cost, error): (1, 5) (2, 3) (2, 4) (3, 3) (4, 1) (4, 1): (2, 4) is beaten by (2, 3) at

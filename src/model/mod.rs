@@ -12,4 +12,6 @@ pub mod keys;
 pub mod summary_options;
 
 pub use keys::{Key, Value, ValueType};
-pub use summary_options::{DEFAULT_ERRORS, ERROR_COLUMNS, SummaryOptions, parse_errors};
+pub use summary_options::{
+    DEFAULT_ERRORS, ERROR_COLUMNS, SummaryOptions, TANGENTIAL_ERRORS, parse_errors,
+};

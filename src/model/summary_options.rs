@@ -19,7 +19,16 @@ pub const ERROR_COLUMNS: &[&str] = &[
     "err_sigma_mid_l2",
     "err_energy_l2",
     "err_u_contact_max",
+    "err_sigma_t_l2",
+    "err_vt_final",
 ];
+
+/// The tangential errors of a frictional scene (SPEC §5: the layer's σ_t in L2 over both
+/// components, the mean tangential velocity at T). Null for every frictionless scene, so a
+/// folder has them only when its scene computes them: the text tables then show them after
+/// the chosen columns unless `--errors` or `[summary]` chose otherwise — a frictional rate
+/// table without its tangential errors would not answer its question.
+pub const TANGENTIAL_ERRORS: &[&str] = &["err_sigma_t_l2", "err_vt_final"];
 
 /// The default selection: what the papers print.
 pub const DEFAULT_ERRORS: &[&str] = &[

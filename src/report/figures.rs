@@ -14,6 +14,9 @@
 //!   dashed in black. Long series are reduced to the minimum and maximum of each of ~1500
 //!   buckets, which keeps the envelope of chattering pressures that plain striding would alias
 //!   away.
+//! - Frictional runs: the energy balance (E, W_f and E + W_f against t in one panel: a scheme
+//!   whose E + W_f stays flat while E falls lost only the friction's work) and the slip velocity
+//!   v_t of the contact node.
 
 use plotters::prelude::*;
 
@@ -380,6 +383,66 @@ pub fn series(
                 .label_font(("sans-serif", 11))
                 .draw()
                 .map_err(|x| e(x.to_string()))?;
+        }
+        root.present().map_err(|x| e(x.to_string()))?;
+    }
+    Ok(svg)
+}
+
+/// The energy-balance panel of frictional runs: per run (one colour each, as elsewhere) E thin,
+/// W_f faded and E + W_f thick, so that the three quantities of several runs stay apart without
+/// a legend per curve (the caption states the line styles).
+pub fn balance(
+    title: &str,
+    energy: &[Curve],
+    work: &[Curve],
+    total: &[Curve],
+) -> Result<String, FigureError> {
+    let e = err(title);
+    let all = || {
+        energy
+            .iter()
+            .chain(work)
+            .chain(total)
+            .flat_map(|c| c.points.iter().copied())
+    };
+    let (Some((x0, x1)), Some((y0, y1))) =
+        (lin_range(all().map(|p| p.0)), lin_range(all().map(|p| p.1)))
+    else {
+        return Err(e("no values to plot".into()));
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (W, 300)).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(36)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|x| e(x.to_string()))?;
+        chart
+            .configure_mesh()
+            .x_desc("t")
+            .y_desc("energy / energy_scale")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(MINOR)
+            .draw()
+            .map_err(|x| e(x.to_string()))?;
+        for (curves, width, faded) in [(work, 1, true), (energy, 1, false), (total, 3, false)] {
+            for c in curves {
+                let col = color(c.color);
+                let style = if faded {
+                    col.mix(0.45).stroke_width(width)
+                } else {
+                    col.stroke_width(width)
+                };
+                chart
+                    .draw_series(LineSeries::new(c.points.clone(), style))
+                    .map_err(|x| e(x.to_string()))?;
+            }
         }
         root.present().map_err(|x| e(x.to_string()))?;
     }

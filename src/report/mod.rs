@@ -327,6 +327,10 @@ struct RunSeries {
     energy: Vec<(f64, f64)>,
     u_exact: Vec<(f64, f64)>,
     sigma_exact: Vec<(f64, f64)>,
+    /// Frictional runs (null columns otherwise): (t, E, W_f) where both are recorded, and
+    /// (t, v_t) the contact node's slip velocity.
+    balance: Vec<(f64, f64, f64)>,
+    v_t: Vec<(f64, f64)>,
 }
 
 /// The series of the runs `chosen`, in time order. Only the series parts that hold them are
@@ -344,13 +348,16 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
     // A run without its part's name (not known to the loader) means: read every part.
     let parts: Option<HashSet<String>> = chosen.iter().map(|r| r.part.clone()).collect();
     let wanted: HashSet<&str> = chosen.iter().map(|r| r.run_id.as_str()).collect();
-    const DRAWN: [&str; 6] = [
+    // The friction columns are absent from frictionless parts: read as nulls, nothing drawn.
+    const DRAWN: [&str; 8] = [
         "t",
         "u_contact",
         "sigma_contact",
         "energy",
         "u_contact_exact",
         "sigma_contact_exact",
+        "friction_work",
+        "v_t_contact",
     ];
     for part in crate::sink::parquet_parts(&folder)? {
         let name = part
@@ -371,7 +378,7 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
         let Ok(cols) = pq::read_rows_f64(&part, &rows, &DRAWN) else {
             continue;
         };
-        let [t, u, s, en, ue, se] = &cols[..] else {
+        let [t, u, s, en, ue, se, wf, vt] = &cols[..] else {
             unreachable!("one vector per drawn column")
         };
         let mut k = 0;
@@ -389,6 +396,13 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
                     push(&mut rs.energy, en[k]);
                     push(&mut rs.u_exact, ue[k]);
                     push(&mut rs.sigma_exact, se[k]);
+                    push(&mut rs.v_t, vt[k]);
+                    if let (Some(e), Some(w)) = (en[k], wf[k])
+                        && e.is_finite()
+                        && w.is_finite()
+                    {
+                        rs.balance.push((t, e, w));
+                    }
                 }
                 k += 1;
             }
@@ -403,13 +417,106 @@ fn read_series(dir: &Path, chosen: &[&runs::Run]) -> anyhow::Result<HashMap<Stri
             &mut rs.energy,
             &mut rs.u_exact,
             &mut rs.sigma_exact,
+            &mut rs.v_t,
         ] {
             if !v.is_sorted_by(|a, b| a.0 <= b.0) {
                 v.sort_by(|a, b| a.0.total_cmp(&b.0));
             }
         }
+        if !rs.balance.is_sorted_by(|a, b| a.0 <= b.0) {
+            rs.balance.sort_by(|a, b| a.0.total_cmp(&b.0));
+        }
     }
     Ok(out)
+}
+
+/// The frictional runs' figures (only when some chosen run has a friction law and recorded its
+/// work): E, W_f and E + W_f against t in one panel — E + W_f flat while E falls is a scheme
+/// that lost only the friction's work, the class the energy table calls "dissipative with
+/// friction accounted" — and the slip velocity v_t of the contact node.
+fn frictional_figures(
+    runs: &Runs,
+    chosen: &[(usize, usize)],
+    series: &HashMap<String, RunSeries>,
+    body: &mut String,
+    count: &mut usize,
+    skipped: &mut Vec<String>,
+) {
+    let (mut e, mut w, mut total, mut slip) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut groups = Vec::new();
+    for &(g, i) in chosen {
+        let r = &runs.runs[i];
+        if !crate::summary::energy::frictional(runs, r) {
+            continue;
+        }
+        let Some(rs) = series.get(&r.run_id) else {
+            continue;
+        };
+        // The unit of `energy_balance_drift` (E⁰ for the layer), so that a flat E + W_f reads 1.
+        let scale = r
+            .energy_scale
+            .or_else(|| rs.balance.first().map(|p| p.1).filter(|x| *x != 0.0));
+        let name = runs.groups[g].title.clone();
+        let mut drawn = false;
+        if let Some(scale) = scale.filter(|_| !rs.balance.is_empty()) {
+            let pick = |f: &dyn Fn(&(f64, f64, f64)) -> f64| -> Vec<(f64, f64)> {
+                let p: Vec<(f64, f64)> = rs.balance.iter().map(|b| (b.0, f(b) / scale)).collect();
+                figures::decimate(&p, 1500)
+            };
+            for (list, points) in [
+                (&mut e, pick(&|b| b.1)),
+                (&mut w, pick(&|b| b.2)),
+                (&mut total, pick(&|b| b.1 + b.2)),
+            ] {
+                list.push(Curve {
+                    name: name.clone(),
+                    points,
+                    color: g,
+                });
+            }
+            drawn = true;
+        }
+        if !rs.v_t.is_empty() {
+            slip.push(Curve {
+                name: name.clone(),
+                points: figures::decimate(&rs.v_t, 1500),
+                color: g,
+            });
+            drawn = true;
+        }
+        if drawn {
+            groups.push(g);
+        }
+    }
+    if groups.is_empty() {
+        return;
+    }
+    body.push_str("<h3 id=\"friction\">Frictional runs: energy balance and slip velocity</h3>\n");
+    body.push_str("<p class=\"note\">Same runs as above, those with a friction law. Energy balance in units of the run's <code>energy_scale</code>: thin E, faded W_f (the frictional work), thick E + W_f — flat when the scheme loses only the friction's work. Slip velocity: the contact node's tangential velocity v_t.</p>\n");
+    body.push_str(&legend(runs, &groups, "thin E, faded W_f, thick E + W_f"));
+    body.push_str("<div class=\"figs\">\n");
+    let mut drawn = Vec::new();
+    if !total.is_empty() {
+        drawn.push(figures::balance(
+            "energy balance E, W_f, E + W_f (t)",
+            &e,
+            &w,
+            &total,
+        ));
+    }
+    if !slip.is_empty() {
+        drawn.push(figures::series("slip velocity v_t(t)", "v_t", &slip, None));
+    }
+    for fig in drawn {
+        match fig {
+            Ok(svg) => {
+                body.push_str(&svg);
+                *count += 1;
+            }
+            Err(x) => skipped.push(x.to_string()),
+        }
+    }
+    body.push_str("</div>\n");
 }
 
 const CSS: &str = "body{font-family:system-ui,-apple-system,'Segoe UI',sans-serif;margin:0 auto;max-width:1560px;padding:16px 24px;color:#222;line-height:1.4}
@@ -703,6 +810,14 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
             }
         }
         body.push_str("</div>\n");
+        frictional_figures(
+            runs,
+            &chosen,
+            &series,
+            &mut body,
+            &mut figures,
+            &mut skipped,
+        );
     }
 
     // 3. The method table, as the terminal prints it, with its legend.

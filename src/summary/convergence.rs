@@ -291,6 +291,17 @@ fn displayed(runs: &Runs, opts: &SummaryOptions) -> (Vec<usize>, Vec<String>) {
             missing.join(", ")
         ));
     }
+    // The default selection carries the tangential errors where the folder has them (only a
+    // frictional scene fills them: a frictionless folder's tables are unchanged).
+    if opts.errors.is_none() {
+        for c in crate::model::TANGENTIAL_ERRORS {
+            if let Some(e) = runs.errors.iter().position(|e| e == c)
+                && !show.contains(&e)
+            {
+                show.push(e);
+            }
+        }
+    }
     let hidden: Vec<&str> = (0..runs.errors.len())
         .filter(|e| !show.contains(e))
         .map(|e| runs.errors[e])

@@ -28,6 +28,21 @@
 //! contact-stabilized Newmark, Moreau–Jean with θ = ½ and e = 1, the discrete gradient)
 //! — a single step that raises F by more than [`ENERGY_TOL`]·F⁰ is growth as well: the proof
 //! forbids it, and rounding stays below 1e-12 (SPEC §6).
+//!
+//! # Frictional runs
+//! With `friction` ≠ `none` the energy alone says nothing about the scheme: E falls by the
+//! frictional work W_f ≥ 0 whatever the method (0.16 E⁰ on the layer's slip regime, SPEC §6),
+//! so every frictional run would read `dissipative`. Such runs are judged by the balance
+//! F + W_f instead (SPEC §5's `energy_balance_drift`, `energy_balance_max_increase`; F is the
+//! `energy` column, which holds the penalty potential for penalty): growing if it rises by
+//! more than δ (or, for the methods SPEC §2.5 proves never raise E + W_f — `kane` with inertia
+//! on the contact node, `moreau-jean` with θ = ½ and e = 1 — one step by more than
+//! [`ENERGY_TOL`]), dissipative if it falls by more than δ (energy lost besides the friction's
+//! work: the scheme's own dissipation), and otherwise [`FRICTION_ACCOUNTED`] when E itself
+//! falls by more than δ and the friction did more than δ of work — the fall is the friction's
+//! work — or conservative (a stuck base
+//! does no work). δ is the same consistency error: the tangential exchange happens at the
+//! same contact node, resolved to one cell and one step.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
@@ -40,8 +55,23 @@ use super::table::{self, Table, TextTable, columns, text_columns};
 /// 1e-12·E⁰ (worst seen 5e-13), so 1e-10 leaves two decades for rounding.
 pub const ENERGY_TOL: f64 = 1e-10;
 
+/// The class of a frictional run whose E + W_f stays within δ while E falls by more than δ:
+/// the energy lost is the friction's work, not the scheme's (module header).
+pub const FRICTION_ACCOUNTED: &str = "dissipative with friction accounted";
+
 /// The energy classes, in the order tables list them.
-pub const CLASSES: [&str; 4] = ["conservative", "dissipative", "growing", "diverged"];
+pub const CLASSES: [&str; 5] = [
+    "conservative",
+    FRICTION_ACCOUNTED,
+    "dissipative",
+    "growing",
+    "diverged",
+];
+
+/// The run has a friction law (`friction` ≠ `none`) and its row the energy balance.
+pub(crate) fn frictional(runs: &Runs, r: &Run) -> bool {
+    runs.param_str(r, "friction").is_some_and(|f| f != "none") && r.energy_balance_drift.is_some()
+}
 
 /// How a run's energy behaved, judged by its scheme's functional.
 #[derive(Debug, Clone, PartialEq)]
@@ -68,7 +98,19 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
     let backward_euler = scheme_label == "backward-euler";
     let theta = runs.param_f64(r, "nitsche_theta");
     let theta_scheme = runs.param_f64(r, "theta_scheme");
+    let friction = frictional(runs, r);
     let (functional, drift, max_increase) = match space {
+        // The `energy` column already holds the penalty potential (SPEC §5).
+        "penalty" if friction => (
+            "E^h + penalty + W_f",
+            r.energy_balance_drift,
+            r.energy_balance_max_increase,
+        ),
+        _ if friction => (
+            "E^h + W_f",
+            r.energy_balance_drift,
+            r.energy_balance_max_increase,
+        ),
         "nitsche" if r.energy_theta_drift.is_some() => {
             ("E_Θ", r.energy_theta_drift, r.energy_theta_max_increase)
         }
@@ -86,10 +128,20 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
             && theta_scheme == Some(0.5)
             && runs.param_f64(r, "restitution") == Some(1.0))
         || (scheme == "discrete-gradient" && (space == "penalty" || nitsche_theta_one));
-    let monotone = (hybrid && (space == "mixed" || nitsche_theta_one))
-        || ((backward_euler || scheme == "theta" && theta_scheme == Some(1.0))
-            && nitsche_theta_one)
-        || comparison;
+    // With friction only what SPEC §2.5 states of E + W_f: kane with inertia and Moreau–Jean
+    // (θ = ½; e = 1 as without friction, e < 1 may gain on a separating row) never raise it.
+    // The other proofs are of the frictionless functional and say nothing of the balance.
+    let monotone = if friction {
+        (scheme == "kane" && with_inertia)
+            || (scheme == "moreau-jean"
+                && theta_scheme == Some(0.5)
+                && runs.param_f64(r, "restitution") == Some(1.0))
+    } else {
+        (hybrid && (space == "mixed" || nitsche_theta_one))
+            || ((backward_euler || scheme == "theta" && theta_scheme == Some(1.0))
+                && nitsche_theta_one)
+            || comparison
+    };
     // The run's own length scale; folders of older versions: the bar's `length`, else 1.
     let length = r.length_scale.unwrap_or_else(|| {
         runs.param_f64(r, "length")
@@ -104,6 +156,11 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
                     "growing"
                 } else if d < -tol {
                     "dissipative"
+                } else if friction
+                    && r.energy_drift.is_some_and(|e| e < -tol)
+                    && r.friction_work.is_some_and(|w| w > tol)
+                {
+                    FRICTION_ACCOUNTED
                 } else {
                     "conservative"
                 }
@@ -662,6 +719,19 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
          d < −δ, conservative otherwise; diverged and failed runs by their status. Group ranges \
          are over the ok runs.\n"
     );
+    // Only folders with frictional runs: the frictionless energy.md keeps its bytes.
+    if runs.runs.iter().any(|r| frictional(runs, r)) {
+        let _ = writeln!(
+            md,
+            "Frictional runs (friction ≠ none) are judged by the balance F + W_f (W_f the \
+             frictional work, SPEC §5's energy_balance_drift and energy_balance_max_increase; \
+             functional \"… + W_f\"), since E alone falls by W_f whatever the scheme: growing if \
+             it rises by more than δ (or one step by more than {ENERGY_TOL:e}·E⁰ for kane with \
+             inertia and Moreau–Jean θ = ½, e = 1), dissipative if it falls by more than δ, \
+             {FRICTION_ACCOUNTED} if it stays within δ while E falls by more than δ, \
+             conservative otherwise.\n"
+        );
+    }
     md.push_str("## Per group (across refinement)\n\n");
     let per_group = TextTable::new(text_columns![
         "#" => Right, "group" => Left, "ok/runs" => Right, "drift" => Right, "max dev" => Right,

@@ -1,6 +1,8 @@
 //! The method-class table (issue 20): one row per method group, its behaviour in four words.
 //!
-//! - energy: `conserving`, `dissipative` or `growing` — the worst energy class
+//! - energy: `conserving`, `dissipative with friction accounted` (frictional runs whose
+//!   E + W_f holds while E falls by the friction's work), `dissipative` or `growing` — the
+//!   worst energy class
 //!   ([`super::energy::classify`], the scheme's own functional, δ = max(1, ν)·h/L) over the
 //!   group's ok runs (growing beats dissipative beats conserving: one growing run is enough to
 //!   show the method can gain energy);
@@ -16,7 +18,7 @@
 //! Written as `methods.{parquet,csv,md,tex}`; the legend states the thresholds.
 
 use super::convergence::lsq_slope;
-use super::energy::classify;
+use super::energy::{FRICTION_ACCOUNTED, classify, frictional};
 use super::runs::{Fixed, Runs};
 use super::table::{self, Kind, Table, TextTable, columns, text_columns};
 
@@ -55,7 +57,9 @@ pub(crate) fn section(runs: &Runs) -> Section {
             .filter(|r| r.ok())
             .collect();
         let classes: Vec<String> = ok.iter().filter_map(|r| classify(runs, r).class).collect();
-        let energy = ["growing", "dissipative", "conservative"]
+        // A frictional run whose E + W_f holds while E falls ranks between: it loses energy,
+        // but only the friction's work (energy.rs).
+        let energy = ["growing", "dissipative", FRICTION_ACCOUNTED, "conservative"]
             .into_iter()
             .find(|c| classes.iter().any(|x| x == c))
             .map(|c| if c == "conservative" { "conserving" } else { c });
@@ -122,6 +126,15 @@ pub(crate) fn section(runs: &Runs) -> Section {
     let legend = format!(
         "energy: the worst energy class of the group's ok runs (see energy.md: scheme's functional, δ = max(1, ν)·h/L); pressure: smooth if max pressure_oscillation ≤ {SMOOTH_PRESSURE} (1 = one rise and one fall), oscillating above; penetration: none if max_penetration ≤ {NO_PENETRATION:e}·L, O(τ) above; rates: least-squares slopes of err_u_l2l2 and err_u_l2h1 against h along the group's longest path with τ ∝ h (ok levels)."
     );
+    // The frictional sentence only where frictional runs are: the frictionless legend keeps
+    // its bytes.
+    let legend = if runs.runs.iter().any(|r| frictional(runs, r)) {
+        format!(
+            "{legend} Frictional runs are judged by E + W_f (W_f the frictional work): {FRICTION_ACCOUNTED} when E + W_f stays within δ while E falls by more than δ (ranked between dissipative and conserving)."
+        )
+    } else {
+        legend
+    };
     let markdown = format!("# Method classes\n\n{legend}\n\n{}", text.markdown());
     let mut latex = String::from(
         "% Method classes (contact-sweep summary)\n\\begin{tabular}{llllrr}\n\\hline\nmethod & energy & pressure & penetration & L2 rate & H1 rate \\\\\n\\hline\n",

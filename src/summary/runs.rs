@@ -73,7 +73,8 @@ const MEASURED: &[(&str, Kind)] = &columns![
     energy_final: F64, energy_drift: F64, energy_max_dev: F64, energy_max_increase: F64,
     energy_theta_max_increase: F64, energy_theta_drift: F64, energy_theta_initial: F64,
     length_scale: F64, energy_scale: F64, search: Str, max_penetration: F64,
-    pressure_oscillation: F64,
+    pressure_oscillation: F64, friction_work: F64, energy_balance_drift: F64,
+    energy_balance_max_increase: F64,
 ];
 
 /// One parameter value.
@@ -159,6 +160,12 @@ pub(crate) struct Run {
     /// Runs columns `max_penetration`, `pressure_oscillation` (None in older folders).
     pub max_penetration: Option<f64>,
     pub pressure_oscillation: Option<f64>,
+    /// Runs columns `friction_work` (W_f(T)), `energy_balance_drift` ((E + W_f)(T) − E⁰) and
+    /// `energy_balance_max_increase` (largest one-step rise of E + W_f), all over
+    /// `energy_scale`; None for frictionless runs and older folders (SPEC §5).
+    pub friction_work: Option<f64>,
+    pub energy_balance_drift: Option<f64>,
+    pub energy_balance_max_increase: Option<f64>,
     /// The `[search]` whose probe this run is (null for grid runs).
     pub search: Option<String>,
     /// The runs part the row was read from (`series/` holds the run's rows under the same name).
@@ -664,6 +671,11 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
     let length_scale = get_f("length_scale")?;
     let energy_scale = get_f("energy_scale")?;
     let (max_pen, press_osc) = (get_f("max_penetration")?, get_f("pressure_oscillation")?);
+    let (w_f, balance_drift, balance_inc) = (
+        get_f("friction_work")?,
+        get_f("energy_balance_drift")?,
+        get_f("energy_balance_max_increase")?,
+    );
     let sample = get_i("ensemble_sample")?;
     let search = strs(&df, "search")?;
     let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
@@ -762,6 +774,9 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             ensemble_sample: sample[i],
             max_penetration: finite(max_pen[i]),
             pressure_oscillation: finite(press_osc[i]),
+            friction_work: w_f[i],
+            energy_balance_drift: balance_drift[i],
+            energy_balance_max_increase: balance_inc[i],
             search: search.as_ref().and_then(|v| v[i].clone()),
             part: part.as_ref().and_then(|v| v[i].clone()),
             impacts: impacts.as_ref().and_then(|v| v[i].clone()),
