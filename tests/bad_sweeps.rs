@@ -207,7 +207,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nerrors = [\"err_u_l2h1\", \"err_u_h1\"]\n",
         "summary.errors",
-        "unknown error column `err_u_h1`; valid: err_u_l2l2, err_u_l2h1, err_u_linfl2, err_sigma_l2, err_sigma_mid_l2, err_energy_l2, err_u_contact_max, or all",
+        "unknown error column `err_u_h1`; valid: err_u_l2l2, err_u_l2h1, err_u_linfl2, err_sigma_l2, err_sigma_mid_l2, err_energy_l2, err_u_contact_max, err_sigma_t_l2, err_vt_final, or all",
     ),
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[summary]\nerrors = []\n",

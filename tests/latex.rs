@@ -200,7 +200,7 @@ fn quickstart_tables_compile_with_the_default_and_with_every_column() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         err.contains("--errors: unknown error column `err_u_h1`")
-            && err.contains("valid: err_u_l2l2, err_u_l2h1, err_u_linfl2, err_sigma_l2, err_sigma_mid_l2, err_energy_l2, err_u_contact_max, or all"),
+            && err.contains("valid: err_u_l2l2, err_u_l2h1, err_u_linfl2, err_sigma_l2, err_sigma_mid_l2, err_energy_l2, err_u_contact_max, err_sigma_t_l2, err_vt_final, or all"),
         "{err}"
     );
 }
