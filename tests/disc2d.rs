@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::run_sweep_text;
+use common::{outcomes, run_sweep_text};
 use contact_sweep::run::RunRecord;
 
 const GRAVITY: f64 = 0.1;
@@ -533,27 +533,6 @@ fn disc_mass_variants_conserve_mass_and_fall_freely() {
 #[test]
 fn ball_mass_variants_conserve_mass_and_fall_freely() {
     check_mass_variants("sphere3d", 8.0, "2");
-}
-
-/// Every run of a sweep given as text, simulated with its full time series (one row a step).
-fn outcomes(text: &str) -> Vec<(String, contact_sweep::run::Outcome)> {
-    use contact_sweep::run::{RunOptions, simulate};
-    use contact_sweep::sweep::{SweepFile, expand};
-    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let o = simulate(
-                &spec.config,
-                &RunOptions {
-                    series_every: 1,
-                    ..RunOptions::default()
-                },
-            );
-            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
-            (spec.label.clone(), o)
-        })
-        .collect()
 }
 
 /// The energy parts and the lowest point in free fall (SPEC §1.3), Crank–Nicolson, both

@@ -17,29 +17,10 @@
 //! h = 8, degree 1) so each test stays well under 10 s in release.
 
 mod common;
+use common::outcomes;
 
-use contact_sweep::run::{Outcome, RunOptions, simulate};
+use contact_sweep::run::Outcome;
 use contact_sweep::sweep::{SweepFile, expand};
-
-/// Every run of a sweep given as text, simulated with its full time series, with its label.
-fn outcomes(text: &str) -> Vec<(String, Outcome)> {
-    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
-    assert!(!plan.runs.is_empty(), "no run planned: {text}");
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let o = simulate(
-                &spec.config,
-                &RunOptions {
-                    series_every: 1,
-                    ..RunOptions::default()
-                },
-            );
-            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
-            (spec.label.clone(), o)
-        })
-        .collect()
-}
 
 /// max_n (x^{n+1} − x^n)/scale over a series.
 fn max_increase(x: &[f64], scale: f64) -> f64 {

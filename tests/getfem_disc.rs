@@ -28,11 +28,12 @@
 //! body 16.5 % lighter than the paper's, the first contact force 460 → 402) and its degree-4
 //! rule left the curved cells' mass 2e-4 off.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use contact_sweep::run::{Outcome, RunOptions, simulate};
-use contact_sweep::sweep::{SweepFile, expand};
+use contact_sweep::run::Outcome;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -121,22 +122,9 @@ method = [{}
             .map(|m| format!("{{ mass = \"{m}\" }},"))
             .collect::<String>()
     );
-    let plan = expand(&SweepFile::parse(&root().join("t.toml"), &text).unwrap()).unwrap();
-    assert_eq!(plan.runs.len(), VARIANTS.len());
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let o = simulate(
-                &spec.config,
-                &RunOptions {
-                    series_every: 1,
-                    ..RunOptions::default()
-                },
-            );
-            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
-            (spec.label.clone(), o)
-        })
-        .collect()
+    let runs = common::outcomes_at(&root().join("t.toml"), &text);
+    assert_eq!(runs.len(), VARIANTS.len());
+    runs
 }
 
 #[test]

@@ -16,15 +16,15 @@
 //! Meshes are small (bar2d h = 0.05: 42 nodes) so each test stays well under 10 s in release.
 
 mod common;
+use common::outcomes;
 
 use std::path::PathBuf;
 
-use contact_sweep::run::{Outcome, RunOptions, RunRecord, simulate};
+use contact_sweep::run::RunRecord;
 use contact_sweep::space::fe::nitsche::{
     ContactPoint, box_contact_faces, face_contact_points, gmsh_contact_faces,
 };
 use contact_sweep::space::fe::{BoxMesh, GmshMesh};
-use contact_sweep::sweep::{SweepFile, expand};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -131,26 +131,6 @@ fn face_quadrature_integrates_the_contact_area() {
     let mesh = GmshMesh::read(&root().join("sweeps/meshes/square_tri_p1.msh")).unwrap();
     let e = gmsh_contact_faces(&mesh, mesh.group("body").unwrap()).unwrap_err();
     assert!(e.contains("dimension 2"), "{e}");
-}
-
-/// Every run of a sweep given as text, simulated with its full time series, with its label.
-fn outcomes(text: &str) -> Vec<(String, Outcome)> {
-    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
-    assert!(!plan.runs.is_empty(), "no run planned: {text}");
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let o = simulate(
-                &spec.config,
-                &RunOptions {
-                    series_every: 1,
-                    ..RunOptions::default()
-                },
-            );
-            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
-            (spec.label.clone(), o)
-        })
-        .collect()
 }
 
 /// max_n (x^{n+1} − x^n)/scale and max_n |x^{n+1} − x^n|/scale.

@@ -195,3 +195,32 @@ pub fn kept_energy(label: &str, o: &Outcome) -> Vec<f64> {
         o.series.energy.clone()
     }
 }
+
+/// Every run of a sweep given as text, simulated with its full time series (one row a step),
+/// with its label; `path` is where the sweep would be (mesh files are relative to it).
+pub fn outcomes_at(path: &Path, text: &str) -> Vec<(String, Outcome)> {
+    let plan = contact_sweep::sweep::expand(
+        &contact_sweep::sweep::SweepFile::parse(path, text).expect("valid sweep"),
+    )
+    .expect("plan");
+    assert!(!plan.runs.is_empty(), "no run planned: {text}");
+    plan.runs
+        .iter()
+        .map(|spec| {
+            let o = simulate(
+                &spec.config,
+                &RunOptions {
+                    series_every: 1,
+                    ..RunOptions::default()
+                },
+            );
+            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
+            (spec.label.clone(), o)
+        })
+        .collect()
+}
+
+/// [`outcomes_at`] for a sweep without mesh files.
+pub fn outcomes(text: &str) -> Vec<(String, Outcome)> {
+    outcomes_at(Path::new("t.toml"), text)
+}
