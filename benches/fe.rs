@@ -315,6 +315,7 @@ fn bench_methods(c: &mut Criterion) {
                 steps: 150,
                 perturbation: None,
                 solver: Solver::Direct,
+                friction: contact_sweep::contact::friction::FrictionLaw::None,
             };
             bench_steps(&mut g, &format!("{space}-{what}"), &cfg);
         }

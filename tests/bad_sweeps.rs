@@ -287,9 +287,9 @@ const CASES: &[(&str, &str, &str)] = &[
         "the oscillator's one dof is normal to the obstacle",
     ),
     (
-        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nfriction = \"tresca\"\ntresca_threshold = 0.1\n",
-        "fixed.friction",
-        "friction on FE scenes is not implemented yet (issue 33)",
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nscheme = \"discrete-gradient\"\nspace = \"penalty\"\nfriction = \"tresca\"\ntresca_threshold = 0.1\n",
+        "fixed.scheme",
+        "discrete-gradient has no frictional version in the literature (SPEC §2.5)",
     ),
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"paoli-schatzman\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",

@@ -32,6 +32,7 @@ pub fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
         steps,
         solver: Solver::Direct,
         perturbation: None,
+        friction: contact_sweep::contact::friction::FrictionLaw::None,
     }
 }
 

@@ -44,6 +44,7 @@ use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::contact::Lcp;
+use crate::contact::friction::FrictionLaw;
 use crate::scene::{FeGeometry, FeSetup, LoadModel};
 use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
@@ -91,6 +92,8 @@ pub struct FeConfig {
     /// Ensemble member: relative amplitude of a uniform perturbation of v⁰ (u⁰ = 0 here) and
     /// its seed.
     pub perturbation: Option<(f64, u64)>,
+    /// The friction law on Γ_C (SPEC §2.5; `None`: today's frictionless engine).
+    pub friction: FrictionLaw,
 }
 
 impl FeConfig {
@@ -253,6 +256,9 @@ struct Geometry {
     on_contact_node: Vec<bool>,
     /// Reduced indices of the vertical component.
     vertical: Vec<usize>,
+    /// Reduced indices of the e_1 component (the tangential direction of `velocity_tangential`,
+    /// SPEC §1.8).
+    tangential: Vec<usize>,
 }
 
 impl Geometry {
@@ -519,6 +525,9 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
     let vertical = (0..dofs.n_free())
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
+    let tangential = (0..dofs.n_free())
+        .filter(|&r| dofs.free[r] % d == 0)
+        .collect();
     let layers = mesh_layers(&*mesh, &group.nodes);
     // Heights above the lowest Γ_C node, as the nodes' (the run adds its gap, [`factor`]).
     let points = gmsh_contact_faces(&mesh, group).map(|faces| {
@@ -544,6 +553,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         contact_weight,
         on_contact_node,
         vertical,
+        tangential,
     })
 }
 
@@ -603,6 +613,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
     }
     let on_contact_node = (0..dofs.n_free()).map(|r| contact_node[r / d]).collect();
     let vertical = (0..dofs.n_free()).filter(|&r| r % d == d - 1).collect();
+    let tangential = (0..dofs.n_free()).filter(|&r| r % d == 0).collect();
     Ok(Geometry {
         mesh: FeMesh::Ball(mesh),
         dofs,
@@ -620,6 +631,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         contact_weight,
         on_contact_node,
         vertical,
+        tangential,
     })
 }
 
@@ -662,6 +674,9 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
     let vertical = (0..dofs.n_free())
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
+    let tangential = (0..dofs.n_free())
+        .filter(|&r| dofs.free[r] % d == 0)
+        .collect();
     let contact_height = vec![0.0; contact.len()];
     // Heights above the bottom face x_d = 0; the run adds its gap ([`factor`]).
     let points = Ok(reduce_points(
@@ -696,6 +711,7 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         contact_weight,
         on_contact_node,
         vertical,
+        tangential,
     })
 }
 
@@ -1430,6 +1446,20 @@ fn reference_record(
 
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
+    if frictional(cfg) {
+        return Outcome {
+            status: Status::Invalid,
+            message: Some(format!(
+                "friction = {} with space = {} and scheme = {} is not implemented yet (issue 33)",
+                cfg.friction.kind().name(),
+                cfg.method.name(),
+                cfg.scheme.label()
+            )),
+            metrics: Metrics::default(),
+            series: Series::default(),
+            reference: None,
+        };
+    }
     if methods::handles(cfg) {
         return methods::simulate(cfg, opts, ctx);
     }
@@ -1441,6 +1471,17 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             let mut done = lockstep::step_together(vec![(0, s)]);
             done.pop().expect("one member, one outcome").1
         }
+    }
+}
+
+/// Whether the run's friction law can produce a tangential force. A law with μ_f = 0 or s = 0
+/// is the frictionless problem, which the frictionless engine solves: the "μ_f = 0 gives the
+/// frictionless numbers bit for bit" rule of SPEC §2.5 holds by construction.
+fn frictional(cfg: &FeConfig) -> bool {
+    match cfg.friction {
+        FrictionLaw::None => false,
+        FrictionLaw::Coulomb { coefficient } => coefficient != 0.0,
+        FrictionLaw::Tresca { threshold } => threshold != 0.0,
     }
 }
 
@@ -1603,6 +1644,9 @@ impl<'a> Stepper<'a> {
         let work: StepWork = fac.chol.work();
         for &r in &g.vertical {
             v[r] = cfg.setup.v0;
+        }
+        for &r in &g.tangential {
+            v[r] = cfg.setup.v0_tangential;
         }
         if let Some((delta, seed)) = cfg.perturbation {
             let mut rng = fastrand::Rng::with_seed(seed);
@@ -2043,6 +2087,8 @@ mod tests {
             gravity: 0.1,
             load: LoadModel::Body,
             v0: 0.0,
+            v0_tangential: 0.0,
+            incline: 0.0,
         }
     }
 

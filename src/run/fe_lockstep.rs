@@ -36,7 +36,7 @@ use crate::space::step_solver::Solver;
 /// method puts it into the operators). `None`: the run steps alone — the methods of SPEC §3.2
 /// (their own loops), CG runs (nothing factored to share), invalid schemes.
 pub fn lockstep_key(cfg: &FeConfig) -> Option<String> {
-    if methods::handles(cfg) || cfg.solver != Solver::Direct {
+    if methods::handles(cfg) || cfg.solver != Solver::Direct || super::frictional(cfg) {
         return None;
     }
     let (_, c, _) = cfg.coefficients().ok()?;

@@ -574,6 +574,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     for &r in &g.vertical {
         v[r] = cfg.setup.v0;
     }
+    for &r in &g.tangential {
+        v[r] = cfg.setup.v0_tangential;
+    }
     if let Some((delta, seed)) = cfg.perturbation {
         let mut rng = fastrand::Rng::with_seed(seed);
         for x in v.iter_mut() {
@@ -1146,6 +1149,7 @@ mod tests {
                 steps: 1,
                 perturbation: None,
                 solver: Solver::Direct,
+                friction: crate::contact::friction::FrictionLaw::None,
             };
             let (sigma, gersh) = kinematic_frequency_sq(&cfg).unwrap();
             eprintln!(

@@ -176,6 +176,7 @@ impl RunConfig {
                 steps,
                 solver: crate::space::step_solver::Solver::Direct,
                 perturbation: None,
+                friction: crate::contact::friction::FrictionLaw::None,
             }),
             // The oscillator's one dof is its mass: no mass variant to keep.
             SceneSetup::Oscillator(params) => RunConfig::Oscillator(oscillator::OscillatorConfig {
@@ -203,8 +204,10 @@ impl RunConfig {
     /// today; the planner refuses a law ≠ none on every other scene before a config is built,
     /// so for them the law is none and nothing changes.
     pub fn with_friction(mut self, law: crate::contact::friction::FrictionLaw) -> RunConfig {
-        if let RunConfig::Layer1d(c) = &mut self {
-            c.layer.friction = law;
+        match &mut self {
+            RunConfig::Layer1d(c) => c.layer.friction = law,
+            RunConfig::Fe(c) => c.friction = law,
+            _ => {}
         }
         self
     }

@@ -147,6 +147,8 @@ impl Scene for BallScene {
             gravity: p.get("gravity"),
             load: LoadModel::from_index(p.get("load")),
             v0: 0.0,
+            v0_tangential: 0.0,
+            incline: 0.0,
         })
     }
 }

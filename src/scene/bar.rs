@@ -137,6 +137,12 @@ pub struct FeSetup {
     pub load: LoadModel,
     /// Initial vertical velocity of every node not on a clamped face.
     pub v0: f64,
+    /// Initial e_1 velocity of every node not on a clamped face (SPEC §1.8
+    /// `velocity_tangential`: the disc thrown obliquely, the sliding block; 0 on the bars).
+    pub v0_tangential: f64,
+    /// The plane's tilt α in degrees (SPEC §1.8 `incline`, mesh scenes): the volume load is
+    /// ρ·gravity·(sin α e_1 − cos α e_d); 0 elsewhere.
+    pub incline: f64,
 }
 
 /// The scenes `bar2d` (dim 2) and `bar3d` (dim 3).
@@ -242,6 +248,8 @@ impl Scene for BarScene {
             gravity: 0.0,
             load: LoadModel::Body,
             v0: -0.5,
+            v0_tangential: 0.0,
+            incline: 0.0,
         })
     }
 }

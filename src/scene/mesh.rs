@@ -189,6 +189,8 @@ impl Scene for MeshScene {
                 gravity: p.get("gravity"),
                 load: LoadModel::from_index(p.get("load")),
                 v0: p.get("velocity"),
+                v0_tangential: 0.0,
+                incline: 0.0,
             }),
         ))
     }

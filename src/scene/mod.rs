@@ -153,13 +153,10 @@ pub trait Scene: Send + Sync {
     /// Whether the scene takes a friction law (SPEC §2.5, `friction` ≠ `none`); `Err` says
     /// why not. A friction law needs a tangential direction at the contact: the 1D bar has
     /// none (its one displacement is normal to the obstacle); the finite-element scenes have
-    /// one, but their frictional steps are part 2 (issue 33).
+    /// one at every Γ_C point (e_1 in 2D, e_1 and e_2 in 3D, SPEC §1.8).
     fn supports_friction(&self) -> Result<(), String> {
         if self.fe_dim().is_some() {
-            return Err(format!(
-                "friction on FE scenes is not implemented yet (issue 33); scene {} takes friction = \"none\" only",
-                self.name()
-            ));
+            return Ok(());
         }
         Err(format!(
             "scene {} has no tangential direction at its contact (its one displacement is normal to the obstacle): friction needs layer1d (SPEC §1.7)",
