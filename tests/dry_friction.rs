@@ -366,4 +366,10 @@ fn moreau_jean_e1_with_impacts_balances_energy_and_friction_work() {
         );
     }
     assert!(w.last().unwrap() > &0.0);
+    // The row carries the same balance, so the summaries judge the oscillator's dry friction
+    // by E + W_f as they do the layer's law (over E⁰ = ½: the same 1e-13 absolute, 2e-13).
+    let drift = o.metrics.energy_balance_drift.unwrap();
+    let rise = o.metrics.energy_balance_max_increase.unwrap();
+    assert!(drift.abs() < 2e-13, "energy_balance_drift {drift:e}");
+    assert!(rise < 2e-13, "energy_balance_max_increase {rise:e}");
 }

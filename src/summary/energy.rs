@@ -70,7 +70,10 @@ pub const CLASSES: [&str; 5] = [
 
 /// The run has a friction law (`friction` ≠ `none`) and its row the energy balance.
 pub(crate) fn frictional(runs: &Runs, r: &Run) -> bool {
-    runs.param_str(r, "friction").is_some_and(|f| f != "none") && r.energy_balance_drift.is_some()
+    let law = runs.param_str(r, "friction").is_some_and(|f| f != "none");
+    // The oscillator's dry friction is its `friction_force` (SPEC §1.5), not a `friction` law.
+    let dry = runs.param_f64(r, "friction_force").is_some_and(|f| f > 0.0);
+    (law || dry) && r.energy_balance_drift.is_some()
 }
 
 /// How a run's energy behaved, judged by its scheme's functional.
