@@ -338,6 +338,85 @@ const CASES: &[(&str, &str, &str)] = &[
         "fixed.friction_force",
         "paoli-schatzman has no frictional version in the literature",
     ),
+    // SPEC §1.8: the tilt of the plane under a mesh body (|α| < 90°: at 90° the weight no
+    // longer presses the body on it), the initial tangential velocity (finite), and each key
+    // only on the scenes that take it (velocity_tangential: layer1d, disc2d, sphere3d, mesh2d,
+    // mesh3d; incline: mesh2d, mesh3d). The range checks come before the mesh file is read.
+    (
+        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"block2d.msh\"\ndt = 0.01\nincline = 90.0\n",
+        "fixed.incline",
+        "must lie in (-90, 90) degrees",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh3d\"\n[fixed]\nmesh = \"block3d.msh\"\ndt = 0.01\n[grid]\nincline = [10.0, -120.0]\n",
+        "grid.incline[1]",
+        "must lie in (-90, 90) degrees",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"block2d.msh\"\ndt = 0.01\n[grid]\nincline = [10.0, nan]\n",
+        "grid.incline[1]",
+        "must be a finite number, got NaN",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh3d\"\n[fixed]\nmesh = \"block3d.msh\"\ndt = 0.01\nincline = -inf\n",
+        "fixed.incline",
+        "must be a finite number, got -inf",
+    ),
+    (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nvelocity_tangential = inf\n",
+        "fixed.velocity_tangential",
+        "must be a finite number, got inf",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"block2d.msh\"\ndt = 0.01\n[grid]\nvelocity_tangential = [1.0, nan]\n",
+        "grid.velocity_tangential[1]",
+        "must be a finite number, got NaN",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nvelocity_tangential = 1.0\n",
+        "fixed.velocity_tangential",
+        "`velocity_tangential` is not a parameter of scene bar2d",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar3d\"\n[fixed]\nh = 0.05\ndt = 0.025\n[grid]\nvelocity_tangential = [0.0, 1.0]\n",
+        "grid.velocity_tangential[1]",
+        "`velocity_tangential` is not a parameter of scene bar3d",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nvelocity_tangential = 1.0\n",
+        "fixed.velocity_tangential",
+        "`velocity_tangential` is not a parameter of scene bar1d",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nvelocity_tangential = 1.0\n",
+        "fixed.velocity_tangential",
+        "`velocity_tangential` is not a parameter of scene oscillator",
+    ),
+    (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nincline = 10.0\n",
+        "fixed.incline",
+        "`incline` is not a parameter of scene disc2d",
+    ),
+    (
+        "name = \"x\"\nscene = \"sphere3d\"\n[fixed]\nh = 8.0\ndt = 0.1\nincline = 10.0\n",
+        "fixed.incline",
+        "`incline` is not a parameter of scene sphere3d",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nincline = 10.0\n",
+        "fixed.incline",
+        "`incline` is not a parameter of scene bar2d",
+    ),
+    (
+        "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nincline = 10.0\n",
+        "fixed.incline",
+        "`incline` is not a parameter of scene layer1d",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nincline = 10.0\n",
+        "fixed.incline",
+        "`incline` is not a parameter of scene oscillator",
+    ),
 ];
 
 #[test]

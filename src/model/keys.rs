@@ -71,11 +71,15 @@ pub enum Key {
     TrescaThreshold,
     /// The layer's height H (SPEC §1.7).
     Height,
-    /// The initial tangential velocity V_t (layer1d, SPEC §1.7).
+    /// The initial tangential velocity: layer1d's V_t (SPEC §1.7); the e_1 velocity of every
+    /// node not clamped on disc2d, sphere3d, mesh2d and mesh3d (SPEC §1.8).
     VelocityTangential,
     /// Dry (Coulomb) friction on the oscillator's mass, F ≥ 0 (SPEC §1.5; default 0, so the
     /// frictionless runs keep their ids).
     FrictionForce,
+    /// The plane's tilt α in degrees (mesh2d/mesh3d, SPEC §1.8): the volume load becomes
+    /// ρ·gravity·(sin α e_1 − cos α e_d). Default 0, so every existing run keeps its id.
+    Incline,
 }
 
 /// What a key's value must look like.
@@ -161,7 +165,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 45] = [
+    pub const ALL: [Key; 46] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -207,6 +211,7 @@ impl Key {
         Key::Height,
         Key::VelocityTangential,
         Key::FrictionForce,
+        Key::Incline,
     ];
 
     pub fn name(self) -> &'static str {
@@ -256,6 +261,7 @@ impl Key {
             Key::Height => "height",
             Key::VelocityTangential => "velocity_tangential",
             Key::FrictionForce => "friction_force",
+            Key::Incline => "incline",
         }
     }
 
@@ -282,6 +288,7 @@ impl Key {
                 | Key::Height
                 | Key::VelocityTangential
                 | Key::FrictionForce
+                | Key::Incline
         )
     }
 
@@ -466,6 +473,19 @@ impl Key {
                 }
             }
             (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
+            // A tilt in degrees: at ±90° the plane is a wall, the weight has no component
+            // pressing the body on it (cos α = 0) and the body falls along it, never resting on
+            // the plane the scene is about; beyond, gravity pulls the body away from the plane.
+            (Key::Incline, Value::Num(x)) => {
+                finite(*x)?;
+                if x.abs() < 90.0 {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "must lie in (-90, 90) degrees (the plane's tilt; at |α| ≥ 90° the weight no longer presses the body on the plane), got {x}"
+                    ))
+                }
+            }
             // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).
             (Key::Gap | Key::Amplitude, Value::Num(x)) => {
                 finite(*x)?;

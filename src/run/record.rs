@@ -213,7 +213,8 @@ schema! {
         friction_coefficient: Option<f64> => "", "Coulomb's μ_f (friction = coulomb)";
         tresca_threshold: Option<f64> => "Pa", "Tresca's threshold s, a traction (friction = tresca)";
         height: Option<f64> => "m", "layer1d: the layer's height H";
-        velocity_tangential: Option<f64> => "m/s", "layer1d: the initial tangential velocity V_t";
+        velocity_tangential: Option<f64> => "m/s", "initial tangential velocity: layer1d's V_t (SPEC §1.7); disc2d, sphere3d, mesh2d, mesh3d: the e_1 velocity of every node not clamped (SPEC §1.8; the disc thrown obliquely, the sliding block)";
+        incline: Option<f64> => "°", "mesh2d, mesh3d: the plane's tilt α in degrees, the volume load ρ·gravity·(sin α e_1 − cos α e_d) (SPEC §1.8)";
         friction_work: Option<f64> => "", "friction: W_f(T)/energy_scale, the work the friction force took from the body (SPEC §5; null without friction)";
         energy_balance_drift: Option<f64> => "", "friction: (E^N + W_f^N − E⁰)/energy_scale — the normal contact's work over the run";
         energy_balance_max_increase: Option<f64> => "", "friction: max_n of the one-step rise of E + W_f, over energy_scale (≤ 0 up to round-off for kane and moreau-jean θ = ½)";
@@ -460,6 +461,7 @@ impl RunRecord {
             tresca_threshold: f(Key::TrescaThreshold),
             height: f(Key::Height),
             velocity_tangential: f(Key::VelocityTangential),
+            incline: f(Key::Incline),
             friction_work: m.friction_work,
             energy_balance_drift: m.energy_balance_drift,
             energy_balance_max_increase: m.energy_balance_max_increase,

@@ -9,8 +9,11 @@
 //! 2D, h ≈ 8 in 3D). `elements` is the number n_t of elements along a quarter of the boundary
 //! circle (even); h and n_t are linked by n_t = 2·round(πR/(4h)).
 //!
+//! `velocity_tangential` (default 0; SPEC §1.8) gives every node the initial velocity V_t e_1:
+//! the disc thrown obliquely, for friction.
+//!
 //! Energies are measured in `energy_scale` = m·|f|·gap, the kinetic energy of the body
-//! reaching the plane in free fall (E⁰ = 0 here). There is no closed form and no reference
+//! reaching the plane in free fall (E⁰ = 0 here), plus ½·m·V_t² when thrown obliquely. There is no closed form and no reference
 //! run yet: the runs report energies and contact observables, not errors.
 //!
 //! Implemented so far (issue 8, in stages): `mixed`, `nitsche` and `penalty` (κ = E·γ0/h_K)
@@ -43,7 +46,7 @@ pub struct BallScene {
     pub dim: usize,
 }
 
-const BALL_PHYSICS: [PhysicsKey; 7] = [
+const BALL_PHYSICS: [PhysicsKey; 8] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -71,6 +74,12 @@ const BALL_PHYSICS: [PhysicsKey; 7] = [
     // A choice key: the index into `Key::Load.choices()`, 0 = body (SPEC §1.3).
     PhysicsKey {
         name: "load",
+        default: 0.0,
+    },
+    // The disc thrown obliquely (SPEC §1.8): the initial e_1 velocity of every node (nothing
+    // is clamped). Default 0: the runs of SPEC §1.3 keep their ids.
+    PhysicsKey {
+        name: "velocity_tangential",
         default: 0.0,
     },
 ];
@@ -147,7 +156,7 @@ impl Scene for BallScene {
             gravity: p.get("gravity"),
             load: LoadModel::from_index(p.get("load")),
             v0: 0.0,
-            v0_tangential: 0.0,
+            v0_tangential: p.get("velocity_tangential"),
             incline: 0.0,
         })
     }

@@ -15,7 +15,10 @@
 //! given by its height instead, `obstacle` (exclusive with `gap`): the planner turns it into
 //! the gap it names, so both spellings of one plane are one run with one id. Loads: `gravity`
 //! (per unit mass, towards the obstacle, default 0) and the initial velocity `velocity` e_d on
-//! every node not clamped (default 0; negative moves towards the obstacle). Material defaults
+//! every node not clamped (default 0; negative moves towards the obstacle). SPEC §1.8 adds
+//! `velocity_tangential` (the initial e_1 velocity of every node not clamped) and `incline`
+//! (α in degrees, |α| < 90: the plane tilted by α, the volume load ρ·gravity·(sin α e_1 −
+//! cos α e_d), so the body slides down +e_1), both default 0. Material defaults
 //! are the bars' (ρ = 1, λ = 0.25, μ = 0.5) and `gap` defaults to the bars' 0.2, so the 002 bar
 //! meshed by Gmsh with `velocity = -0.5` is `bar2d`.
 //!
@@ -48,7 +51,7 @@ pub struct MeshScene {
     pub dim: usize,
 }
 
-const MESH_PHYSICS: [PhysicsKey; 7] = [
+const MESH_PHYSICS: [PhysicsKey; 9] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -77,6 +80,17 @@ const MESH_PHYSICS: [PhysicsKey; 7] = [
     // only with gravity (the planner drops it otherwise).
     PhysicsKey {
         name: "load",
+        default: 0.0,
+    },
+    // SPEC §1.8: the initial e_1 velocity of every node not clamped (the sliding block) and
+    // the plane's tilt α in degrees (the volume load ρ·gravity·(sin α e_1 − cos α e_d)). Both
+    // default to 0, so the runs of SPEC §1.6 keep their ids.
+    PhysicsKey {
+        name: "velocity_tangential",
+        default: 0.0,
+    },
+    PhysicsKey {
+        name: "incline",
         default: 0.0,
     },
 ];
@@ -189,8 +203,8 @@ impl Scene for MeshScene {
                 gravity: p.get("gravity"),
                 load: LoadModel::from_index(p.get("load")),
                 v0: p.get("velocity"),
-                v0_tangential: 0.0,
-                incline: 0.0,
+                v0_tangential: p.get("velocity_tangential"),
+                incline: p.get("incline"),
             }),
         ))
     }
