@@ -518,6 +518,58 @@ fn friction_none_keeps_every_run_id() {
     assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
 }
 
+/// SPEC §1.8's keys at their defaults keep every run id: `velocity_tangential = 0` on every
+/// disc2d/sphere3d/mesh2d/mesh3d sweep file and `incline = 0` on the mesh files, set on top of
+/// the file as `--set` does (a physics key at its default never enters the canonical text), and
+/// the 003 disc's CN run keeps the id main gives it. Files that already set a key are skipped
+/// for it (overriding would change their runs).
+#[test]
+fn velocity_tangential_and_incline_at_zero_keep_every_run_id() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps");
+    let mut checked = 0;
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let scene = ["disc2d", "sphere3d", "mesh2d", "mesh3d"]
+            .into_iter()
+            .find(|s| text.contains(&format!("scene = \"{s}\"")));
+        let Some(scene) = scene else { continue };
+        let mut sets = Vec::new();
+        if !text.contains("velocity_tangential") {
+            sets.push("velocity_tangential=0.0".to_string());
+        }
+        if scene.starts_with("mesh") && !text.contains("incline") {
+            sets.push("incline=0.0".to_string());
+        }
+        if sets.is_empty() {
+            continue;
+        }
+        let base = SweepFile::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let with = SweepFile::load_with(&path, &sets).unwrap_or_else(|e| panic!("{e}"));
+        let a = sweep::expand(&base).unwrap_or_else(|e| panic!("{e}"));
+        let b = sweep::expand(&with).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(ids(&a), ids(&b), "{}", path.display());
+        checked += 1;
+    }
+    // 9 files today: the five 003 disc and sphere sweeps, comparison_disc, disc_p2_load,
+    // bar2d_triangles and hertz_halfdisc (the sliding-block and friction files set the keys).
+    assert!(checked >= 9, "only {checked} sweep files checked");
+    let p = plan(
+        "name = \"t\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nT = 1.0\nvelocity_tangential = 0.0\n",
+    );
+    // The id of this run on main before the key existed (`contact-sweep plan`).
+    assert_eq!(p.runs[0].run_id, "831b1028f988a386");
+    let moving = plan(
+        "name = \"t\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nT = 1.0\nvelocity_tangential = 1.0\n",
+    );
+    assert_ne!(moving.runs[0].run_id, "831b1028f988a386");
+}
+
 /// The friction keys on the layer (SPEC §2.5, §7): a bound applies to its own law only, so
 /// across a `friction` axis the frictionless runs (and Tresca's runs crossed with Coulomb's
 /// coefficients) collapse, with the reason; `none` never enters an id, each bound does.

@@ -66,3 +66,7 @@ for n in 2 3 4 6; do
     conv cube_hex.geo $n 3 1 cube_hex_q1_n$n.msh -bin
     conv cube_hex.geo $n 3 2 cube_hex_q2_n$n.msh -bin
 done
+# The sliding blocks of SPEC §1.8 (nothing clamped, Γ_C the bottom face; sweeps/sliding_block.toml,
+# tests/sliding_block.rs).
+g block2d.geo -2 -order 1 -o block2d.msh
+g block3d.geo -3 -order 1 -o block3d.msh

@@ -1,0 +1,22 @@
+// The sliding block of SPEC §1.8 in 2D: the rectangle [0,1] x [0,0.5] as N x M transfinite
+// quadrilaterals (recombined): N M quads, (N+1)(M+1) nodes at degree 1; h = sqrt(1/N^2 + 0.25/M^2).
+// Physical groups: contact = bottom y = 0 (N lines), body. Nothing is clamped: the block rests
+// on the plane and slides on it (sweeps/sliding_block.toml, tests/sliding_block.rs).
+N = 8;
+M = 4;
+Point(1) = {0, 0, 0};
+Point(2) = {1, 0, 0};
+Point(3) = {1, 0.5, 0};
+Point(4) = {0, 0.5, 0};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Transfinite Curve {1, 3} = N + 1;
+Transfinite Curve {2, 4} = M + 1;
+Transfinite Surface {1};
+Recombine Surface {1};
+Physical Curve("contact") = {1};
+Physical Surface("body") = {1};

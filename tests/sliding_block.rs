@@ -1,0 +1,439 @@
+//! The sliding block (SPEC §1.8, issue 33 "done when" 1): a Gmsh block with nothing clamped
+//! (`sweeps/meshes/block2d.msh`, 8 × 4 Q1 quadrilaterals of [0,1]×[0,0.5];
+//! `sweeps/meshes/block3d.msh`, 4 × 2 × 2 Q1 hexahedra of [0,1]×[0,0.5]²) resting on the plane
+//! (gap 0) under gravity g, thrown along it at V e_1, on a flat plane and on one tilted by α.
+//!
+//! The invariant. Let P_c = 1ᵀM v_c be the total momentum along e_c (1 the vector of ones on the
+//! dofs of component c), ΣF_c = 1ᵀF_c the summed volume load (ρ|Ω|·g·(sin α, −cos α) along
+//! (e_1, e_d): the body load ∫ρ f·φ sums to ∫ρ f since Σ_a φ_a = 1, whatever the mass variant)
+//! and f_n ≥ 0, f_t the contact forces on the body along e_d and e_1. Without clamping, a rigid
+//! translation 1_c has no strain, so K 1_c = 0 and, K being symmetric, 1_cᵀK = 0 (Nitsche's Θ
+//! term too: σ(1_c) = 0). Crank–Nicolson (β = ¼, γ = ½) with the contact force f^k in each
+//! level's equation M a^k = F − K u^k + f^k reads
+//!   M(v^{n+1} − v^n) = τ/2 (2F − K(u^n + u^{n+1}) + f^n + f^{n+1}),
+//! so, multiplied by 1_cᵀ,
+//!   P_c^{n+1} − P_c^n = τ (ΣF_c + ½(Σf_c^n + Σf_c^{n+1})).
+//! While every contact point slides forward (+e_1) at both levels, Coulomb's law gives
+//! f_t = −μ_f f_n point by point, hence Σf_1^k = −μ_f Σf_d^k for k = n, n+1, and
+//!   (P_1 + μ_f P_d)^{n+1} − (P_1 + μ_f P_d)^n = τ (ΣF_1 + μ_f ΣF_d):
+//!   Q = P_1 + μ_f P_d − (ΣF_1 + μ_f ΣF_d)·t is constant,
+//! for any mass matrix (M only enters through P). The same holds with one force per step (kane:
+//! M(v^{n+1} − v^n) = τ(F − K u^{n+½} + f); moreau-jean: the impulse p = τf), the frictional
+//! work aside; the Nitsche and penalty forces obey the same law at the quadrature points.
+//! With μ_f = 0 it says P_1 − ΣF_1·t is constant: the frictionless block keeps its tangential
+//! momentum on a flat plane and gains m·g·sin α per unit time on the incline.
+//!
+//! How the test sees P. The engines record a reference run's displacements at every node and
+//! step (`RunContext::record_reference`, the library path a reference run takes); every scheme
+//! here has (u^{n+1} − u^n)/τ = (v^n + v^{n+1})/2 (CN and Moreau–Jean θ = ½ by their update,
+//! kane by v^{n+1} = 2Δu/τ − v^n), so with the consistent mass's row sums m_a = ∫ρφ_a
+//!   P_c^{n+½} = Σ_a m_a (u_{a,c}^{n+1} − u_{a,c}^n)/τ = (P_c^n + P_c^{n+1})/2,
+//! and Q at the half levels is the mean of two consecutive Q's: constant where Q is.
+//!
+//! What runs now and what awaits the frictional engines: the frictionless assertions run (P_1 −
+//! ΣF_1·t constant for mixed + CN, kane, moreau-jean, nitsche + CN, penalty + CN, flat and
+//! tilted, 2D and 3D; the incline's load; the block resting on the plane). The frictional
+//! invariant and `stop_time` are `#[ignore]`d until the Coulomb engines (mixed, the §3.2
+//! methods, Nitsche/penalty) are merged: run them with `--include-ignored`.
+
+use std::path::{Path, PathBuf};
+
+use contact_sweep::run::{Outcome, RunContext, RunOptions, simulate_with};
+use contact_sweep::space::fe::{DofMap, GmshMesh, Mesh, assemble_load};
+use contact_sweep::sweep::{SweepFile, expand};
+
+/// The block's material and load (sweeps/sliding_block.toml): ρ = 1, λ = μ = 10 (E = 25,
+/// ν = 0.25), g = 0.1, thrown at V = 0.5, τ = 0.05.
+const RHO: f64 = 1.0;
+const LAME: f64 = 10.0;
+const GRAVITY: f64 = 0.1;
+const V: f64 = 0.5;
+const DT: f64 = 0.05;
+/// Coulomb's coefficient of the frictional runs.
+const MU_F: f64 = 0.2;
+/// The tilt of the inclined runs (tan α = 0.087 < μ_f: the block still stops).
+const INCLINE: f64 = 5.0;
+
+/// The methods of the issue: (label, sweep bundle).
+const METHODS: [(&str, &str); 5] = [
+    (
+        "mixed + CN",
+        "{ space = \"mixed\", scheme = \"crank-nicolson\" }",
+    ),
+    ("kane", "{ space = \"mixed\", scheme = \"kane\" }"),
+    (
+        "moreau-jean",
+        "{ space = \"mixed\", scheme = \"moreau-jean\", restitution = 0.0 }",
+    ),
+    (
+        "nitsche + CN",
+        "{ space = \"nitsche\", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3, scheme = \"crank-nicolson\" }",
+    ),
+    (
+        "penalty + CN",
+        "{ space = \"penalty\", penalty_gamma0 = 100.0, scheme = \"crank-nicolson\" }",
+    ),
+];
+
+fn sweeps_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps")
+}
+
+fn mesh_path(dim: usize) -> PathBuf {
+    sweeps_dir().join(format!("meshes/block{dim}d.msh"))
+}
+
+/// One run of the block and what the test reads from it.
+struct Trace {
+    what: String,
+    outcome: Outcome,
+    /// ρ|Ω|: 0.5 (2D), 0.25 (3D).
+    mass: f64,
+    /// t^{n+½} and P^{n+½} per direction (e_1 first, e_d last).
+    t_half: Vec<f64>,
+    p_half: Vec<[f64; 3]>,
+    /// Whether every Γ_C node moved forward (Δu_1 > 0) in step n → n+1.
+    all_forward: Vec<bool>,
+    /// The centre of mass's vertical displacement Σ m_a u_{a,d}/m at each step.
+    com_d: Vec<f64>,
+    /// The engine's total contact force (along +e_d) at each step.
+    force: Vec<f64>,
+    /// The plain mean of u_1 over every node at each step.
+    mean_u1: Vec<f64>,
+    dim: usize,
+}
+
+impl Trace {
+    /// ΣF along e_1 and e_d: ρ|Ω|·g·(sin α, −cos α).
+    fn load_sum(&self, incline: f64) -> (f64, f64) {
+        let (s, c) = incline.to_radians().sin_cos();
+        (self.mass * GRAVITY * s, -self.mass * GRAVITY * c)
+    }
+}
+
+/// Plan and run the block with one method; `friction`: Coulomb's μ_f (None: frictionless).
+fn trace(dim: usize, method: (&str, &str), incline: f64, friction: Option<f64>, t: f64) -> Trace {
+    let friction_keys = friction.map_or(String::new(), |mu| {
+        format!("friction = \"coulomb\"\nfriction_coefficient = {mu:?}\n")
+    });
+    let text = format!(
+        "name = \"block\"\nscene = \"mesh{dim}d\"\n[fixed]\nmesh = \"meshes/block{dim}d.msh\"\ndensity = {RHO:?}\nlame_lambda = {LAME:?}\nlame_mu = {LAME:?}\ngravity = {GRAVITY:?}\ngap = 0.0\nvelocity_tangential = {V:?}\nincline = {incline:?}\nT = {t:?}\ndt = {DT:?}\n{friction_keys}[grid]\nmethod = [{}]\n",
+        method.1
+    );
+    let path = sweeps_dir().join("sliding_block_test.toml");
+    let plan = expand(&SweepFile::parse(&path, &text).expect("valid sweep")).expect("plan");
+    assert_eq!(plan.runs.len(), 1, "{text}");
+    let spec = &plan.runs[0];
+    let what = format!("{dim}D {} α = {incline}° μ_f = {friction:?}", method.0);
+    let o = simulate_with(
+        &spec.config,
+        &RunOptions {
+            series_every: 1,
+            ..RunOptions::default()
+        },
+        &RunContext {
+            reference: None,
+            record_reference: Some((1, 1)),
+        },
+    );
+    assert_eq!(o.status.as_str(), "ok", "{what}: {:?}", o.message);
+    let data = o
+        .reference
+        .as_ref()
+        .expect("a recorded run keeps its solution");
+
+    // The consistent mass's row sums m_a = ∫ρφ_a (1ᵀM restricted to node a, any component).
+    let mesh = GmshMesh::read(&mesh_path(dim)).expect("the committed block mesh");
+    let n = mesh.num_nodes();
+    let mut e1 = [0.0; 3];
+    e1[0] = 1.0;
+    let lumped = assemble_load(&mesh, &DofMap::all(n * dim), RHO, e1, &|_| 1.0);
+    let m_a: Vec<f64> = (0..n).map(|a| lumped[a * dim]).collect();
+    let mass: f64 = m_a.iter().sum();
+    let contact = mesh.contact_nodes();
+    assert_eq!(data.lattice[0], n, "{what}: the record holds every node");
+
+    let stride = n * dim;
+    let u = |k: usize, a: usize, c: usize| data.u[k * stride + a * dim + c];
+    let mut t_half = Vec::new();
+    let mut p_half = Vec::new();
+    let mut all_forward = Vec::new();
+    for k in 0..data.times - 1 {
+        let mut p = [0.0; 3];
+        for (c, pc) in p.iter_mut().enumerate().take(dim) {
+            *pc = (0..n)
+                .map(|a| m_a[a] * (u(k + 1, a, c) - u(k, a, c)))
+                .sum::<f64>()
+                / DT;
+        }
+        // Keep e_d last whatever the dimension: p[dim − 1] is the normal momentum.
+        t_half.push((k as f64 + 0.5) * DT);
+        p_half.push(p);
+        all_forward.push(contact.iter().all(|&a| u(k + 1, a, 0) > u(k, a, 0)));
+    }
+    let mean_u1 = (0..data.times)
+        .map(|k| (0..n).map(|a| u(k, a, 0)).sum::<f64>() / n as f64)
+        .collect();
+    let com_d = (0..data.times)
+        .map(|k| (0..n).map(|a| m_a[a] * u(k, a, dim - 1)).sum::<f64>() / mass)
+        .collect();
+    Trace {
+        what,
+        mass,
+        t_half,
+        p_half,
+        all_forward,
+        com_d,
+        force: data.force.clone(),
+        mean_u1,
+        dim,
+        outcome: o,
+    }
+}
+
+/// |Ω| of the blocks: the rectangle 1 × 0.5, the box 1 × 0.5 × 0.5.
+fn volume(dim: usize) -> f64 {
+    if dim == 2 { 0.5 } else { 0.25 }
+}
+
+/// max_n |x^n − x^0| over a slice of half levels, relative to `scale`.
+fn max_dev(x: impl Iterator<Item = f64>, scale: f64) -> f64 {
+    let v: Vec<f64> = x.collect();
+    v.iter()
+        .map(|y| ((y - v[0]) / scale).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Frictionless (μ_f = 0 is the law-free engine, every method available now): P_1 − ΣF_1·t is
+/// constant to 1e-10·mV for the five methods, flat and tilted, 2D and 3D; on the flat plane the
+/// block slides at its initial mean velocity V; on the incline its momentum grows at m·g·sin α,
+/// the incline's load measured through the engine's own displacements.
+///
+/// Tolerance 1e-10·mV: the identity is exact in exact arithmetic (module header); P^{n+½} is a
+/// difference quotient of displacements of size ≤ V·T ≈ 5 (flat) and ½ g sin α T² ≈ 2.7 (tilted)
+/// over τ = 0.05, so its round-off is ~ 1e-16·5/0.05·√(nodes) ≈ 1e-13, and the step solves
+/// (sparse Cholesky, exact active sets) are backward stable: 1e-10 leaves three decades.
+#[test]
+fn frictionless_block_keeps_its_tangential_momentum() {
+    let t = 10.0;
+    for dim in [2, 3] {
+        for method in METHODS {
+            for incline in [0.0, INCLINE] {
+                let tr = trace(dim, method, incline, None, t);
+                let m = RHO * volume(dim);
+                assert!(
+                    (tr.mass - m).abs() <= 1e-13 * m,
+                    "{}: Σ∫ρφ_a = {} ≠ ρ|Ω| = {m}",
+                    tr.what,
+                    tr.mass
+                );
+                let (f1, _) = tr.load_sum(incline);
+                let q = tr.t_half.iter().zip(&tr.p_half).map(|(t, p)| p[0] - f1 * t);
+                let dev = max_dev(q, m * V);
+                println!("{}: max |ΔQ|/(mV) = {dev:.2e}", tr.what);
+                assert!(
+                    dev <= 1e-10,
+                    "{}: P_1 − ΣF_1·t moved by {dev:e}·mV",
+                    tr.what
+                );
+                // The first half level: P_1^{½} = m(V + ½τ·g sin α) (P_1 = mV at t = 0 and
+                // the invariant), so the mean tangential velocity is V where the plane is flat.
+                let p0 = tr.p_half[0][0];
+                let want = m * V + f1 * 0.5 * DT;
+                assert!(
+                    (p0 - want).abs() <= 1e-12 * m * V,
+                    "{}: P_1^{{½}} = {p0}, want {want}",
+                    tr.what
+                );
+            }
+        }
+    }
+}
+
+/// The block rests on the plane (mixed + CN, consistent mass). Crank–Nicolson's normal momentum
+/// balance with the engine's recorded contact force, P_d^{n+½} − P_d^{½} = τ Σ_{k=1..n} (ΣF_d +
+/// (f^{k−1} + 2f^k + f^{k+1})/4) (the CN increment of the module header averaged over two
+/// steps), holds to 1e-10·m·g·T: the plane carries the weight ρ|Ω|·g·cos α and nothing else
+/// acts along e_d. The centre of mass settles by at most 3δ, δ = ρ g cos α H²/(3E') the static
+/// settlement of the centre of mass of a free column of height H = 0.5 under its weight
+/// (E' = E/(1 − ν²) in plane strain, E in 3D, where the lateral faces are free): a suddenly
+/// applied weight doubles the static settlement in an undamped elastic body (measured 1.9δ in
+/// 2D, 2.4δ in 3D, where CN's chatter adds energy), 3δ leaving room for the coarse Q1 mesh. It
+/// rises above its start only by what the energy CN gained allows: with F the body load,
+/// −Fᵀu = m·g·cos α·z (z the centre of mass's vertical displacement, the along-slope part
+/// aside on the incline), and ½vᵀMv ≥ P_1²/(2m), so m·g·cos α·z ≤ E^n − E⁰ +
+/// (P_1^0² − P_1^n²)/(2m) — flat: z ≤ max_n (E^n − E⁰)/(m g) (the consistent mass's CN gains up
+/// to 1e-2 of the energy scale here: SPEC §2.1's spurious growth, which lifts the 3D block
+/// 3e-3 off the plane at times). The nodes never go below the plane (max_penetration at
+/// round-off).
+#[test]
+fn frictionless_block_rests_on_the_plane() {
+    let t = 10.0;
+    let e = LAME * (3.0 * LAME + 2.0 * LAME) / (LAME + LAME);
+    let nu = LAME / (2.0 * (LAME + LAME));
+    for dim in [2, 3] {
+        for incline in [0.0, INCLINE] {
+            let tr = trace(dim, METHODS[0], incline, None, t);
+            let (_, fd) = tr.load_sum(incline);
+            let m = tr.mass;
+            let mut acc = 0.0;
+            let mut worst: f64 = 0.0;
+            for n in 1..tr.p_half.len() {
+                let f = &tr.force;
+                acc += DT * (fd + (f[n - 1] + 2.0 * f[n] + f[n + 1]) / 4.0);
+                let dp = tr.p_half[n][tr.dim - 1] - tr.p_half[0][tr.dim - 1];
+                worst = worst.max((dp - acc).abs());
+            }
+            let scale = m * GRAVITY * t;
+            println!("{}: normal balance {:.2e}·mgT", tr.what, worst / scale);
+            assert!(
+                worst <= 1e-10 * scale,
+                "{}: P_d − ∫(ΣF_d + f) off by {:e}·mgT",
+                tr.what,
+                worst / scale
+            );
+            let e_eff = if dim == 2 { e / (1.0 - nu * nu) } else { e };
+            let delta = RHO * GRAVITY * incline.to_radians().cos() * 0.25 / (3.0 * e_eff);
+            let settle = tr.com_d.iter().fold(0.0_f64, |a, z| a.max(-z));
+            let rise = tr.com_d.iter().fold(0.0_f64, |a, &z| a.max(z));
+            println!(
+                "{}: centre of mass settles by at most {settle:.3e} (δ = {delta:.3e}), rises by {rise:.1e}",
+                tr.what
+            );
+            assert!(settle <= 3.0 * delta, "{}: settled by {settle:e}", tr.what);
+            if incline == 0.0 {
+                let gained = tr.outcome.metrics.energy_max_dev.expect("reported")
+                    * tr.outcome.metrics.energy_scale.expect("reported");
+                let allowed = gained / (m * GRAVITY) + 1e-14;
+                assert!(
+                    rise <= allowed,
+                    "{}: rose by {rise:e} > {allowed:e}, more than the energy gained allows",
+                    tr.what
+                );
+            }
+            let pen = tr
+                .outcome
+                .metrics
+                .max_penetration
+                .expect("FE runs report it");
+            assert!(pen <= 1e-12, "{}: penetration {pen:e}", tr.what);
+        }
+    }
+}
+
+/// A body with nothing clamped runs with every mass variant of the FE scenes (issue 33, part
+/// 3): the step matrix M + cτ²K is positive definite as soon as M is positive on the rigid
+/// motions (the null space of K) — true of every variant: the ones that zero layer 0 or the
+/// Γ_C rows keep the mass of the nodes above Γ_C, on which no rigid motion vanishes; the one
+/// that would keep no mass at all (a single element layer) is refused with its reason. On the
+/// flat frictionless plane the block (symmetric about x = ½, as every layer-based variant)
+/// translates at V: the plain mean of u_1 over the nodes is V·t, the lateral Poisson spreading
+/// under the weight being antisymmetric. Tolerance 1e-8·V·T: the asymmetry is round-off, which
+/// the contact's chatter amplifies where Γ_C keeps mass (CN with a mass on the contact rows
+/// gains up to 1e-1 of the energy scale here, SPEC §2.1): measured 3e-10 (3D lumped), ≤ 2e-11
+/// with the massless variants.
+#[test]
+fn frictionless_block_slides_with_every_mass_variant() {
+    let t = 10.0;
+    for dim in [2, 3] {
+        for mass in [
+            "consistent",
+            "lumped",
+            "mod1",
+            "mod2",
+            "mod3",
+            "zero-contact",
+        ] {
+            let bundle =
+                format!("{{ space = \"mixed\", mass = \"{mass}\", scheme = \"crank-nicolson\" }}");
+            let tr = trace(dim, (mass, &bundle), 0.0, None, t);
+            let dev = tr
+                .mean_u1
+                .iter()
+                .enumerate()
+                .map(|(k, x)| (x - V * k as f64 * DT).abs())
+                .fold(0.0, f64::max)
+                / (V * t);
+            println!("{}: mean u_1 − V·t ≤ {dev:.2e}·V·T", tr.what);
+            assert!(dev <= 1e-8, "{}: mean u_1 off V·t by {dev:e}·V·T", tr.what);
+            let drift = tr.outcome.metrics.energy_drift.expect("reported");
+            println!("{}: energy drift {drift:.2e}·energy_scale", tr.what);
+        }
+    }
+}
+
+/// Issue 33 "done when" 1 — awaits the Coulomb engines (mixed in the stepper, the §3.2 methods,
+/// Nitsche/penalty friction): while every contact point slides forward, Q = P_1 + μ_f P_d −
+/// (ΣF_1 + μ_f ΣF_d)·t stays constant to 1e-10·mV (the tolerance of the frictionless test, the
+/// same round-off: the contact solves are exact active-set or Newton solves to round-off), for
+/// the five methods, flat and on the incline, 2D and 3D. The forward-sliding window is read
+/// from the displacements (every Γ_C node moves forward at every step up to its end); it must
+/// last at least half the rigid stopping time V/(g(μ_f cos α − sin α)): the elastic block's
+/// mean velocity follows the rigid one to μ_f·v_d, v_d ≈ 1e-2 its vertical vibration, so the
+/// contact points keep sliding until near the stop.
+#[test]
+#[ignore = "awaits the Coulomb engines (wt-mixed, wt-methods, wt-nitsche): run with --include-ignored after they merge"]
+fn sliding_block_keeps_the_frictional_invariant_until_it_sticks() {
+    for dim in [2, 3] {
+        for method in METHODS {
+            for incline in [0.0, INCLINE] {
+                let (s, c) = incline.to_radians().sin_cos();
+                let t_rigid = V / (GRAVITY * (MU_F * c - s));
+                let tr = trace(dim, method, incline, Some(MU_F), 1.2 * t_rigid);
+                let (f1, fd) = tr.load_sum(incline);
+                let m = tr.mass;
+                let window = tr.all_forward.iter().take_while(|&&f| f).count();
+                let t_end = window as f64 * DT;
+                println!(
+                    "{}: every contact point slides forward until t = {t_end:.3} (rigid stop {t_rigid:.3})",
+                    tr.what
+                );
+                assert!(
+                    t_end >= 0.5 * t_rigid,
+                    "{}: a contact point stopped sliding at t = {t_end} < t_rigid/2",
+                    tr.what
+                );
+                let d = tr.dim - 1;
+                let q = tr.t_half[..window]
+                    .iter()
+                    .zip(&tr.p_half[..window])
+                    .map(|(t, p)| p[0] + MU_F * p[d] - (f1 + MU_F * fd) * t);
+                let dev = max_dev(q, m * V);
+                println!("{}: max |ΔQ|/(mV) = {dev:.2e}", tr.what);
+                assert!(dev <= 1e-10, "{}: Q moved by {dev:e}·mV", tr.what);
+            }
+        }
+    }
+}
+
+/// Issue 33 — awaits the friction tally's `stop_time` (wt-mixed) and the Coulomb engines: the
+/// block stops near the rigid time V/(g(μ_f cos α − sin α)) (25 flat, 44.6 at 5°). Tolerance
+/// 5 %: while every point slides the invariant gives the mean velocity V − a·t − μ_f·v_d
+/// (a the rigid deceleration, v_d the centre of mass's vertical velocity, ≲ 1e-2 by the rest
+/// test's settlement bound), a shift of μ_f·v_d/a ≲ 0.1 (0.4 %); the last slip–stick
+/// transition of the elastic block lasts about a shear round trip 2H/c_s = 0.32 (1.3 % of 25):
+/// 5 % holds both twice over.
+#[test]
+#[ignore = "awaits stop_time (wt-mixed's friction tally) and the Coulomb engines: run with --include-ignored after they merge"]
+fn sliding_block_stops_near_the_rigid_time() {
+    for dim in [2, 3] {
+        for method in METHODS {
+            for incline in [0.0, INCLINE] {
+                let (s, c) = incline.to_radians().sin_cos();
+                let t_rigid = V / (GRAVITY * (MU_F * c - s));
+                let tr = trace(dim, method, incline, Some(MU_F), 1.2 * t_rigid);
+                let stop = tr
+                    .outcome
+                    .metrics
+                    .stop_time
+                    .unwrap_or_else(|| panic!("{}: no stop_time", tr.what));
+                println!("{}: stop_time {stop:.4} (rigid {t_rigid:.4})", tr.what);
+                assert!(
+                    (stop - t_rigid).abs() <= 0.05 * t_rigid,
+                    "{}: stop_time {stop} vs rigid {t_rigid}",
+                    tr.what
+                );
+            }
+        }
+    }
+}
