@@ -1446,6 +1446,10 @@ fn reference_record(
 
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
+    // The methods of SPEC §3.2 solve friction with the nodal multiplier in their own loops.
+    if frictional(cfg) && methods::handles(cfg) && cfg.method == ContactMethod::Mixed {
+        return methods::simulate(cfg, opts, ctx);
+    }
     if frictional(cfg) {
         return Outcome {
             status: Status::Invalid,

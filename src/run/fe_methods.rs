@@ -59,6 +59,49 @@
 //! K u^pred = Kuⁿ + τKvⁿ + KM⁻¹Bᵀν and K(uⁿ + θτvⁿ)). So a step costs the solve and one sparse
 //! product, as Crank–Nicolson's does (measured: `benches/fe.rs`, `bar2d-methods`). Every 64
 //! steps the products are recomputed from the state. Nothing is allocated in the time loop.
+//!
+//! Friction (SPEC §2.5, `space = "mixed"`; issue 33). The contact rows grow from B (the
+//! vertical dof of each Γ_C node, normal force λ = f_n ≥ 0 on the body) to C = [B; T], T the
+//! node's e_1 (and e_2) dofs carrying the tangential force f_t on the body: the force term
+//! Bᵀλ of every step above becomes Cᵀr, r = (f_n, f_t) per node, and the condensation
+//! Z = A⁻¹Cᵀ, H = cCZ covers the tangential columns (the frictional factor). A step is still
+//! y = A⁻¹b, one contact problem on the contact set, and y + cZμ with μ = (c_f/c) r; the
+//! problem is the Coulomb (or Tresca) law on the pair
+//!
+//!   gap = q_n + (Hμ)_n ≥ 0 ⊥ μ_n ≥ 0,   slip = q_t + (Hμ)_t,   |μ_t| ≤ b, μ_t = −b·slip/|slip|,
+//!
+//! solved by the semismooth Newton method of [`crate::contact::coulomb`] (the Coulomb disc in
+//! 3D). Coulomb's bound b = μ_f μ_n is scale free; Tresca's s·w_j (w_j = ∫_ΓC φ_j, a force) is
+//! multiplied by c_f/c, and by τ where the unknown is an impulse. Per method (the slip is the
+//! scheme's, SPEC §2.5; f̄_t is the tangential force as it enters the momentum equation over
+//! the step, which W_f^{n+1} = W_f^n − Σ_j f̄_t,j·(u_t,j^{n+1} − u_t,j^n) uses):
+//! - `kane`: q_n = Buⁿ + g + By, q_t = Ty (slip = u_t^{n+1} − u_tⁿ = TΔu), μ = 2(λ, f_t)^{n+1},
+//!   f̄_t = f_t^{n+1}. The trapezoidal rule gives ΔE = Δuᵀ Cᵀr exactly (massless rows included:
+//!   their row is K u^{n+½} = F + Cᵀr), so Δ(E + W_f) = λ·BΔu = −λ·(Buⁿ + g) ≤ 0: the normal
+//!   force does no positive work and friction's work is all in W_f;
+//! - `contact-stabilized-newmark`: the predictor is frictionless (the M-projection onto the
+//!   admissible set constrains the normal rows only); the corrector is `kane`'s with
+//!   q_n = Bu^pred + g + By, q_t = T(u^pred − uⁿ) + Ty, μ = 2(λ, f_t)^{n+1}, f̄_t = f_t^{n+1};
+//! - `generalized-alpha`/`hht`: q_n = By + g, q_t = Ty − Tuⁿ, μ = r^{n+1}; the force of the
+//!   previous step enters the right-hand side as κ_f Cᵀrⁿ (tangential rows included), so
+//!   f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ;
+//! - `moreau-jean`: De Saxcé's law per node on the velocity-level problem, over the nodes with
+//!   (Buⁿ + g) + ½τBvⁿ ≤ 0 only (the solver's active mask; the others carry no impulse):
+//!   "gap" = Bv^{n+1} + eBvⁿ, q_n = (1 + e)Bvⁿ + By; "slip" = v_t^{n+1}, q_t = Tvⁿ + Ty; the
+//!   impulses p = cμ, reported forces p/τ, Tresca's bound s·w_j·τ. f̄_t = p_t/τ, so
+//!   −f̄_t·Δu_t = −p_t·Tv^{n+θ} and with θ = ½ Δ(E + W_f) = p_n·Bv^{n+½} = ½(1 − e) p_n·Bvⁿ:
+//!   zero for e = 1 (conserved to round-off), ≤ 0 on a node that approaches for e < 1;
+//! - kinematic `central-difference`: after a contact dof is put on the obstacle by the normal
+//!   impulse (force λ_j = m_j Δv_j/τ), the node's tangential force is the one that stops its
+//!   slip increment, f_t = −m_j(u_t^pred − u_tⁿ)/τ², projected onto the disc |f_t| ≤ b
+//!   (b = μ_f λ_j, Tresca s·w_j, none without a normal impulse): u_t += τ²f_t/m_j,
+//!   v_t^{n+½} += τf_t/m_j. A local projection per node, no solve; f̄_t = f_t^{n+1}.
+//!
+//! Measured per step (SPEC §5): W_f, the rise of E + W_f, the contact node-steps in stick
+//! (|Δu_t| ≤ 1e-12·h) and in slip, |Σf_t|/Σf_n, and the series' σ_t (the total e_1 contact
+//! force), the Γ_C mean of v_1 and W_f; at T the mean velocities 1ᵀMv/1ᵀM1 along e_1 (3D: the
+//! norm over e_1, e_2) and e_d. A law with μ_f = 0 or s = 0 never reaches this module's
+//! frictional path (the engine routes it to the frictionless one: bit for bit).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -69,6 +112,7 @@ use super::{
     lowest_contact, mass_matrix, ref_map, reference_record,
 };
 use crate::contact::Lcp;
+use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
 use crate::run::fe_nitsche::{
     NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
@@ -300,6 +344,274 @@ pub(super) fn kinematic_frequency_sq(cfg: &FeConfig) -> Result<(f64, f64), (&'st
         }
         delta *= 2.0;
     }
+}
+
+/// The frictional part of a run (module header): the law, the tangential dofs of each Γ_C node,
+/// the step's forces, and what the run measures. Allocated once per run.
+struct Friction {
+    law: FrictionLaw,
+    /// Tangential directions per node (d − 1).
+    nt: usize,
+    /// Reduced index of direction k of contact node j: `tdofs[j·nt + k]`.
+    tdofs: Vec<usize>,
+    /// The nodes' trapezoidal weights (sum 1): Γ_C means.
+    mean_weight: Vec<f64>,
+    /// Tresca's weights w_j = ∫_ΓC φ_j of the nodes.
+    weight: Vec<f64>,
+    /// The step's forces on the body (f_n ≥ 0 per node; f_t per node and direction), forces
+    /// also where the method's unknowns are impulses.
+    f_n: Vec<f64>,
+    f_t: Vec<f64>,
+    /// f_tⁿ, the previous step's (generalized-α's f̄_t).
+    f_t_prev: Vec<f64>,
+    /// u_tⁿ at the tangential dofs (the slip's reference).
+    u_t_prev: Vec<f64>,
+    /// f̄_t = (1 − w) f_tⁿ + w f_t^{n+1} (SPEC §2.5).
+    weight_new: f64,
+    /// |Δu_t| below this is stick (1e-12·h, SPEC §5).
+    stick_tol: f64,
+    /// The directions' masses 1ᵀM1 over e_1, (e_2,) e_d (mean velocities 1ᵀMv/1ᵀM1).
+    mass_dir: [f64; 3],
+    /// Reduced rows of each direction (0 … d−1), for the mean velocities.
+    dir_rows: Vec<Vec<usize>>,
+    work: f64,
+    balance_prev: Option<f64>,
+    max_increase: f64,
+    stick: i64,
+    slip: i64,
+    ratio_max: Option<f64>,
+    /// min over the steps of the tangential work −Σ f_t^{n+1}·Δu_t (≥ 0 for every
+    /// position-level method, SPEC §2.5), in the run's units.
+    tangential_work_min: f64,
+    /// Mean e_1 velocity of the previous observed step, and the first time it reached 0
+    /// (SPEC §1.8 `stop_time`, for a body thrown along e_1).
+    v_t_prev: f64,
+    stop_time: Option<f64>,
+}
+
+impl Friction {
+    fn new(
+        g: &Geometry,
+        cfg: &FeConfig,
+        m: &SymMatrix,
+        weight_new: f64,
+    ) -> Result<Friction, String> {
+        let d = cfg.setup.dim;
+        let nt = d - 1;
+        let mut tdofs = Vec::with_capacity(g.contact.len() * nt);
+        for &c in &g.contact {
+            // A node is clamped or free as a whole and its components are consecutive
+            // (node-major numbering): its e_k dof sits k − (d − 1) rows before e_d's.
+            let node = g.dofs.free[c] / d;
+            for k in 0..nt {
+                let r = c + k - nt;
+                if g.dofs.free[r] != node * d + k {
+                    return Err(format!(
+                        "the tangential dof {k} of a Γ_C node is not where the numbering puts it"
+                    ));
+                }
+                tdofs.push(r);
+            }
+        }
+        let weight = tresca_weights(g)?;
+        let n = g.dofs.n_free();
+        let ones = vec![1.0; n];
+        let mut m1 = vec![0.0; n];
+        m.matvec_into(&ones, &mut m1);
+        let dir_rows: Vec<Vec<usize>> = (0..d)
+            .map(|k| (0..n).filter(|&r| g.dofs.free[r] % d == k).collect())
+            .collect();
+        let mut mass_dir = [0.0; 3];
+        for (k, rows) in dir_rows.iter().enumerate() {
+            mass_dir[k] = rows.iter().map(|&r| m1[r]).sum();
+        }
+        let nc = g.contact.len();
+        Ok(Friction {
+            law: cfg.friction,
+            nt,
+            tdofs,
+            mean_weight: g.contact_weight.clone(),
+            weight,
+            f_n: vec![0.0; nc],
+            f_t: vec![0.0; nc * nt],
+            f_t_prev: vec![0.0; nc * nt],
+            u_t_prev: vec![0.0; nc * nt],
+            weight_new,
+            stick_tol: 1e-12 * cfg.setup.h,
+            mass_dir,
+            dir_rows,
+            work: 0.0,
+            balance_prev: None,
+            max_increase: f64::NEG_INFINITY,
+            stick: 0,
+            slip: 0,
+            ratio_max: None,
+            tangential_work_min: f64::INFINITY,
+            v_t_prev: cfg.setup.v0_tangential,
+            stop_time: None,
+        })
+    }
+
+    /// Keep u_tⁿ before a step.
+    fn begin(&mut self, u: &[f64]) {
+        for (p, &r) in self.u_t_prev.iter_mut().zip(&self.tdofs) {
+            *p = u[r];
+        }
+    }
+
+    /// The step's bookkeeping once u^{n+1} and the forces (`f_n`, `f_t`) are known: W_f, stick
+    /// and slip, the apparent friction coefficient, the tangential work.
+    fn end(&mut self, u: &[f64]) {
+        let nt = self.nt;
+        let w = self.weight_new;
+        let (mut sum_n, mut sum_t, mut tw) = (0.0, [0.0; 2], 0.0);
+        for (j, &fn_j) in self.f_n.iter().enumerate() {
+            let (mut du2, mut dw) = (0.0, 0.0);
+            for k in 0..nt {
+                let i = j * nt + k;
+                let du = u[self.tdofs[i]] - self.u_t_prev[i];
+                let fbar = (1.0 - w) * self.f_t_prev[i] + w * self.f_t[i];
+                dw -= fbar * du;
+                tw -= self.f_t[i] * du;
+                du2 += du * du;
+                sum_t[k] += self.f_t[i];
+            }
+            self.work += dw;
+            if fn_j > 0.0 {
+                sum_n += fn_j;
+                if du2.sqrt() <= self.stick_tol {
+                    self.stick += 1;
+                } else {
+                    self.slip += 1;
+                }
+            }
+        }
+        self.tangential_work_min = self.tangential_work_min.min(tw);
+        if sum_n > 0.0 {
+            let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
+            self.ratio_max = Some(self.ratio_max.map_or(r, |x| x.max(r)));
+        }
+        self.f_t_prev.copy_from_slice(&self.f_t);
+    }
+
+    /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
+    /// nodes' trapezoidal weights), W_f.
+    fn series(&self, v: &[f64]) -> [f64; 3] {
+        let sigma_t = self.f_t.iter().step_by(self.nt).sum();
+        let v_t = self
+            .tdofs
+            .iter()
+            .step_by(self.nt)
+            .zip(&self.mean_weight)
+            .map(|(&r, w)| w * v[r])
+            .sum();
+        [sigma_t, v_t, self.work]
+    }
+
+    /// Kinematic friction (module header): with the normal impulses' forces in `f_n`, the
+    /// tangential force of each node that stops its slip increment, projected onto the disc
+    /// of radius b, applied to u_t and v_t^{n+½}. `diag` is the lumped mass.
+    fn kinematic(&mut self, u: &mut [f64], v: &mut [f64], diag: &[f64], tau: f64) {
+        let nt = self.nt;
+        let t2 = tau * tau;
+        for j in 0..self.f_n.len() {
+            let ts = &self.tdofs[j * nt..(j + 1) * nt];
+            let f = &mut self.f_t[j * nt..(j + 1) * nt];
+            let fn_j = self.f_n[j];
+            if fn_j <= 0.0 {
+                f.iter_mut().for_each(|x| *x = 0.0);
+                continue;
+            }
+            let b = self.law.bound(fn_j, self.weight[j]);
+            let mut norm2 = 0.0;
+            for (k, &r) in ts.iter().enumerate() {
+                f[k] = -diag[r] * (u[r] - self.u_t_prev[j * nt + k]) / t2;
+                norm2 += f[k] * f[k];
+            }
+            let norm = norm2.sqrt();
+            // Stick inside the disc (the slip increment is cancelled exactly: u_t = u_tⁿ),
+            // slide on its boundary along the stick force.
+            let stick = norm <= b;
+            for (k, &r) in ts.iter().enumerate() {
+                if stick {
+                    u[r] = self.u_t_prev[j * nt + k];
+                } else {
+                    f[k] *= b / norm;
+                    u[r] += t2 * f[k] / diag[r];
+                }
+                v[r] += tau * f[k] / diag[r];
+            }
+        }
+    }
+
+    /// The mean velocity 1ᵀMv/1ᵀM1 along direction k, from the carried Mv.
+    fn mean_velocity(&self, mv: &[f64], k: usize) -> f64 {
+        self.dir_rows[k].iter().map(|&r| mv[r]).sum::<f64>() / self.mass_dir[k]
+    }
+
+    /// After observing step `step` with energy E: the rise of E + W_f, and the first time the
+    /// mean e_1 velocity of a body thrown along e_1 reaches 0 (linear interpolation).
+    fn balance(&mut self, step: usize, tau: f64, energy: f64, mv: &[f64]) {
+        let b = energy + self.work;
+        if let Some(prev) = self.balance_prev {
+            self.max_increase = self.max_increase.max(b - prev);
+        }
+        self.balance_prev = Some(b);
+        let vt = self.mean_velocity(mv, 0);
+        if step > 0 && self.stop_time.is_none() && self.v_t_prev != 0.0 {
+            let (a, c) = (self.v_t_prev, vt);
+            if c == 0.0 || a.signum() != c.signum() {
+                self.stop_time = Some((step as f64 - 1.0 + a / (a - c)) * tau);
+            }
+        }
+        self.v_t_prev = vt;
+    }
+
+    /// The friction columns of SPEC §5 (energies over `scale`).
+    fn report(&self, metrics: &mut Metrics, mv: &[f64], d: usize, scale: f64, steps: usize) {
+        metrics.friction_work = Some(self.work / scale);
+        if let (Some(b), Some(e0)) = (self.balance_prev, metrics.energy_initial) {
+            metrics.energy_balance_drift = Some((b - e0) / scale);
+        }
+        metrics.energy_balance_max_increase = Some(if steps > 0 {
+            self.max_increase / scale
+        } else {
+            0.0
+        });
+        metrics.stick_steps = Some(self.stick);
+        metrics.slip_steps = Some(self.slip);
+        metrics.friction_ratio_max = self.ratio_max;
+        let vt = if d == 3 {
+            self.mean_velocity(mv, 0).hypot(self.mean_velocity(mv, 1))
+        } else {
+            self.mean_velocity(mv, 0)
+        };
+        metrics.tangential_velocity_final = Some(vt);
+        metrics.normal_velocity_final = Some(self.mean_velocity(mv, d - 1));
+        metrics.stop_time = self.stop_time;
+    }
+}
+
+/// Tresca's weights w_j = ∫_ΓC φ_j of the Γ_C nodes, from Nitsche's quadrature of Γ_C (its
+/// u_n row holds −φ on the vertical dofs: u_n = −u_d).
+fn tresca_weights(g: &Geometry) -> Result<Vec<f64>, String> {
+    let points = g
+        .points
+        .as_ref()
+        .map_err(|e| format!("Tresca's weights need Γ_C's quadrature: {e}"))?;
+    let mut slot = vec![usize::MAX; g.dofs.n_free()];
+    for (j, &c) in g.contact.iter().enumerate() {
+        slot[c] = j;
+    }
+    let mut w = vec![0.0; g.contact.len()];
+    for p in points {
+        for (&r, &un) in p.dofs.iter().zip(&p.un) {
+            if slot[r] != usize::MAX {
+                w[slot[r]] -= p.weight * un;
+            }
+        }
+    }
+    Ok(w)
 }
 
 /// The discrete gradient's Newton scratch (allocated once per run).
@@ -569,6 +881,32 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
     let mut work: Option<StepWork> = fac.as_ref().map(|f| f.chol.work());
     let diag = m.diagonal();
+    // Friction (module header): f̄_t's weight of f_t^{n+1} is generalized-α's 1 − α_f, the
+    // other methods' force of the step itself.
+    let mut fric = if super::frictional(cfg) {
+        let weight_new = match meth {
+            Method::Alpha(p) => 1.0 - p.alpha_f,
+            _ => 1.0,
+        };
+        if !matches!(meth, Method::Kinematic) {
+            return fail(
+                Status::Invalid,
+                format!(
+                    "friction = {} with space = {} and scheme = {} is not implemented yet (issue 33)",
+                    cfg.friction.kind().name(),
+                    cfg.method.name(),
+                    cfg.scheme.label()
+                ),
+                metrics,
+            );
+        }
+        match Friction::new(g, cfg, m, weight_new) {
+            Ok(f) => Some(f),
+            Err(e) => return fail(Status::Invalid, e, metrics),
+        }
+    } else {
+        None
+    };
     // Dofs without inertia (mod1/…/zero-contact with kane): their velocity is Δu/τ.
     let massless: Vec<usize> = (0..n).filter(|&i| diag[i] == 0.0).collect();
     for &r in &g.vertical {
@@ -635,8 +973,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                        ku: &[f64],
                        force: f64,
                        tmp: &mut [f64],
-                       err: &mut [f64]|
-     -> Result<(), Divergence> {
+                       err: &mut [f64],
+                       friction: Option<[f64; 3]>|
+     -> Result<f64, Divergence> {
         let kinetic = 0.5 * v.iter().zip(mv).map(|(x, y)| x * y).sum::<f64>();
         let elastic = 0.5 * u.iter().zip(ku).map(|(x, y)| x * y).sum::<f64>();
         let gravity = -u.iter().zip(&force_vec).map(|(x, y)| x * y).sum::<f64>();
@@ -673,6 +1012,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             data.u_contact.push(uc);
         }
         let exact = refmap.as_ref().map(|rm| rm.compare(g, step, u, err, tmp));
+        if let Some([sigma_t, v_t, work]) = friction {
+            obs.set_friction(sigma_t, v_t, work);
+        }
         obs.observe(
             StepValues {
                 step,
@@ -691,6 +1033,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             },
             exact,
         )
+        .map(|()| e)
     };
 
     let mut done = 0usize;
@@ -704,11 +1047,19 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
         if let Some(ops) = nit {
             // The state's own contact force at t = 0 (zero unless the body starts in contact).
             let (_, _, f) = ops.energy_terms_and_force(&u);
-            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err, None).map_err(Stop::Diverged)?;
         } else {
-            observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            let fv = fric.as_ref().map(|fr| fr.series(&v));
+            let e = observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err, fv)
+                .map_err(Stop::Diverged)?;
+            if let Some(fr) = fric.as_mut() {
+                fr.balance(0, tau, e, &mv);
+            }
         }
         for step in 1..=cfg.steps {
+            if let Some(fr) = fric.as_mut() {
+                fr.begin(&u);
+            }
             let force = match meth {
                 Method::Kinematic => {
                     for i in 0..n {
@@ -716,11 +1067,17 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                         u[i] += tau * v[i];
                     }
                     let mut force = 0.0;
-                    for (&ci, gi) in g.contact.iter().zip(&gaps) {
+                    for (j, (&ci, gi)) in g.contact.iter().zip(&gaps).enumerate() {
                         let (uc, dv, l) = crate::time::kinematic_impulse(u[ci], -gi, diag[ci], tau);
                         u[ci] = uc;
                         v[ci] += dv;
                         force += l;
+                        if let Some(fr) = fric.as_mut() {
+                            fr.f_n[j] = l;
+                        }
+                    }
+                    if let Some(fr) = fric.as_mut() {
+                        fr.kinematic(&mut u, &mut v, &diag, tau);
                     }
                     g.k.matvec_into(&u, &mut ku);
                     for i in 0..n {
@@ -1020,11 +1377,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                     _ => {}
                 }
             }
-            observe_timer
+            if let Some(fr) = fric.as_mut() {
+                fr.end(&u);
+            }
+            let fv = fric.as_ref().map(|fr| fr.series(&v));
+            let e = observe_timer
                 .time(step, || {
-                    observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err)
+                    observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err, fv)
                 })
                 .map_err(Stop::Diverged)?;
+            if let Some(fr) = fric.as_mut() {
+                fr.balance(step, tau, e, &mv);
+            }
             done = step;
             opts.step_stop(step, CLOCK_EVERY, start)?;
         }
@@ -1048,6 +1412,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     metrics.err_sigma_mid_l2 = None;
     metrics.contact_toggles = Some(metrics.contact_switches);
     metrics.energy_scale = energy_scale.or(metrics.energy_initial);
+    if let (Some(fr), Some(scale)) = (&fric, metrics.energy_scale) {
+        fr.report(&mut metrics, &mv, cfg.setup.dim, scale, done);
+    }
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
         _ => None,
@@ -1119,6 +1486,41 @@ mod tests {
     use super::*;
     use crate::scene::{BarScene, Physics, Scene, SceneSetup};
     use crate::space::step_solver::Solver;
+
+    /// Tresca's weights ∫_ΓC φ_j sum to |Γ_C|: the bars' bottom face 0.1 (2D) and 0.1² (3D),
+    /// the corners half (2D) or a quarter (3D) of an interior node's h^{d−1} (Gauss
+    /// quadrature of Q1 traces is exact: a few ulps).
+    #[test]
+    fn tresca_weights_integrate_the_shape_functions() {
+        for (dim, h) in [(2, 0.05), (3, 0.1)] {
+            let scene = BarScene { dim };
+            let physics = Physics(
+                scene
+                    .physics()
+                    .iter()
+                    .map(|k| (k.name, k.default))
+                    .collect(),
+            );
+            let SceneSetup::Fe(setup) =
+                scene.setup(&physics, scene.mesh_from_h(&physics, h).unwrap())
+            else {
+                unreachable!("the bars are FE scenes")
+            };
+            let (geo, _) = GEOMETRIES.get(geometry_key(&setup), || build_geometry(&setup));
+            let g = geo.unwrap();
+            let w = tresca_weights(&g).unwrap();
+            let total: f64 = w.iter().sum();
+            let area = 0.1f64.powi(dim as i32 - 1);
+            let (lo, hi) = w
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
+            let interior = h.powi(dim as i32 - 1);
+            eprintln!("bar{dim}d h = {h}: Σw = {total:e}, min {lo:e}, max {hi:e}");
+            assert!((total - area).abs() <= 1e-14 * area);
+            assert!((hi - interior).abs() <= 1e-14 * interior);
+            assert!((lo - interior / f64::from(1 << (dim - 1))).abs() <= 1e-14 * interior);
+        }
+    }
 
     /// The certified ω²_max is an upper bound (σM − K positive definite, by construction) and
     /// tight: 1 % below it σM − K is indefinite (so the CFL step is within ~0.5 % of the true
