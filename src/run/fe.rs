@@ -526,7 +526,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
     let tangential = (0..dofs.n_free())
-        .filter(|&r| dofs.free[r] % d == 0)
+        .filter(|&r| dofs.free[r].is_multiple_of(d))
         .collect();
     let layers = mesh_layers(&*mesh, &group.nodes);
     // Heights above the lowest Γ_C node, as the nodes' (the run adds its gap, [`factor`]).
@@ -675,7 +675,7 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         .filter(|&r| dofs.free[r] % d == d - 1)
         .collect();
     let tangential = (0..dofs.n_free())
-        .filter(|&r| dofs.free[r] % d == 0)
+        .filter(|&r| dofs.free[r].is_multiple_of(d))
         .collect();
     let contact_height = vec![0.0; contact.len()];
     // Heights above the bottom face x_d = 0; the run adds its gap ([`factor`]).
