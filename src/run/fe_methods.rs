@@ -111,9 +111,9 @@ use super::{
     build_geometry, factor, factor_failure, factor_key_gap, geometry_key, gravity_load,
     lowest_contact, mass_matrix, ref_map, reference_record,
 };
-use crate::contact::Lcp;
 use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
+use crate::contact::{FrictionalContact, Lcp};
 use crate::run::fe_nitsche::{
     NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
 };
@@ -362,8 +362,13 @@ struct Friction {
     /// also where the method's unknowns are impulses.
     f_n: Vec<f64>,
     f_t: Vec<f64>,
-    /// f_tⁿ, the previous step's (generalized-α's f̄_t).
+    /// f_tⁿ, the previous step's (generalized-α's f̄_t and right-hand side).
     f_t_prev: Vec<f64>,
+    /// The implicit methods' contact problem (None: kinematic central difference): the rows
+    /// C node-major (normal, e_1 (, e_2) per node), the condensation, the solver and its data —
+    /// free gaps, free slips, the active mask (Moreau–Jean), the unknowns μ (node-major, warm
+    /// start of the next step) and Tresca's weights in μ's unit.
+    implicit: Option<Implicit>,
     /// u_tⁿ at the tangential dofs (the slip's reference).
     u_t_prev: Vec<f64>,
     /// f̄_t = (1 − w) f_tⁿ + w f_t^{n+1} (SPEC §2.5).
@@ -389,7 +394,165 @@ struct Friction {
     stop_time: Option<f64>,
 }
 
+/// The implicit methods' frictional contact problem (see [`Friction::implicit`]).
+struct Implicit {
+    rows: Vec<usize>,
+    factor: Arc<FrictionalFactor>,
+    solver: FrictionalContact,
+    q_n: Vec<f64>,
+    q_t: Vec<f64>,
+    active: Vec<bool>,
+    mu: Vec<f64>,
+    weights: Vec<f64>,
+}
+
+/// The frictional condensation of a step matrix A = M + cK: Z̄ = A⁻¹Cᵀ (n × dm, column-major)
+/// over every row of the Γ_C nodes, node-major, and H̄ = cCZ̄ (dm × dm, row-major, symmetrised)
+/// — the frictionless Z and H are its normal columns and rows.
+#[derive(Debug)]
+struct FrictionalFactor {
+    z: Vec<f64>,
+    h: Vec<f64>,
+}
+
+/// Per step matrix, as [`FACTORS`] (its key with a suffix).
+static FRICTIONAL_FACTORS: Cache<FrictionalFactor> = Cache::new();
+
+fn frictional_factor(
+    f: &Factored,
+    n: usize,
+    rows: &[usize],
+    c: f64,
+) -> Result<FrictionalFactor, String> {
+    let nr = rows.len();
+    let mut z = vec![0.0; n * nr];
+    for (j, &r) in rows.iter().enumerate() {
+        z[j * n + r] = 1.0;
+    }
+    let mut work = f.chol.work_for(nr);
+    f.chol
+        .try_solve_many_in_place(&mut z, nr, &mut work)
+        .map_err(|e| format!("the frictional condensation columns A⁻¹Cᵀ: {e}"))?;
+    let mut h = vec![0.0; nr * nr];
+    for (i, &ri) in rows.iter().enumerate() {
+        for j in 0..nr {
+            h[i * nr + j] = c * z[j * n + ri];
+        }
+    }
+    // Symmetric in exact arithmetic (A is); symmetrise the round-off.
+    for i in 0..nr {
+        for j in 0..i {
+            let x = 0.5 * (h[i * nr + j] + h[j * nr + i]);
+            h[i * nr + j] = x;
+            h[j * nr + i] = x;
+        }
+    }
+    Ok(FrictionalFactor { z, h })
+}
+
 impl Friction {
+    /// Attach the implicit methods' contact problem: the condensation of the step matrix
+    /// (cached under `key`) and the scale of μ: f = `force_per_mu`·μ, so Tresca's bound s·w_j
+    /// on the force is s·w_j/`force_per_mu` on μ.
+    fn attach(
+        &mut self,
+        g: &Geometry,
+        f: &Factored,
+        key: String,
+        c: f64,
+        force_per_mu: f64,
+    ) -> Result<(), String> {
+        let d = self.nt + 1;
+        let nc = g.contact.len();
+        let mut rows = Vec::with_capacity(nc * d);
+        for (j, &ci) in g.contact.iter().enumerate() {
+            rows.push(ci);
+            rows.extend_from_slice(&self.tdofs[j * self.nt..(j + 1) * self.nt]);
+        }
+        let (factor, _) = FRICTIONAL_FACTORS.get(key + "|friction", || {
+            frictional_factor(f, g.dofs.n_free(), &rows, c)
+        });
+        let factor = factor?;
+        let solver = FrictionalContact::new(nc, d, factor.h.clone());
+        self.implicit = Some(Implicit {
+            rows,
+            factor,
+            solver,
+            q_n: vec![0.0; nc],
+            q_t: vec![0.0; nc * self.nt],
+            active: vec![true; nc],
+            mu: vec![0.0; nc * d],
+            weights: self.weight.iter().map(|w| w / force_per_mu).collect(),
+        });
+        Ok(())
+    }
+
+    /// The free gaps q_n and slips q_t = Ty + `off` (T the tangential rows; `off` the method's
+    /// slip reference at those rows, module header) into the problem; `gap(j)` is node j's.
+    fn set_free(&mut self, y: &[f64], off: impl Fn(usize) -> f64, gap: impl Fn(usize) -> f64) {
+        let im = self.implicit.as_mut().expect("an implicit method");
+        for (j, q) in im.q_n.iter_mut().enumerate() {
+            *q = gap(j);
+        }
+        for (q, &r) in im.q_t.iter_mut().zip(&self.tdofs) {
+            *q = y[r] + off(r);
+        }
+    }
+
+    /// Solve the step's problem (over the active nodes if `masked`), then y += cZ̄μ and
+    /// sd += cCᵀμ; the normal unknowns into `normal` (the frictionless code's λ). Returns the
+    /// Newton steps.
+    fn solve(
+        &mut self,
+        c: f64,
+        masked: bool,
+        y: &mut [f64],
+        sd: &mut [f64],
+        normal: &mut [f64],
+    ) -> Result<usize, String> {
+        let d = self.nt + 1;
+        let im = self.implicit.as_mut().expect("an implicit method");
+        let it = im
+            .solver
+            .solve(
+                &self.law,
+                &im.weights,
+                &im.q_n,
+                &im.q_t,
+                masked.then_some(&im.active[..]),
+                &mut im.mu,
+                LCP_MAX_ITER,
+                LCP_TOL,
+            )
+            .map_err(|e| e.to_string())?;
+        add_columns(&im.factor.z, &im.mu, c, y);
+        add_rows(&im.rows, &im.mu, c, sd);
+        for (l, m) in normal.iter_mut().zip(im.mu.iter().step_by(d)) {
+            *l = *m;
+        }
+        Ok(it)
+    }
+
+    /// The step's forces f = `s`·μ (s = c_f/c's inverse, or c/τ for impulses) into f_n, f_t.
+    fn take_forces(&mut self, s: f64) {
+        let d = self.nt + 1;
+        let im = self.implicit.as_ref().expect("an implicit method");
+        for (j, fn_j) in self.f_n.iter_mut().enumerate() {
+            *fn_j = s * im.mu[j * d];
+            for k in 0..self.nt {
+                self.f_t[j * self.nt + k] = s * im.mu[j * d + 1 + k];
+            }
+        }
+    }
+
+    /// y += s·f_tⁿ at the tangential rows (generalized-α's history term κ_f Cᵀrⁿ, whose
+    /// normal part the frictionless code adds).
+    fn add_previous_tangential(&self, s: f64, y: &mut [f64]) {
+        for (&r, f) in self.tdofs.iter().zip(&self.f_t_prev) {
+            y[r] += s * f;
+        }
+    }
+
     fn new(
         g: &Geometry,
         cfg: &FeConfig,
@@ -435,6 +598,7 @@ impl Friction {
             f_n: vec![0.0; nc],
             f_t: vec![0.0; nc * nt],
             f_t_prev: vec![0.0; nc * nt],
+            implicit: None,
             u_t_prev: vec![0.0; nc * nt],
             weight_new,
             stick_tol: 1e-12 * cfg.setup.h,
@@ -766,15 +930,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     // The step factor (the engine's cache, the engine's key) or, for the explicit step, the
     // lumped mass alone.
     let c = step_coefficient(meth, tau);
+    let key = c.map(|c| {
+        format!(
+            "{}|{:?}|{:?}|{:e}",
+            geometry_key(&cfg.setup),
+            cfg.mass,
+            cfg.method,
+            c
+        ) + &factor_key_gap(g, cfg)
+    });
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
-            let key = format!(
-                "{}|{:?}|{:?}|{:e}",
-                geometry_key(&cfg.setup),
-                cfg.mass,
-                cfg.method,
-                c
-            ) + &factor_key_gap(g, cfg);
+            let key = key.clone().expect("made with c");
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
@@ -888,22 +1055,35 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             Method::Alpha(p) => 1.0 - p.alpha_f,
             _ => 1.0,
         };
-        if !matches!(meth, Method::Kinematic) {
-            return fail(
-                Status::Invalid,
-                format!(
-                    "friction = {} with space = {} and scheme = {} is not implemented yet (issue 33)",
-                    cfg.friction.kind().name(),
-                    cfg.method.name(),
-                    cfg.scheme.label()
-                ),
-                metrics,
-            );
-        }
-        match Friction::new(g, cfg, m, weight_new) {
-            Ok(f) => Some(f),
+        // μ's unit: the force enters the right-hand side as c_f·Cᵀr and the solution is
+        // y + cZ̄μ, so r = (c/c_f)μ (module header); Moreau–Jean's impulse p = cμ is the force
+        // p/τ.
+        let force_per_mu = match (meth, c) {
+            (Method::Kinematic, _) => None,
+            (Method::Kane | Method::Csn, Some(_)) => Some(0.5),
+            (Method::Alpha(_), Some(_)) => Some(1.0),
+            (Method::MoreauJean(_), Some(c)) => Some(c / tau),
+            _ => {
+                return fail(
+                    Status::Invalid,
+                    format!(
+                        "scheme {} has no frictional version (SPEC §2.5)",
+                        cfg.scheme.label()
+                    ),
+                    metrics,
+                );
+            }
+        };
+        let mut fr = match Friction::new(g, cfg, m, weight_new) {
+            Ok(f) => f,
             Err(e) => return fail(Status::Invalid, e, metrics),
+        };
+        if let (Some(s), Some(f), Some(c), Some(key)) = (force_per_mu, &fac, c, key)
+            && let Err(e) = fr.attach(g, f, key, c, s)
+        {
+            return fail(Status::SolverFailed, e, metrics);
         }
+        Some(fr)
     } else {
         None
     };
@@ -1101,16 +1281,31 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = u[ci] + y[ci] + gi;
-                            }
-                            let it = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it = if let Some(fr) = fric.as_mut() {
+                                // Slip = TΔu: q_t = Ty.
+                                fr.set_free(
+                                    &y,
+                                    |_| 0.0,
+                                    |j| u[g.contact[j]] + y[g.contact[j]] + gaps[j],
+                                );
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(0.5);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = u[ci] + y[ci] + gi;
+                                }
+                                let it = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it
+                            };
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
                             g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
@@ -1152,16 +1347,31 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = pred[ci] + y[ci] + gi;
-                            }
-                            let it2 = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it2 = if let Some(fr) = fric.as_mut() {
+                                // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
+                                fr.set_free(
+                                    &y,
+                                    |r| pred[r] - u[r],
+                                    |j| pred[g.contact[j]] + y[g.contact[j]] + gaps[j],
+                                );
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(0.5);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = pred[ci] + y[ci] + gi;
+                                }
+                                let it2 = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it2
+                            };
                             newton_max = newton_max.max(it + it2);
                             iterations += it2 as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
                                 let md = sd[i] - c * kd[i];
@@ -1233,20 +1443,34 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                     + (c + kf) * force_vec[i];
                             }
                             add_rows(&g.contact, &lambda_prev, kf, &mut y);
+                            if let Some(fr) = fric.as_ref() {
+                                fr.add_previous_tangential(kf, &mut y);
+                            }
                             sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = y[ci] + gi;
-                            }
-                            let it = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it = if let Some(fr) = fric.as_mut() {
+                                // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
+                                fr.set_free(&y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(1.0);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = y[ci] + gi;
+                                }
+                                let it = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it
+                            };
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             lambda_prev.copy_from_slice(&lambda);
                             // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
                             // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
@@ -1286,7 +1510,28 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                     0.0
                                 };
                             }
-                            if any {
+                            if let Some(fr) = fric.as_mut() {
+                                // De Saxcé on velocities over the active nodes: "gap" =
+                                // Bv^{n+1} + eBvⁿ (q as above), slip = v_t^{n+1} = T(vⁿ + Δv).
+                                if any {
+                                    fr.set_free(&y, |r| v[r], |j| q[j]);
+                                    fr.implicit
+                                        .as_mut()
+                                        .expect("attached")
+                                        .active
+                                        .copy_from_slice(&rows);
+                                    let it = fr
+                                        .solve(c, true, &mut y, &mut sd, &mut lambda)
+                                        .map_err(|e| Stop::Solver(step, e))?;
+                                    newton_max = newton_max.max(it);
+                                    iterations += it as i64;
+                                } else {
+                                    let im = fr.implicit.as_mut().expect("attached");
+                                    im.mu.iter_mut().for_each(|x| *x = 0.0);
+                                    lambda.iter_mut().for_each(|l| *l = 0.0);
+                                }
+                                fr.take_forces(c / tau);
+                            } else if any {
                                 let it = lcp
                                     .solve_on(&q, &mut lambda, &rows, LCP_MAX_ITER, LCP_TOL)
                                     .map_err(|e| Stop::Solver(step, e.to_string()))?;
