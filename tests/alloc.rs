@@ -308,6 +308,39 @@ method = [
     );
 }
 
+/// Friction in the same methods (issue 33): the frictional condensation and the solver's
+/// workspace are made at setup, the semismooth Newton reuses its buffers, the tally its
+/// vectors; kane (Coulomb, the LU kept while the node states repeat), Moreau–Jean (Tresca,
+/// the active mask), generalized-α (f_tⁿ in the right-hand side), kinematic central
+/// difference's local projection — bar2d (d = 2) and bar3d (the disc's linearised
+/// projection).
+#[test]
+fn frictional_comparison_methods_allocate_nothing() {
+    for (scene, h) in [("bar2d", 0.05), ("bar3d", 0.1)] {
+        assert_loop_allocates_nothing(
+            &format!(
+                r#"
+name = "alloc-fe-friction"
+scene = "{scene}"
+[fixed]
+T = T_FINAL
+h = {h}
+dt = 0.01
+[grid]
+method = [
+  {{ mass = "consistent", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "mod3", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "consistent", scheme = "moreau-jean", friction = "tresca", tresca_threshold = 0.02 }},
+  {{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "lumped", scheme = "central-difference", dt = 0.002, friction = "coulomb", friction_coefficient = 0.05 }},
+]
+"#
+            ),
+            1.0,
+        );
+    }
+}
+
 /// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and
 /// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried):
 /// inactive before the impact, active after.

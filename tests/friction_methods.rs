@@ -244,6 +244,13 @@ fn balance_never_rises(scene: &str, draws: &[(f64, f64, f64)], extra: &str, bars
             // Kane's and CSN's steps do the tangential work −f_t^{n+1}·Δu_t ≥ 0 (the law's
             // sign): W_f never decreases beyond the rounding of its sum (1e-15 scales).
             if label.contains("kane") || label.contains("contact-stabilized") {
+                let scale = o.metrics.energy_scale.unwrap();
+                let wf: Vec<f64> = o.series.rows().map(|r| r.friction_work.unwrap()).collect();
+                let fall = wf
+                    .windows(2)
+                    .map(|w| (w[1] - w[0]) / scale)
+                    .fold(0.0f64, f64::min);
+                assert!(fall >= -1e-15, "{place} {label}: W_f fell by {fall:.3e}");
                 assert!(work >= -1e-15, "{place} {label}: W_f = {work:.3e}");
             }
             // Where nodes slid, those steps' work is positive: W_f > 0. (Generalized-α's and
