@@ -385,9 +385,6 @@ struct Friction {
     stick: i64,
     slip: i64,
     ratio_max: Option<f64>,
-    /// min over the steps of the tangential work −Σ f_t^{n+1}·Δu_t (≥ 0 for every
-    /// position-level method, SPEC §2.5), in the run's units.
-    tangential_work_min: f64,
     /// Mean e_1 velocity of the previous observed step, and the first time it reached 0
     /// (SPEC §1.8 `stop_time`, for a body thrown along e_1).
     v_t_prev: f64,
@@ -610,7 +607,6 @@ impl Friction {
             stick: 0,
             slip: 0,
             ratio_max: None,
-            tangential_work_min: f64::INFINITY,
             v_t_prev: cfg.setup.v0_tangential,
             stop_time: None,
         })
@@ -624,11 +620,11 @@ impl Friction {
     }
 
     /// The step's bookkeeping once u^{n+1} and the forces (`f_n`, `f_t`) are known: W_f, stick
-    /// and slip, the apparent friction coefficient, the tangential work.
+    /// and slip, the apparent friction coefficient.
     fn end(&mut self, u: &[f64]) {
         let nt = self.nt;
         let w = self.weight_new;
-        let (mut sum_n, mut sum_t, mut tw) = (0.0, [0.0; 2], 0.0);
+        let (mut sum_n, mut sum_t) = (0.0, [0.0; 2]);
         for (j, &fn_j) in self.f_n.iter().enumerate() {
             let (mut du2, mut dw) = (0.0, 0.0);
             for k in 0..nt {
@@ -636,7 +632,6 @@ impl Friction {
                 let du = u[self.tdofs[i]] - self.u_t_prev[i];
                 let fbar = (1.0 - w) * self.f_t_prev[i] + w * self.f_t[i];
                 dw -= fbar * du;
-                tw -= self.f_t[i] * du;
                 du2 += du * du;
                 sum_t[k] += self.f_t[i];
             }
@@ -650,7 +645,6 @@ impl Friction {
                 }
             }
         }
-        self.tangential_work_min = self.tangential_work_min.min(tw);
         if sum_n > 0.0 {
             let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
             self.ratio_max = Some(self.ratio_max.map_or(r, |x| x.max(r)));
