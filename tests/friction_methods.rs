@@ -34,8 +34,12 @@ fn draws(seed: u64, hs: &[f64], count: usize) -> Vec<(f64, f64, f64)> {
 }
 
 /// The friction columns every frictional run reports, and the checks common to all: the run
-/// hit the obstacle and |Σf_t| ≤ μ_f Σf_n (the law holds per node, so for the sums; 1e-12 for
-/// the rounding of the sums and of the solver's projection onto the disc).
+/// hit the obstacle and |Σf_t| ≤ μ_f Σf_n (the law holds per node, so for the sums). The
+/// semismooth Newton stops at a natural residual of 1e-12 of the problem's force scale — the
+/// largest |f| or r|q| over the nodes, the force that would stop one node's free motion alone,
+/// up to ~100 times a step's mean node force at an impact on these meshes — so a node's
+/// |f_t| may exceed μ_f f_n by 1e-12 of that: 1e-10 relative (measured up to 6.5e-12 on the
+/// tetrahedra cube, where every node slides the same way and the sums sit on the cone).
 fn check_common(place: &str, label: &str, o: &Outcome, mu: Option<f64>) -> (f64, f64) {
     let m = &o.metrics;
     let work = m
@@ -59,7 +63,7 @@ fn check_common(place: &str, label: &str, o: &Outcome, mu: Option<f64>) -> (f64,
     );
     if let (Some(mu), Some(r)) = (mu, ratio) {
         assert!(
-            r <= mu * (1.0 + 1e-12),
+            r <= mu * (1.0 + 1e-10),
             "{place} {label}: |Σf_t|/Σf_n = {r} above μ_f = {mu}"
         );
     }
@@ -418,5 +422,45 @@ method = [
         );
         // Friction took energy: v̄_1 fell below V.
         assert!(v1 < v_t && m.friction_work.unwrap() > 0.0, "{}", spec.label);
+    }
+}
+
+/// The Gmsh path (mesh3d, issue 22's clamped cube of P1 tetrahedra, 125 nodes, dropped as
+/// bar3d is): its Γ_C nodes' tangential dofs and Tresca's weights from the mesh's faces. Kane
+/// and Moreau–Jean (e = 0, 1) keep the bounds of [`balance_never_rises`], Moreau–Jean e = 1
+/// conserves E + W_f, kinematic central difference never penetrates, and friction does work
+/// (μ_f = 0.05 and s = 0.02: the struck face slides outwards, as the bars').
+#[test]
+fn mesh3d_tetrahedra_friction() {
+    const TET_CUBE: &str = "sweeps/meshes/conv/cube_tet_p1_n4.msh";
+    for law in [
+        "friction = \"coulomb\"\nfriction_coefficient = 0.05",
+        "friction = \"tresca\"\ntresca_threshold = 0.02",
+    ] {
+        let fixed = format!("T = 1.5\nmesh = \"{TET_CUBE}\"\nvelocity = -0.5\ndt = 0.03");
+        let methods = "  { mass = \"consistent\", scheme = \"kane\" },\n  { mass = \"mod3\", scheme = \"kane\" },\n  { mass = \"consistent\", scheme = \"moreau-jean\", theta_scheme = 0.5, restitution = 0.0 },\n  { mass = \"lumped\", scheme = \"moreau-jean\", theta_scheme = 0.5, restitution = 1.0 },\n  { mass = \"lumped\", scheme = \"central-difference\", dt = 0.01 },\n";
+        let mu = law.contains("coulomb").then_some(0.05);
+        for (label, o) in frictional_sweep("mesh3d", &fixed, law, methods) {
+            let (work, rise) = check_common("mesh3d cube", &label, &o, mu);
+            let (step, drift) = balance_changes(&o);
+            eprintln!("    max |Δ(E + W_f)| {step:.3e}, |drift| {drift:.3e}");
+            assert!(work > 0.0, "{label}: friction did no work");
+            if label.contains("central-difference") {
+                let pen = o.metrics.max_penetration.unwrap();
+                assert!(
+                    pen <= 1e-14 * o.metrics.length_scale.unwrap(),
+                    "{label}: {pen:.3e}"
+                );
+            } else {
+                assert!(rise <= 1e-12, "{label}: E + W_f rose by {rise:.3e}·scale");
+            }
+            if label.contains("e=1)") {
+                let n = o.metrics.steps as f64;
+                assert!(
+                    step <= 1e-12 && drift <= 1e-12 * n,
+                    "{label}: {step:.3e} {drift:.3e}"
+                );
+            }
+        }
     }
 }

@@ -573,7 +573,11 @@ impl Friction {
                 tdofs.push(r);
             }
         }
-        let weight = tresca_weights(g)?;
+        // Only Tresca reads the weights (a Gmsh contact group without faces has none).
+        let weight = match cfg.friction {
+            FrictionLaw::Tresca { .. } => tresca_weights(g)?,
+            _ => vec![0.0; g.contact.len()],
+        };
         let n = g.dofs.n_free();
         let ones = vec![1.0; n];
         let mut m1 = vec![0.0; n];
