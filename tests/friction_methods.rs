@@ -50,7 +50,8 @@ fn check_common(place: &str, label: &str, o: &Outcome, mu: Option<f64>) -> (f64,
         .expect("a frictional run reports energy_balance_max_increase");
     let ratio = m.friction_ratio_max;
     eprintln!(
-        "{place} {label}: W_f/scale {work:.4e}, max rise of E + W_f {rise:.3e}, drift {:.3e}, stick {:?} slip {:?}, |Σf_t|/Σf_n ≤ {ratio:?}, its {} (max {:?})",
+        "{place} {label}: min tangential work {:.2e}, W_f/scale {work:.4e}, max rise of E + W_f {rise:.3e}, drift {:.3e}, stick {:?} slip {:?}, |Σf_t|/Σf_n ≤ {ratio:?}, its {} (max {:?})",
+        m.tangential_work_min.unwrap(),
         m.energy_balance_drift.unwrap(),
         m.stick_steps,
         m.slip_steps,
@@ -61,6 +62,17 @@ fn check_common(place: &str, label: &str, o: &Outcome, mu: Option<f64>) -> (f64,
         m.contact_phases.unwrap() >= 1,
         "{place} {label}: the body must hit the obstacle"
     );
+    // Every position-level method's step does the tangential work −Σf_t^{n+1}·Δu_t ≥ 0 (SPEC
+    // §2.5: the law's own sign, per node); a stuck node's Δu_t is the solver's residual, whose
+    // work is ~1e-12 of a force times 1e-12 of a displacement: nothing at 1e-15 scales.
+    // (Moreau–Jean's slip is v_t^{n+1}, not Δu_t/τ: no sign.)
+    let own = m.tangential_work_min.expect("a frictional run reports it");
+    if !label.contains("moreau-jean") {
+        assert!(
+            own >= -1e-15,
+            "{place} {label}: a step's tangential work {own:.3e}"
+        );
+    }
     if let (Some(mu), Some(r)) = (mu, ratio) {
         assert!(
             r <= mu * (1.0 + 1e-10),

@@ -108,8 +108,8 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, gravity_load,
-    lowest_contact, mass_matrix, ref_map, reference_record,
+    build_geometry, factor, factor_failure, factor_key_gap, frictional, geometry_key, gravity_load,
+    lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
 };
 use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -117,6 +117,7 @@ use crate::contact::{FrictionalContact, Lcp};
 use crate::run::fe_nitsche::{
     NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
 };
+use crate::run::friction_tally::FrictionTally;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::space::fe::SymMatrix;
@@ -347,7 +348,7 @@ pub(super) fn kinematic_frequency_sq(cfg: &FeConfig) -> Result<(f64, f64), (&'st
 }
 
 /// The frictional part of a run (module header): the law, the tangential dofs of each Γ_C node,
-/// the step's forces, and what the run measures. Allocated once per run.
+/// the step's forces and the run's [`FrictionTally`]. Allocated once per run.
 struct Friction {
     law: FrictionLaw,
     /// Tangential directions per node (d − 1).
@@ -358,44 +359,33 @@ struct Friction {
     mean_weight: Vec<f64>,
     /// Tresca's weights w_j = ∫_ΓC φ_j of the nodes.
     weight: Vec<f64>,
-    /// The step's forces on the body (f_n ≥ 0 per node; f_t per node and direction), forces
-    /// also where the method's unknowns are impulses.
-    f_n: Vec<f64>,
-    f_t: Vec<f64>,
-    /// f_tⁿ, the previous step's (generalized-α's f̄_t and right-hand side).
-    f_t_prev: Vec<f64>,
-    /// The implicit methods' contact problem (None: kinematic central difference): the rows
-    /// C node-major (normal, e_1 (, e_2) per node), the condensation, the solver and its data —
-    /// free gaps, free slips, the active mask (Moreau–Jean), the unknowns μ (node-major, warm
-    /// start of the next step) and Tresca's weights in μ's unit.
-    implicit: Option<Implicit>,
-    /// u_tⁿ at the tangential dofs (the slip's reference).
+    /// The step's forces on the body, node-major [f_n, f_t…] (forces also where the method's
+    /// unknowns are impulses). Until the step's solve, the previous step's: generalized-α's
+    /// f_tⁿ of the right-hand side.
+    forces: Vec<f64>,
+    /// u_tⁿ at the tangential dofs (the slip's reference), then Δu_t.
     u_t_prev: Vec<f64>,
-    /// f̄_t = (1 − w) f_tⁿ + w f_t^{n+1} (SPEC §2.5).
-    weight_new: f64,
-    /// |Δu_t| below this is stick (1e-12·h, SPEC §5).
-    stick_tol: f64,
-    /// The directions' masses 1ᵀM1 over e_1, (e_2,) e_d (mean velocities 1ᵀMv/1ᵀM1).
-    mass_dir: [f64; 3],
-    /// Reduced rows of each direction (0 … d−1), for the mean velocities.
+    du_t: Vec<f64>,
+    /// The implicit methods' contact problem (None: kinematic central difference).
+    implicit: Option<Implicit>,
+    tally: FrictionTally,
+    /// Reduced rows of each direction (e_1, (e_2,) e_d) and their masses 1ᵀM1: the mean
+    /// velocities 1ᵀMv/1ᵀM1 from the carried Mv.
     dir_rows: Vec<Vec<usize>>,
-    work: f64,
-    balance_prev: Option<f64>,
-    max_increase: f64,
-    stick: i64,
-    slip: i64,
-    ratio_max: Option<f64>,
-    /// Mean e_1 velocity of the previous observed step, and the first time it reached 0
-    /// (SPEC §1.8 `stop_time`, for a body thrown along e_1).
-    v_t_prev: f64,
-    stop_time: Option<f64>,
+    mass_dir: Vec<f64>,
 }
 
-/// The implicit methods' frictional contact problem (see [`Friction::implicit`]).
+/// The implicit methods' frictional contact problem over the step matrix's frictional
+/// condensation ([`Factored::friction`]: Z's normal columns, then the tangential ones; W over
+/// the rows C node-major, normal then e_1 (, e_2) per node).
 struct Implicit {
+    fac: Arc<Factored>,
+    /// C's rows (dofs) and Z's columns in the node-major order of μ.
     rows: Vec<usize>,
-    factor: Arc<FrictionalFactor>,
+    cols: Vec<usize>,
     solver: FrictionalContact,
+    /// The free gaps and slips of the step, the active mask (Moreau–Jean), the unknowns μ
+    /// (node-major, the next step's warm start) and Tresca's weights in μ's unit.
     q_n: Vec<f64>,
     q_t: Vec<f64>,
     active: Vec<bool>,
@@ -403,85 +393,98 @@ struct Implicit {
     weights: Vec<f64>,
 }
 
-/// The frictional condensation of a step matrix A = M + cK: Z̄ = A⁻¹Cᵀ (n × dm, column-major)
-/// over every row of the Γ_C nodes, node-major, and H̄ = cCZ̄ (dm × dm, row-major, symmetrised)
-/// — the frictionless Z and H are its normal columns and rows.
-#[derive(Debug)]
-struct FrictionalFactor {
-    z: Vec<f64>,
-    h: Vec<f64>,
-}
-
-/// Per step matrix, as [`FACTORS`] (its key with a suffix).
-static FRICTIONAL_FACTORS: Cache<FrictionalFactor> = Cache::new();
-
-fn frictional_factor(
-    f: &Factored,
-    n: usize,
-    rows: &[usize],
-    c: f64,
-) -> Result<FrictionalFactor, String> {
-    let nr = rows.len();
-    let mut z = vec![0.0; n * nr];
-    for (j, &r) in rows.iter().enumerate() {
-        z[j * n + r] = 1.0;
-    }
-    let mut work = f.chol.work_for(nr);
-    f.chol
-        .try_solve_many_in_place(&mut z, nr, &mut work)
-        .map_err(|e| format!("the frictional condensation columns A⁻¹Cᵀ: {e}"))?;
-    let mut h = vec![0.0; nr * nr];
-    for (i, &ri) in rows.iter().enumerate() {
-        for j in 0..nr {
-            h[i * nr + j] = c * z[j * n + ri];
-        }
-    }
-    // Symmetric in exact arithmetic (A is); symmetrise the round-off.
-    for i in 0..nr {
-        for j in 0..i {
-            let x = 0.5 * (h[i * nr + j] + h[j * nr + i]);
-            h[i * nr + j] = x;
-            h[j * nr + i] = x;
-        }
-    }
-    Ok(FrictionalFactor { z, h })
-}
-
 impl Friction {
-    /// Attach the implicit methods' contact problem: the condensation of the step matrix
-    /// (cached under `key`) and the scale of μ: f = `force_per_mu`·μ, so Tresca's bound s·w_j
+    /// `weight_new` is f̄_t's weight of f_t^{n+1} (SPEC §2.5).
+    fn new(
+        g: &Geometry,
+        cfg: &FeConfig,
+        m: &SymMatrix,
+        weight_new: f64,
+    ) -> Result<Friction, String> {
+        let d = cfg.setup.dim;
+        let nt = d - 1;
+        let nc = g.contact.len();
+        let tdofs = tangential_dofs(g)?;
+        let weight = g
+            .contact_weight
+            .iter()
+            .map(|w| w * g.contact_measure)
+            .collect();
+        let n = g.dofs.n_free();
+        let dir_rows: Vec<Vec<usize>> = (0..d)
+            .map(|k| (0..n).filter(|&r| g.dofs.free[r] % d == k).collect())
+            .collect();
+        // 1ᵀM1 over each direction: M applied to the direction's indicator, summed on it.
+        let mut one = vec![0.0; n];
+        let mut m1 = vec![0.0; n];
+        let mass_dir = dir_rows
+            .iter()
+            .map(|rows| {
+                one.iter_mut().for_each(|x| *x = 0.0);
+                rows.iter().for_each(|&r| one[r] = 1.0);
+                m.matvec_into(&one, &mut m1);
+                rows.iter().map(|&r| m1[r]).sum()
+            })
+            .collect();
+        Ok(Friction {
+            law: cfg.friction,
+            nt,
+            tdofs,
+            mean_weight: g.contact_weight.clone(),
+            weight,
+            forces: vec![0.0; nc * d],
+            u_t_prev: vec![0.0; nc * nt],
+            du_t: vec![0.0; nc * nt],
+            implicit: None,
+            tally: FrictionTally::new(nc, d, cfg.setup.h, weight_new),
+            dir_rows,
+            mass_dir,
+        })
+    }
+
+    /// Attach the implicit methods' contact problem on the factor `fac` (made with the
+    /// frictional columns) and the scale of μ: f = `force_per_mu`·μ, so Tresca's bound s·w_j
     /// on the force is s·w_j/`force_per_mu` on μ.
     fn attach(
         &mut self,
         g: &Geometry,
-        f: &Factored,
-        key: String,
-        c: f64,
+        fac: &Arc<Factored>,
         force_per_mu: f64,
     ) -> Result<(), String> {
-        let d = self.nt + 1;
-        let nc = g.contact.len();
-        let mut rows = Vec::with_capacity(nc * d);
+        let ff = fac
+            .friction
+            .as_ref()
+            .ok_or("the step factor has no frictional columns")?;
+        let (nt, nc) = (self.nt, g.contact.len());
+        let d = nt + 1;
+        let (mut rows, mut cols) = (Vec::with_capacity(nc * d), Vec::with_capacity(nc * d));
         for (j, &ci) in g.contact.iter().enumerate() {
             rows.push(ci);
-            rows.extend_from_slice(&self.tdofs[j * self.nt..(j + 1) * self.nt]);
+            cols.push(j);
+            for k in 0..nt {
+                rows.push(ff.tangential[j * nt + k]);
+                cols.push(nc + j * nt + k);
+            }
         }
-        let (factor, _) = FRICTIONAL_FACTORS.get(key + "|friction", || {
-            frictional_factor(f, g.dofs.n_free(), &rows, c)
-        });
-        let factor = factor?;
-        let solver = FrictionalContact::new(nc, d, factor.h.clone());
         self.implicit = Some(Implicit {
+            fac: Arc::clone(fac),
             rows,
-            factor,
-            solver,
+            cols,
+            solver: FrictionalContact::new(nc, d, ff.w.clone()),
             q_n: vec![0.0; nc],
-            q_t: vec![0.0; nc * self.nt],
+            q_t: vec![0.0; nc * nt],
             active: vec![true; nc],
             mu: vec![0.0; nc * d],
             weights: self.weight.iter().map(|w| w / force_per_mu).collect(),
         });
         Ok(())
+    }
+
+    /// Keep u_tⁿ before a step.
+    fn begin(&mut self, u: &[f64]) {
+        for (p, &r) in self.u_t_prev.iter_mut().zip(&self.tdofs) {
+            *p = u[r];
+        }
     }
 
     /// The free gaps q_n and slips q_t = Ty + `off` (T the tangential rows; `off` the method's
@@ -522,188 +525,84 @@ impl Friction {
                 LCP_TOL,
             )
             .map_err(|e| e.to_string())?;
-        add_columns(&im.factor.z, &im.mu, c, y);
-        add_rows(&im.rows, &im.mu, c, sd);
+        let n = y.len();
+        for ((&mk, &col), &row) in im.mu.iter().zip(&im.cols).zip(&im.rows) {
+            if mk != 0.0 {
+                let f = c * mk;
+                for (yi, zi) in y.iter_mut().zip(&im.fac.z[col * n..(col + 1) * n]) {
+                    *yi += f * zi;
+                }
+                sd[row] += f;
+            }
+        }
         for (l, m) in normal.iter_mut().zip(im.mu.iter().step_by(d)) {
             *l = *m;
         }
         Ok(it)
     }
 
-    /// The step's forces f = `s`·μ (s = c_f/c's inverse, or c/τ for impulses) into f_n, f_t.
+    /// The step's forces f = `s`·μ (s: μ's force, module header).
     fn take_forces(&mut self, s: f64) {
-        let d = self.nt + 1;
         let im = self.implicit.as_ref().expect("an implicit method");
-        for (j, fn_j) in self.f_n.iter_mut().enumerate() {
-            *fn_j = s * im.mu[j * d];
-            for k in 0..self.nt {
-                self.f_t[j * self.nt + k] = s * im.mu[j * d + 1 + k];
-            }
+        for (f, m) in self.forces.iter_mut().zip(&im.mu) {
+            *f = s * m;
         }
     }
 
     /// y += s·f_tⁿ at the tangential rows (generalized-α's history term κ_f Cᵀrⁿ, whose
-    /// normal part the frictionless code adds).
+    /// normal part the frictionless code adds); `forces` still holds the previous step's.
     fn add_previous_tangential(&self, s: f64, y: &mut [f64]) {
-        for (&r, f) in self.tdofs.iter().zip(&self.f_t_prev) {
-            y[r] += s * f;
-        }
-    }
-
-    fn new(
-        g: &Geometry,
-        cfg: &FeConfig,
-        m: &SymMatrix,
-        weight_new: f64,
-    ) -> Result<Friction, String> {
-        let d = cfg.setup.dim;
-        let nt = d - 1;
-        let mut tdofs = Vec::with_capacity(g.contact.len() * nt);
-        for &c in &g.contact {
-            // A node is clamped or free as a whole and its components are consecutive
-            // (node-major numbering): its e_k dof sits k − (d − 1) rows before e_d's.
-            let node = g.dofs.free[c] / d;
-            for k in 0..nt {
-                let r = c + k - nt;
-                if g.dofs.free[r] != node * d + k {
-                    return Err(format!(
-                        "the tangential dof {k} of a Γ_C node is not where the numbering puts it"
-                    ));
-                }
-                tdofs.push(r);
+        let d = self.nt + 1;
+        for (j, f) in self.forces.chunks_exact(d).enumerate() {
+            for (k, fk) in f[1..].iter().enumerate() {
+                y[self.tdofs[j * self.nt + k]] += s * fk;
             }
         }
-        // Only Tresca reads the weights (a Gmsh contact group without faces has none).
-        let weight = match cfg.friction {
-            FrictionLaw::Tresca { .. } => tresca_weights(g)?,
-            _ => vec![0.0; g.contact.len()],
-        };
-        let n = g.dofs.n_free();
-        let ones = vec![1.0; n];
-        let mut m1 = vec![0.0; n];
-        m.matvec_into(&ones, &mut m1);
-        let dir_rows: Vec<Vec<usize>> = (0..d)
-            .map(|k| (0..n).filter(|&r| g.dofs.free[r] % d == k).collect())
-            .collect();
-        let mut mass_dir = [0.0; 3];
-        for (k, rows) in dir_rows.iter().enumerate() {
-            mass_dir[k] = rows.iter().map(|&r| m1[r]).sum();
-        }
-        let nc = g.contact.len();
-        Ok(Friction {
-            law: cfg.friction,
-            nt,
-            tdofs,
-            mean_weight: g.contact_weight.clone(),
-            weight,
-            f_n: vec![0.0; nc],
-            f_t: vec![0.0; nc * nt],
-            f_t_prev: vec![0.0; nc * nt],
-            implicit: None,
-            u_t_prev: vec![0.0; nc * nt],
-            weight_new,
-            stick_tol: 1e-12 * cfg.setup.h,
-            mass_dir,
-            dir_rows,
-            work: 0.0,
-            balance_prev: None,
-            max_increase: f64::NEG_INFINITY,
-            stick: 0,
-            slip: 0,
-            ratio_max: None,
-            v_t_prev: cfg.setup.v0_tangential,
-            stop_time: None,
-        })
     }
 
-    /// Keep u_tⁿ before a step.
-    fn begin(&mut self, u: &[f64]) {
-        for (p, &r) in self.u_t_prev.iter_mut().zip(&self.tdofs) {
-            *p = u[r];
-        }
-    }
-
-    /// The step's bookkeeping once u^{n+1} and the forces (`f_n`, `f_t`) are known: W_f, stick
-    /// and slip, the apparent friction coefficient.
-    fn end(&mut self, u: &[f64]) {
-        let nt = self.nt;
-        let w = self.weight_new;
-        let (mut sum_n, mut sum_t) = (0.0, [0.0; 2]);
-        for (j, &fn_j) in self.f_n.iter().enumerate() {
-            let (mut du2, mut dw) = (0.0, 0.0);
-            for k in 0..nt {
-                let i = j * nt + k;
-                let du = u[self.tdofs[i]] - self.u_t_prev[i];
-                let fbar = (1.0 - w) * self.f_t_prev[i] + w * self.f_t[i];
-                dw -= fbar * du;
-                du2 += du * du;
-                sum_t[k] += self.f_t[i];
-            }
-            self.work += dw;
-            if fn_j > 0.0 {
-                sum_n += fn_j;
-                if du2.sqrt() <= self.stick_tol {
-                    self.stick += 1;
-                } else {
-                    self.slip += 1;
-                }
-            }
-        }
-        if sum_n > 0.0 {
-            let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
-            self.ratio_max = Some(self.ratio_max.map_or(r, |x| x.max(r)));
-        }
-        self.f_t_prev.copy_from_slice(&self.f_t);
-    }
-
-    /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
-    /// nodes' trapezoidal weights), W_f.
-    fn series(&self, v: &[f64]) -> [f64; 3] {
-        let sigma_t = self.f_t.iter().step_by(self.nt).sum();
-        let v_t = self
-            .tdofs
-            .iter()
-            .step_by(self.nt)
-            .zip(&self.mean_weight)
-            .map(|(&r, w)| w * v[r])
-            .sum();
-        [sigma_t, v_t, self.work]
-    }
-
-    /// Kinematic friction (module header): with the normal impulses' forces in `f_n`, the
+    /// Kinematic friction (module header): with the normal impulses' forces in `forces`, the
     /// tangential force of each node that stops its slip increment, projected onto the disc
     /// of radius b, applied to u_t and v_t^{n+½}. `diag` is the lumped mass.
     fn kinematic(&mut self, u: &mut [f64], v: &mut [f64], diag: &[f64], tau: f64) {
-        let nt = self.nt;
+        let (nt, d) = (self.nt, self.nt + 1);
         let t2 = tau * tau;
-        for j in 0..self.f_n.len() {
+        for (j, f) in self.forces.chunks_exact_mut(d).enumerate() {
             let ts = &self.tdofs[j * nt..(j + 1) * nt];
-            let f = &mut self.f_t[j * nt..(j + 1) * nt];
-            let fn_j = self.f_n[j];
-            if fn_j <= 0.0 {
-                f.iter_mut().for_each(|x| *x = 0.0);
+            let prev = &self.u_t_prev[j * nt..(j + 1) * nt];
+            let (fn_j, ft) = f.split_first_mut().expect("d ≥ 2");
+            if *fn_j <= 0.0 {
+                ft.iter_mut().for_each(|x| *x = 0.0);
                 continue;
             }
-            let b = self.law.bound(fn_j, self.weight[j]);
+            let b = self.law.bound(*fn_j, self.weight[j]);
             let mut norm2 = 0.0;
-            for (k, &r) in ts.iter().enumerate() {
-                f[k] = -diag[r] * (u[r] - self.u_t_prev[j * nt + k]) / t2;
-                norm2 += f[k] * f[k];
+            for ((fk, &r), p) in ft.iter_mut().zip(ts).zip(prev) {
+                *fk = -diag[r] * (u[r] - p) / t2;
+                norm2 += *fk * *fk;
             }
             let norm = norm2.sqrt();
             // Stick inside the disc (the slip increment is cancelled exactly: u_t = u_tⁿ),
             // slide on its boundary along the stick force.
             let stick = norm <= b;
-            for (k, &r) in ts.iter().enumerate() {
+            for ((fk, &r), p) in ft.iter_mut().zip(ts).zip(prev) {
                 if stick {
-                    u[r] = self.u_t_prev[j * nt + k];
+                    u[r] = *p;
                 } else {
-                    f[k] *= b / norm;
-                    u[r] += t2 * f[k] / diag[r];
+                    *fk *= b / norm;
+                    u[r] += t2 * *fk / diag[r];
                 }
-                v[r] += tau * f[k] / diag[r];
+                v[r] += tau * *fk / diag[r];
             }
         }
+    }
+
+    /// The step's bookkeeping once u^{n+1} and the forces are known (the tally: W_f, stick
+    /// and slip, the apparent friction coefficient, the step's tangential work).
+    fn end(&mut self, u: &[f64]) {
+        for ((du, p), &r) in self.du_t.iter_mut().zip(&self.u_t_prev).zip(&self.tdofs) {
+            *du = u[r] - p;
+        }
+        self.tally.step(&self.forces, &self.du_t);
     }
 
     /// The mean velocity 1ᵀMv/1ᵀM1 along direction k, from the carried Mv.
@@ -711,69 +610,39 @@ impl Friction {
         self.dir_rows[k].iter().map(|&r| mv[r]).sum::<f64>() / self.mass_dir[k]
     }
 
-    /// After observing step `step` with energy E: the rise of E + W_f, and the first time the
-    /// mean e_1 velocity of a body thrown along e_1 reaches 0 (linear interpolation).
-    fn balance(&mut self, step: usize, tau: f64, energy: f64, mv: &[f64]) {
-        let b = energy + self.work;
-        if let Some(prev) = self.balance_prev {
-            self.max_increase = self.max_increase.max(b - prev);
-        }
-        self.balance_prev = Some(b);
-        let vt = self.mean_velocity(mv, 0);
-        if step > 0 && self.stop_time.is_none() && self.v_t_prev != 0.0 {
-            let (a, c) = (self.v_t_prev, vt);
-            if c == 0.0 || a.signum() != c.signum() {
-                self.stop_time = Some((step as f64 - 1.0 + a / (a - c)) * tau);
-            }
-        }
-        self.v_t_prev = vt;
+    /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
+    /// nodes' trapezoidal weights), W_f.
+    fn series(&self, v: &[f64]) -> [f64; 3] {
+        let v_t = self
+            .tdofs
+            .iter()
+            .step_by(self.nt)
+            .zip(&self.mean_weight)
+            .map(|(&r, w)| w * v[r])
+            .sum();
+        [self.tally.total_tangential()[0], v_t, self.tally.work()]
     }
 
-    /// The friction columns of SPEC §5 (energies over `scale`).
-    fn report(&self, metrics: &mut Metrics, mv: &[f64], d: usize, scale: f64, steps: usize) {
-        metrics.friction_work = Some(self.work / scale);
-        if let (Some(b), Some(e0)) = (self.balance_prev, metrics.energy_initial) {
-            metrics.energy_balance_drift = Some((b - e0) / scale);
-        }
-        metrics.energy_balance_max_increase = Some(if steps > 0 {
-            self.max_increase / scale
-        } else {
-            0.0
-        });
-        metrics.stick_steps = Some(self.stick);
-        metrics.slip_steps = Some(self.slip);
-        metrics.friction_ratio_max = self.ratio_max;
+    /// After observing step `step` with energy E: E + W_f and the mean e_1 velocity (the
+    /// stop time) into the tally.
+    fn observed(&mut self, step: usize, tau: f64, energy: f64, mv: &[f64]) {
+        self.tally.energy(energy);
+        let v1 = self.mean_velocity(mv, 0);
+        self.tally.velocity(step as f64 * tau, v1);
+    }
+
+    /// The friction columns of SPEC §5 (energies over `scale`): the tally's, and the mean
+    /// velocities at T (3D: the tangential norm).
+    fn report(&self, metrics: &mut Metrics, mv: &[f64], scale: f64) {
+        let d = self.nt + 1;
         let vt = if d == 3 {
             self.mean_velocity(mv, 0).hypot(self.mean_velocity(mv, 1))
         } else {
             self.mean_velocity(mv, 0)
         };
-        metrics.tangential_velocity_final = Some(vt);
-        metrics.normal_velocity_final = Some(self.mean_velocity(mv, d - 1));
-        metrics.stop_time = self.stop_time;
+        let vn = self.mean_velocity(mv, d - 1);
+        self.tally.finish(metrics, scale, vt, vn);
     }
-}
-
-/// Tresca's weights w_j = ∫_ΓC φ_j of the Γ_C nodes, from Nitsche's quadrature of Γ_C (its
-/// u_n row holds −φ on the vertical dofs: u_n = −u_d).
-fn tresca_weights(g: &Geometry) -> Result<Vec<f64>, String> {
-    let points = g
-        .points
-        .as_ref()
-        .map_err(|e| format!("Tresca's weights need Γ_C's quadrature: {e}"))?;
-    let mut slot = vec![usize::MAX; g.dofs.n_free()];
-    for (j, &c) in g.contact.iter().enumerate() {
-        slot[c] = j;
-    }
-    let mut w = vec![0.0; g.contact.len()];
-    for p in points {
-        for (&r, &un) in p.dofs.iter().zip(&p.un) {
-            if slot[r] != usize::MAX {
-                w[slot[r]] -= p.weight * un;
-            }
-        }
-    }
-    Ok(w)
 }
 
 /// The discrete gradient's Newton scratch (allocated once per run).
@@ -928,18 +797,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     // The step factor (the engine's cache, the engine's key) or, for the explicit step, the
     // lumped mass alone.
     let c = step_coefficient(meth, tau);
-    let key = c.map(|c| {
-        format!(
-            "{}|{:?}|{:?}|{:e}",
-            geometry_key(&cfg.setup),
-            cfg.mass,
-            cfg.method,
-            c
-        ) + &factor_key_gap(g, cfg)
-    });
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
-            let key = key.clone().expect("made with c");
+            // With friction the factor carries the tangential columns (the engine's factor
+            // makes them for a frictional mixed run): not the frictionless entry.
+            let key = format!(
+                "{}|{:?}|{:?}|{:e}",
+                geometry_key(&cfg.setup),
+                cfg.mass,
+                cfg.method,
+                c
+            ) + &factor_key_gap(g, cfg)
+                + if frictional(cfg) { "|friction" } else { "" };
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
@@ -1048,7 +917,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let diag = m.diagonal();
     // Friction (module header): f̄_t's weight of f_t^{n+1} is generalized-α's 1 − α_f, the
     // other methods' force of the step itself.
-    let mut fric = if super::frictional(cfg) {
+    let mut fric = if frictional(cfg) {
         let weight_new = match meth {
             Method::Alpha(p) => 1.0 - p.alpha_f,
             _ => 1.0,
@@ -1076,8 +945,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             Ok(f) => f,
             Err(e) => return fail(Status::Invalid, e, metrics),
         };
-        if let (Some(s), Some(f), Some(c), Some(key)) = (force_per_mu, &fac, c, key)
-            && let Err(e) = fr.attach(g, f, key, c, s)
+        if let (Some(s), Some(f)) = (force_per_mu, &fac)
+            && let Err(e) = fr.attach(g, f, s)
         {
             return fail(Status::SolverFailed, e, metrics);
         }
@@ -1231,7 +1100,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             let e = observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err, fv)
                 .map_err(Stop::Diverged)?;
             if let Some(fr) = fric.as_mut() {
-                fr.balance(0, tau, e, &mv);
+                fr.observed(0, tau, e, &mv);
             }
         }
         for step in 1..=cfg.steps {
@@ -1251,7 +1120,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                         v[ci] += dv;
                         force += l;
                         if let Some(fr) = fric.as_mut() {
-                            fr.f_n[j] = l;
+                            fr.forces[j * (fr.nt + 1)] = l;
                         }
                     }
                     if let Some(fr) = fric.as_mut() {
@@ -1630,7 +1499,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                 })
                 .map_err(Stop::Diverged)?;
             if let Some(fr) = fric.as_mut() {
-                fr.balance(step, tau, e, &mv);
+                fr.observed(step, tau, e, &mv);
             }
             done = step;
             opts.step_stop(step, CLOCK_EVERY, start)?;
@@ -1656,7 +1525,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     metrics.contact_toggles = Some(metrics.contact_switches);
     metrics.energy_scale = energy_scale.or(metrics.energy_initial);
     if let (Some(fr), Some(scale)) = (&fric, metrics.energy_scale) {
-        fr.report(&mut metrics, &mv, cfg.setup.dim, scale, done);
+        fr.report(&mut metrics, &mv, scale);
     }
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
@@ -1729,41 +1598,6 @@ mod tests {
     use super::*;
     use crate::scene::{BarScene, Physics, Scene, SceneSetup};
     use crate::space::step_solver::Solver;
-
-    /// Tresca's weights ∫_ΓC φ_j sum to |Γ_C|: the bars' bottom face 0.1 (2D) and 0.1² (3D),
-    /// the corners half (2D) or a quarter (3D) of an interior node's h^{d−1} (Gauss
-    /// quadrature of Q1 traces is exact: a few ulps).
-    #[test]
-    fn tresca_weights_integrate_the_shape_functions() {
-        for (dim, h) in [(2, 0.05), (3, 0.05)] {
-            let scene = BarScene { dim };
-            let physics = Physics(
-                scene
-                    .physics()
-                    .iter()
-                    .map(|k| (k.name, k.default))
-                    .collect(),
-            );
-            let SceneSetup::Fe(setup) =
-                scene.setup(&physics, scene.mesh_from_h(&physics, h).unwrap())
-            else {
-                unreachable!("the bars are FE scenes")
-            };
-            let (geo, _) = GEOMETRIES.get(geometry_key(&setup), || build_geometry(&setup));
-            let g = geo.unwrap();
-            let w = tresca_weights(&g).unwrap();
-            let total: f64 = w.iter().sum();
-            let area = 0.1f64.powi(dim as i32 - 1);
-            let (lo, hi) = w
-                .iter()
-                .fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
-            let interior = h.powi(dim as i32 - 1);
-            eprintln!("bar{dim}d h = {h}: Σw = {total:e}, min {lo:e}, max {hi:e}");
-            assert!((total - area).abs() <= 1e-14 * area);
-            assert!((hi - interior).abs() <= 1e-14 * interior);
-            assert!((lo - interior / f64::from(1 << (dim - 1))).abs() <= 1e-14 * interior);
-        }
-    }
 
     /// The certified ω²_max is an upper bound (σM − K positive definite, by construction) and
     /// tight: 1 % below it σM − K is indefinite (so the CFL step is within ~0.5 % of the true
