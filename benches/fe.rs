@@ -29,6 +29,13 @@
 //!   γ0 = 1e-3) and the penalty on the paper's disc (P2, h = 4, τ = 0.1, T = 15: the impact at
 //!   t ≈ 10).
 //!
+//! - `bar2d-friction/…` (issue 33, done-when 5): one step of mixed + Crank–Nicolson on bar2d at
+//!   21 120 dofs (h = 0.1/32: 33 × 321 nodes, 33 contact nodes), consistent mass, τ = h/2,
+//!   T = 1 (the impact at t = 0.4, then contact to the end), frictionless against Coulomb
+//!   (μ_f = 0.3: the frictional contact solve over 66 unknowns and twice Z's columns) and
+//!   Tresca; the engine's stepping time per step, factor cached. The target: frictional ÷
+//!   frictionless ≤ 1.5.
+//!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).
 
@@ -213,6 +220,11 @@ fn bench_steps(
     };
     let warm = simulate(&run, &opts);
     assert_eq!(warm.status.as_str(), "ok", "{what}: {:?}", warm.message);
+    // The contact solver's work, to read beside the time.
+    eprintln!(
+        "{what}: {} contact iterations over {} steps (at most {:?} in one step)",
+        warm.metrics.iterations, warm.metrics.steps, warm.metrics.iterations_max_step
+    );
     g.bench_function(what, |b| {
         b.iter_custom(|iters| {
             let mut total = Duration::ZERO;
@@ -323,7 +335,33 @@ fn bench_methods(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 33's cost of friction per step (module header, `bar2d-friction`).
+fn bench_friction(c: &mut Criterion) {
+    use contact_sweep::contact::friction::FrictionLaw;
+    let mut g = c.benchmark_group("bar2d-friction");
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    let h: f64 = 0.1 / 32.0;
+    let dt = h / 2.0;
+    let steps = (1.0 / dt).round() as usize;
+    let mut base = config(2, h, steps);
+    base.mass = MassVariant::Consistent;
+    base.scheme = Scheme::Newmark(NewmarkParams::crank_nicolson());
+    for (what, friction) in [
+        ("none", FrictionLaw::None),
+        ("coulomb-0.3", FrictionLaw::Coulomb { coefficient: 0.3 }),
+        ("tresca-0.05", FrictionLaw::Tresca { threshold: 0.05 }),
+    ] {
+        let cfg = FeConfig {
+            friction,
+            ..base.clone()
+        };
+        bench_steps(&mut g, what, &cfg);
+    }
+    g.finish();
+}
+
 fn fe(c: &mut Criterion) {
+    bench_friction(c);
     bench_methods(c);
     bench_ball(c, "disc2d-q2-h4", 2, 4.0);
     bench_ball(c, "sphere3d-q2-h8", 3, 8.0);

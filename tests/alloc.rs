@@ -184,6 +184,35 @@ method = [
     );
 }
 
+/// Friction on the FE scenes (SPEC §2.5, issue 33): mixed + Crank–Nicolson and backward Euler
+/// with Coulomb and Tresca on bar2d and bar3d (3D: the disc's linearised projection) — the
+/// frictional contact solve (semismooth Newton, its dense LU) and the friction tally, nothing
+/// allocated.
+#[test]
+fn fe_frictional_time_loops_allocate_nothing() {
+    for (scene, h) in [("bar2d", "0.05"), ("bar3d", "0.1")] {
+        assert_loop_allocates_nothing(
+            &format!(
+                r#"
+name = "alloc-fe-friction"
+scene = "{scene}"
+[fixed]
+T = T_FINAL
+h = {h}
+dt = 0.01
+[grid]
+method = [
+  {{ mass = "consistent", scheme = "crank-nicolson", friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "mod3", scheme = "backward-euler", friction = "coulomb", friction_coefficient = 0.3 }},
+  {{ mass = "consistent", scheme = "crank-nicolson", friction = "tresca", tresca_threshold = 0.05 }},
+]
+"#
+            ),
+            1.0,
+        );
+    }
+}
+
 /// The FE engine on bar3d (a 3 × 3 × 21-node box at h = 0.1: the contact face has 9 nodes, so
 /// the LCP has several unknowns and switches), both masses and both schemes.
 #[test]
@@ -306,6 +335,39 @@ method = [
 "#,
         1.0,
     );
+}
+
+/// Friction in the same methods (issue 33): the frictional condensation and the solver's
+/// workspace are made at setup, the semismooth Newton reuses its buffers, the tally its
+/// vectors; kane (Coulomb, the LU kept while the node states repeat), Moreau–Jean (Tresca,
+/// the active mask), generalized-α (f_tⁿ in the right-hand side), kinematic central
+/// difference's local projection — bar2d (d = 2) and bar3d (the disc's linearised
+/// projection).
+#[test]
+fn frictional_comparison_methods_allocate_nothing() {
+    for (scene, h) in [("bar2d", 0.05), ("bar3d", 0.1)] {
+        assert_loop_allocates_nothing(
+            &format!(
+                r#"
+name = "alloc-fe-friction"
+scene = "{scene}"
+[fixed]
+T = T_FINAL
+h = {h}
+dt = 0.01
+[grid]
+method = [
+  {{ mass = "consistent", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "mod3", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "consistent", scheme = "moreau-jean", friction = "tresca", tresca_threshold = 0.02 }},
+  {{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ mass = "lumped", scheme = "central-difference", dt = 0.002, friction = "coulomb", friction_coefficient = 0.05 }},
+]
+"#
+            ),
+            1.0,
+        );
+    }
 }
 
 /// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and

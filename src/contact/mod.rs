@@ -19,12 +19,16 @@
 //!
 //! Friction (SPEC §2.5) is a law of its own, [`friction`]: the law as data (none, Tresca,
 //! Coulomb) and the exact case analysis of one point's normal and tangential rows, which every
-//! stepper calls with its condensed rows — the same local solve for every scheme.
+//! stepper calls with its condensed rows — the same local solve for every scheme. Several
+//! coupled frictional nodes (the FE scenes' Γ_C) are [`coulomb`]'s: semismooth Newton on the
+//! Alart–Curnier functions over the condensed normal and tangential rows.
 
+pub mod coulomb;
 pub mod friction;
 pub mod gradient;
 pub mod lcp;
 
+pub use coulomb::{FrictionalContact, FrictionalContactError};
 pub use lcp::{Lcp, LcpError};
 
 /// A contact law φ(s) on the scalar contact argument.

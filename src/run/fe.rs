@@ -40,11 +40,12 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
+use super::friction_tally::FrictionTally;
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
-use crate::contact::Lcp;
 use crate::contact::friction::FrictionLaw;
+use crate::contact::{FrictionalContact, Lcp};
 use crate::scene::{FeGeometry, FeSetup, LoadModel};
 use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use crate::space::fe::locate::{PlainMesh, PointLocator};
@@ -252,6 +253,9 @@ struct Geometry {
     points: Result<Vec<ContactPoint>, String>,
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     contact_weight: Vec<f64>,
+    /// |Γ_C|, the measure the weights were normalised by: contact_weight_i·|Γ_C| = ∫_ΓC φ_i,
+    /// Tresca's node weight w_i (SPEC §2.5).
+    contact_measure: f64,
     /// Reduced dofs that belong to a Γ_C node (all components).
     on_contact_node: Vec<bool>,
     /// Reduced indices of the vertical component.
@@ -297,6 +301,19 @@ struct Factored {
     h: Vec<f64>,
     /// Nitsche's rows of the run (Θ, γ0 applied); Z's columns are then A⁻¹(−t_q).
     nitsche: Option<NitscheOps>,
+    /// Mixed with friction (SPEC §2.5): the tangential rows; Z then holds the tangential
+    /// columns after the normal ones.
+    friction: Option<FrictionFactor>,
+}
+
+/// The mixed method's condensation over the normal and tangential rows C of Γ_C.
+#[derive(Debug)]
+struct FrictionFactor {
+    /// Reduced index of each Γ_C node's tangential dofs, node-major (d − 1 per node, e_1 then
+    /// e_2): Z's column nc + i(d − 1) + c is A⁻¹ of the unit vector there.
+    tangential: Vec<usize>,
+    /// W = cτ² C Z (dm × dm, row-major), rows and columns node-major [normal, tangential…].
+    w: Vec<f64>,
 }
 
 /// A process-wide cache: entries shared by concurrent runs (a second run waits for the first to
@@ -512,6 +529,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         ));
     }
     contact_weight.iter_mut().for_each(|w| *w /= total);
+    let contact_measure = total;
     let mut contact_node = vec![false; nn];
     for &n in &cnodes {
         contact_node[n] = true;
@@ -551,6 +569,7 @@ fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, String> {
         contact_node,
         points,
         contact_weight,
+        contact_measure,
         on_contact_node,
         vertical,
         tangential,
@@ -604,6 +623,17 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         .map(|&n| mesh.coords[n][d - 1])
         .collect();
     let contact_weight = mesh.contact_node_weights();
+    // |Γ_C| by the faces' quadrature of `contact_node_weights` (the weights' normalisation).
+    let contact_measure = mesh
+        .contact_faces
+        .iter()
+        .map(|&f| {
+            mesh.face_points(&mesh.boundary_faces[f], 3)
+                .iter()
+                .map(|q| q.weight)
+                .sum::<f64>()
+        })
+        .sum();
     // The ball keeps its own face quadrature (its run ids and figures predate the general one);
     // all its dofs are free, so global and reduced dofs coincide.
     let points = Ok(contact_points(&mesh, s.lame_lambda, s.lame_mu, 1.0));
@@ -629,6 +659,7 @@ fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
         contact_node,
         points,
         contact_weight,
+        contact_measure,
         on_contact_node,
         vertical,
         tangential,
@@ -665,6 +696,8 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         .collect();
     let total: f64 = contact_weight.iter().sum();
     contact_weight.iter_mut().for_each(|w| *w /= total);
+    // The bottom face's measure: the product of the horizontal extents.
+    let contact_measure = extent[..d - 1].iter().product();
     let mut on_contact_node = vec![false; dofs.n_free()];
     for &n in &bottom {
         for c in 0..d {
@@ -709,6 +742,7 @@ fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<Geometry, S
         contact_node,
         points,
         contact_weight,
+        contact_measure,
         on_contact_node,
         vertical,
         tangential,
@@ -1055,6 +1089,12 @@ fn factor_key(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> String {
         c_tau2,
         cfg.solver
     ) + &factor_key_gap(g, cfg)
+        + if frictional(cfg) && cfg.method == ContactMethod::Mixed {
+            // The tangential columns are added: not the frictionless entry.
+            "|friction"
+        } else {
+            ""
+        }
 }
 
 fn factor_key_gap(g: &Geometry, cfg: &FeConfig) -> String {
@@ -1099,19 +1139,27 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
     factor_nitsche(g, cfg, c_tau2, ops)
 }
 
-/// The mixed method's factor: A = M + cτ²K, Z = A⁻¹Bᵀ, H = cτ² B Z.
+/// The mixed method's factor: A = M + cτ²K, Z = A⁻¹Bᵀ, H = cτ² B Z. With friction Z also holds
+/// A⁻¹ of the tangential unit vectors of the Γ_C nodes and W = cτ² C Z spans the normal and
+/// tangential rows ([`FrictionFactor`]); H and the normal columns are made as without.
 fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String> {
     let (m, mass_total) = mass_matrix(g, &cfg.setup, &cfg.mass)?;
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| e.to_string())?;
     let n = g.dofs.n_free();
     let nc = g.contact.len();
-    let mut z = vec![0.0; n * nc];
-    for (j, &c) in g.contact.iter().enumerate() {
+    let tangential = if frictional(cfg) {
+        tangential_dofs(g)?
+    } else {
+        Vec::new()
+    };
+    let nz = nc + tangential.len();
+    let mut z = vec![0.0; n * nz];
+    for (j, &c) in g.contact.iter().chain(&tangential).enumerate() {
         z[j * n + c] = 1.0;
     }
-    let mut work = chol.work_for(nc);
-    chol.try_solve_many_in_place(&mut z, nc, &mut work)
+    let mut work = chol.work_for(nz);
+    chol.try_solve_many_in_place(&mut z, nz, &mut work)
         .map_err(|e| format!("the condensation columns A⁻¹Bᵀ: {e}"))?;
     let mut h = vec![0.0; nc * nc];
     for (i, &ci) in g.contact.iter().enumerate() {
@@ -1120,13 +1168,34 @@ fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, S
         }
     }
     // W is symmetric in exact arithmetic; symmetrise the round-off.
-    for i in 0..nc {
-        for j in 0..i {
-            let s = 0.5 * (h[i * nc + j] + h[j * nc + i]);
-            h[i * nc + j] = s;
-            h[j * nc + i] = s;
+    symmetrise(&mut h, nc);
+    let friction = (!tangential.is_empty()).then(|| {
+        let d = g.mesh.dim();
+        let dm = nc * d;
+        // Row/column (i, a) of W: node i's normal (a = 0) or tangential a − 1; its dof and
+        // its column of Z.
+        let dof = |k: usize| {
+            let (i, a) = (k / d, k % d);
+            if a == 0 {
+                g.contact[i]
+            } else {
+                tangential[i * (d - 1) + a - 1]
+            }
+        };
+        let col = |k: usize| {
+            let (i, a) = (k / d, k % d);
+            if a == 0 { i } else { nc + i * (d - 1) + a - 1 }
+        };
+        let mut w = vec![0.0; dm * dm];
+        for r in 0..dm {
+            let dr = dof(r);
+            for c in 0..dm {
+                w[r * dm + c] = c_tau2 * z[col(c) * n + dr];
+            }
         }
-    }
+        symmetrise(&mut w, dm);
+        FrictionFactor { tangential, w }
+    });
     Ok(Factored {
         m_products: m.without_zeros(),
         m,
@@ -1135,7 +1204,42 @@ fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, S
         z,
         h,
         nitsche: None,
+        friction,
     })
+}
+
+/// The average of a square matrix (row-major, k × k) and its transpose, in place.
+fn symmetrise(h: &mut [f64], k: usize) {
+    for i in 0..k {
+        for j in 0..i {
+            let s = 0.5 * (h[i * k + j] + h[j * k + i]);
+            h[i * k + j] = s;
+            h[j * k + i] = s;
+        }
+    }
+}
+
+/// The reduced indices of the Γ_C nodes' tangential dofs, node-major (e_1, then e_2 in 3D).
+/// Every Γ_C node's dofs are free (only the clamped face is removed, and it is not Γ_C), so
+/// node i's component c sits d − 1 − c below its vertical one; checked against the DofMap.
+fn tangential_dofs(g: &Geometry) -> Result<Vec<usize>, String> {
+    let d = g.mesh.dim();
+    let mut out = Vec::with_capacity(g.contact.len() * (d - 1));
+    for &cv in &g.contact {
+        let global = g.dofs.free[cv];
+        for c in 0..d - 1 {
+            let want = global - (d - 1 - c);
+            match (cv.checked_sub(d - 1 - c), g.dofs.free_index(want)) {
+                (Some(r), Some(f)) if r == f => out.push(r),
+                _ => {
+                    return Err(format!(
+                        "friction: the tangential dof {c} of the Γ_C node with global vertical dof {global} is not free"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ) factored once, Z = A⁻¹C and W = P Z
@@ -1201,6 +1305,7 @@ fn factor_nitsche(
         z,
         h,
         nitsche: Some(ops),
+        friction: None,
     })
 }
 
@@ -1503,7 +1608,11 @@ fn reference_record(
 
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
-    if frictional(cfg) {
+    // The methods of SPEC §3.2 solve friction with the nodal multiplier in their own loops.
+    if frictional(cfg) && methods::handles(cfg) && cfg.method == ContactMethod::Mixed {
+        return methods::simulate(cfg, opts, ctx);
+    }
+    if frictional(cfg) && !mixed_stepper(cfg) {
         return Outcome {
             status: Status::Invalid,
             message: Some(format!(
@@ -1529,6 +1638,12 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
             done.pop().expect("one member, one outcome").1
         }
     }
+}
+
+/// Whether [`Stepper`] runs `cfg` with `mixed` contact: the Newmark family and the θ-scheme
+/// (the hybrid scheme is Nitsche's and the penalty's; SPEC §3.2's methods have their own loops).
+fn mixed_stepper(cfg: &FeConfig) -> bool {
+    cfg.method == ContactMethod::Mixed && !methods::handles(cfg) && cfg.coefficients().is_ok()
 }
 
 /// Whether the run's friction law can produce a tangential force. A law with μ_f = 0 or s = 0
@@ -1605,6 +1720,33 @@ struct Stepper<'a> {
     fall_error: f64,
     touched: bool,
     done: usize,
+    /// Mixed with friction: the frictional contact problem in place of the LCP, and the
+    /// friction observables. `lambda` then holds the normal forces, then the tangential ones
+    /// (Z's column order, [`FrictionFactor`]).
+    fric: Option<Box<FrictionStep>>,
+}
+
+/// A frictional mixed run's contact workspace and tally (SPEC §2.5, §1.8).
+struct FrictionStep {
+    solver: FrictionalContact,
+    law: FrictionLaw,
+    /// Tresca's node weights w_i = ∫_ΓC φ_i.
+    weights: Vec<f64>,
+    /// The free gaps and slip increments of the step, and the forces (node-major
+    /// [f_n, f_t…], the solver's warm start).
+    q_n: Vec<f64>,
+    q_t: Vec<f64>,
+    forces: Vec<f64>,
+    /// u_t^n at the Γ_C nodes' tangential dofs, then Δu_t.
+    ut_prev: Vec<f64>,
+    du_t: Vec<f64>,
+    tally: FrictionTally,
+    /// Reduced dofs of e_1 and e_2 (3D) and e_d of every node, and 1ᵀM1 over each: the mean
+    /// velocities 1ᵀMv/1ᵀM1 from the carried M v.
+    axes: [Vec<usize>; 3],
+    axis_mass: [f64; 3],
+    /// The last mean velocities (e_1, e_2, e_d).
+    mean_v: [f64; 3],
 }
 
 impl<'a> Stepper<'a> {
@@ -1733,6 +1875,43 @@ impl<'a> Stepper<'a> {
             return Err(fail(status, msg, metrics));
         }
         let lowest = lowest_contact(g);
+        let fric = fac.friction.as_ref().map(|ff| {
+            let d = g.mesh.dim();
+            let m = g.contact.len();
+            let axis =
+                |c: usize| -> Vec<usize> { (0..n).filter(|&r| g.dofs.free[r] % d == c).collect() };
+            let axes = [
+                axis(0),
+                if d == 3 { axis(1) } else { Vec::new() },
+                axis(d - 1),
+            ];
+            // 1ᵀM1 over each axis: M applied to the axis' indicator, summed on it.
+            let axis_mass = [0, 1, 2].map(|k| {
+                let mut one = vec![0.0; n];
+                axes[k].iter().for_each(|&r| one[r] = 1.0);
+                fac.m.matvec_into(&one.clone(), &mut one);
+                axes[k].iter().map(|&r| one[r]).sum::<f64>()
+            });
+            Box::new(FrictionStep {
+                solver: FrictionalContact::new(m, d, ff.w.clone()),
+                law: cfg.friction,
+                weights: g
+                    .contact_weight
+                    .iter()
+                    .map(|w| w * g.contact_measure)
+                    .collect(),
+                q_n: vec![0.0; m],
+                q_t: vec![0.0; ff.tangential.len()],
+                forces: vec![0.0; m * d],
+                ut_prev: vec![0.0; ff.tangential.len()],
+                du_t: vec![0.0; ff.tangential.len()],
+                // f̄ = (1 − γ) fⁿ + γ f^{n+1}: Newmark's γ, the θ-scheme's θ.
+                tally: FrictionTally::new(m, d, cfg.setup.h, gamma),
+                axes,
+                axis_mass,
+                mean_v: [0.0; 3],
+            })
+        });
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some();
         let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
@@ -1770,7 +1949,8 @@ impl<'a> Stepper<'a> {
             tmp: vec![0.0; n],
             err: vec![0.0; n],
             q: vec![0.0; nc],
-            lambda: vec![0.0; nc],
+            // Frictional: the tangential forces after the normal ones (Z's columns).
+            lambda: vec![0.0; nc * fac.friction.as_ref().map_or(1, |_| g.mesh.dim())],
             lcp,
             newton_work,
             kink,
@@ -1783,6 +1963,7 @@ impl<'a> Stepper<'a> {
             fall_error: 0.0,
             touched: false,
             done: 0,
+            fric,
             geo,
             fac,
         })
@@ -1814,6 +1995,7 @@ impl<'a> Stepper<'a> {
             obs,
             fall_error,
             touched,
+            fric,
             ..
         } = self;
         let (g, nit, tau, fall) = (&**geo, fac.nitsche.as_ref(), *tau, *fall);
@@ -1834,7 +2016,20 @@ impl<'a> Stepper<'a> {
                 .map(|(&c, l)| l * u[c])
                 .sum();
             let uma: f64 = carried.map_or_else(|| dot(u, ma), |c| c.1);
-            fu + contact - uma
+            match (fric.as_ref(), fac.friction.as_ref()) {
+                // With friction Cᵀf has tangential rows too: uᵀKu = uᵀ(F + Cᵀf − Ma).
+                (Some(_), Some(ff)) => {
+                    let nc = g.contact.len();
+                    let tangential: f64 = ff
+                        .tangential
+                        .iter()
+                        .zip(&lambda[nc..])
+                        .map(|(&c, l)| l * u[c])
+                        .sum();
+                    fu + (contact + tangential) - uma
+                }
+                _ => fu + contact - uma,
+            }
         };
         let [kinetic, elastic, gravity] = [0.5 * kinetic, 0.5 * uku, -fu];
         let e = kinetic + elastic + gravity;
@@ -1853,7 +2048,8 @@ impl<'a> Stepper<'a> {
                 let (pot, t, f) = ops.energy_terms_and_force(u);
                 (e + pot, t, f)
             }
-            None => (e, None, lambda.iter().sum()),
+            // The normal forces (frictional runs hold the tangential ones after them).
+            None => (e, None, lambda[..g.contact.len()].iter().sum()),
         };
         let mean = |x: &[f64]| -> f64 {
             g.contact
@@ -1863,6 +2059,28 @@ impl<'a> Stepper<'a> {
                 .sum()
         };
         let uc = mean(u);
+        if let (Some(fr), Some(ff)) = (fric.as_mut(), fac.friction.as_ref()) {
+            // The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v; the stop
+            // time and E + W_f in the tally; the series' Σf_t along e_1, the Γ_C mean of v_1
+            // and W_f (SPEC §5).
+            for k in 0..3 {
+                fr.mean_v[k] = if fr.axes[k].is_empty() {
+                    0.0
+                } else {
+                    fr.axes[k].iter().map(|&r| mv[r]).sum::<f64>() / fr.axis_mass[k]
+                };
+            }
+            fr.tally.energy(e);
+            fr.tally.velocity(step as f64 * tau, fr.mean_v[0]);
+            let t = ff.tangential.len() / g.contact.len();
+            let v1: f64 = g
+                .contact_weight
+                .iter()
+                .enumerate()
+                .map(|(i, w)| w * v[ff.tangential[i * t]])
+                .sum();
+            obs.set_friction(fr.tally.total_tangential()[0], v1, fr.tally.work());
+        }
         if fall != 0.0 && !*touched {
             if force > 0.0 {
                 *touched = true;
@@ -1982,6 +2200,39 @@ impl<'a> Stepper<'a> {
             .map_err(|e| Stop::Solver(step, e))?;
             self.newton_max = self.newton_max.max(it);
             self.iterations += it as i64;
+        } else if let (Some(fr), Some(ff)) = (self.fric.as_mut(), fac.friction.as_ref()) {
+            // q_n = y_d + gap, q_t = y_t − u_t^n (the contact-free step's slip increment);
+            // u^{n+1} = y + cτ²Z f over the normal and tangential columns ([`lockstep`]).
+            let g = &*self.geo;
+            for ((qi, &ci), gi) in fr.q_n.iter_mut().zip(&g.contact).zip(&self.gaps) {
+                *qi = y[ci] + gi;
+            }
+            for ((qt, up), &ct) in fr.q_t.iter_mut().zip(&mut fr.ut_prev).zip(&ff.tangential) {
+                *up = self.u[ct];
+                *qt = y[ct] - *up;
+            }
+            let it = fr
+                .solver
+                .solve(
+                    &fr.law,
+                    &fr.weights,
+                    &fr.q_n,
+                    &fr.q_t,
+                    None,
+                    &mut fr.forces,
+                    LCP_MAX_ITER,
+                    LCP_TOL,
+                )
+                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+            let (nc, d) = (g.contact.len(), g.mesh.dim());
+            for i in 0..nc {
+                self.lambda[i] = fr.forces[i * d];
+                for c in 1..d {
+                    self.lambda[nc + i * (d - 1) + c - 1] = fr.forces[i * d + c];
+                }
+            }
+            self.newton_max = self.newton_max.max(it);
+            self.iterations += it as i64;
         } else {
             let g = &*self.geo;
             for ((qi, &ci), gi) in self.q.iter_mut().zip(&g.contact).zip(&self.gaps) {
@@ -2062,6 +2313,12 @@ impl<'a> Stepper<'a> {
             std::mem::swap(&mut self.a, &mut self.tmp);
             std::mem::swap(&mut self.ma, &mut self.pred);
         }
+        if let (Some(fr), Some(ff)) = (self.fric.as_mut(), self.fac.friction.as_ref()) {
+            for ((du, up), &ct) in fr.du_t.iter_mut().zip(&fr.ut_prev).zip(&ff.tangential) {
+                *du = self.u[ct] - up;
+            }
+            fr.tally.step(&fr.forces, &fr.du_t);
+        }
         let mut timer = self.observe_timer;
         let r = timer.time(step, || self.observe(step));
         self.observe_timer = timer;
@@ -2092,6 +2349,17 @@ impl<'a> Stepper<'a> {
         metrics.err_sigma_mid_l2 = None;
         metrics.contact_toggles = Some(metrics.contact_switches);
         metrics.energy_scale = self.energy_scale.or(metrics.energy_initial);
+        if let Some(fr) = self.fric.as_ref() {
+            // SPEC §5: the e_1 component in 2D, the tangential norm in 3D.
+            let [v1, v2, vn] = fr.mean_v;
+            let vt = if fr.axes[1].is_empty() {
+                v1
+            } else {
+                (v1 * v1 + v2 * v2).sqrt()
+            };
+            let scale = metrics.energy_scale.unwrap_or(1.0);
+            fr.tally.finish(metrics, scale, vt, vn);
+        }
         let reference = match self.record {
             Some((_, data)) if status == Status::Ok => Some(data),
             _ => None,

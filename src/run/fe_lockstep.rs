@@ -230,9 +230,11 @@ fn add_contact(
     block: &mut [f64],
 ) {
     let n = fac.chol.n();
-    let touched = active
-        .iter()
-        .any(|(_, s)| s.lambda.iter().any(|&l| l > 0.0));
+    let touched = active.iter().any(|(_, s)| {
+        s.lambda
+            .iter()
+            .any(|&l| l > 0.0 || (l != 0.0 && s.fric.is_some()))
+    });
     if !touched {
         return;
     }
@@ -241,8 +243,9 @@ fn add_contact(
         for c in 0..nz {
             let zc = &fac.z[c * n + lo..c * n + hi];
             for ((_, s), y) in active.iter().zip(block.chunks_exact_mut(n)) {
+                // Normal forces are ≥ 0, a frictional run's tangential ones of either sign.
                 let l = s.lambda[c];
-                if l > 0.0 {
+                if l > 0.0 || (l != 0.0 && s.fric.is_some()) {
                     let f = c_tau2 * l;
                     for (yi, zi) in y[lo..hi].iter_mut().zip(zc) {
                         *yi += f * zi;

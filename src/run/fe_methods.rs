@@ -59,20 +59,65 @@
 //! K u^pred = Kuⁿ + τKvⁿ + KM⁻¹Bᵀν and K(uⁿ + θτvⁿ)). So a step costs the solve and one sparse
 //! product, as Crank–Nicolson's does (measured: `benches/fe.rs`, `bar2d-methods`). Every 64
 //! steps the products are recomputed from the state. Nothing is allocated in the time loop.
+//!
+//! Friction (SPEC §2.5, `space = "mixed"`; issue 33). The contact rows grow from B (the
+//! vertical dof of each Γ_C node, normal force λ = f_n ≥ 0 on the body) to C = [B; T], T the
+//! node's e_1 (and e_2) dofs carrying the tangential force f_t on the body: the force term
+//! Bᵀλ of every step above becomes Cᵀr, r = (f_n, f_t) per node, and the condensation
+//! Z = A⁻¹Cᵀ, H = cCZ covers the tangential columns (the frictional factor). A step is still
+//! y = A⁻¹b, one contact problem on the contact set, and y + cZμ with μ = (c_f/c) r; the
+//! problem is the Coulomb (or Tresca) law on the pair
+//!
+//!   gap = q_n + (Hμ)_n ≥ 0 ⊥ μ_n ≥ 0,   slip = q_t + (Hμ)_t,   |μ_t| ≤ b, μ_t = −b·slip/|slip|,
+//!
+//! solved by the semismooth Newton method of [`crate::contact::coulomb`] (the Coulomb disc in
+//! 3D). Coulomb's bound b = μ_f μ_n is scale free; Tresca's s·w_j (w_j = ∫_ΓC φ_j, a force) is
+//! multiplied by c_f/c, and by τ where the unknown is an impulse. Per method (the slip is the
+//! scheme's, SPEC §2.5; f̄_t is the tangential force as it enters the momentum equation over
+//! the step, which W_f^{n+1} = W_f^n − Σ_j f̄_t,j·(u_t,j^{n+1} − u_t,j^n) uses):
+//! - `kane`: q_n = Buⁿ + g + By, q_t = Ty (slip = u_t^{n+1} − u_tⁿ = TΔu), μ = 2(λ, f_t)^{n+1},
+//!   f̄_t = f_t^{n+1}. The trapezoidal rule gives ΔE = Δuᵀ Cᵀr exactly (massless rows included:
+//!   their row is K u^{n+½} = F + Cᵀr), so Δ(E + W_f) = λ·BΔu = −λ·(Buⁿ + g) ≤ 0: the normal
+//!   force does no positive work and friction's work is all in W_f;
+//! - `contact-stabilized-newmark`: the predictor is frictionless (the M-projection onto the
+//!   admissible set constrains the normal rows only); the corrector is `kane`'s with
+//!   q_n = Bu^pred + g + By, q_t = T(u^pred − uⁿ) + Ty, μ = 2(λ, f_t)^{n+1}, f̄_t = f_t^{n+1};
+//! - `generalized-alpha`/`hht`: q_n = By + g, q_t = Ty − Tuⁿ, μ = r^{n+1}; the force of the
+//!   previous step enters the right-hand side as κ_f Cᵀrⁿ (tangential rows included), so
+//!   f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ;
+//! - `moreau-jean`: De Saxcé's law per node on the velocity-level problem, over the nodes with
+//!   (Buⁿ + g) + ½τBvⁿ ≤ 0 only (the solver's active mask; the others carry no impulse):
+//!   "gap" = Bv^{n+1} + eBvⁿ, q_n = (1 + e)Bvⁿ + By; "slip" = v_t^{n+1}, q_t = Tvⁿ + Ty; the
+//!   impulses p = cμ, reported forces p/τ, Tresca's bound s·w_j·τ. f̄_t = p_t/τ, so
+//!   −f̄_t·Δu_t = −p_t·Tv^{n+θ} and with θ = ½ Δ(E + W_f) = p_n·Bv^{n+½} = ½(1 − e) p_n·Bvⁿ:
+//!   zero for e = 1 (conserved to round-off), ≤ 0 on a node that approaches for e < 1;
+//! - kinematic `central-difference`: after a contact dof is put on the obstacle by the normal
+//!   impulse (force λ_j = m_j Δv_j/τ), the node's tangential force is the one that stops its
+//!   slip increment, f_t = −m_j(u_t^pred − u_tⁿ)/τ², projected onto the disc |f_t| ≤ b
+//!   (b = μ_f λ_j, Tresca s·w_j, none without a normal impulse): u_t += τ²f_t/m_j,
+//!   v_t^{n+½} += τf_t/m_j. A local projection per node, no solve; f̄_t = f_t^{n+1}.
+//!
+//! Measured per step (SPEC §5): W_f, the rise of E + W_f, the contact node-steps in stick
+//! (|Δu_t| ≤ 1e-12·h) and in slip, |Σf_t|/Σf_n, and the series' σ_t (the total e_1 contact
+//! force), the Γ_C mean of v_1 and W_f; at T the mean velocities 1ᵀMv/1ᵀM1 along e_1 (3D: the
+//! norm over e_1, e_2) and e_d. A law with μ_f = 0 or s = 0 never reaches this module's
+//! frictional path (the engine routes it to the frictionless one: bit for bit).
 
 use std::sync::Arc;
 use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, geometry_key, gravity_load,
-    lowest_contact, mass_matrix, ref_map, reference_record,
+    build_geometry, factor, factor_failure, factor_key_gap, frictional, geometry_key, gravity_load,
+    lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
 };
-use crate::contact::Lcp;
+use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
+use crate::contact::{FrictionalContact, Lcp};
 use crate::run::fe_nitsche::{
     NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
 };
+use crate::run::friction_tally::FrictionTally;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::space::fe::SymMatrix;
@@ -302,6 +347,304 @@ pub(super) fn kinematic_frequency_sq(cfg: &FeConfig) -> Result<(f64, f64), (&'st
     }
 }
 
+/// The frictional part of a run (module header): the law, the tangential dofs of each Γ_C node,
+/// the step's forces and the run's [`FrictionTally`]. Allocated once per run.
+struct Friction {
+    law: FrictionLaw,
+    /// Tangential directions per node (d − 1).
+    nt: usize,
+    /// Reduced index of direction k of contact node j: `tdofs[j·nt + k]`.
+    tdofs: Vec<usize>,
+    /// The nodes' trapezoidal weights (sum 1): Γ_C means.
+    mean_weight: Vec<f64>,
+    /// Tresca's weights w_j = ∫_ΓC φ_j of the nodes.
+    weight: Vec<f64>,
+    /// The step's forces on the body, node-major [f_n, f_t…] (forces also where the method's
+    /// unknowns are impulses). Until the step's solve, the previous step's: generalized-α's
+    /// f_tⁿ of the right-hand side.
+    forces: Vec<f64>,
+    /// u_tⁿ at the tangential dofs (the slip's reference), then Δu_t.
+    u_t_prev: Vec<f64>,
+    du_t: Vec<f64>,
+    /// The implicit methods' contact problem (None: kinematic central difference).
+    implicit: Option<Implicit>,
+    tally: FrictionTally,
+    /// Reduced rows of each direction (e_1, (e_2,) e_d) and their masses 1ᵀM1: the mean
+    /// velocities 1ᵀMv/1ᵀM1 from the carried Mv.
+    dir_rows: Vec<Vec<usize>>,
+    mass_dir: Vec<f64>,
+}
+
+/// The implicit methods' frictional contact problem over the step matrix's frictional
+/// condensation ([`Factored::friction`]: Z's normal columns, then the tangential ones; W over
+/// the rows C node-major, normal then e_1 (, e_2) per node).
+struct Implicit {
+    fac: Arc<Factored>,
+    /// C's rows (dofs) and Z's columns in the node-major order of μ.
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    solver: FrictionalContact,
+    /// The free gaps and slips of the step, the active mask (Moreau–Jean), the unknowns μ
+    /// (node-major, the next step's warm start) and Tresca's weights in μ's unit.
+    q_n: Vec<f64>,
+    q_t: Vec<f64>,
+    active: Vec<bool>,
+    mu: Vec<f64>,
+    weights: Vec<f64>,
+}
+
+impl Friction {
+    /// `weight_new` is f̄_t's weight of f_t^{n+1} (SPEC §2.5).
+    fn new(
+        g: &Geometry,
+        cfg: &FeConfig,
+        m: &SymMatrix,
+        weight_new: f64,
+    ) -> Result<Friction, String> {
+        let d = cfg.setup.dim;
+        let nt = d - 1;
+        let nc = g.contact.len();
+        let tdofs = tangential_dofs(g)?;
+        let weight = g
+            .contact_weight
+            .iter()
+            .map(|w| w * g.contact_measure)
+            .collect();
+        let n = g.dofs.n_free();
+        let dir_rows: Vec<Vec<usize>> = (0..d)
+            .map(|k| (0..n).filter(|&r| g.dofs.free[r] % d == k).collect())
+            .collect();
+        // 1ᵀM1 over each direction: M applied to the direction's indicator, summed on it.
+        let mut one = vec![0.0; n];
+        let mut m1 = vec![0.0; n];
+        let mass_dir = dir_rows
+            .iter()
+            .map(|rows| {
+                one.iter_mut().for_each(|x| *x = 0.0);
+                rows.iter().for_each(|&r| one[r] = 1.0);
+                m.matvec_into(&one, &mut m1);
+                rows.iter().map(|&r| m1[r]).sum()
+            })
+            .collect();
+        Ok(Friction {
+            law: cfg.friction,
+            nt,
+            tdofs,
+            mean_weight: g.contact_weight.clone(),
+            weight,
+            forces: vec![0.0; nc * d],
+            u_t_prev: vec![0.0; nc * nt],
+            du_t: vec![0.0; nc * nt],
+            implicit: None,
+            tally: FrictionTally::new(nc, d, cfg.setup.h, weight_new),
+            dir_rows,
+            mass_dir,
+        })
+    }
+
+    /// Attach the implicit methods' contact problem on the factor `fac` (made with the
+    /// frictional columns) and the scale of μ: f = `force_per_mu`·μ, so Tresca's bound s·w_j
+    /// on the force is s·w_j/`force_per_mu` on μ.
+    fn attach(
+        &mut self,
+        g: &Geometry,
+        fac: &Arc<Factored>,
+        force_per_mu: f64,
+    ) -> Result<(), String> {
+        let ff = fac
+            .friction
+            .as_ref()
+            .ok_or("the step factor has no frictional columns")?;
+        let (nt, nc) = (self.nt, g.contact.len());
+        let d = nt + 1;
+        let (mut rows, mut cols) = (Vec::with_capacity(nc * d), Vec::with_capacity(nc * d));
+        for (j, &ci) in g.contact.iter().enumerate() {
+            rows.push(ci);
+            cols.push(j);
+            for k in 0..nt {
+                rows.push(ff.tangential[j * nt + k]);
+                cols.push(nc + j * nt + k);
+            }
+        }
+        self.implicit = Some(Implicit {
+            fac: Arc::clone(fac),
+            rows,
+            cols,
+            solver: FrictionalContact::new(nc, d, ff.w.clone()),
+            q_n: vec![0.0; nc],
+            q_t: vec![0.0; nc * nt],
+            active: vec![true; nc],
+            mu: vec![0.0; nc * d],
+            weights: self.weight.iter().map(|w| w / force_per_mu).collect(),
+        });
+        Ok(())
+    }
+
+    /// Keep u_tⁿ before a step.
+    fn begin(&mut self, u: &[f64]) {
+        for (p, &r) in self.u_t_prev.iter_mut().zip(&self.tdofs) {
+            *p = u[r];
+        }
+    }
+
+    /// The free gaps q_n and slips q_t = Ty + `off` (T the tangential rows; `off` the method's
+    /// slip reference at those rows, module header) into the problem; `gap(j)` is node j's.
+    fn set_free(&mut self, y: &[f64], off: impl Fn(usize) -> f64, gap: impl Fn(usize) -> f64) {
+        let im = self.implicit.as_mut().expect("an implicit method");
+        for (j, q) in im.q_n.iter_mut().enumerate() {
+            *q = gap(j);
+        }
+        for (q, &r) in im.q_t.iter_mut().zip(&self.tdofs) {
+            *q = y[r] + off(r);
+        }
+    }
+
+    /// Solve the step's problem (over the active nodes if `masked`), then y += cZ̄μ and
+    /// sd += cCᵀμ; the normal unknowns into `normal` (the frictionless code's λ). Returns the
+    /// Newton steps.
+    fn solve(
+        &mut self,
+        c: f64,
+        masked: bool,
+        y: &mut [f64],
+        sd: &mut [f64],
+        normal: &mut [f64],
+    ) -> Result<usize, String> {
+        let d = self.nt + 1;
+        let im = self.implicit.as_mut().expect("an implicit method");
+        let it = im
+            .solver
+            .solve(
+                &self.law,
+                &im.weights,
+                &im.q_n,
+                &im.q_t,
+                masked.then_some(&im.active[..]),
+                &mut im.mu,
+                LCP_MAX_ITER,
+                LCP_TOL,
+            )
+            .map_err(|e| e.to_string())?;
+        let n = y.len();
+        for ((&mk, &col), &row) in im.mu.iter().zip(&im.cols).zip(&im.rows) {
+            if mk != 0.0 {
+                let f = c * mk;
+                for (yi, zi) in y.iter_mut().zip(&im.fac.z[col * n..(col + 1) * n]) {
+                    *yi += f * zi;
+                }
+                sd[row] += f;
+            }
+        }
+        for (l, m) in normal.iter_mut().zip(im.mu.iter().step_by(d)) {
+            *l = *m;
+        }
+        Ok(it)
+    }
+
+    /// The step's forces f = `s`·μ (s: μ's force, module header).
+    fn take_forces(&mut self, s: f64) {
+        let im = self.implicit.as_ref().expect("an implicit method");
+        for (f, m) in self.forces.iter_mut().zip(&im.mu) {
+            *f = s * m;
+        }
+    }
+
+    /// y += s·f_tⁿ at the tangential rows (generalized-α's history term κ_f Cᵀrⁿ, whose
+    /// normal part the frictionless code adds); `forces` still holds the previous step's.
+    fn add_previous_tangential(&self, s: f64, y: &mut [f64]) {
+        let d = self.nt + 1;
+        for (j, f) in self.forces.chunks_exact(d).enumerate() {
+            for (k, fk) in f[1..].iter().enumerate() {
+                y[self.tdofs[j * self.nt + k]] += s * fk;
+            }
+        }
+    }
+
+    /// Kinematic friction (module header): with the normal impulses' forces in `forces`, the
+    /// tangential force of each node that stops its slip increment, projected onto the disc
+    /// of radius b, applied to u_t and v_t^{n+½}. `diag` is the lumped mass.
+    fn kinematic(&mut self, u: &mut [f64], v: &mut [f64], diag: &[f64], tau: f64) {
+        let (nt, d) = (self.nt, self.nt + 1);
+        let t2 = tau * tau;
+        for (j, f) in self.forces.chunks_exact_mut(d).enumerate() {
+            let ts = &self.tdofs[j * nt..(j + 1) * nt];
+            let prev = &self.u_t_prev[j * nt..(j + 1) * nt];
+            let (fn_j, ft) = f.split_first_mut().expect("d ≥ 2");
+            if *fn_j <= 0.0 {
+                ft.iter_mut().for_each(|x| *x = 0.0);
+                continue;
+            }
+            let b = self.law.bound(*fn_j, self.weight[j]);
+            let mut norm2 = 0.0;
+            for ((fk, &r), p) in ft.iter_mut().zip(ts).zip(prev) {
+                *fk = -diag[r] * (u[r] - p) / t2;
+                norm2 += *fk * *fk;
+            }
+            let norm = norm2.sqrt();
+            // Stick inside the disc (the slip increment is cancelled exactly: u_t = u_tⁿ),
+            // slide on its boundary along the stick force.
+            let stick = norm <= b;
+            for ((fk, &r), p) in ft.iter_mut().zip(ts).zip(prev) {
+                if stick {
+                    u[r] = *p;
+                } else {
+                    *fk *= b / norm;
+                    u[r] += t2 * *fk / diag[r];
+                }
+                v[r] += tau * *fk / diag[r];
+            }
+        }
+    }
+
+    /// The step's bookkeeping once u^{n+1} and the forces are known (the tally: W_f, stick
+    /// and slip, the apparent friction coefficient, the step's tangential work).
+    fn end(&mut self, u: &[f64]) {
+        for ((du, p), &r) in self.du_t.iter_mut().zip(&self.u_t_prev).zip(&self.tdofs) {
+            *du = u[r] - p;
+        }
+        self.tally.step(&self.forces, &self.du_t);
+    }
+
+    /// The mean velocity 1ᵀMv/1ᵀM1 along direction k, from the carried Mv.
+    fn mean_velocity(&self, mv: &[f64], k: usize) -> f64 {
+        self.dir_rows[k].iter().map(|&r| mv[r]).sum::<f64>() / self.mass_dir[k]
+    }
+
+    /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
+    /// nodes' trapezoidal weights), W_f.
+    fn series(&self, v: &[f64]) -> [f64; 3] {
+        let v_t = self
+            .tdofs
+            .iter()
+            .step_by(self.nt)
+            .zip(&self.mean_weight)
+            .map(|(&r, w)| w * v[r])
+            .sum();
+        [self.tally.total_tangential()[0], v_t, self.tally.work()]
+    }
+
+    /// After observing step `step` with energy E: E + W_f and the mean e_1 velocity (the
+    /// stop time) into the tally.
+    fn observed(&mut self, step: usize, tau: f64, energy: f64, mv: &[f64]) {
+        self.tally.energy(energy);
+        let v1 = self.mean_velocity(mv, 0);
+        self.tally.velocity(step as f64 * tau, v1);
+    }
+
+    /// The friction columns of SPEC §5 (energies over `scale`): the tally's, and the mean
+    /// velocities at T (3D: the tangential norm).
+    fn report(&self, metrics: &mut Metrics, mv: &[f64], scale: f64) {
+        let d = self.nt + 1;
+        let vt = if d == 3 {
+            self.mean_velocity(mv, 0).hypot(self.mean_velocity(mv, 1))
+        } else {
+            self.mean_velocity(mv, 0)
+        };
+        let vn = self.mean_velocity(mv, d - 1);
+        self.tally.finish(metrics, scale, vt, vn);
+    }
+}
+
 /// The discrete gradient's Newton scratch (allocated once per run).
 struct GradientWork {
     s: Vec<f64>,
@@ -456,13 +799,16 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let c = step_coefficient(meth, tau);
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
+            // With friction the factor carries the tangential columns (the engine's factor
+            // makes them for a frictional mixed run): not the frictionless entry.
             let key = format!(
                 "{}|{:?}|{:?}|{:e}",
                 geometry_key(&cfg.setup),
                 cfg.mass,
                 cfg.method,
                 c
-            ) + &factor_key_gap(g, cfg);
+            ) + &factor_key_gap(g, cfg)
+                + if frictional(cfg) { "|friction" } else { "" };
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
@@ -569,6 +915,45 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
     let mut work: Option<StepWork> = fac.as_ref().map(|f| f.chol.work());
     let diag = m.diagonal();
+    // Friction (module header): f̄_t's weight of f_t^{n+1} is generalized-α's 1 − α_f, the
+    // other methods' force of the step itself.
+    let mut fric = if frictional(cfg) {
+        let weight_new = match meth {
+            Method::Alpha(p) => 1.0 - p.alpha_f,
+            _ => 1.0,
+        };
+        // μ's unit: the force enters the right-hand side as c_f·Cᵀr and the solution is
+        // y + cZ̄μ, so r = (c/c_f)μ (module header); Moreau–Jean's impulse p = cμ is the force
+        // p/τ.
+        let force_per_mu = match (meth, c) {
+            (Method::Kinematic, _) => None,
+            (Method::Kane | Method::Csn, Some(_)) => Some(0.5),
+            (Method::Alpha(_), Some(_)) => Some(1.0),
+            (Method::MoreauJean(_), Some(c)) => Some(c / tau),
+            _ => {
+                return fail(
+                    Status::Invalid,
+                    format!(
+                        "scheme {} has no frictional version (SPEC §2.5)",
+                        cfg.scheme.label()
+                    ),
+                    metrics,
+                );
+            }
+        };
+        let mut fr = match Friction::new(g, cfg, m, weight_new) {
+            Ok(f) => f,
+            Err(e) => return fail(Status::Invalid, e, metrics),
+        };
+        if let (Some(s), Some(f)) = (force_per_mu, &fac)
+            && let Err(e) = fr.attach(g, f, s)
+        {
+            return fail(Status::SolverFailed, e, metrics);
+        }
+        Some(fr)
+    } else {
+        None
+    };
     // Dofs without inertia (mod1/…/zero-contact with kane): their velocity is Δu/τ.
     let massless: Vec<usize> = (0..n).filter(|&i| diag[i] == 0.0).collect();
     for &r in &g.vertical {
@@ -635,8 +1020,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                        ku: &[f64],
                        force: f64,
                        tmp: &mut [f64],
-                       err: &mut [f64]|
-     -> Result<(), Divergence> {
+                       err: &mut [f64],
+                       friction: Option<[f64; 3]>|
+     -> Result<f64, Divergence> {
         let kinetic = 0.5 * v.iter().zip(mv).map(|(x, y)| x * y).sum::<f64>();
         let elastic = 0.5 * u.iter().zip(ku).map(|(x, y)| x * y).sum::<f64>();
         let gravity = -u.iter().zip(&force_vec).map(|(x, y)| x * y).sum::<f64>();
@@ -673,6 +1059,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             data.u_contact.push(uc);
         }
         let exact = refmap.as_ref().map(|rm| rm.compare(g, step, u, err, tmp));
+        if let Some([sigma_t, v_t, work]) = friction {
+            obs.set_friction(sigma_t, v_t, work);
+        }
         obs.observe(
             StepValues {
                 step,
@@ -691,6 +1080,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             },
             exact,
         )
+        .map(|()| e)
     };
 
     let mut done = 0usize;
@@ -704,11 +1094,19 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
         if let Some(ops) = nit {
             // The state's own contact force at t = 0 (zero unless the body starts in contact).
             let (_, _, f) = ops.energy_terms_and_force(&u);
-            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err, None).map_err(Stop::Diverged)?;
         } else {
-            observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err).map_err(Stop::Diverged)?;
+            let fv = fric.as_ref().map(|fr| fr.series(&v));
+            let e = observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err, fv)
+                .map_err(Stop::Diverged)?;
+            if let Some(fr) = fric.as_mut() {
+                fr.observed(0, tau, e, &mv);
+            }
         }
         for step in 1..=cfg.steps {
+            if let Some(fr) = fric.as_mut() {
+                fr.begin(&u);
+            }
             let force = match meth {
                 Method::Kinematic => {
                     for i in 0..n {
@@ -716,11 +1114,17 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                         u[i] += tau * v[i];
                     }
                     let mut force = 0.0;
-                    for (&ci, gi) in g.contact.iter().zip(&gaps) {
+                    for (j, (&ci, gi)) in g.contact.iter().zip(&gaps).enumerate() {
                         let (uc, dv, l) = crate::time::kinematic_impulse(u[ci], -gi, diag[ci], tau);
                         u[ci] = uc;
                         v[ci] += dv;
                         force += l;
+                        if let Some(fr) = fric.as_mut() {
+                            fr.forces[j * (fr.nt + 1)] = l;
+                        }
+                    }
+                    if let Some(fr) = fric.as_mut() {
+                        fr.kinematic(&mut u, &mut v, &diag, tau);
                     }
                     g.k.matvec_into(&u, &mut ku);
                     for i in 0..n {
@@ -744,16 +1148,31 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = u[ci] + y[ci] + gi;
-                            }
-                            let it = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it = if let Some(fr) = fric.as_mut() {
+                                // Slip = TΔu: q_t = Ty.
+                                fr.set_free(
+                                    &y,
+                                    |_| 0.0,
+                                    |j| u[g.contact[j]] + y[g.contact[j]] + gaps[j],
+                                );
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(0.5);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = u[ci] + y[ci] + gi;
+                                }
+                                let it = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it
+                            };
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
                             g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
@@ -795,16 +1214,31 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = pred[ci] + y[ci] + gi;
-                            }
-                            let it2 = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it2 = if let Some(fr) = fric.as_mut() {
+                                // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
+                                fr.set_free(
+                                    &y,
+                                    |r| pred[r] - u[r],
+                                    |j| pred[g.contact[j]] + y[g.contact[j]] + gaps[j],
+                                );
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(0.5);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = pred[ci] + y[ci] + gi;
+                                }
+                                let it2 = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it2
+                            };
                             newton_max = newton_max.max(it + it2);
                             iterations += it2 as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             g.k.matvec_into(&y, &mut kd);
                             for i in 0..n {
                                 let md = sd[i] - c * kd[i];
@@ -876,20 +1310,34 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                     + (c + kf) * force_vec[i];
                             }
                             add_rows(&g.contact, &lambda_prev, kf, &mut y);
+                            if let Some(fr) = fric.as_ref() {
+                                fr.add_previous_tangential(kf, &mut y);
+                            }
                             sd.copy_from_slice(&y);
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                *qi = y[ci] + gi;
-                            }
-                            let it = lcp
-                                .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                            let it = if let Some(fr) = fric.as_mut() {
+                                // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
+                                fr.set_free(&y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
+                                let it = fr
+                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
+                                    .map_err(|e| Stop::Solver(step, e))?;
+                                fr.take_forces(1.0);
+                                it
+                            } else {
+                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
+                                    *qi = y[ci] + gi;
+                                }
+                                let it = lcp
+                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
+                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
+                                add_columns(&f.z, &lambda, c, &mut y);
+                                add_rows(&g.contact, &lambda, c, &mut sd);
+                                it
+                            };
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
-                            add_columns(&f.z, &lambda, c, &mut y);
-                            add_rows(&g.contact, &lambda, c, &mut sd);
                             lambda_prev.copy_from_slice(&lambda);
                             // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
                             // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
@@ -929,7 +1377,28 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                     0.0
                                 };
                             }
-                            if any {
+                            if let Some(fr) = fric.as_mut() {
+                                // De Saxcé on velocities over the active nodes: "gap" =
+                                // Bv^{n+1} + eBvⁿ (q as above), slip = v_t^{n+1} = T(vⁿ + Δv).
+                                if any {
+                                    fr.set_free(&y, |r| v[r], |j| q[j]);
+                                    fr.implicit
+                                        .as_mut()
+                                        .expect("attached")
+                                        .active
+                                        .copy_from_slice(&rows);
+                                    let it = fr
+                                        .solve(c, true, &mut y, &mut sd, &mut lambda)
+                                        .map_err(|e| Stop::Solver(step, e))?;
+                                    newton_max = newton_max.max(it);
+                                    iterations += it as i64;
+                                } else {
+                                    let im = fr.implicit.as_mut().expect("attached");
+                                    im.mu.iter_mut().for_each(|x| *x = 0.0);
+                                    lambda.iter_mut().for_each(|l| *l = 0.0);
+                                }
+                                fr.take_forces(c / tau);
+                            } else if any {
                                 let it = lcp
                                     .solve_on(&q, &mut lambda, &rows, LCP_MAX_ITER, LCP_TOL)
                                     .map_err(|e| Stop::Solver(step, e.to_string()))?;
@@ -1020,11 +1489,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                     _ => {}
                 }
             }
-            observe_timer
+            if let Some(fr) = fric.as_mut() {
+                fr.end(&u);
+            }
+            let fv = fric.as_ref().map(|fr| fr.series(&v));
+            let e = observe_timer
                 .time(step, || {
-                    observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err)
+                    observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err, fv)
                 })
                 .map_err(Stop::Diverged)?;
+            if let Some(fr) = fric.as_mut() {
+                fr.observed(step, tau, e, &mv);
+            }
             done = step;
             opts.step_stop(step, CLOCK_EVERY, start)?;
         }
@@ -1048,6 +1524,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     metrics.err_sigma_mid_l2 = None;
     metrics.contact_toggles = Some(metrics.contact_switches);
     metrics.energy_scale = energy_scale.or(metrics.energy_initial);
+    if let (Some(fr), Some(scale)) = (&fric, metrics.energy_scale) {
+        fr.report(&mut metrics, &mv, scale);
+    }
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
         _ => None,

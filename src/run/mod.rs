@@ -10,6 +10,7 @@ pub mod bar1d;
 pub mod estimate;
 pub mod fe;
 mod fe_nitsche;
+pub mod friction_tally;
 pub mod impacts;
 pub mod layer1d;
 pub mod observe;

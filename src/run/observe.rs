@@ -107,6 +107,10 @@ pub struct Metrics {
     /// again (null while it moves at T), and the exact rest time (null if after T).
     pub stop_time: Option<f64>,
     pub stop_time_exact: Option<f64>,
+    /// min over the steps of the step's own tangential work −Σ f_t^{n+1}·Δu_t over
+    /// energy_scale (FE scenes with friction, [`super::friction_tally`]; ≥ 0 for the
+    /// position-level methods, SPEC §2.5). Not a column of the runs table: for the tests.
+    pub tangential_work_min: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].

@@ -1,0 +1,257 @@
+//! The friction observables of a finite-element run (SPEC §1.8, §2.5, §5), one tally for every
+//! FE engine with friction (the mixed Newmark/θ stepper, SPEC §3.2's methods, Nitsche).
+//!
+//! Per step n → n+1 the engine hands over the contact forces f^{n+1} of its contact points
+//! (node-major [f_n, f_t…], d per point, on the body: f_n ≥ 0 along e_d, f_t along e_1 (, e_2))
+//! and the tangential displacement increments Δu_t = u_t^{n+1} − u_t^n. The tally keeps
+//!
+//! - the frictional work W_f^{n+1} = W_f^n − Σ_i f̄_t,i·Δu_t,i with the scheme's
+//!   f̄ = (1 − γ) f_t^n + γ f_t^{n+1} (CN/Newmark: γ; θ-scheme: θ; generalized-α: 1 − α_f;
+//!   kane, Moreau–Jean: 1), the tangential force as it enters the momentum equation, so that
+//!   E^{n+1} + W_f^{n+1} − (E^n + W_f^n) is the normal contact's work in the step;
+//! - the largest one-step rise of E + W_f (the engine reports each E^n, step 0 first);
+//! - the step's own tangential work −Σ_i f_t,i^{n+1}·Δu_t,i, whose minimum over the steps is
+//!   ≥ 0 for every position-level method (the law's sign: f_t opposes the slip);
+//! - contact point-steps in stick (f_n > 0 and |Δu_t| ≤ 1e-12·h) and in slip;
+//! - max over the contact steps of |Σ f_t|/Σ f_n, the apparent friction coefficient;
+//! - the total tangential force Σ_i f_t,i of the step (the series' `sigma_t_contact`);
+//! - `stop_time`: the first time the body's mean tangential velocity 1ᵀMv_1/1ᵀM1 (reported by
+//!   the engine every step) reaches 0, linearly interpolated between the two steps where it
+//!   changes sign; none if it never does or starts at 0.
+//!
+//! Nothing is allocated after [`FrictionTally::new`].
+
+use super::Metrics;
+
+/// The running friction observables of one run (module header).
+#[derive(Debug, Clone)]
+pub struct FrictionTally {
+    points: usize,
+    /// d: rows per point (normal, then d − 1 tangential).
+    d: usize,
+    /// 1e-12·h: a point-step sticks when |Δu_t| is below it.
+    stick_tol: f64,
+    /// f̄ = (1 − γ) fⁿ + γ f^{n+1}.
+    gamma: f64,
+    /// f_t^n of each point ((d − 1) per point).
+    ft_prev: Vec<f64>,
+    work: f64,
+    /// E + W_f of the last reported step, and E⁰.
+    balance_prev: Option<f64>,
+    e0: Option<f64>,
+    max_inc: f64,
+    tangential_work_min: f64,
+    stick: i64,
+    slip: i64,
+    ratio_max: Option<f64>,
+    total_t: [f64; 2],
+    /// The mean tangential velocity: its first value, the last (t, v), the stop.
+    v_first: Option<f64>,
+    v_last: Option<(f64, f64)>,
+    stop_time: Option<f64>,
+    steps: usize,
+}
+
+impl FrictionTally {
+    /// A tally for `points` contact points in dimension `d` (2 or 3), mesh size `h` (the
+    /// stick threshold 1e-12·h) and the scheme's weight `gamma` of f^{n+1} in f̄.
+    pub fn new(points: usize, d: usize, h: f64, gamma: f64) -> Self {
+        assert!(d == 2 || d == 3, "d = 2 or 3");
+        FrictionTally {
+            points,
+            d,
+            stick_tol: 1e-12 * h,
+            gamma,
+            ft_prev: vec![0.0; points * (d - 1)],
+            work: 0.0,
+            balance_prev: None,
+            e0: None,
+            max_inc: f64::NEG_INFINITY,
+            tangential_work_min: f64::INFINITY,
+            stick: 0,
+            slip: 0,
+            ratio_max: None,
+            total_t: [0.0; 2],
+            v_first: None,
+            v_last: None,
+            stop_time: None,
+            steps: 0,
+        }
+    }
+
+    /// Step n → n+1: the forces f^{n+1} (`points`·d, node-major) and the increments Δu_t
+    /// (`points`·(d − 1), node-major). Returns W_f^{n+1}.
+    pub fn step(&mut self, forces: &[f64], du_t: &[f64]) -> f64 {
+        let (d, t) = (self.d, self.d - 1);
+        assert_eq!(forces.len(), self.points * d, "d forces per point");
+        assert_eq!(du_t.len(), self.points * t, "d − 1 increments per point");
+        let (g0, g1) = (1.0 - self.gamma, self.gamma);
+        let (mut work, mut own) = (0.0, 0.0);
+        let (mut sum_n, mut sum_t) = (0.0, [0.0; 2]);
+        for i in 0..self.points {
+            let f_n = forces[i * d];
+            let ft = &forces[i * d + 1..(i + 1) * d];
+            let du = &du_t[i * t..(i + 1) * t];
+            let prev = &mut self.ft_prev[i * t..(i + 1) * t];
+            let mut du2 = 0.0;
+            for c in 0..t {
+                work -= (g0 * prev[c] + g1 * ft[c]) * du[c];
+                own -= ft[c] * du[c];
+                du2 += du[c] * du[c];
+                prev[c] = ft[c];
+                sum_t[c] += ft[c];
+            }
+            sum_n += f_n;
+            if f_n > 0.0 {
+                if du2.sqrt() <= self.stick_tol {
+                    self.stick += 1;
+                } else {
+                    self.slip += 1;
+                }
+            }
+        }
+        self.work += work;
+        self.tangential_work_min = self.tangential_work_min.min(own);
+        self.total_t = sum_t;
+        if sum_n > 0.0 {
+            let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
+            self.ratio_max = Some(self.ratio_max.map_or(r, |m| m.max(r)));
+        }
+        self.steps += 1;
+        self.work
+    }
+
+    /// E^n of the state just made (step 0 first): the balance E + W_f and its largest rise.
+    pub fn energy(&mut self, e: f64) {
+        let balance = e + self.work;
+        if let Some(prev) = self.balance_prev {
+            self.max_inc = self.max_inc.max(balance - prev);
+        }
+        self.e0.get_or_insert(e);
+        self.balance_prev = Some(balance);
+    }
+
+    /// The body's mean tangential velocity 1ᵀMv_1/1ᵀM1 at time t (every step, step 0 first).
+    pub fn velocity(&mut self, t: f64, v: f64) {
+        let first = *self.v_first.get_or_insert(v);
+        if self.stop_time.is_none()
+            && first != 0.0
+            && let Some((t0, v0)) = self.v_last
+            && v * first.signum() <= 0.0
+        {
+            // v0 has the sign of the first value (no stop yet): v0 − v ≠ 0.
+            self.stop_time = Some(t0 + (t - t0) * v0 / (v0 - v));
+        }
+        self.v_last = Some((t, v));
+    }
+
+    /// W_f so far.
+    pub fn work(&self) -> f64 {
+        self.work
+    }
+
+    /// Σ_i f_t,i of the last step (e_1, e_2; the second 0 in 2D).
+    pub fn total_tangential(&self) -> [f64; 2] {
+        self.total_t
+    }
+
+    /// min over the steps of the step's own tangential work −Σ f_t^{n+1}·Δu_t (∞ before the
+    /// first step).
+    pub fn tangential_work_min(&self) -> f64 {
+        self.tangential_work_min
+    }
+
+    /// The friction columns (SPEC §5) into `metrics`: energies over `energy_scale`, and the
+    /// body's final mean tangential (3D: the norm of both) and normal velocities.
+    pub fn finish(
+        &self,
+        metrics: &mut Metrics,
+        energy_scale: f64,
+        tangential_velocity_final: f64,
+        normal_velocity_final: f64,
+    ) {
+        let scale = energy_scale.abs().max(f64::MIN_POSITIVE);
+        metrics.friction_work = Some(self.work / scale);
+        metrics.energy_balance_drift = match (self.balance_prev, self.e0) {
+            (Some(b), Some(e0)) => Some((b - e0) / scale),
+            _ => None,
+        };
+        metrics.energy_balance_max_increase = Some(if self.steps > 0 && self.max_inc.is_finite() {
+            self.max_inc / scale
+        } else {
+            0.0
+        });
+        metrics.stick_steps = Some(self.stick);
+        metrics.slip_steps = Some(self.slip);
+        metrics.friction_ratio_max = self.ratio_max;
+        metrics.tangential_velocity_final = Some(tangential_velocity_final);
+        metrics.normal_velocity_final = Some(normal_velocity_final);
+        metrics.stop_time = self.stop_time;
+        metrics.tangential_work_min = Some(if self.steps > 0 {
+            self.tangential_work_min / scale
+        } else {
+            0.0
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two points in 2D over two steps, by hand: W_f with CN's f̄, the own work, stick/slip,
+    /// the ratio, the balance. Binary fractions: exact.
+    #[test]
+    fn a_hand_computed_tally() {
+        let mut t = FrictionTally::new(2, 2, 0.5, 0.5);
+        t.energy(1.0);
+        // Step 1: point 0 slides +0.25 under f_t = −0.5 (f_n = 2), point 1 sticks (f_n = 1,
+        // f_t = 0.25), W_f = −(½·0 + ½·(−0.5))·0.25 = 0.0625.
+        let w = t.step(&[2.0, -0.5, 1.0, 0.25], &[0.25, 0.0]);
+        assert_eq!(w, 0.0625);
+        assert_eq!(t.tangential_work_min(), 0.125);
+        t.energy(0.9375);
+        // Step 2: no contact, point 0 moves back by 0.5: f̄ = ½(−0.5) + 0, W_f += −0.125.
+        let w = t.step(&[0.0, 0.0, 0.0, 0.0], &[-0.5, 0.0]);
+        assert_eq!(w, -0.0625);
+        t.energy(1.0);
+        let mut m = Metrics::default();
+        t.finish(&mut m, 2.0, 0.1, -0.2);
+        assert_eq!(m.friction_work, Some(-0.03125));
+        assert_eq!(m.stick_steps, Some(1));
+        assert_eq!(m.slip_steps, Some(1));
+        // |Σf_t|/Σf_n = 0.25/3 at step 1.
+        assert_eq!(m.friction_ratio_max, Some(0.25 / 3.0));
+        // E + W_f: 1, 1, 0.9375: the rise 0 at step 1, and drift −0.0625/2.
+        assert_eq!(m.energy_balance_max_increase, Some(0.0));
+        assert_eq!(m.energy_balance_drift, Some(-0.03125));
+        assert_eq!(m.tangential_work_min, Some(0.0));
+    }
+
+    /// The stop time interpolates linearly where the mean velocity changes sign, once; it is
+    /// null when the velocity starts at 0 or never changes sign.
+    #[test]
+    fn stop_time_interpolates_the_sign_change() {
+        let mut t = FrictionTally::new(1, 3, 1.0, 1.0);
+        for (time, v) in [
+            (0.0, 1.0),
+            (0.5, 0.5),
+            (1.0, -0.25),
+            (1.5, 0.5),
+            (2.0, -1.0),
+        ] {
+            t.velocity(time, v);
+        }
+        let mut m = Metrics::default();
+        t.finish(&mut m, 1.0, 0.0, 0.0);
+        // Between (0.5, 0.5) and (1.0, −0.25): 0.5 + 0.5·0.5/0.75.
+        assert!((m.stop_time.unwrap() - (0.5 + 0.25 / 0.75)).abs() < 1e-15);
+        let mut t = FrictionTally::new(1, 2, 1.0, 1.0);
+        for (time, v) in [(0.0, 0.0), (0.5, 0.5), (1.0, -0.25)] {
+            t.velocity(time, v);
+        }
+        let mut m = Metrics::default();
+        t.finish(&mut m, 1.0, 0.0, 0.0);
+        assert_eq!(m.stop_time, None);
+    }
+}
