@@ -39,7 +39,7 @@
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
-use super::fe_nitsche::{NewtonWork, NitscheOps, newton};
+use super::fe_nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
 use super::friction_tally::FrictionTally;
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
@@ -766,6 +766,12 @@ fn reduce_points(points: Vec<ContactPoint>, dofs: &DofMap) -> Vec<ContactPoint> 
                         p.dofs[k] = any;
                         p.un[k] = 0.0;
                         p.sn[k] = 0.0;
+                        // The tangential rows (friction), d − 1 of each, k apart.
+                        let kk = p.un.len();
+                        for i in (k..p.ut.len()).step_by(kk) {
+                            p.ut[i] = 0.0;
+                            p.st[i] = 0.0;
+                        }
                     }
                 }
             }
@@ -1095,6 +1101,17 @@ fn factor_key(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> String {
         } else {
             ""
         }
+        + &factor_key_friction(cfg)
+}
+
+/// A frictional Nitsche/penalty run's factor has the tangential rows (their k_q = 1/(γτ) holds
+/// τ itself, not only cτ²): its own entry; empty for every other run.
+fn factor_key_friction(cfg: &FeConfig) -> String {
+    if frictional(cfg) && cfg.method != ContactMethod::Mixed {
+        format!("|friction τ {:e}", cfg.dt)
+    } else {
+        String::new()
+    }
 }
 
 fn factor_key_gap(g: &Geometry, cfg: &FeConfig) -> String {
@@ -1135,6 +1152,9 @@ fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factored, String>
     // plane is the run's gap below it (the ball's gap is in its geometry: nothing added).
     if !g.gap_in_geometry {
         ops.gap.iter_mut().for_each(|x| *x += cfg.setup.gap);
+    }
+    if frictional(cfg) {
+        ops = ops.with_friction(points()?, cfg.dt);
     }
     factor_nitsche(g, cfg, c_tau2, ops)
 }
@@ -1261,29 +1281,39 @@ fn factor_nitsche(
     // The points' dofs are reduced indices already ([`reduce_points`]).
     let red = |gd: usize| gd;
     if theta != 0.0 {
+        // σ_n's rows, and with friction the σ_t rows too (the full-vector form's
+        // −Θ∫γ σ_t(u)·σ_t(v), fe_nitsche header).
+        let td = ops.friction.as_ref().map_or(0, |f| f.td);
         for q in 0..nq {
             let f = c_tau2 * theta * ops.w[q] * ops.gamma[q];
-            let (d, sq) = (&ops.dofs[q * k..(q + 1) * k], &ops.s[q * k..(q + 1) * k]);
-            for (i, &gi) in d.iter().enumerate() {
-                for (j, &gj) in d.iter().enumerate() {
-                    let pos = a
-                        .pattern
-                        .position(red(gi), red(gj))
-                        .expect("element dofs are in the pattern");
-                    a.values[pos] -= f * sq[i] * sq[j];
+            let d = &ops.dofs[q * k..(q + 1) * k];
+            for r in 0..=td {
+                let sq = match (r, ops.friction.as_ref()) {
+                    (0, _) => &ops.s[q * k..(q + 1) * k],
+                    (r, Some(fr)) => &fr.st[(q * td + r - 1) * k..(q * td + r) * k],
+                    (_, None) => unreachable!("no tangential rows without friction"),
+                };
+                for (i, &gi) in d.iter().enumerate() {
+                    for (j, &gj) in d.iter().enumerate() {
+                        let pos = a
+                            .pattern
+                            .position(red(gi), red(gj))
+                            .expect("element dofs are in the pattern");
+                        a.values[pos] -= f * sq[i] * sq[j];
+                    }
                 }
             }
         }
     }
+    // The condensed unknowns: the points' P_γ (and P_t with friction).
+    let nq = ops.unknowns();
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
     })?;
     let mut z = vec![0.0; n * nq];
     for q in 0..nq {
-        for (&gd, &c) in ops.dofs[q * k..(q + 1) * k]
-            .iter()
-            .zip(&ops.c[q * k..(q + 1) * k])
-        {
+        let (c_row, dofs) = ops.c_row(q);
+        for (&gd, &c) in dofs.iter().zip(c_row) {
             z[q * n + red(gd)] += c;
         }
     }
@@ -1293,8 +1323,10 @@ fn factor_nitsche(
     })?;
     let mut h = vec![0.0; nq * nq];
     for q in 0..nq {
+        let (p_row, dofs) = ops.p_row(q);
         for r in 0..nq {
-            h[q * nq + r] = ops.apply(&ops.p, q, &z[r * n..(r + 1) * n]);
+            let zr = &z[r * n..(r + 1) * n];
+            h[q * nq + r] = p_row.iter().zip(dofs).map(|(a, &g)| a * zr[g]).sum();
         }
     }
     Ok(Factored {
@@ -1612,7 +1644,12 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
     if frictional(cfg) && methods::handles(cfg) && cfg.method == ContactMethod::Mixed {
         return methods::simulate(cfg, opts, ctx);
     }
-    if frictional(cfg) && !mixed_stepper(cfg) {
+    // Friction is solved by Nitsche and the penalty with the Newmark family and θ-schemes
+    // (fe_nitsche header), by the mixed method in [`Stepper`] and in the §3.2 methods' loops.
+    let nitsche_solved = cfg.method != ContactMethod::Mixed
+        && matches!(cfg.scheme, Scheme::Newmark(_) | Scheme::Theta(_))
+        && !methods::handles(cfg);
+    if frictional(cfg) && !mixed_stepper(cfg) && !nitsche_solved {
         return Outcome {
             status: Status::Invalid,
             message: Some(format!(
@@ -1646,14 +1683,18 @@ fn mixed_stepper(cfg: &FeConfig) -> bool {
     cfg.method == ContactMethod::Mixed && !methods::handles(cfg) && cfg.coefficients().is_ok()
 }
 
-/// Whether the run's friction law can produce a tangential force. A law with μ_f = 0 or s = 0
-/// is the frictionless problem, which the frictionless engine solves: the "μ_f = 0 gives the
-/// frictionless numbers bit for bit" rule of SPEC §2.5 holds by construction.
+/// Whether the run takes the frictional engine. A law with μ_f = 0 or s = 0 is the
+/// frictionless problem, which the frictionless engine solves: the "μ_f = 0 gives the
+/// frictionless numbers bit for bit" rule of SPEC §2.5 holds by construction — except Nitsche
+/// with Θ ≠ 0, whose frictional form at μ_f = 0 is the full-vector frictionless Nitsche (σ_t = 0
+/// imposed weakly with its Θ term, SPEC §2.5), not `none`'s: any Coulomb/Tresca law takes
+/// the frictional engine there.
 fn frictional(cfg: &FeConfig) -> bool {
+    let full_vector = matches!(cfg.method, ContactMethod::Nitsche { theta, .. } if theta != 0.0);
     match cfg.friction {
         FrictionLaw::None => false,
-        FrictionLaw::Coulomb { coefficient } => coefficient != 0.0,
-        FrictionLaw::Tresca { threshold } => threshold != 0.0,
+        FrictionLaw::Coulomb { coefficient } => coefficient != 0.0 || full_vector,
+        FrictionLaw::Tresca { threshold } => threshold != 0.0 || full_vector,
     }
 }
 
@@ -1708,6 +1749,8 @@ struct Stepper<'a> {
     lambda: Vec<f64>,
     lcp: Lcp,
     newton_work: NewtonWork,
+    /// Friction with Nitsche/penalty (SPEC §2.5): u_t^n, the previous forces, the tally.
+    friction: Option<FrictionState>,
     /// Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
     kink: Vec<f64>,
     newton_max: usize,
@@ -1812,7 +1855,7 @@ impl<'a> Stepper<'a> {
         let n = g.dofs.n_free();
         let nit = fac.nitsche.as_ref();
         // Contact unknowns: the Γ_C nodes' vertical dofs (mixed) or Nitsche's points.
-        let nc = nit.map_or(g.contact.len(), NitscheOps::len);
+        let nc = nit.map_or(g.contact.len(), NitscheOps::unknowns);
         metrics.contact_dofs = Some(nc as i64);
         // Gap of each contact dof: its height above the plane (ball) or the run's gap (box).
         let base_gap = if g.gap_in_geometry {
@@ -1838,7 +1881,10 @@ impl<'a> Stepper<'a> {
                 fac.h.clone()
             },
         );
-        let newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+        let newton_work = match nit {
+            Some(o) if o.friction.is_some() => NewtonWork::frictional(nc, o.per_point()),
+            _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
+        };
         let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
         let work: StepWork = fac.chol.work();
         for &r in &g.vertical {
@@ -1854,6 +1900,19 @@ impl<'a> Stepper<'a> {
             }
         }
         fac.m.matvec_into(&v, &mut mv);
+        let friction = match nit {
+            Some(o) if o.friction.is_some() => {
+                // M 1_t for the mean tangential velocity (setup only).
+                let mut ones = vec![0.0; n];
+                g.tangential.iter().for_each(|&r| ones[r] = 1.0);
+                let mut m1 = vec![0.0; n];
+                fac.m.matvec_into(&ones, &mut m1);
+                let mut f = FrictionState::new(o, cfg.friction, &g.tangential, &m1);
+                f.start(&mv);
+                Some(f)
+            }
+            _ => None,
+        };
         // Gravity (SPEC §1.3, [`gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
         // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0).
         let fall = -cfg.setup.gravity;
@@ -1953,6 +2012,7 @@ impl<'a> Stepper<'a> {
             lambda: vec![0.0; nc * fac.friction.as_ref().map_or(1, |_| g.mesh.dim())],
             lcp,
             newton_work,
+            friction,
             kink,
             newton_max: 0,
             iterations: 0,
@@ -2176,7 +2236,30 @@ impl<'a> Stepper<'a> {
     fn contact(&mut self, step: usize, y: &[f64]) -> Result<(), Stop<String>> {
         let c_tau2 = self.c_tau2;
         let fac = &*self.fac;
-        if let Some(ops) = fac.nitsche.as_ref() {
+        if let (Some(ops), Some(fr)) = (fac.nitsche.as_ref(), self.friction.as_mut()) {
+            // x0 = P y (+ k u_t^n), then the frictional Newton (fe_nitsche header); λ holds the
+            // previous step's forces, its warm start.
+            if self.hybrid {
+                return Err(Stop::Solver(
+                    step,
+                    "friction is not defined for the hybrid scheme".into(),
+                ));
+            }
+            fr.start_step(ops, y, &self.u, &self.lambda, &mut self.q);
+            let it = newton_friction(
+                ops,
+                fr.law,
+                &fac.h,
+                c_tau2,
+                &self.q,
+                &mut self.lambda,
+                &mut fr.slides,
+                &mut self.newton_work,
+            )
+            .map_err(|e| Stop::Solver(step, e))?;
+            self.newton_max = self.newton_max.max(it);
+            self.iterations += it as i64;
+        } else if let Some(ops) = fac.nitsche.as_ref() {
             // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ).
             for (k, qk) in self.q.iter_mut().enumerate() {
                 *qk = ops.apply(&ops.p, k, y);
@@ -2319,10 +2402,27 @@ impl<'a> Stepper<'a> {
             }
             fr.tally.step(&fr.forces, &fr.du_t);
         }
+        if let (Some(fr), Some(ops)) = (self.friction.as_mut(), self.fac.nitsche.as_ref()) {
+            let t = step as f64 * self.tau;
+            let (ft, vt, wf) = fr.after_step(
+                ops,
+                &self.u,
+                &self.mv,
+                &self.lambda,
+                self.gamma,
+                t,
+                self.tau,
+            );
+            self.obs.set_friction(ft, vt, wf);
+        }
+        let e_prev = self.obs.last_energy();
         let mut timer = self.observe_timer;
         let r = timer.time(step, || self.observe(step));
         self.observe_timer = timer;
         r.map_err(Stop::Diverged)?;
+        if let Some(fr) = self.friction.as_mut() {
+            fr.balance(e_prev, self.obs.last_energy());
+        }
         self.done = step;
         self.opts.step_stop(step, CLOCK_EVERY, self.start)
     }
@@ -2359,6 +2459,11 @@ impl<'a> Stepper<'a> {
             };
             let scale = metrics.energy_scale.unwrap_or(1.0);
             fr.tally.finish(metrics, scale, vt, vn);
+        }
+        if let Some(fr) = &self.friction {
+            let e0 = metrics.energy_initial.unwrap_or(0.0);
+            let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
+            fr.finish(metrics, scale, e0, self.done);
         }
         let reference = match self.record {
             Some((_, data)) if status == Status::Ok => Some(data),

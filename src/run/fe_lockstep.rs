@@ -217,7 +217,7 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
 /// the L2 cache while the tile's columns are added.
 const TILE: usize = 2048;
 
-/// u^{n+1} = y + cτ² Σ_{λ_c > 0} λ_c z_c for every member (column j of `block` is member j's
+/// u^{n+1} = y + cτ² Σ_{λ_c ≠ 0} λ_c z_c for every member (column j of `block` is member j's
 /// y), by tiles of rows: each tile of a column z_c is read once for all members while their
 /// tiles of y stay in cache (column by column over the whole vectors, a group of 8 would stream
 /// its y's from memory once per column). Each entry of y receives the columns' terms in
@@ -230,11 +230,9 @@ fn add_contact(
     block: &mut [f64],
 ) {
     let n = fac.chol.n();
-    let touched = active.iter().any(|(_, s)| {
-        s.lambda
-            .iter()
-            .any(|&l| l > 0.0 || (l != 0.0 && s.fric.is_some()))
-    });
+    let touched = active
+        .iter()
+        .any(|(_, s)| s.lambda.iter().any(|&l| l != 0.0));
     if !touched {
         return;
     }
@@ -243,9 +241,10 @@ fn add_contact(
         for c in 0..nz {
             let zc = &fac.z[c * n + lo..c * n + hi];
             for ((_, s), y) in active.iter().zip(block.chunks_exact_mut(n)) {
-                // Normal forces are ≥ 0, a frictional run's tangential ones of either sign.
+                // ≠ 0, not > 0: a frictional run's tangential forces have either sign (the
+                // normal ones, and every frictionless force, are ≥ 0: the same terms).
                 let l = s.lambda[c];
-                if l > 0.0 || (l != 0.0 && s.fric.is_some()) {
+                if l != 0.0 {
                     let f = c_tau2 * l;
                     for (yi, zi) in y[lo..hi].iter_mut().zip(zc) {
                         *yi += f * zi;

@@ -25,6 +25,25 @@
 //! 1/γ_q = κ_q = E·γ0/h_K: the force φ_q = w_q κ_q [u_n − g_q]_+, its potential
 //! ½Σ w κ [u_n − g]_+² added to E^h ([`NitscheOps::penalty`]).
 
+//!
+//! Friction (SPEC §2.5; [`FrictionOps`]): GetFEM's full-vector Nitsche with Coulomb or Tresca
+//! friction. Per point, besides P_γ the d − 1 tangential values
+//!   P_t,q(u) = σ_t,q(u) − k_q (u_t,q − u_t,q^n),   k_q = 1/(γ_q τ)  (penalty: k_q = κ_q,
+//! σ_t rows 0), and the tangential traction f_t = proj onto the disc of radius r of P_t, with
+//! r = μ_f f_n (Coulomb, f_n = (1/γ)[P_γ − g]_+) or r = s while f_n > 0 (Tresca, SPEC §2.5:
+//! acting only in contact). The residual's Θ terms add −cτ²Θ Σ w γ σ_t σ_tᵀ to A (Θ ≠ 0) and
+//! the tangential test direction is Θγσ_t(v) − v_t, so C gains the columns u_t − Θγσ_t and P
+//! the rows P_t: the condensed unknowns are x = (P_γ, P_t) per point (d of them), W = P A⁻¹C
+//! over all of them, λ_q = w_q (f_n, f_t) the point's forces along C's columns, and
+//!   G(x) = x − x0 − cτ² W Λ(x) = 0,   x0 = P y (+ k_q u_t^n in the tangential rows).
+//! Semismooth Newton with the generalised Jacobian of Λ per point block: ∂λ_n/∂x_n = w/γ when
+//! active; in stick (|P_t| ≤ r) ∂λ_t/∂P_t = w I; in slip λ_t = w r P̂_t, whose derivative is
+//! w (r/|P_t|)(I − P̂_t P̂_tᵀ) (2D: 0, the clamp) and, for Coulomb, ∂λ_t/∂x_n = w (μ_f/γ) P̂_t.
+//! A point without normal contact has λ = 0 and a zero block, so only the active points' d × d
+//! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
+//! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
+
+use crate::contact::friction::FrictionLaw;
 use crate::space::fe::nitsche::ContactPoint;
 
 /// Semismooth Newton: relative tolerance and iteration cap (SPEC §4).
@@ -48,6 +67,27 @@ pub(crate) struct NitscheOps {
     /// Penalty (SPEC §2.4) instead of Nitsche: P = u_n, 1/γ_q = κ_q, and the penalty
     /// potential ½Σ w κ [u_n − g]_+² belongs to E^h.
     pub penalty: bool,
+    /// The tangential rows of a frictional run (module header); `None` without friction, and
+    /// then the unknowns are the Q normal values as before.
+    pub friction: Option<FrictionOps>,
+}
+
+/// The tangential rows of a frictional run, flat over points and directions (point q's
+/// direction i at row q·(d − 1) + i, each row k long over the point's dofs).
+#[derive(Debug)]
+pub(crate) struct FrictionOps {
+    /// Tangential directions per point, d − 1.
+    pub td: usize,
+    /// u_t (the e_i component of u at the point).
+    pub ut: Vec<f64>,
+    /// σ_t (Nitsche; zero for the penalty), for A's Θ term.
+    pub st: Vec<f64>,
+    /// P_t's linear part σ_t − k u_t.
+    pub pt: Vec<f64>,
+    /// C's tangential columns u_t − Θγσ_t (the traction's direction on the body).
+    pub ct: Vec<f64>,
+    /// k_q = 1/(γ_q τ) (Nitsche) or κ_q (penalty), per point.
+    pub kt: Vec<f64>,
 }
 
 impl NitscheOps {
@@ -65,6 +105,7 @@ impl NitscheOps {
             gap: Vec::with_capacity(points.len()),
             theta,
             penalty: false,
+            friction: None,
         };
         for pt in points {
             let g = gamma0 * pt.gamma;
@@ -96,8 +137,78 @@ impl NitscheOps {
         o
     }
 
+    /// The tangential rows for friction with step τ (module header): from the same points
+    /// as [`NitscheOps::new`] or [`NitscheOps::penalty`] (their γ_q already set).
+    pub fn with_friction(mut self, points: &[ContactPoint], tau: f64) -> NitscheOps {
+        let k = self.k;
+        let td = points.first().map_or(0, |p| p.ut.len() / k.max(1));
+        let rows = points.len() * td * k;
+        let mut f = FrictionOps {
+            td,
+            ut: Vec::with_capacity(rows),
+            st: Vec::with_capacity(rows),
+            pt: Vec::with_capacity(rows),
+            ct: Vec::with_capacity(rows),
+            kt: Vec::with_capacity(points.len()),
+        };
+        for (q, p) in points.iter().enumerate() {
+            let g = self.gamma[q];
+            // Penalty: f_t = proj(−κ Δu_t), no σ_t; Nitsche: σ_t − Δu_t/(γτ).
+            let (kq, sig) = if self.penalty {
+                (1.0 / g, 0.0)
+            } else {
+                (1.0 / (g * tau), 1.0)
+            };
+            f.kt.push(kq);
+            for (u, st) in p.ut.iter().zip(&p.st) {
+                let st = sig * st;
+                f.ut.push(*u);
+                f.st.push(st);
+                f.pt.push(st - kq * u);
+                f.ct.push(u - self.theta * g * st);
+            }
+        }
+        self.friction = Some(f);
+        self
+    }
+
     pub fn len(&self) -> usize {
         self.w.len()
+    }
+
+    /// Unknowns per point: 1 (frictionless) or d (normal and tangential).
+    pub fn per_point(&self) -> usize {
+        1 + self.friction.as_ref().map_or(0, |f| f.td)
+    }
+
+    /// The condensed unknowns: Q, or Q·d with friction.
+    pub fn unknowns(&self) -> usize {
+        self.len() * self.per_point()
+    }
+
+    /// Unknown j's row of P (P_γ or P_t's linear part) and column of C, over its point's dofs.
+    pub fn p_row(&self, j: usize) -> (&[f64], &[usize]) {
+        self.rows(j, false)
+    }
+
+    pub fn c_row(&self, j: usize) -> (&[f64], &[usize]) {
+        self.rows(j, true)
+    }
+
+    fn rows(&self, j: usize, c: bool) -> (&[f64], &[usize]) {
+        let d = self.per_point();
+        let (q, a) = (j / d, j % d);
+        let dofs = self.row(&self.dofs, q);
+        let k = self.k;
+        let row = match (&self.friction, a) {
+            (_, 0) => self.row(if c { &self.c } else { &self.p }, q),
+            (Some(f), a) => {
+                let r = q * f.td + a - 1;
+                &(if c { &f.ct } else { &f.pt })[r * k..(r + 1) * k]
+            }
+            (None, _) => unreachable!("one unknown per point without friction"),
+        };
+        (row, dofs)
     }
 
     fn row<'a, T>(&self, v: &'a [T], q: usize) -> &'a [T] {
@@ -146,6 +257,14 @@ pub(crate) struct NewtonWork {
     nonzero: Vec<usize>,
     jac: Vec<f64>,
     perm: Vec<usize>,
+    /// Friction only ([`NewtonWork::frictional`]): the points' d × d derivative blocks, which
+    /// points are in normal contact, and D δ over the active unknowns.
+    blocks: Vec<f64>,
+    point_active: Vec<bool>,
+    d_delta: Vec<f64>,
+    /// The full Newton step and the iterate it starts from (the line search's).
+    step: Vec<f64>,
+    x_old: Vec<f64>,
 }
 
 impl NewtonWork {
@@ -158,8 +277,267 @@ impl NewtonWork {
             nonzero: Vec::with_capacity(nq),
             jac: vec![0.0; nq * nq],
             perm: vec![0; nq],
+            blocks: Vec::new(),
+            point_active: Vec::new(),
+            d_delta: Vec::new(),
+            step: Vec::new(),
+            x_old: Vec::new(),
         }
     }
+
+    /// The frictional Newton's scratch: `nu` unknowns in points of `d` ([`newton_friction`]).
+    pub fn frictional(nu: usize, d: usize) -> NewtonWork {
+        let mut w = NewtonWork::new(nu);
+        w.blocks = vec![0.0; nu * d];
+        w.point_active = vec![false; nu / d.max(1)];
+        w.d_delta = vec![0.0; nu];
+        w.step = vec![0.0; nu];
+        w.x_old = vec![0.0; nu];
+        w
+    }
+}
+
+/// One point's forces λ_q = w (f_n, f_t) at x_q = (P_γ, P_t) and their derivative block
+/// D[b][a] = ∂λ_b/∂x_a (module header). Returns whether the point is in normal contact and
+/// whether it slides (the projection is active).
+#[allow(clippy::too_many_arguments)]
+fn point_forces(
+    x: &[f64],
+    gap: f64,
+    w: f64,
+    gamma: f64,
+    law: FrictionLaw,
+    lambda: &mut [f64],
+    block: &mut [f64],
+) -> (bool, bool) {
+    let d = x.len();
+    block.iter_mut().for_each(|b| *b = 0.0);
+    let pen = x[0] - gap;
+    if pen <= 0.0 {
+        lambda.iter_mut().for_each(|l| *l = 0.0);
+        return (false, false);
+    }
+    let f_n = pen / gamma;
+    lambda[0] = w * f_n;
+    block[0] = w / gamma;
+    // The disc's radius and its derivative in x_n.
+    let (r, dr) = match law {
+        FrictionLaw::Coulomb { coefficient } => (coefficient * f_n, coefficient / gamma),
+        FrictionLaw::Tresca { threshold } => (threshold, 0.0),
+        FrictionLaw::None => (0.0, 0.0),
+    };
+    let z = &x[1..];
+    let norm = z.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if r <= 0.0 {
+        lambda[1..].iter_mut().for_each(|l| *l = 0.0);
+        return (true, false);
+    }
+    if norm <= r {
+        for i in 0..d - 1 {
+            lambda[1 + i] = w * z[i];
+            block[(1 + i) * d + 1 + i] = w;
+        }
+        return (true, false);
+    }
+    let s = r / norm;
+    for i in 0..d - 1 {
+        let zi = z[i] / norm;
+        lambda[1 + i] = w * r * zi;
+        block[(1 + i) * d] = w * dr * zi;
+        for j in 0..d - 1 {
+            let delta = if i == j { 1.0 } else { 0.0 };
+            block[(1 + i) * d + 1 + j] = w * s * (delta - zi * z[j] / norm);
+        }
+    }
+    (true, true)
+}
+
+/// Tolerances and weights of one frictional solve ([`newton_friction`]).
+struct Scales {
+    /// max(|x0_n|, |g|): the normal rows' scale.
+    n: f64,
+    /// max |x0_t|: the tangential rows' fixed scale (the merit's weight).
+    t0: f64,
+}
+
+/// Λ(x), the blocks, G(x) into `work` at x = `work.s`; returns (max |G_n|, max |G_t|, the
+/// tangential rows' scale max(|x0_t|, |x_t|, Σ_r |cτ² W_jr Λ_r|), the merit Σ (G/scale)² with the
+/// fixed scales).
+#[allow(clippy::too_many_arguments)]
+fn evaluate(
+    ops: &NitscheOps,
+    law: FrictionLaw,
+    w: &[f64],
+    c_tau2: f64,
+    x0: &[f64],
+    sc: &Scales,
+    lambda: &mut [f64],
+    slides: &mut [bool],
+    work: &mut NewtonWork,
+) -> (f64, f64, f64, f64) {
+    let (nq, d) = (ops.len(), ops.per_point());
+    let nu = nq * d;
+    work.nonzero.clear();
+    work.active.clear();
+    for q in 0..nq {
+        let (on, slide) = point_forces(
+            &work.s[q * d..(q + 1) * d],
+            ops.gap[q],
+            ops.w[q],
+            ops.gamma[q],
+            law,
+            &mut lambda[q * d..(q + 1) * d],
+            &mut work.blocks[q * d * d..(q + 1) * d * d],
+        );
+        work.point_active[q] = on;
+        slides[q] = slide;
+        if on {
+            work.active.extend(q * d..(q + 1) * d);
+            work.nonzero
+                .extend((q * d..(q + 1) * d).filter(|&r| lambda[r] != 0.0));
+        }
+    }
+    let (mut res_n, mut res_t, mut scale_t, mut merit) = (0.0f64, 0.0f64, sc.t0, 0.0);
+    for j in 0..nu {
+        let row = &w[j * nu..(j + 1) * nu];
+        // (WΛ)_j and Σ_r |W_jr Λ_r|: the size of the terms the sum cancels (its rounding).
+        let (mut wl, mut wabs) = (0.0, 0.0);
+        for &r in &work.nonzero {
+            let t = row[r] * lambda[r];
+            wl += t;
+            wabs += t.abs();
+        }
+        let (wl, wabs) = (c_tau2 * wl, c_tau2 * wabs);
+        let g = work.s[j] - x0[j] - wl;
+        work.g[j] = g;
+        if j % d == 0 {
+            // Relative to the fixed normal scale, or to the terms if they are larger.
+            res_n = res_n.max(g.abs() * (sc.n / sc.n.max(wabs)));
+            merit += (g / sc.n).powi(2);
+        } else {
+            res_t = res_t.max(g.abs());
+            scale_t = scale_t.max(work.s[j].abs()).max(wabs);
+            merit += (g / sc.t0).powi(2);
+        }
+    }
+    (res_n, res_t, scale_t, merit)
+}
+
+/// The frictional condensed problem G(x) = x − x0 − cτ² W Λ(x) = 0 (module header) over the
+/// Q·d unknowns (point-major), the normal kinks the gaps. `lambda` holds the previous step's
+/// forces on entry (the warm start x = x0 + cτ²Wλ) and Λ(x) on return; `slides` receives
+/// whether each point slides. Tolerance 1e-12 relative, per kind of unknown: the normal rows
+/// against max(|x0_n|, |g|) as the frictionless Newton, the tangential rows (a traction, not
+/// a length) against the largest of |x0_t|, |x_t| and Σ_r |cτ² W_jr Λ_r| — the terms they
+/// cancel, whose rounding a normal force's coupling into a tangential row can leave at 1e-11
+/// of a tiny |x_t| (measured on bar2d: a 2.97e-11 floor that never met 1e-12·max|x_t|); the
+/// normal rows likewise when those terms exceed max(|x0_n|, |g|). The full semismooth step can cycle: in 2D a sliding point's force w r sign(P_t) has a zero
+/// derivative in P_t, so a step that flips the sign is not seen coming, and the next flips it
+/// back (measured on the disc thrown obliquely: a 2-cycle from the second contact step). So
+/// each step is damped by backtracking on the merit Σ (G/scale)² (halving up to 30 times):
+/// a shorter step lands in the stick band |P_t| ≤ r, whose Jacobian is exact.
+/// Returns the iteration count. Allocates nothing.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn newton_friction(
+    ops: &NitscheOps,
+    law: FrictionLaw,
+    w: &[f64],
+    c_tau2: f64,
+    x0: &[f64],
+    lambda: &mut [f64],
+    slides: &mut [bool],
+    work: &mut NewtonWork,
+) -> Result<usize, String> {
+    let (nq, d) = (ops.len(), ops.per_point());
+    let nu = nq * d;
+    let mut sc = Scales {
+        n: f64::MIN_POSITIVE,
+        t0: f64::MIN_POSITIVE,
+    };
+    for q in 0..nq {
+        sc.n = sc.n.max(x0[q * d].abs()).max(ops.gap[q].abs());
+        for a in 1..d {
+            sc.t0 = sc.t0.max(x0[q * d + a].abs());
+        }
+    }
+    // Warm start from the previous step's forces.
+    work.nonzero.clear();
+    work.nonzero.extend((0..nu).filter(|&r| lambda[r] != 0.0));
+    for j in 0..nu {
+        let row = &w[j * nu..(j + 1) * nu];
+        let wl: f64 = work.nonzero.iter().map(|&r| row[r] * lambda[r]).sum();
+        work.s[j] = x0[j] + c_tau2 * wl;
+    }
+    let (mut res_n, mut res_t, mut scale_t, mut merit) =
+        evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
+    for it in 0..=NEWTON_MAX_ITER {
+        if res_n <= NEWTON_TOL * sc.n && res_t <= NEWTON_TOL * scale_t {
+            return Ok(it);
+        }
+        if it == NEWTON_MAX_ITER {
+            break;
+        }
+        let na = work.active.len();
+        // J_AA = I − cτ² W_AA D_A, D block diagonal over the active points.
+        for (i, &ji) in work.active.iter().enumerate() {
+            let row = &w[ji * nu..(ji + 1) * nu];
+            for (c, &jc) in work.active.iter().enumerate() {
+                let (q, a) = (jc / d, jc % d);
+                let blk = &work.blocks[q * d * d..(q + 1) * d * d];
+                let wd: f64 = (0..d).map(|b| row[q * d + b] * blk[b * d + a]).sum();
+                work.jac[i * na + c] = f64::from(u8::from(i == c)) - c_tau2 * wd;
+            }
+            work.delta[i] = -work.g[ji];
+        }
+        lu_solve(
+            &mut work.jac[..na * na],
+            na,
+            &mut work.perm[..na],
+            &mut work.delta[..na],
+        )
+        .map_err(|e| format!("semismooth Newton (friction): {e} (iteration {it})"))?;
+        // The full step: (D δ)_A, δ_I = −G_I + cτ² W_IA (D δ)_A, δ_A from the LU.
+        for (i, &ji) in work.active.iter().enumerate() {
+            let (q, b) = (ji / d, ji % d);
+            let blk = &work.blocks[q * d * d..(q + 1) * d * d];
+            let base = i - b;
+            work.d_delta[i] = (0..d).map(|a| blk[b * d + a] * work.delta[base + a]).sum();
+        }
+        for q in 0..nq {
+            if work.point_active[q] {
+                continue;
+            }
+            for j in q * d..(q + 1) * d {
+                let row = &w[j * nu..(j + 1) * nu];
+                let mut acc = -work.g[j];
+                for (i, &ji) in work.active.iter().enumerate() {
+                    acc += c_tau2 * row[ji] * work.d_delta[i];
+                }
+                work.step[j] = acc;
+            }
+        }
+        for (i, &ji) in work.active.iter().enumerate() {
+            work.step[ji] = work.delta[i];
+        }
+        work.x_old[..nu].copy_from_slice(&work.s[..nu]);
+        let mut alpha = 1.0;
+        for _ in 0..30 {
+            for j in 0..nu {
+                work.s[j] = work.x_old[j] + alpha * work.step[j];
+            }
+            let r = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
+            (res_n, res_t, scale_t) = (r.0, r.1, r.2);
+            if r.3 < merit {
+                merit = r.3;
+                break;
+            }
+            alpha *= 0.5;
+        }
+    }
+    Err(format!(
+        "semismooth Newton (friction) did not converge in {NEWTON_MAX_ITER} iterations (residuals {res_n:.3e} normal, {res_t:.3e} tangential; scale {:.3e})",
+        sc.n
+    ))
 }
 
 /// Solve G(s) = s − s0 − cτ² W φ(s) = 0 with φ_q(s) = (w_q/γ_q)[s − k_q]_+ (module header;
@@ -246,6 +624,199 @@ pub(crate) fn newton(
     ))
 }
 
+/// A frictional run's state besides the engine's (SPEC §2.5): the slip's reference u_t^n, the
+/// previous step's forces (for f̄ in W_f), and the friction tally of the run (SPEC §5's
+/// friction columns), all allocated once per run.
+#[derive(Debug)]
+pub(crate) struct FrictionState {
+    pub law: FrictionLaw,
+    /// u_t,q^n per point and direction, set by the step's contact solve from u^n.
+    pub ut_n: Vec<f64>,
+    /// λ of the previous step (point-major, d per point).
+    pub lambda_prev: Vec<f64>,
+    /// Whether each point slides (the disc projection active) at the last step.
+    pub slides: Vec<bool>,
+    /// The e_1 dofs and 1_tᵀM1_t: the mean tangential velocity 1_tᵀMv / 1_tᵀM1_t.
+    tangential: Vec<usize>,
+    tangential_mass: f64,
+    /// W_f (raw), the last E + W_f, the largest one-step rise of E + W_f, the smallest
+    /// one-step tangential work −Σ f_t^{n+1}·Δu_t (raw), point-steps in stick and in slip,
+    /// max |f_t|/f_n over the contact point-steps.
+    pub work: f64,
+    balance_prev: f64,
+    balance_max_increase: f64,
+    pub tangential_work_min: f64,
+    pub stick_steps: i64,
+    pub slip_steps: i64,
+    pub ratio_max: Option<f64>,
+    /// The mean tangential velocity of the last step, and the first time it reached 0.
+    vt_prev: f64,
+    pub vt: f64,
+    pub stop_time: Option<f64>,
+}
+
+impl FrictionState {
+    /// For `ops` (with friction) and the run's law; `tangential` the e_1 dofs, `m1` = M 1_t.
+    pub fn new(
+        ops: &NitscheOps,
+        law: FrictionLaw,
+        tangential: &[usize],
+        m1: &[f64],
+    ) -> FrictionState {
+        let td = ops.friction.as_ref().map_or(0, |f| f.td);
+        FrictionState {
+            law,
+            ut_n: vec![0.0; ops.len() * td],
+            lambda_prev: vec![0.0; ops.unknowns()],
+            slides: vec![false; ops.len()],
+            tangential: tangential.to_vec(),
+            tangential_mass: tangential.iter().map(|&r| m1[r]).sum(),
+            work: 0.0,
+            balance_prev: f64::NAN,
+            balance_max_increase: f64::NEG_INFINITY,
+            tangential_work_min: f64::INFINITY,
+            stick_steps: 0,
+            slip_steps: 0,
+            ratio_max: None,
+            vt_prev: f64::NAN,
+            vt: f64::NAN,
+            stop_time: None,
+        }
+    }
+
+    /// x0 = P y with the tangential rows' k_q u_t^n (module header), u_t^n kept; `lambda`
+    /// (the previous step's forces) saved for W_f.
+    pub fn start_step(
+        &mut self,
+        ops: &NitscheOps,
+        y: &[f64],
+        u_n: &[f64],
+        lambda: &[f64],
+        x0: &mut [f64],
+    ) {
+        let f = ops
+            .friction
+            .as_ref()
+            .expect("a frictional run has tangential rows");
+        let d = ops.per_point();
+        for (j, x) in x0.iter_mut().enumerate() {
+            let (row, dofs) = ops.p_row(j);
+            *x = row.iter().zip(dofs).map(|(a, &g)| a * y[g]).sum();
+            let (q, a) = (j / d, j % d);
+            if a > 0 {
+                let r = q * f.td + a - 1;
+                let urow = &f.ut[r * ops.k..(r + 1) * ops.k];
+                let ut = urow.iter().zip(dofs).map(|(a, &g)| a * u_n[g]).sum::<f64>();
+                self.ut_n[r] = ut;
+                *x += f.kt[q] * ut;
+            }
+        }
+        self.lambda_prev.copy_from_slice(lambda);
+    }
+
+    /// After step n's update (u = u^{n+1}, `mv` = M v^{n+1}): W_f −= Σ f̄_t·Δu_t with f̄ =
+    /// (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ; λ_t includes the
+    /// point's weight), the step's tangential work, stick/slip and |f_t|/f_n of the points in
+    /// contact, the mean tangential velocity and its first zero. Returns (Σ λ_t along e_1 —
+    /// the total tangential force on the body —, the mean tangential velocity, W_f).
+    #[allow(clippy::too_many_arguments)]
+    pub fn after_step(
+        &mut self,
+        ops: &NitscheOps,
+        u: &[f64],
+        mv: &[f64],
+        lambda: &[f64],
+        weight: f64,
+        t: f64,
+        tau: f64,
+    ) -> (f64, f64, f64) {
+        let f = ops
+            .friction
+            .as_ref()
+            .expect("a frictional run has tangential rows");
+        let d = ops.per_point();
+        let mut step_work = 0.0;
+        let mut force = 0.0;
+        for q in 0..ops.len() {
+            let dofs = &ops.dofs[q * ops.k..(q + 1) * ops.k];
+            let mut ft2 = 0.0;
+            for i in 0..f.td {
+                let r = q * f.td + i;
+                let urow = &f.ut[r * ops.k..(r + 1) * ops.k];
+                let ut = urow.iter().zip(dofs).map(|(a, &g)| a * u[g]).sum::<f64>();
+                let du = ut - self.ut_n[r];
+                let (l0, l1) = (self.lambda_prev[q * d + 1 + i], lambda[q * d + 1 + i]);
+                self.work -= ((1.0 - weight) * l0 + weight * l1) * du;
+                step_work -= l1 * du;
+                ft2 += l1 * l1;
+                if i == 0 {
+                    force += l1;
+                }
+            }
+            let ln = lambda[q * d];
+            if ln > 0.0 {
+                if self.slides[q] {
+                    self.slip_steps += 1;
+                } else {
+                    self.stick_steps += 1;
+                }
+                // |f_t|/f_n: the weights cancel.
+                let r = ft2.sqrt() / ln;
+                self.ratio_max = Some(self.ratio_max.map_or(r, |m| m.max(r)));
+            }
+        }
+        self.tangential_work_min = self.tangential_work_min.min(step_work);
+        let vt = self.mean_velocity(mv);
+        self.vt_prev = self.vt;
+        self.vt = vt;
+        if self.stop_time.is_none() && self.vt_prev != 0.0 && self.vt_prev * vt <= 0.0 {
+            // Linear interpolation between the two steps where it changes sign (SPEC §1.8).
+            self.stop_time = Some(t - tau + tau * self.vt_prev / (self.vt_prev - vt));
+        }
+        (force, vt, self.work)
+    }
+
+    /// 1_tᵀMv / 1_tᵀM1_t (0 without tangential mass).
+    pub fn mean_velocity(&self, mv: &[f64]) -> f64 {
+        if self.tangential_mass == 0.0 {
+            return 0.0;
+        }
+        self.tangential.iter().map(|&r| mv[r]).sum::<f64>() / self.tangential_mass
+    }
+
+    /// Step 0: the initial mean tangential velocity.
+    pub fn start(&mut self, mv: &[f64]) {
+        self.vt = self.mean_velocity(mv);
+    }
+
+    /// After step n's observation: the rise of E + W_f from E^n (+ W_f^n) to `energy` E^{n+1}
+    /// (+ W_f^{n+1}); `e_prev` is E^n, used at the first step (W_f⁰ = 0).
+    pub fn balance(&mut self, e_prev: f64, energy: f64) {
+        if self.balance_prev.is_nan() {
+            self.balance_prev = e_prev;
+        }
+        let b = energy + self.work;
+        self.balance_max_increase = self.balance_max_increase.max(b - self.balance_prev);
+        self.balance_prev = b;
+    }
+
+    /// The friction columns (SPEC §5), energies over `scale`, the drift of E + W_f from `e0`.
+    pub fn finish(&self, m: &mut super::Metrics, scale: f64, e0: f64, steps: usize) {
+        m.friction_work = Some(self.work / scale);
+        m.energy_balance_drift = Some((self.balance_prev - e0) / scale);
+        m.energy_balance_max_increase = Some(if steps > 0 {
+            self.balance_max_increase / scale
+        } else {
+            0.0
+        });
+        m.stick_steps = Some(self.stick_steps);
+        m.slip_steps = Some(self.slip_steps);
+        m.friction_ratio_max = self.ratio_max;
+        m.tangential_velocity_final = Some(self.vt);
+        m.stop_time = self.stop_time;
+    }
+}
+
 /// In-place LU with partial pivoting of the n×n row-major `a`, then solve for `b` (overwritten).
 pub(crate) fn lu_solve(
     a: &mut [f64],
@@ -322,6 +893,7 @@ mod tests {
             gap: vec![1.0],
             theta: 1.0,
             penalty: false,
+            friction: None,
         };
         let mut work = NewtonWork::new(1);
         let mut phi = [0.0];

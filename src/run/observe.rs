@@ -459,6 +459,11 @@ impl Observer {
         self.friction = Some([sigma_t, v_t, work]);
     }
 
+    /// The energy of the last observed step (a frictional engine's E + W_f balance).
+    pub fn last_energy(&self) -> f64 {
+        self.last_e
+    }
+
     /// First observed time with a negative contact pressure (a non-zero contact force).
     pub fn first_contact(&self) -> Option<f64> {
         self.first_contact

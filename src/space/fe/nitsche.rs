@@ -10,6 +10,11 @@
 //! only involve the dofs of the elements with a face on Γ_C — what the per-step solve condenses
 //! onto (SPEC §4). The face rule has 3 Gauss points per direction (order 5 ≥ 4, 003 §4.2).
 //!
+//! Friction (SPEC §1.8, §2.5) needs the tangential parts too, in the directions e_i, i < d
+//! (e_1 in 2D, e_1 and e_2 in 3D): u_t,i = u_i and σ_t,i(u) = (σ(u)n)_i = −σ_id =
+//! −μ(∂_i u_d + ∂_d u_i) (the tangential part of the traction σ(u)n, n = −e_d). They are d − 1
+//! more rows of each kind per point, made with the same shape values and gradients.
+//!
 //! Any other mesh (the bars' box, a Gmsh mesh: [`face_contact_points`]) gives its Γ_C as
 //! [`ContactFace`]s: an element and the reference coordinates of the vertices of its face on
 //! Γ_C. Every supported reference face is flat (a segment, a triangle, an axis-aligned square),
@@ -43,6 +48,30 @@ pub struct ContactPoint {
     pub un: Vec<f64>,
     /// σ_n(u) = Σ sn[k] u[dofs[k]] (= λ div u + 2μ ∂_d u_d).
     pub sn: Vec<f64>,
+    /// The tangential rows, d − 1 of them, each over `dofs` (row i at [i·k, (i+1)·k)):
+    /// u_t,i = u_i, and σ_t,i(u) = −μ(∂_i u_d + ∂_d u_i) (module header).
+    pub ut: Vec<f64>,
+    pub st: Vec<f64>,
+}
+
+/// The tangential rows of one point: u_t,i = Σ_a N_a u_{a,i} and σ_t,i = −μ(∂_i u_d + ∂_d u_i),
+/// from the shape values `n` and physical gradients `g` of its element's NN nodes.
+fn tangential_rows<const D: usize, const NN: usize>(
+    n: &[f64; NN],
+    g: &[[f64; D]; NN],
+    mu: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let k = NN * D;
+    let mut ut = vec![0.0; (D - 1) * k];
+    let mut st = vec![0.0; (D - 1) * k];
+    for i in 0..D - 1 {
+        for a in 0..NN {
+            ut[i * k + a * D + i] = n[a];
+            st[i * k + a * D + D - 1] = -mu * g[a][i];
+            st[i * k + a * D + i] = -mu * g[a][D - 1];
+        }
+    }
+    (ut, st)
 }
 
 /// The contact points of the faces of Γ_C of `mesh` for Lamé (λ, μ) and Nitsche's γ0.
@@ -85,6 +114,7 @@ fn points_generic<const D: usize, const NN: usize>(
                 }
                 sn[a * D + D - 1] += 2.0 * mu * g[a][D - 1];
             }
+            let (ut, st) = tangential_rows::<D, NN>(&n, &g, mu);
             out.push(ContactPoint {
                 weight: q.weight,
                 gamma: gamma0 * mesh.diameters[e],
@@ -92,6 +122,8 @@ fn points_generic<const D: usize, const NN: usize>(
                 dofs: dofs.clone(),
                 un,
                 sn,
+                ut,
+                st,
             });
         }
     }
@@ -305,9 +337,10 @@ fn faces_generic<const D: usize, const NN: usize>(
             let (_, jinv) = det_inv(&jac);
             let mut un = vec![0.0; NN * D];
             let mut sn = vec![0.0; NN * D];
+            let mut grads = [[0.0; D]; NN];
             for a in 0..NN {
                 // ∇N_a = J⁻ᵀ ∇_ξ N_a.
-                let mut g = [0.0; D];
+                let g = &mut grads[a];
                 for (i, gi) in g.iter_mut().enumerate() {
                     *gi = (0..D).map(|j| jinv[j][i] * dn[a][j]).sum();
                 }
@@ -317,6 +350,7 @@ fn faces_generic<const D: usize, const NN: usize>(
                 }
                 sn[a * D + D - 1] += 2.0 * mu * g[D - 1];
             }
+            let (ut, st) = tangential_rows::<D, NN>(&n, &grads, mu);
             out.push(ContactPoint {
                 weight: w * area,
                 gamma: gamma0 * diameter,
@@ -324,6 +358,8 @@ fn faces_generic<const D: usize, const NN: usize>(
                 dofs: dofs.clone(),
                 un,
                 sn,
+                ut,
+                st,
             });
         }
     }
@@ -400,6 +436,33 @@ mod tests {
                     .iter()
                     .map(|&f| 1e-3 * mesh.diameters[mesh.boundary_faces[f].element])
                     .collect();
+                // Tangential rows (friction): σ_t,i = −μ(A_id + A_di) and u_t,i = (A x_q + b)_i,
+                // with x_q recovered from the field u = x_d e_d (u_n = −x_d) and the rows'
+                // u_t of the field x ↦ x_i; same rounding bound.
+                let k = dim * mesh.element_nodes(0).len();
+                for p in &pts {
+                    assert_eq!((p.ut.len(), p.st.len()), ((dim - 1) * k, (dim - 1) * k));
+                    let mut xq = [0.0; 3];
+                    for (j, xj) in xq.iter_mut().enumerate().take(dim) {
+                        let mut f = vec![0.0; u.len()];
+                        for (n, x) in mesh.coords.iter().enumerate() {
+                            f[n * dim] = x[j];
+                        }
+                        *xj = apply(&p.ut[..k], &p.dofs, &f);
+                    }
+                    for i in 0..dim - 1 {
+                        let (ur, sr) = (&p.ut[i * k..(i + 1) * k], &p.st[i * k..(i + 1) * k]);
+                        let want_st = -mu * (a[i][dim - 1] + a[dim - 1][i]);
+                        let st = apply(sr, &p.dofs, &u);
+                        assert!(
+                            (st - want_st).abs() < 1e-11 * want_sn.abs(),
+                            "{st} {want_st}"
+                        );
+                        let want_ut = b[i] + (0..dim).map(|j| a[i][j] * xq[j]).sum::<f64>();
+                        let ut = apply(ur, &p.dofs, &u);
+                        assert!((ut - want_ut).abs() < 1e-11 * 25.0, "{ut} {want_ut}");
+                    }
+                }
                 for p in &pts {
                     let sn = apply(&p.sn, &p.dofs, &u);
                     assert!(
