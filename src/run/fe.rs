@@ -1915,7 +1915,9 @@ impl<'a> Stepper<'a> {
         };
         // Gravity (SPEC §1.3, [`gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
         // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0).
-        let fall = -cfg.setup.gravity;
+        // The fall along e_d: on an incline (SPEC §1.8) the load's e_d part is −g cos α (cos 0 = 1:
+        // the flat runs' numbers unchanged); free_fall_error compares the centre of mass with it.
+        let fall = -cfg.setup.gravity * cfg.setup.incline.to_radians().cos();
         let (force_vec, vertical_mass, energy_scale) = match gravity_load(g, cfg, &fac.m) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(None) => (vec![0.0; n], 0.0, None),

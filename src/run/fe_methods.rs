@@ -971,7 +971,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     // Gravity as in the engine ([`gravity_load`]): F, and a⁰ with M a⁰ = F − Ku⁰ on the dofs
     // with inertia (u⁰ = 0, no contact at t = 0), the start of generalized-α and of central
     // difference.
-    let fall = -cfg.setup.gravity;
+    // The fall along e_d: on an incline (SPEC §1.8) the load's e_d part is −g cos α (cos 0 = 1:
+    // the flat runs' numbers unchanged); free_fall_error compares the centre of mass with it.
+    let fall = -cfg.setup.gravity * cfg.setup.incline.to_radians().cos();
     let (force_vec, m_ed, vertical_mass, energy_scale) = match gravity_load(g, cfg, m) {
         Err(e) => return fail(Status::Invalid, e, metrics),
         Ok(None) => (vec![0.0; n], vec![0.0; n], 0.0, None),
