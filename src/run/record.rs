@@ -221,12 +221,12 @@ schema! {
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
         slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
         friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |f_t|/f_n, the apparent friction coefficient";
-        tangential_velocity_final: Option<f64> => "m/s", "the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d)";
-        normal_velocity_final: Option<f64> => "m/s", "the normal component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d)";
+        tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D)";
+        normal_velocity_final: Option<f64> => "m/s", "friction: the normal component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
         err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (SPEC §1.5; 0: frictionless)";
-        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); null if it still moves at T";
+        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (SPEC §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
