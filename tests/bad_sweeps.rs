@@ -83,6 +83,18 @@ const CASES: &[(&str, &str, &str)] = &[
         "grid.nitsche_gamma0[1]",
         "must be > 0",
     ),
+    // λ = 0 (ν = 0) is a material; λ < 0 is refused, μ = 0 too (K would have more than the
+    // rigid motions in its null space).
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.25\ndt = 0.01\nlame_lambda = -1.0\n",
+        "fixed.lame_lambda",
+        "must be ≥ 0",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.25\ndt = 0.01\nlame_mu = 0.0\n",
+        "fixed.lame_mu",
+        "must be > 0",
+    ),
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nmass = \"weights\"\nmass_weights = [2.0, -1.0]\n",
         "fixed.mass_weights",

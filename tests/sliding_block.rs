@@ -112,11 +112,24 @@ impl Trace {
 
 /// Plan and run the block with one method; `friction`: Coulomb's μ_f (None: frictionless).
 fn trace(dim: usize, method: (&str, &str), incline: f64, friction: Option<f64>, t: f64) -> Trace {
+    trace_with(dim, method, incline, friction, t, LAME, 0.0)
+}
+
+/// [`trace`] with Lamé's λ (μ = [`LAME`]; λ = 0 is ν = 0) and the initial gap given.
+fn trace_with(
+    dim: usize,
+    method: (&str, &str),
+    incline: f64,
+    friction: Option<f64>,
+    t: f64,
+    lambda: f64,
+    gap: f64,
+) -> Trace {
     let friction_keys = friction.map_or(String::new(), |mu| {
         format!("friction = \"coulomb\"\nfriction_coefficient = {mu:?}\n")
     });
     let text = format!(
-        "name = \"block\"\nscene = \"mesh{dim}d\"\n[fixed]\nmesh = \"meshes/block{dim}d.msh\"\ndensity = {RHO:?}\nlame_lambda = {LAME:?}\nlame_mu = {LAME:?}\ngravity = {GRAVITY:?}\ngap = 0.0\nvelocity_tangential = {V:?}\nincline = {incline:?}\nT = {t:?}\ndt = {DT:?}\n{friction_keys}[grid]\nmethod = [{}]\n",
+        "name = \"block\"\nscene = \"mesh{dim}d\"\n[fixed]\nmesh = \"meshes/block{dim}d.msh\"\ndensity = {RHO:?}\nlame_lambda = {lambda:?}\nlame_mu = {LAME:?}\ngravity = {GRAVITY:?}\ngap = {gap:?}\nvelocity_tangential = {V:?}\nincline = {incline:?}\nT = {t:?}\ndt = {DT:?}\n{friction_keys}[grid]\nmethod = [{}]\n",
         method.1
     );
     let path = sweeps_dir().join("sliding_block_test.toml");
@@ -375,14 +388,49 @@ fn frictionless_block_slides_with_every_mass_variant() {
     }
 }
 
-/// Issue 33 "done when" 1: while every contact point slides forward, Q = P_1 + μ_f P_d −
+/// The forward-sliding window of a frictional trace (the steps up to the first where some Γ_C
+/// node does not move forward) and Q's largest change over it, relative to m·V:
+/// Q = P_1 + μ_f P_d − (ΣF_1 + μ_f ΣF_d)·t. Asserts the window lasts at least a fifth of the
+/// rigid stopping time V/(g(μ_f cos α − sin α)), so that Q is tested over hundreds of steps:
+/// kane and Moreau–Jean slide until near the stop (0.85–0.97·t_rigid: the elastic block's mean
+/// velocity follows the rigid one to μ_f·v_d, v_d ≈ 1e-2 its vertical vibration); the
+/// Crank–Nicolson runs' chatter makes some node stick or step back earlier (measured ≥ 0.24,
+/// mixed + CN in 3D at 5°).
+fn frictional_invariant(tr: &Trace, incline: f64, t_rigid: f64) -> (usize, f64) {
+    let (f1, fd) = tr.load_sum(incline);
+    let window = tr.all_forward.iter().take_while(|&&f| f).count();
+    let t_end = window as f64 * DT;
+    println!(
+        "{}: every contact point slides forward until t = {t_end:.3} (rigid stop {t_rigid:.3})",
+        tr.what
+    );
+    assert!(
+        t_end >= 0.2 * t_rigid,
+        "{}: a contact point stopped sliding at t = {t_end} < t_rigid/5",
+        tr.what
+    );
+    let d = tr.dim - 1;
+    let q = tr.t_half[..window]
+        .iter()
+        .zip(&tr.p_half[..window])
+        .map(|(t, p)| p[0] + MU_F * p[d] - (f1 + MU_F * fd) * t);
+    let dev = max_dev(q, tr.mass * V);
+    println!("{}: max |ΔQ|/(mV) = {dev:.2e}", tr.what);
+    (window, dev)
+}
+
+/// Issue 33 "done when" 1 in 2D: while every contact point slides forward, Q = P_1 + μ_f P_d −
 /// (ΣF_1 + μ_f ΣF_d)·t stays constant to 1e-10·mV (the tolerance of the frictionless test, the
 /// same round-off: the contact solves are exact active-set or Newton solves to round-off), for
-/// the five methods, flat and on the incline, 2D and 3D. The forward-sliding window is read
-/// from the displacements (every Γ_C node moves forward at every step up to its end); it must
-/// last at least half the rigid stopping time V/(g(μ_f cos α − sin α)): the elastic block's
-/// mean velocity follows the rigid one to μ_f·v_d, v_d ≈ 1e-2 its vertical vibration, so the
-/// contact points keep sliding until near the stop.
+/// the five methods, flat and on the incline (measured ≤ 9.5e-11·mV, Nitsche at 5°).
+///
+/// The same block in 3D (ν = 0.25) is measured here too, and does not keep Q exactly, nor
+/// should it: the Coulomb disc gives f_t1 = −μ_f f_n·cos θ_i, θ_i the angle of node i's slip
+/// from e_1, and the box's Γ_C nodes also slip sideways as it spreads under its weight
+/// (Poisson), so Σ f_t1 ≠ −μ_f Σ f_n: measured 1.0e-3 … 5.0e-3·mV over the five methods'
+/// windows, asserted below 1e-2 (μ_f times the lateral slip velocity over V, ~ν·the weight's
+/// strain rate over the vibration, is of that order). The exact 3D statement, where the slip
+/// stays along e_1, is the next test.
 #[test]
 fn sliding_block_keeps_the_frictional_invariant_until_it_sticks() {
     for dim in [2, 3] {
@@ -391,37 +439,43 @@ fn sliding_block_keeps_the_frictional_invariant_until_it_sticks() {
                 let (s, c) = incline.to_radians().sin_cos();
                 let t_rigid = V / (GRAVITY * (MU_F * c - s));
                 let tr = trace(dim, method, incline, Some(MU_F), 1.2 * t_rigid);
-                let (f1, fd) = tr.load_sum(incline);
-                let m = tr.mass;
-                let window = tr.all_forward.iter().take_while(|&&f| f).count();
-                let t_end = window as f64 * DT;
-                println!(
-                    "{}: every contact point slides forward until t = {t_end:.3} (rigid stop {t_rigid:.3})",
-                    tr.what
-                );
-                // Measured windows: ≥ 0.33·t_rigid (2D CN at 5°: 14.5–16.9 of 25 / 44.6; kane and
-                // Moreau–Jean 0.85–0.97), 3D ≥ 0.26 (mixed + CN at 5°): asserted 0.25.
-                assert!(
-                    t_end >= 0.25 * t_rigid,
-                    "{}: a contact point stopped sliding at t = {t_end} < t_rigid/4",
-                    tr.what
-                );
-                let d = tr.dim - 1;
-                let q = tr.t_half[..window]
-                    .iter()
-                    .zip(&tr.p_half[..window])
-                    .map(|(t, p)| p[0] + MU_F * p[d] - (f1 + MU_F * fd) * t);
-                let dev = max_dev(q, m * V);
-                println!("{}: max |ΔQ|/(mV) = {dev:.2e}", tr.what);
-                // 2D: the identity holds to round-off (measured ≤ 9.5e-11·mV, Nitsche at 5°).
-                // 3D: the Coulomb disc gives f_t1 = −μ_f f_n·cos θ_i with θ_i the angle of node
-                // i's slip from e_1, and the block's Γ_C nodes also slip sideways (Poisson's
-                // spreading), so Σ f_t1 ≠ −μ_f Σ f_n and Q is not exactly invariant: measured
-                // 1.0e-3 … 5.0e-3·mV over the forward-sliding windows of the five methods.
-                // Asserted: the 2D identity to 1e-10, the 3D drift below 1e-2.
+                let (_, dev) = frictional_invariant(&tr, incline, t_rigid);
                 let tol = if dim == 2 { 1e-10 } else { 1e-2 };
                 assert!(dev <= tol, "{}: Q moved by {dev:e}·mV", tr.what);
             }
+        }
+    }
+}
+
+/// Issue 33 "done when" 1 in 3D: the invariant to 1e-10·mV for the five methods, flat and on
+/// the incline, where SPEC §1.8's premise holds — every contact point slides along +e_1. With
+/// Lamé λ = 0 (ν = 0) the weight and the e_1–e_d friction strain the box in no lateral way, and
+/// on the structured Q1 box the solution independent of x_2 with u_2 = 0 solves the discrete
+/// equations (every e_2 equation's terms carry ∂/∂x_2 of u_1, u_d or u_2 itself), so the
+/// lateral momentum P_2 stays at round-off and the disc law gives f_t = −μ_f f_n e_1 at each
+/// node. The box starts 1e-3 above the plane: resting at gap 0, Moreau–Jean's index set
+/// (predicted gap (Buⁿ + g) + ½τBvⁿ ≤ 0, SPEC §3.2) decides nodes whose gap is 0 to round-off by
+/// the sign of that round-off, which breaks the box's mirror symmetry at the second step
+/// (lateral displacements of 1e-5 per step, P_2 ~ 1e-9 … 4e-5·mV after, measured): a property of
+/// the method's sharp index set, not of the friction. Landing at √(2g·1e-3) = 0.014, every node
+/// penetrates by ~τ·v/2 = 3.5e-4 and stays in the index set by that margin.
+/// Tolerance 1e-10·mV as in 2D (measured ≤ 4.5e-11·mV, penalty at 5°); P_2 ≤ 1e-9·mV over the
+/// window (measured ≤ 1.4e-10·mV, Nitsche at 5°: round-off grown by the CN chatter).
+#[test]
+fn sliding_block_keeps_the_frictional_invariant_in_3d_when_it_slides_along_e1() {
+    for method in METHODS {
+        for incline in [0.0, INCLINE] {
+            let (s, c) = incline.to_radians().sin_cos();
+            let t_rigid = V / (GRAVITY * (MU_F * c - s));
+            let tr = trace_with(3, method, incline, Some(MU_F), 1.2 * t_rigid, 0.0, 1e-3);
+            let (window, dev) = frictional_invariant(&tr, incline, t_rigid);
+            assert!(dev <= 1e-10, "{}: Q moved by {dev:e}·mV", tr.what);
+            let lateral = tr.p_half[..window]
+                .iter()
+                .fold(0.0f64, |a, p| a.max(p[1].abs()))
+                / (tr.mass * V);
+            println!("{}: max |P_2|/(mV) = {lateral:.2e}", tr.what);
+            assert!(lateral <= 1e-9, "{}: P_2 = {lateral:e}·mV", tr.what);
         }
     }
 }
@@ -435,7 +489,11 @@ fn sliding_block_keeps_the_frictional_invariant_until_it_sticks() {
 #[test]
 fn sliding_block_stops_near_the_rigid_time() {
     for dim in [2, 3] {
-        for method in METHODS {
+        let mod3 = (
+            "mixed mod3 + CN",
+            "{ space = \"mixed\", mass = \"mod3\", scheme = \"crank-nicolson\" }",
+        );
+        for method in METHODS.into_iter().chain([mod3]) {
             for incline in [0.0, INCLINE] {
                 let (s, c) = incline.to_radians().sin_cos();
                 let t_rigid = V / (GRAVITY * (MU_F * c - s));
@@ -450,9 +508,15 @@ fn sliding_block_stops_near_the_rigid_time() {
                 // and Moreau–Jean stop within 5 % on the flat plane, kane within 10 % at 5°
                 // (the net deceleration g(μ_f cos α − sin α) is 2 % of g there, so the elastic
                 // block's stick–slip end weighs more).
+                // Crank–Nicolson with the redistributed mass mod3 (002's remedy for the
+                // spurious oscillations: no inertia at Γ_C, the block does not hop,
+                // energy_balance_max_increase ≤ 5e-4 of the scale) stops 3.3 % (2D) and 4.9 %
+                // (3D) late on the flat plane, a little after kane and Moreau–Jean: asserted
+                // within 6 %; at 5° it has not stopped by 1.2·t_rigid (printed).
                 let bound = match (method.0, incline == 0.0) {
                     ("kane" | "moreau-jean", true) => Some(0.05),
                     ("kane", false) => Some(0.10),
+                    ("mixed mod3 + CN", true) => Some(0.06),
                     _ => None,
                 };
                 let Some(bound) = bound else { continue };
@@ -463,5 +527,41 @@ fn sliding_block_stops_near_the_rigid_time() {
                 );
             }
         }
+    }
+}
+
+/// `zero-contact` (003's modified mass: Γ_C's rows and columns of the consistent M removed)
+/// keeps 1ᵀM1 = m − ⅔·m_layer, m_layer the bottom element layer's mass: Q1's vertical factor
+/// [2 1; 1 2]/6 puts ½ of the layer in the Γ_C rows and ⅓ in their mutual block, so the removed
+/// part is 2·½ − ⅓ = ⅔ of it — 1/6 of the 2D block (4 layers), 1/3 of the 3D one (2 layers).
+/// The whole weight still presses on the plane, so the momentum 1ᵀMv of the remaining inertia
+/// m_M decelerates at μ_f·m·g/m_M: the block stops at (m_M/m)·V/(μ_f g) — 20.83 (2D) and 16.67
+/// (3D) on the flat plane. Tolerance 5 % as for kane and Moreau–Jean (the elastic block's end of
+/// the slide; measured 0.7 % and 0.6 % late). A consistency error O(h) of the variant, not of
+/// the friction: the test pins what the reported `stop_time` means for it.
+#[test]
+fn zero_contact_mass_stops_the_block_early_by_the_mass_it_removes() {
+    let bundle = "{ space = \"mixed\", mass = \"zero-contact\", scheme = \"crank-nicolson\" }";
+    for (dim, layers) in [(2, 4.0), (3, 2.0)] {
+        let t_rigid = V / (GRAVITY * MU_F);
+        let tr = trace(
+            dim,
+            ("zero-contact + CN", bundle),
+            0.0,
+            Some(MU_F),
+            1.2 * t_rigid,
+        );
+        let kept = 1.0 - 2.0 / 3.0 / layers;
+        let want = kept * t_rigid;
+        let stop = tr.outcome.metrics.stop_time.unwrap_or(f64::NAN);
+        println!(
+            "{}: stop_time {stop:.4}, (m_M/m)·t_rigid = {want:.4}",
+            tr.what
+        );
+        assert!(
+            (stop - want).abs() <= 0.05 * want,
+            "{}: stop_time {stop} vs {want}",
+            tr.what
+        );
     }
 }

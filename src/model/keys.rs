@@ -405,7 +405,18 @@ impl Key {
             (Key::NitscheGamma0 | Key::PenaltyGamma0, Value::Num(x)) => positive(*x),
             (Key::Length | Key::Young | Key::Density | Key::Height, Value::Num(x)) => positive(*x),
             (Key::VelocityTangential, Value::Num(x)) => finite(*x).map(|_| ()),
-            (Key::LameLambda | Key::LameMu, Value::Num(x)) => positive(*x),
+            // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
+            // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the
+            // rigid motions.
+            (Key::LameLambda, Value::Num(x)) => {
+                finite(*x)?;
+                if *x >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must be ≥ 0, got {x}"))
+                }
+            }
+            (Key::LameMu, Value::Num(x)) => positive(*x),
             (Key::RightEnd, Value::Str(s)) => match s.as_str() {
                 "clamped" | "free" => Ok(()),
                 _ => Err(format!(
