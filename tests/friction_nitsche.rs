@@ -6,7 +6,9 @@
 //!   measured on the thrown disc) and does no frictional work;
 //! - friction does non-negative work per step on bar2d (Nitsche Θ = 0, 1; penalty);
 //! - done-when 3: the engine equals GetFEM 5.4 (tests/getfem/disc_nitsche_friction.py, the
-//!   GWFL form, GetFEM's Newton) on the P2 disc thrown obliquely, to 1e-8 (measured ~1e-11).
+//!   GWFL form, GetFEM's Newton) on the P2 disc thrown obliquely, to 1e-8 (measured ~1e-11; the
+//!   slip node by node, from the run's recorded displacements, 1e-10), with the same Gauss
+//!   points in stick and in slip.
 //!
 //! The initial tangential velocity is set on the planned run's setup (`FeSetup.v0_tangential`)
 //! through the library.
@@ -15,62 +17,32 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use contact_sweep::run::{Outcome, RunConfig, RunOptions, simulate};
-use contact_sweep::sweep::{SweepFile, expand};
+use common::getfem::{disc_mesh, disc_sweep, floats, run_script};
+use contact_sweep::run::{Outcome, RunConfig, RunContext};
+use contact_sweep::space::fe::GmshMesh;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
 /// Every run of the sweep `text` (as the file `path`) with its series, the initial tangential
-/// velocity set on the run's setup (the disc thrown obliquely, SPEC §1.8).
-fn outcomes_with(path: &Path, text: &str, vt: f64) -> Vec<(String, Outcome)> {
-    let plan = expand(&SweepFile::parse(path, text).expect("valid sweep")).expect("plan");
-    assert!(!plan.runs.is_empty());
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let mut cfg = spec.config.clone();
-            if let RunConfig::Fe(fe) = &mut cfg {
-                fe.setup.v0_tangential = vt;
-            }
-            let o = simulate(
-                &cfg,
-                &RunOptions {
-                    series_every: 1,
-                    ..RunOptions::default()
-                },
-            );
-            assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
-            (spec.label.clone(), o)
-        })
-        .collect()
+/// velocity set on the run's setup (the disc thrown obliquely, SPEC §1.8), in the context `ctx`.
+fn outcomes_with(path: &Path, text: &str, vt: f64, ctx: &RunContext) -> Vec<(String, Outcome)> {
+    let thrown = |cfg: &mut RunConfig| {
+        if let RunConfig::Fe(fe) = cfg {
+            fe.setup.v0_tangential = vt;
+        }
+    };
+    common::outcomes_edited(path, text, thrown, ctx)
 }
 
 fn disc(methods: &str, t_final: f64) -> String {
-    format!(
-        r#"
-name = "disc-friction"
-scene = "mesh2d"
-[fixed]
-mesh = "{}"
-density = 1.0
-lame_lambda = 20.0
-lame_mu = 20.0
-gravity = 0.1
-gap = 5.0
-T = {t_final}
-dt = 0.1
-scheme = "crank-nicolson"
-[grid]
-method = [{methods}]
-"#,
-        root().join("sweeps/meshes/disc_p2.msh").display()
-    )
+    disc_sweep("disc-friction", methods, t_final)
 }
 
 /// GetFEM's run of the disc thrown obliquely (tests/getfem/disc_nitsche_friction.py): per
-/// step the energy, ∫f_n, ∫f_t, W_f and the mean tangential velocity, and the body's mass.
+/// step the energy, ∫f_n, ∫f_t, ∫Δu_t, W_f, the mean tangential velocity, the Gauss points of
+/// Γ_C in stick and in slip, the displacement of each Γ_C node (at `contact_xy`); the body's mass.
 struct Getfem {
     energy: Vec<f64>,
     force_n: Vec<f64>,
@@ -78,59 +50,66 @@ struct Getfem {
     slip: Vec<f64>,
     work: Vec<f64>,
     vt: Vec<f64>,
+    stick_points: Vec<f64>,
+    slip_points: Vec<f64>,
+    contact_xy: Vec<[f64; 2]>,
+    /// Per step, per Γ_C node (the order of `contact_xy`): (u_x, u_y).
+    contact_u: Vec<Vec<[f64; 2]>>,
     mass: f64,
 }
 
 fn getfem_run(t_final: f64, vt: f64, mu: f64) -> Getfem {
-    let install = std::process::Command::new("bash")
-        .arg(root().join("tests/install_getfem.sh"))
-        .status()
-        .expect("bash");
-    assert!(install.success(), "tests/install_getfem.sh failed");
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("getfem.json");
-    let o = std::process::Command::new("/usr/bin/python3")
-        .arg(root().join("tests/getfem/disc_nitsche_friction.py"))
-        .arg(root().join("sweeps/meshes/disc_p2.msh"))
-        .arg(&out)
-        .args([t_final, 0.1, 5.0, vt, mu, 1.0, 1e-3].map(|x| x.to_string()))
-        .output()
-        .expect("python3");
-    assert!(
-        o.status.success(),
-        "disc_nitsche_friction.py: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
-    let list = |k: &str| -> Vec<f64> {
-        v[k].as_array()
-            .unwrap()
-            .iter()
-            .map(|y| y.as_f64().unwrap())
-            .collect()
+    let args = [t_final, 0.1, 5.0, vt, mu, 1.0, 1e-3].map(|x| x.to_string());
+    let v = run_script("disc_nitsche_friction.py", &args);
+    let pair = |p: &serde_json::Value| -> [f64; 2] {
+        let p = floats(p);
+        [p[0], p[1]]
+    };
+    let pairs = |x: &serde_json::Value| -> Vec<[f64; 2]> {
+        x.as_array().unwrap().iter().map(pair).collect()
     };
     Getfem {
-        energy: list("energy"),
-        force_n: list("force_n"),
-        force_t: list("force_t"),
-        slip: list("slip"),
-        work: list("friction_work"),
-        vt: list("vt"),
+        energy: floats(&v["energy"]),
+        force_n: floats(&v["force_n"]),
+        force_t: floats(&v["force_t"]),
+        slip: floats(&v["slip"]),
+        work: floats(&v["friction_work"]),
+        vt: floats(&v["vt"]),
+        stick_points: floats(&v["stick_points"]),
+        slip_points: floats(&v["slip_points"]),
+        contact_xy: pairs(&v["contact_xy"]),
+        contact_u: v["contact_u"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(pairs)
+            .collect(),
         mass: v["body_mass"].as_f64().unwrap(),
     }
 }
 
 /// Done-when 3 of issue 33: the engine's Nitsche + Coulomb (Θ = 1, γ0 = 1e-3, μ_f = 0.3)
 /// equals GetFEM's on the same Gmsh P2 disc thrown obliquely (gravity 0.1, gap 5, v⁰ = 0.5 e_1,
-/// Crank–Nicolson, τ = 0.1), step by step through the first contact phase: the energy (in
-/// units of energy_scale = m|f|·5 + ½m·V_t² ≈ 785), the normal and tangential contact forces (in units of
-/// the phase's largest normal force), W_f (in units of energy_scale) and the mean tangential
-/// velocity (in units of V), to 1e-8 (measured: 1.5e-12, 8.4e-12, 1.0e-11, 4.4e-13, 6.0e-12 over
-/// the 30 contact steps to T = 13; the phase is still on at T). Why 1e-8: the matrices agree to round-off in M and F and
-/// to ~1e-11 in the curved cells' K (tests/getfem_disc.rs); both Newtons solve to ≤ 1e-11 of
-/// their right-hand sides; a contact phase of ~20 steps amplifies that by no more than a few
-/// hundred. The slip itself is in W_f's increments (−f̄_t·Δu_t summed over Γ_C) and in GetFEM's
-/// ∫Δu_t, which is checked against the body's rigid drift V·τ·|Γ_C| in free flight.
+/// Crank–Nicolson, τ = 0.1), step by step through the first contact phase (steps 101..130, still
+/// on at T = 13), to 1e-8:
+/// - the energy, in units of energy_scale = m|f|·5 + ½m·V_t² ≈ 785: measured 1.2e-12;
+/// - the normal and tangential contact forces, in units of the phase's largest normal force:
+///   8.4e-12 and 1.0e-11;
+/// - W_f, in units of energy_scale: 3.5e-13; the mean tangential velocity, in units of V: 6.0e-12;
+/// - the slip pointwise: Δu_t = u_1^{k} − u_1^{k−1} at each of Γ_C's 33 nodes (vertices and edge
+///   midpoints, matched to GetFEM's by their coordinates) and each step k ≤ 130, in units of the
+///   phase's largest |Δu_t| (0.119): 1.0e-10. Larger than the rest because Δu_t is a difference
+///   of displacements ~6.5 (the body drifts V·T): 1.2e-11 absolute, 2e-12 of u.
+///
+/// Why 1e-8: the matrices agree to round-off in M and F and to ~1e-11 in the curved cells' K
+/// (tests/getfem_disc.rs); both Newtons solve to ≤ 1e-11 of their right-hand sides; a contact
+/// phase of ~30 steps amplifies that by no more than a few hundred.
+///
+/// Stick and slip: no Γ_C node sticks in either run (|Δu_t| ≤ 1e-12·h = 4.7e-12 at no node-step;
+/// the smallest |Δu_t| in the phase is 4.4e-5, far from the threshold on both sides) — Nitsche's
+/// stick is regularised (f_t = σ_t − Δu_t/(γτ) inside the cone) and decided at the Gauss points:
+/// there, of the point-steps in contact, 74 stick (|p_t| ≤ μ_f f_n) and 249 slip in both runs,
+/// exactly (SPEC §5's `stick_steps`/`slip_steps` against GetFEM's count).
 #[test]
 fn nitsche_coulomb_equals_getfem_on_the_thrown_p2_disc() {
     let (t_final, vt, mu) = (13.0, 0.5, 0.3);
@@ -139,7 +118,12 @@ fn nitsche_coulomb_equals_getfem_on_the_thrown_p2_disc() {
         r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3, friction = "coulomb", friction_coefficient = 0.3 },"#,
         t_final,
     );
-    let runs = outcomes_with(&root().join("t.toml"), &text, vt);
+    // Every node's displacement at every step (stride 1 in space and time).
+    let record = RunContext {
+        reference: None,
+        record_reference: Some((1, 1)),
+    };
+    let runs = outcomes_with(&root().join("t.toml"), &text, vt, &record);
     let (label, o) = &runs[0];
     let scale = o.metrics.energy_scale.unwrap();
     // m|f|·gap + ½m·V_t² (the thrown body's kinetic energy counts, tests/sliding_block.rs).
@@ -205,6 +189,99 @@ fn nitsche_coulomb_equals_getfem_on_the_thrown_p2_disc() {
         "{} vs {drift}",
         gf.slip[1]
     );
+    compare_nodal_slip(label, o, &gf, first, end);
+}
+
+/// The slip node by node: Δu_t = u_1^k − u_1^{k−1} at every Γ_C node (vertices and edge
+/// midpoints of the P2 faces) and step k ≤ `end`, the engine's recorded displacements against
+/// GetFEM's, nodes matched by their coordinates in the file; and which nodes stick, which
+/// Gauss points stick. See the test's doc comment for the figures.
+fn compare_nodal_slip(label: &str, o: &Outcome, gf: &Getfem, first: usize, end: usize) {
+    let mesh = GmshMesh::read(&disc_mesh()).expect("the committed P2 disc");
+    let data = o.reference.as_ref().expect("the run recorded itself");
+    let (n, d) = (mesh.coords.len(), 2);
+    assert_eq!(data.lattice[0], n, "the record holds every node");
+    assert_eq!(data.times, gf.contact_u.len(), "a record a step");
+    let u = |k: usize, a: usize| data.u[k * n * d + a * d];
+    // GetFEM's Γ_C (faces below the centre) is the engine's `contact` group: the same nodes,
+    // each of GetFEM's at exactly one of the engine's (the file's coordinates, read by both).
+    let contact = mesh.contact_nodes();
+    assert_eq!(contact.len(), gf.contact_xy.len(), "Γ_C's nodes");
+    let node: Vec<usize> = gf
+        .contact_xy
+        .iter()
+        .map(|p| {
+            let near: Vec<usize> = contact
+                .iter()
+                .copied()
+                .filter(|&a| (mesh.coords[a][0] - p[0]).hypot(mesh.coords[a][1] - p[1]) < 1e-9)
+                .collect();
+            assert_eq!(
+                near.len(),
+                1,
+                "GetFEM's Γ_C node {p:?}: engine nodes {near:?}"
+            );
+            near[0]
+        })
+        .collect();
+    let mut sorted = node.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, contact, "a one-to-one match");
+
+    let du_e = |k: usize, j: usize| u(k, node[j]) - u(k - 1, node[j]);
+    let du_g = |k: usize, j: usize| gf.contact_u[k][j][0] - gf.contact_u[k - 1][j][0];
+    let nodes = 0..node.len();
+    let slip_max = (first..=end)
+        .flat_map(|k| nodes.clone().map(move |j| du_g(k, j).abs()))
+        .fold(0.0f64, f64::max);
+    let mut err = 0.0f64;
+    // Stick at a node: |Δu_t| ≤ 1e-12·h (SPEC §5's criterion). The counts are compared per step
+    // over the node-steps where both sides are a factor 1e3 or more from the threshold (a
+    // difference of 1e-8 of the largest slip could move a node across it otherwise).
+    let thr = 1e-12 * mesh.h;
+    let (mut stuck_e, mut stuck_g, mut unclear) = (0usize, 0usize, 0usize);
+    let mut smallest = f64::INFINITY;
+    for k in 1..=end {
+        let (mut se, mut sg) = (0, 0);
+        for j in nodes.clone() {
+            let (e, g) = (du_e(k, j), du_g(k, j));
+            err = err.max((e - g).abs() / slip_max);
+            if k >= first {
+                smallest = smallest.min(e.abs()).min(g.abs());
+            }
+            let (lo, hi) = (e.abs().min(g.abs()), e.abs().max(g.abs()));
+            if lo > 1e3 * thr || hi < 1e-3 * thr {
+                se += usize::from(e.abs() <= thr);
+                sg += usize::from(g.abs() <= thr);
+            } else {
+                unclear += 1;
+            }
+        }
+        assert_eq!(se, sg, "{label}: step {k}: Γ_C nodes in stick");
+        stuck_e += se;
+        stuck_g += sg;
+    }
+    // The Gauss points of Γ_C in contact (f_n > 0), in stick (|p_t| ≤ μ_f f_n) and in slip:
+    // the engine counts them over the run, which ends inside the first contact phase. Equal
+    // counts, exactly: in GetFEM's run the points in contact are ≥ 3e-4 from the cone's edge
+    // (||p_t| − μ_f f_n|) and have f_n ≥ 1.7e-6, in units of the phase's largest ∫f_n (measured
+    // with the script), where the two runs' tractions agree to ~1e-11.
+    let sum = |x: &[f64]| x.iter().sum::<f64>() as i64;
+    let (gp_stick, gp_slip) = (sum(&gf.stick_points), sum(&gf.slip_points));
+    let (m_stick, m_slip) = (o.metrics.stick_steps, o.metrics.slip_steps);
+    eprintln!(
+        "{label}: Γ_C nodal slip Δu_t over steps 1..={end}: max |Δu_t| {slip_max:.4} in the phase, error {err:.2e} of it; smallest |Δu_t| in the phase {smallest:.2e} (threshold 1e-12·h = {thr:.1e}); node-steps in stick: engine {stuck_e}, GetFEM {stuck_g} (near the threshold, not compared: {unclear}); Gauss point-steps in stick/slip: engine {m_stick:?}/{m_slip:?}, GetFEM {gp_stick}/{gp_slip}"
+    );
+    assert!(
+        err <= 1e-8,
+        "{label}: nodal slip differs from GetFEM's by {err:.3e}"
+    );
+    assert_eq!(end, gf.force_n.len() - 1, "the phase lasts to T");
+    assert_eq!(
+        (m_stick, m_slip),
+        (Some(gp_stick), Some(gp_slip)),
+        "{label}"
+    );
 }
 
 /// SPEC §2.5: μ_f = 0 (and s = 0) give the frictionless run's numbers bit for bit with the
@@ -229,7 +306,12 @@ fn zero_friction_is_frictionless_except_the_full_vector_theta_term() {
         .iter()
         .flat_map(|sp| laws.iter().map(move |l| m(sp, l)))
         .collect();
-    let runs = outcomes_with(&root().join("t.toml"), &disc(&methods, 13.0), 0.5);
+    let runs = outcomes_with(
+        &root().join("t.toml"),
+        &disc(&methods, 13.0),
+        0.5,
+        &RunContext::default(),
+    );
     assert_eq!(runs.len(), 9);
     for group in runs.chunks(3) {
         let (l0, o0) = &group[0];

@@ -30,9 +30,9 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
+use common::getfem::{disc_sweep, floats, run_script};
 use contact_sweep::run::Outcome;
 
 fn root() -> PathBuf {
@@ -55,74 +55,32 @@ type GetfemRun = (f64, Vec<f64>, Vec<f64>);
 
 /// GetFEM's run of every variant, with the body's mass.
 fn getfem_runs() -> (f64, Vec<GetfemRun>) {
-    let install = Command::new("bash")
-        .arg(root().join("tests/install_getfem.sh"))
-        .status()
-        .expect("bash");
-    assert!(install.success(), "tests/install_getfem.sh failed");
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("getfem.json");
-    let o = Command::new("/usr/bin/python3")
-        .arg(root().join("tests/getfem/disc_mixed.py"))
-        .arg(root().join("sweeps/meshes/disc_p2.msh"))
-        .arg(&out)
-        .args(["40", "0.1", "5", &VARIANTS.join(",")])
-        .output()
-        .expect("python3");
-    assert!(
-        o.status.success(),
-        "disc_mixed.py: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
-    let list = |x: &serde_json::Value| -> Vec<f64> {
-        x.as_array()
-            .unwrap()
-            .iter()
-            .map(|y| y.as_f64().unwrap())
-            .collect()
-    };
+    let args = ["40", "0.1", "5", &VARIANTS.join(",")].map(String::from);
+    let v = run_script("disc_mixed.py", &args);
     let runs = VARIANTS
         .iter()
         .map(|m| {
             let r = &v["variants"][m];
             (
                 r["mass_total"].as_f64().unwrap(),
-                list(&r["energy"]),
-                list(&r["force"]),
+                floats(&r["energy"]),
+                floats(&r["force"]),
             )
         })
         .collect();
     (v["body_mass"].as_f64().unwrap(), runs)
 }
 
-fn engine_runs(path: &Path) -> Vec<(String, Outcome)> {
-    let text = format!(
-        r#"
-name = "getfem-disc"
-scene = "mesh2d"
-[fixed]
-mesh = "{}"
-density = 1.0
-lame_lambda = 20.0
-lame_mu = 20.0
-gravity = 0.1
-gap = 5.0
-T = 40.0
-dt = 0.1
-scheme = "crank-nicolson"
-[grid]
-method = [{}
-  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 }},
-]
-"#,
-        path.display(),
-        MASSES
-            .iter()
-            .map(|m| format!("{{ mass = \"{m}\" }},"))
-            .collect::<String>()
+fn engine_runs() -> Vec<(String, Outcome)> {
+    let methods = MASSES
+        .iter()
+        .map(|m| format!("{{ mass = \"{m}\" }},"))
+        .chain([r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 },"#.into()])
+        .collect::<String>();
+    let runs = common::outcomes_at(
+        &root().join("t.toml"),
+        &disc_sweep("getfem-disc", &methods, 40.0),
     );
-    let runs = common::outcomes_at(&root().join("t.toml"), &text);
     assert_eq!(runs.len(), VARIANTS.len());
     runs
 }
@@ -130,7 +88,7 @@ method = [{}
 #[test]
 fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
     let (body_mass, getfem) = getfem_runs();
-    let engine = engine_runs(&root().join("sweeps/meshes/disc_p2.msh"));
+    let engine = engine_runs();
     let scale = body_mass * 0.1 * 5.0;
     for ((mass, (label, o)), (gf_mass, gf_energy, gf_force)) in
         VARIANTS.iter().zip(&engine).zip(&getfem)

@@ -1,11 +1,13 @@
 //! Shared helpers of the integration tests.
 #![allow(dead_code)]
 
+pub mod getfem;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use contact_sweep::run::bar1d::Bar1dConfig;
-use contact_sweep::run::{Outcome, RunConfig, RunOptions, Status, simulate};
+use contact_sweep::run::{Outcome, RunConfig, RunContext, RunOptions, Status, simulate};
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactInit, ContactMethod, MassVariant};
 use contact_sweep::time::Scheme;
@@ -199,6 +201,17 @@ pub fn kept_energy(label: &str, o: &Outcome) -> Vec<f64> {
 /// Every run of a sweep given as text, simulated with its full time series (one row a step),
 /// with its label; `path` is where the sweep would be (mesh files are relative to it).
 pub fn outcomes_at(path: &Path, text: &str) -> Vec<(String, Outcome)> {
+    outcomes_edited(path, text, |_| {}, &RunContext::default())
+}
+
+/// [`outcomes_at`] with each planned configuration changed by `edit` first (a setting the
+/// sweep keys do not reach) and simulated in the context `ctx` (e.g. recording the solution).
+pub fn outcomes_edited(
+    path: &Path,
+    text: &str,
+    edit: impl Fn(&mut RunConfig),
+    ctx: &RunContext,
+) -> Vec<(String, Outcome)> {
     let plan = contact_sweep::sweep::expand(
         &contact_sweep::sweep::SweepFile::parse(path, text).expect("valid sweep"),
     )
@@ -207,12 +220,15 @@ pub fn outcomes_at(path: &Path, text: &str) -> Vec<(String, Outcome)> {
     plan.runs
         .iter()
         .map(|spec| {
-            let o = simulate(
-                &spec.config,
+            let mut cfg = spec.config.clone();
+            edit(&mut cfg);
+            let o = contact_sweep::run::simulate_with(
+                &cfg,
                 &RunOptions {
                     series_every: 1,
                     ..RunOptions::default()
                 },
+                ctx,
             );
             assert_eq!(o.status.as_str(), "ok", "{}: {:?}", spec.label, o.message);
             (spec.label.clone(), o)

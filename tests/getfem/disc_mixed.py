@@ -28,6 +28,9 @@ with N = −e_y the obstacle's normal, σ_n(u) = N·σ(u)N, P_γ(u) = u·N − �
 node-to-node distance), integrated by the face rule of IM_TRIANGLE(5): 3 Gauss points per face,
 as the engine's Γ_C rule. The contact force reported is ∫_ΓC (1/γ)[P_γ(u) − g]_+.
 
+The mesh, K, M, F, Γ_C, γ, the Nitsche model and the Newmark update: tests/getfem/common.py
+(shared with tests/getfem/disc_nitsche_friction.py).
+
 Usage: disc_mixed.py MESH OUT.json [T dt gap [VARIANTS]]
 """
 import json
@@ -37,31 +40,17 @@ import getfem as gf
 import numpy as np
 import scipy.linalg as sla
 
-RHO, LAM, MU, GRAV = 1.0, 20.0, 20.0, 0.1
-gf.util_trace_level(0)
+import common as c
+
 mesh_path, out_path = sys.argv[1], sys.argv[2]
 T = float(sys.argv[3]) if len(sys.argv) > 3 else 40.0
 TAU = float(sys.argv[4]) if len(sys.argv) > 4 else 0.1
 GAP = float(sys.argv[5]) if len(sys.argv) > 5 else 5.0
 STEPS = int(round(T / TAU))
 
-m = gf.Mesh('import', 'gmsh', mesh_path)
-mfu = gf.MeshFem(m, 2)
-mfu.set_classical_fem(2)
-mim = gf.MeshIm(m, gf.Integ('IM_TRIANGLE(13)'))
-n = mfu.nbdof()
-pts = m.pts()
-
-# Γ_C: the boundary faces below the centre's height (all their nodes at y ≤ y_centre).
-ymin, ymax = pts[1].min(), pts[1].max()
-ycentre = 0.5 * (ymin + ymax)
-outer = m.outer_faces()
-contact_pids = set()
-for k in range(outer.shape[1]):
-    pid = m.pid_in_faces(outer[:, k:k + 1])
-    if all(pts[1][p] <= ycentre + 1e-9 for p in pid):
-        contact_pids.update(int(p) for p in pid)
-contact_pids = sorted(contact_pids)
+disc = c.Disc(mesh_path)
+m, n, pts, K, F = disc.m, disc.n, disc.pts, disc.K, disc.F
+contact_pids = disc.contact_pids
 
 # Layers by topology over the cells' points (midside nodes included, as the engine's).
 cv_pids = [set(int(p) for p in m.pid_from_cvid(cv)[0]) for cv in range(m.nbcvs())]
@@ -80,45 +69,12 @@ while any(l is None for l in layer):
 layer = [k if l is None else l for l in layer]
 
 # The dofs of each point: the vector dof 2i + c is component c of basic dof i.
-dof_xy = mfu.basic_dof_nodes()
-
-
-def dofs_at(p):
-    x = pts[:, p]
-    return [d for d in range(n) if abs(dof_xy[0, d] - x[0]) < 1e-9 and abs(dof_xy[1, d] - x[1]) < 1e-9]
-
-
-contact_dofs = [dofs_at(p) for p in contact_pids]
+contact_dofs = [disc.dofs_at(p) for p in contact_pids]
 vertical = [sorted(ds)[1] for ds in contact_dofs]
-gaps = np.array([pts[1][p] - ymin + GAP for p in contact_pids])
+gaps = np.array([pts[1][p] - disc.ymin + GAP for p in contact_pids])
 
-mf0 = gf.MeshFem(m, 1)
-mf0.set_classical_discontinuous_fem(0)
-U0 = np.zeros(n)
-
-
-def mass(weights):
-    """ρ ∫ w φ_a·φ_b with the element weights `weights` (one per convex)."""
-    w = np.zeros(mf0.nbdof())
-    for cv in range(m.nbcvs()):
-        w[mf0.basic_dof_from_cv(cv)[0]] = weights[cv]
-    M = gf.asm('generic', mim, 2, f'{RHO}*w*(Test_u.Test2_u)', -1, 'u', 1, mfu, U0, 'w', 0, mf0, w)
-    return M.full()
-
-
-md = gf.Model('real')
-md.add_fem_variable('u', mfu)
-md.add_initialized_data('lambda', [LAM])
-md.add_initialized_data('mu', [MU])
-md.add_isotropic_linearized_elasticity_brick(mim, 'u', 'lambda', 'mu')
-md.assembly('build_matrix')
-K = md.tangent_matrix().full()
-K = 0.5 * (K + K.T)
-F = gf.asm('generic', mim, 1, f'{RHO}*[0,{-GRAV}].Test_u', -1, 'u', 1, mfu, U0)
-F = np.asarray(F).ravel()
-
-one = np.ones(m.nbcvs())
-M_full = mass(one)
+mass = disc.mass
+M_full = mass(np.ones(m.nbcvs()))
 layer_mass = lambda l: mass(np.array([1.0 if x == l else 0.0 for x in layer]))[0::2, 0::2].sum()
 total = M_full[0::2, 0::2].sum()
 m0, m1 = layer_mass(0), layer_mass(1)
@@ -159,7 +115,7 @@ def lcp(H, q, active, tol):
 
 def run(name):
     M = variant(name)
-    beta = 0.25
+    beta = c.BETA
     A = M + beta * TAU**2 * K
     cho = sla.cho_factor(A)
     B = np.zeros((len(vertical), n))
@@ -177,71 +133,36 @@ def run(name):
     force = [0.0]
     active = []
     for _ in range(STEPS):
-        p = u + TAU * v + TAU**2 * (0.5 - beta) * a
+        p = c.predictor(u, v, a, TAU)
         ufree = sla.cho_solve(cho, M @ p + beta * TAU**2 * F)
         q = B @ ufree + gaps
         lam, active = lcp(H, q, active, 1e-13 * max(1.0, np.abs(q).max()))
-        un = ufree + beta * TAU**2 * (Z @ lam)
-        an = (un - p) / (beta * TAU**2)
-        v = v + TAU * (0.5 * a + 0.5 * an)
-        u, a = un, an
-        energy.append(0.5 * v @ M @ v + 0.5 * u @ K @ u - F @ u)
+        u, v, a = c.advance(ufree + beta * TAU**2 * (Z @ lam), p, v, a, TAU)
+        energy.append(c.energy(M, K, F, u, v))
         force.append(float(lam.sum()))
     return {'mass_total': float(M[0::2, 0::2].sum()), 'energy': energy, 'force': force}
 
 
-CONTACT_REGION = 101
-faces = [outer[:, k] for k in range(outer.shape[1])
-         if all(pts[1][p] <= ycentre + 1e-9 for p in m.pid_in_faces(outer[:, k:k + 1]))]
-m.set_region(CONTACT_REGION, np.array(faces).T)
-mim_c = gf.MeshIm(m, gf.Integ('IM_TRIANGLE(5)'))
-
-
 def run_nitsche(theta=1.0, gamma0=1e-3):
     M = M_full
-    beta = 0.25
-    # γ = γ0·h_K per cell, h_K = the largest distance between two of its nodes.
-    gam = np.zeros(mf0.nbdof())
-    for cv in range(m.nbcvs()):
-        x = pts[:, m.pid_from_cvid(cv)[0]]
-        hk = max(np.hypot(*(x[:, a] - x[:, b])) for a in range(x.shape[1]) for b in range(a))
-        gam[mf0.basic_dof_from_cv(cv)[0]] = gamma0 * hk
-    plane = ymin - GAP
-    md = gf.Model('real')
-    md.add_fem_variable('u', mfu)
-    md.add_initialized_fem_data('gam', mf0, gam)
-    md.add_initialized_data('theta', [theta])
-    md.add_initialized_data('lam', [LAM])
-    md.add_initialized_data('mu', [MU])
-    md.add_initialized_data('btau2', [beta * TAU**2])
-    A = M + beta * TAU**2 * K
-    A_sp = gf.Spmat('empty', n, n)
-    A_sp.add(np.arange(n), np.arange(n), A)
-    md.add_explicit_matrix('u', 'u', A_sp)
-    rhs_brick = md.add_explicit_rhs('u', np.zeros(n))
-    sig = '(lam*Trace(Grad_{0})*Id(2) + mu*(Grad_{0} + Grad_{0}\'))'
-    sn = lambda w: f'([0,-1].({sig.format(w)}*[0,-1]))'
-    P = f'(u.[0,-1] - gam*{sn("u")} - (X(2) - ({plane!r})))'
-    expr = (f'btau2*(-theta*gam*{sn("u")}*{sn("Test_u")} '
-            f'+ (1/gam)*pos_part({P})*(Test_u.[0,-1] - theta*gam*{sn("Test_u")}))')
-    md.add_nonlinear_term(mim_c, expr, CONTACT_REGION)
-    force_expr = f'(1/gam)*pos_part({P})'
+    A = M + c.BETA * TAU**2 * K
+    md, rhs_brick = disc.nitsche_model(A, gamma0, theta, [('btau2', [c.BETA * TAU**2])])
+    plane = disc.plane(GAP)
+    md.add_nonlinear_term(disc.mim_c, f'btau2*({c.nitsche_normal_terms(plane)})',
+                          c.CONTACT_REGION)
+    force_expr = c.normal_force('u', plane)
     u = np.zeros(n)
     v = np.zeros(n)
     a = np.linalg.solve(M, F)
     energy = [0.0]
     force = [0.0]
     for _ in range(STEPS):
-        p = u + TAU * v + TAU**2 * (0.5 - beta) * a
-        md.set_private_rhs(rhs_brick, M @ p + beta * TAU**2 * F)
-        md.set_variable('u', u)
-        md.solve('max_res', 1e-10, 'max_iter', 100)
-        un = np.asarray(md.variable('u')).copy()
-        an = (un - p) / (beta * TAU**2)
-        v = v + TAU * (0.5 * a + 0.5 * an)
-        u, a = un, an
-        energy.append(0.5 * v @ M @ v + 0.5 * u @ K @ u - F @ u)
-        force.append(float(gf.asm('generic', mim_c, 0, force_expr, CONTACT_REGION, md)))
+        p = c.predictor(u, v, a, TAU)
+        un, _ = c.nitsche_solve(md, rhs_brick, M @ p + c.BETA * TAU**2 * F, u,
+                                'max_res', 1e-10, 'max_iter', 100)
+        u, v, a = c.advance(un, p, v, a, TAU)
+        energy.append(c.energy(M, K, F, u, v))
+        force.append(float(gf.asm('generic', disc.mim_c, 0, force_expr, c.CONTACT_REGION, md)))
     return {'mass_total': float(M[0::2, 0::2].sum()), 'energy': energy, 'force': force}
 
 
