@@ -113,6 +113,10 @@ def synth_series(method: dict, h: float, dt: float, steps: int, rng, with_exact:
         step=np.arange(steps + 1, dtype=np.int64), t=t, u_contact=u,
         v_contact=np.gradient(u, dt), sigma_contact=sigma, energy=energy,
     )
+    if kind == "dissipate":
+        # A frictional run's W_f^n (SPEC §2.5): here friction takes 90 % of what is lost, so
+        # E + W_f falls by a tenth of the loss (plot_energy_impacts.py --balance draws it).
+        out["friction_work"] = 0.9 * (e0 - energy)
     if method["params"]["space"] == "nitsche":
         # The Nitsche-modified energy that the analysis proves non-increasing.
         out["energy_theta"] = energy - 0.5 * h * sigma**2 / YOUNG * 1e-2

@@ -2,6 +2,7 @@
 """Energy against time of the impact methods of 003 §4.2 (Figs 11 and 12).
 
     python3 analysis/plot_energy_impacts.py DIR [DIR ...] [--out FIGDIR] [--stem NAME] [--no-theta]
+                                            [--balance] [--only COL=VALUE ...]
 
 One figure per results folder DIR (e.g. out/003_fig11 from
 sweeps/003_fig11_disc.toml): the discrete energy E^h of every run divided by
@@ -21,6 +22,14 @@ comes back after the release (--no-theta leaves E_Θ out). Curves drawn
 earlier are drawn wider, so one that coincides with a later one (Nitsche + CN
 under Nitsche-Hybrid during the contact) still shows as its outline. The first contact time of the runs (the
 earliest) is marked by a dotted vertical line.
+
+With --balance, frictional runs (series column friction_work, W_f^n, SPEC
+§2.5) also get E^h + W_f, dash-dotted in the run's colour: the energy plus the
+work friction took, which changes only by the normal contact's work (kane and
+moreau-jean θ = ½ never raise it). Runs without friction_work are drawn as
+before. --only COL=VALUE (repeatable) keeps the runs whose runs-table column
+equals VALUE (numbers compared as numbers), e.g. --only h=1 for one level of a
+refinement sweep.
 
 The file is energy_impacts_SWEEP.png (+ .pdf), or NAME.png with --stem (one
 DIR only). Per run the script prints the drift (E^N − E⁰)/scale and the
@@ -94,6 +103,24 @@ def scale_of(row: dict, energy: np.ndarray) -> tuple[float | None, str]:
     return None, ""
 
 
+def only_mask(column: pl.Series, value: str) -> pl.Series:
+    """Rows of `column` equal to `value`: as numbers for a numeric column, else as text."""
+    if column.dtype.is_numeric():
+        try:
+            x = float(value)
+        except ValueError:
+            return pl.Series([False] * column.len())
+        return (column.cast(pl.Float64) == x).fill_null(False)
+    return (column.cast(pl.String) == value).fill_null(False)
+
+
+def parse_only(text: str) -> tuple[str, str]:
+    col, sep, value = text.partition("=")
+    if not sep or not col or not value:
+        raise argparse.ArgumentTypeError(f"--only takes COL=VALUE, not {text!r}")
+    return col.strip(), value.strip()
+
+
 def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
     runs = sd.load_runs(run_dir)
     if not args.include_failed:
@@ -104,7 +131,14 @@ def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
     for c in EXTRA_RUN_COLUMNS:
         if c not in runs.columns:
             runs = runs.with_columns(pl.lit(None, dtype=pl.Float64).alias(c))
-    series = sd.load_series(run_dir, run_ids=runs["run_id"].to_list(), columns=["energy", "energy_theta"])
+    for col, value in args.only or []:
+        if col not in runs.columns:
+            print(f"{run_dir}: no column {col} in the runs table, --only {col}={value} keeps nothing")
+            runs = runs.head(0)
+            continue
+        runs = runs.filter(only_mask(runs[col], value))
+    columns = ["energy", "energy_theta"] + (["friction_work"] if args.balance else [])
+    series = sd.load_series(run_dir, run_ids=runs["run_id"].to_list(), columns=columns)
     # The join on run_id: every series row gets its run's label and scale.
     joined = series.join(runs.select(["run_id"] + [c for c in runs.columns if c not in series.columns]),
                          on="run_id", how="inner")
@@ -123,7 +157,11 @@ def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
             print(f"{run_dir}: run {rid} has no energy scale and E⁰ = 0, left out")
             continue
         et = s["energy_theta"].to_numpy().astype(float) if s["energy_theta"].null_count() < s.height else None
-        rows.append((paper_name(row), row, t, e / scale, None if et is None else et / scale, scale_name))
+        bal = None
+        if args.balance and s["friction_work"].null_count() < s.height:
+            # E^h + W_f: W_f^n is J, like the energy (0 before the first contact step).
+            bal = (e + s["friction_work"].fill_null(0.0).to_numpy().astype(float)) / scale
+        rows.append((paper_name(row), row, t, e / scale, None if et is None else et / scale, scale_name, bal))
     if not rows:
         print(f"{run_dir}: no run could be normalised, nothing to draw")
         return None
@@ -141,7 +179,7 @@ def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
     fig, (ax_all, ax_zoom) = plt.subplots(2, 1, figsize=(9, 8.5), sharex=True, layout="constrained")
     zoom_lo, zoom_hi = np.inf, -np.inf
     left_window = []
-    for i, (name, row, t, rel, rel_theta, _) in enumerate(rows):
+    for i, (name, row, t, rel, rel_theta, _, rel_bal) in enumerate(rows):
         st = sd.style(i)
         lw = max(2.6 - 0.5 * i, 1.0)
         e0 = rel[np.isfinite(rel)][0] if np.isfinite(rel).any() else 0.0
@@ -152,16 +190,27 @@ def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
         label = f"{name}: drift {drift:+.2e}, max dev {max_dev:.2e}"
         if phases is not None:
             label += f", {phases} contact phase{'s' if phases != 1 else ''}"
+        bal_text = ""
+        if rel_bal is not None:
+            bal_drift = rel_bal[-1] - e0
+            label += f"; E + W_f drift {bal_drift:+.2e}"
+            bal_text = f", E(T)+W_f−E⁰ = {bal_drift:+.3e}"
         print(f"{row.get('sweep')} {name}: E(T)−E⁰ = {drift:+.3e}, max |E−E⁰| = {max_dev:.3e} (× {scale_names[0]})"
-              + (f", contact phases {phases}" if phases is not None else ""))
+              + bal_text + (f", contact phases {phases}" if phases is not None else ""))
         for ax in (ax_all, ax_zoom):
             ax.plot(t, rel, color=st["color"], lw=lw, label=label if ax is ax_all else None)
             if rel_theta is not None and not args.no_theta:
                 ax.plot(t, rel_theta, color=st["color"], lw=max(lw - 0.8, 0.8), ls="--",
                         label=f"{name}: E_Θ" if ax is ax_all else None)
+            if rel_bal is not None:
+                ax.plot(t, rel_bal, color=st["color"], lw=max(lw - 0.8, 0.8), ls="-.",
+                        label=f"{name}: E + W_f" if ax is ax_all else None)
         if max_dev <= ZOOM_WITHIN:
             zoom_lo = min(zoom_lo, float(np.nanmin(rel)))
             zoom_hi = max(zoom_hi, float(np.nanmax(rel)))
+            if rel_bal is not None:
+                zoom_lo = min(zoom_lo, float(np.nanmin(rel_bal)))
+                zoom_hi = max(zoom_hi, float(np.nanmax(rel_bal)))
             if rel_theta is not None and not args.no_theta:
                 zoom_lo = min(zoom_lo, float(np.nanmin(rel_theta)))
                 zoom_hi = max(zoom_hi, float(np.nanmax(rel_theta)))
@@ -188,7 +237,9 @@ def draw_folder(run_dir: str, out: str, stem: str | None, args) -> str | None:
         ax.grid(True, alpha=0.3)
         ax.ticklabel_format(axis="y", useOffset=False)
     fig.suptitle(f"sweep {', '.join(sweeps)} ({', '.join(scenes)}): energy against time"
-                 + ("; dashed: E_Θ" if any(r[4] is not None for r in rows) and not args.no_theta else ""))
+                 + ("; dashed: E_Θ" if any(r[4] is not None for r in rows) and not args.no_theta else "")
+                 + ("; dash-dot: E + W_f" if any(r[6] is not None for r in rows) else "")
+                 + "".join(f"; {c} = {v}" for c, v in args.only or []))
     fig.legend(loc="outside lower center", ncols=1, fontsize="small")
     name = stem or f"energy_impacts_{sd.safe_name(sweeps[0] if len(sweeps) == 1 else os.path.basename(run_dir))}"
     return sd.save_figure(fig, out, name)
@@ -202,6 +253,10 @@ def main() -> int:
     ap.add_argument("--stem", help="file name without extension (only with one DIR)")
     ap.add_argument("--no-theta", action="store_true", help="leave out E_Θ of the Nitsche runs")
     ap.add_argument("--include-failed", action="store_true", help="also draw runs whose status is not ok")
+    ap.add_argument("--balance", action="store_true",
+                    help="also draw E + W_f (series friction_work) for the frictional runs, dash-dotted")
+    ap.add_argument("--only", action="append", type=parse_only, metavar="COL=VALUE",
+                    help="keep the runs whose runs-table column equals VALUE (repeatable), e.g. h=1")
     args = ap.parse_args()
     if args.stem and len(args.dirs) > 1:
         ap.error("--stem names one figure: give one DIR")

@@ -16,4 +16,8 @@ py="${PYTHON:-python3}"
 "$py" "$here/plot_work_precision.py" "$work/synthetic" --out "$work/figures"
 "$py" "$here/plot_work_precision.py" "$work/synthetic" --out "$work/figures" --error err_sigma_l2
 "$py" "$here/plot_energy_impacts.py" "$work/synthetic" --out "$work/figures"
+# E + W_f of the frictional synthetic runs, one sweep (--only), in a folder of its own (a
+# second call into figures/ would replace the first one's manifest entry).
+"$py" "$here/plot_energy_impacts.py" "$work/synthetic" --out "$work/figures_balance" --balance --only sweep=refine
+"$py" "$here/check_figures.py" "$work/figures_balance"
 "$py" "$here/check_figures.py" "$work/figures"
