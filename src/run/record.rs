@@ -151,7 +151,7 @@ schema! {
         repeats: i64 => "", "timing repeats (results are identical across repeats)";
         steps: i64 => "", "time steps completed";
         dofs: i64 => "", "unknowns of the space discretisation";
-        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step; two with contact-stabilized-newmark; the Newton iterations of discrete-gradient)";
+        iterations: i64 => "", "contact solves (1D: one exact branch enumeration per step; two with contact-stabilized-newmark; the Newton iterations of discrete-gradient); 2D/3D: the contact solver's iterations summed over the steps (LCP pivots, or the semismooth Newton's iterations with friction and with Nitsche/penalty)";
         factorizations: i64 => "", "matrix factorisations performed (0 with solver = cg, which factors nothing)";
         solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
         contact_switches: i64 => "", "times the contact pressure switched on or off";
@@ -191,7 +191,7 @@ schema! {
         impact_energy_theta_after: Option<Vec<Option<f64>>> => "J", "per phase: E_Θ at the step after the phase (Nitsche; else null)";
         energy_theta_initial: Option<f64> => "J", "E_Θ⁰, the augmented energy of the initial state (Nitsche; the unit of the impacts' E_Θ losses)";
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
-        iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed) or semismooth Newton iterations (Nitsche) (2D/3D)";
+        iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed), semismooth Newton iterations (mixed with friction: the Alart–Curnier Newton; Nitsche, penalty) (2D/3D)";
         max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
         right_end: Option<String> => "", "bar1d's end x = L: clamped (SPEC §1.1) or free (the flying bar, SPEC §1.4)";
         velocity: Option<f64> => "m/s", "uniform initial velocity v0 (bar1d, oscillator; negative towards the obstacle)";
