@@ -434,9 +434,12 @@ fn rho_one_equals_crank_nicolson(label: &str, runs: &[(String, Outcome)], tol: f
 /// solution, O(τ²) and not round-off.
 const RHO_ONE_TOL: f64 = 1e-7;
 
+/// [`ALPHA_SPACES`] and Nitsche's skew-symmetric Θ = −1 (its step matrix has +Σ w γ σ σᵀ).
 fn cn_and_rho_one(law: &str) -> String {
+    let skew = r#"space = "nitsche", nitsche_theta = -1.0, nitsche_gamma0 = 0.001"#;
     ALPHA_SPACES
         .iter()
+        .chain([&skew])
         .flat_map(|sp| {
             [
                 format!("{{ {sp}, scheme = \"crank-nicolson\"{law} }},\n"),
@@ -467,7 +470,7 @@ method = [
             cn_and_rho_one(law)
         );
         let runs = common::outcomes(&text);
-        assert_eq!(runs.len(), 6);
+        assert_eq!(runs.len(), 8);
         rho_one_equals_crank_nicolson("bar2d", &runs, RHO_ONE_TOL);
     }
 }
@@ -480,7 +483,7 @@ fn generalized_alpha_rho_one_is_crank_nicolson_on_the_thrown_disc() {
         &disc_with("", &cn_and_rho_one(law), 13.0),
         0.5,
     );
-    assert_eq!(runs.len(), 6);
+    assert_eq!(runs.len(), 8);
     rho_one_equals_crank_nicolson("disc", &runs, RHO_ONE_TOL);
 }
 
