@@ -342,7 +342,8 @@ method = [
 /// vectors; kane (Coulomb, the LU kept while the node states repeat), Moreau–Jean (Tresca,
 /// the active mask), generalized-α (f_tⁿ in the right-hand side), kinematic central
 /// difference's local projection — bar2d (d = 2) and bar3d (the disc's linearised
-/// projection).
+/// projection); and generalized-α/HHT with Nitsche (Θ = 0, 1) and the penalty, whose
+/// frictional Newton and state (fe_nitsche) are made at setup.
 #[test]
 fn frictional_comparison_methods_allocate_nothing() {
     for (scene, h) in [("bar2d", 0.05), ("bar3d", 0.1)] {
@@ -362,6 +363,9 @@ method = [
   {{ mass = "consistent", scheme = "moreau-jean", friction = "tresca", tresca_threshold = 0.02 }},
   {{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
   {{ mass = "lumped", scheme = "central-difference", dt = 0.002, friction = "coulomb", friction_coefficient = 0.05 }},
+  {{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1, friction = "coulomb", friction_coefficient = 0.3 }},
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "generalized-alpha", rho_inf = 0.5, friction = "tresca", tresca_threshold = 0.02 }},
+  {{ space = "penalty", penalty_gamma0 = 100.0, scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
 ]
 "#
             ),

@@ -304,11 +304,6 @@ const CASES: &[(&str, &str, &str)] = &[
         "discrete-gradient has no frictional version in the literature (SPEC §2.5)",
     ),
     (
-        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 4.0\ndt = 0.1\nspace = \"nitsche\"\nscheme = \"generalized-alpha\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.2\n",
-        "fixed.scheme",
-        "with space = nitsche and scheme = generalized-alpha is not implemented yet (issue 33)",
-    ),
-    (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"paoli-schatzman\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
         "fixed.scheme",
         "paoli-schatzman has no frictional version in the literature (SPEC §2.5)",

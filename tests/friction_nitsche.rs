@@ -17,7 +17,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::getfem::{disc_mesh, disc_sweep, floats, run_script};
+use common::getfem::{disc_mesh, disc_sweep_with, floats, run_script};
 use contact_sweep::run::{Outcome, RunConfig, RunContext};
 use contact_sweep::space::fe::GmshMesh;
 
@@ -37,7 +37,12 @@ fn outcomes_with(path: &Path, text: &str, vt: f64, ctx: &RunContext) -> Vec<(Str
 }
 
 fn disc(methods: &str, t_final: f64) -> String {
-    disc_sweep("disc-friction", methods, t_final)
+    disc_with(r#"scheme = "crank-nicolson""#, methods, t_final)
+}
+
+/// [`disc`] with the fixed line `scheme` (empty: each method sets its scheme).
+fn disc_with(scheme: &str, methods: &str, t_final: f64) -> String {
+    disc_sweep_with("disc-friction", scheme, methods, t_final)
 }
 
 /// GetFEM's run of the disc thrown obliquely (tests/getfem/disc_nitsche_friction.py): per
@@ -396,6 +401,356 @@ method = [
             assert!(
                 m.friction_ratio_max.unwrap() <= 0.3 * (1.0 + 1e-12),
                 "{label}"
+            );
+        }
+    }
+}
+
+/// The frictional Nitsche/penalty spaces of the generalized-α tests: Θ = 0, Θ = 1 (GetFEM's
+/// γ0 = 1e-3) and the penalty.
+const ALPHA_SPACES: [&str; 3] = [
+    r#"space = "nitsche", nitsche_theta = 0.0, nitsche_gamma0 = 0.001"#,
+    r#"space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001"#,
+    r#"space = "penalty", penalty_gamma0 = 100.0"#,
+];
+
+/// SPEC §2.5 with generalized-α/HHT (issue 33): μ_f = 0 and s = 0 give the frictionless rows
+/// bit for bit with the penalty and with Nitsche at Θ = 0 (the frictionless engine solves them,
+/// `fe::frictional`), on the disc thrown obliquely through its first impact.
+#[test]
+fn zero_friction_is_frictionless_with_generalized_alpha() {
+    let laws = [
+        "",
+        r#", friction = "coulomb", friction_coefficient = 0.0"#,
+        r#", friction = "tresca", tresca_threshold = 0.0"#,
+    ];
+    let mut methods = String::new();
+    for space in [ALPHA_SPACES[0], ALPHA_SPACES[2]] {
+        for scheme in [
+            r#"scheme = "hht", hht_alpha = 0.1"#,
+            r#"scheme = "generalized-alpha", rho_inf = 0.5"#,
+        ] {
+            for law in laws {
+                methods += &format!("{{ {space}, {scheme}{law} }},");
+            }
+        }
+    }
+    let runs = outcomes_with(&root().join("t.toml"), &disc_with("", &methods, 13.0), 0.5);
+    assert_eq!(runs.len(), 12);
+    for group in runs.chunks(3) {
+        let (l0, o0) = &group[0];
+        assert!(
+            o0.metrics.first_contact_time.is_some(),
+            "{l0}: the disc lands"
+        );
+        for (l, o) in &group[1..] {
+            assert_eq!(o.series.energy, o0.series.energy, "{l} against {l0}");
+            assert_eq!(o.series.sigma_contact, o0.series.sigma_contact, "{l}");
+            assert_eq!(o.series.u_contact, o0.series.u_contact, "{l}");
+        }
+    }
+}
+
+/// Generalized-α with ρ∞ = 1 (α_m = α_f = ½, β = ¼, γ = ½) is Crank–Nicolson with friction too
+/// (fe_methods header): the same step matrix M + τ²/4 K_Θ with its tangential Θ rows, the same
+/// right-hand side while the equation at tⁿ holds (it does at t = 0, and ½ of the equations at
+/// tⁿ and t^{n+1} is the step's, so by induction at every step), the same frictional Newton with
+/// c = τ²/4 and slip reference u_tⁿ, and f̄_t = ½(f_tⁿ + f_t^{n+1}) is CN's W_f weight. The runs
+/// differ only by the arithmetic of the right-hand sides (M ũ − κ_m M aⁿ − κ_f K_Θ uⁿ + κ_f f_cⁿ
+/// against M pⁿ), then amplified through the contact phases.
+fn rho_one_equals_crank_nicolson(label: &str, runs: &[(String, Outcome)], tol: f64) {
+    for pair in runs.chunks(2) {
+        let ((lc, cn), (la, al)) = (&pair[0], &pair[1]);
+        assert!(
+            lc.contains("crank-nicolson") && la.contains("ρ∞"),
+            "{lc} / {la}"
+        );
+        let scale = cn.metrics.energy_scale.unwrap();
+        let max_diff = |a: &[f64], b: &[f64]| -> f64 {
+            assert_eq!(a.len(), b.len());
+            a.iter()
+                .zip(b)
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        };
+        let col = |o: &Outcome, f: fn(&contact_sweep::run::SeriesRow) -> Option<f64>| -> Vec<f64> {
+            o.series.rows().map(|r| f(&r).unwrap_or(0.0)).collect()
+        };
+        let fmax = cn
+            .series
+            .sigma_contact
+            .iter()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        let e = max_diff(&cn.series.energy, &al.series.energy) / scale;
+        let f = max_diff(&cn.series.sigma_contact, &al.series.sigma_contact) / fmax;
+        let ft = max_diff(
+            &col(cn, |r| r.sigma_t_contact),
+            &col(al, |r| r.sigma_t_contact),
+        ) / fmax;
+        let w = max_diff(&col(cn, |r| r.friction_work), &col(al, |r| r.friction_work)) / scale;
+        let wf = cn.metrics.friction_work.unwrap();
+        eprintln!(
+            "{label} {la} against {lc}: energy {e:.2e}, f_n {f:.2e}, f_t {ft:.2e}, W_f {w:.2e} (W_f {wf:.3e}; slip {:?}/{:?}, stick {:?}/{:?})",
+            cn.metrics.slip_steps,
+            al.metrics.slip_steps,
+            cn.metrics.stick_steps,
+            al.metrics.stick_steps
+        );
+        // CN's W_f can be negative (f̄ = ½(fⁿ + f^{n+1}), SPEC §2.5), not zero: friction acts.
+        assert!(wf != 0.0, "{lc}: friction works");
+        for (what, d) in [("energy", e), ("f_n", f), ("f_t", ft), ("W_f", w)] {
+            assert!(d <= tol, "{label} {la}: {what} differs from CN by {d:.3e}");
+        }
+        assert_eq!(cn.metrics.slip_steps, al.metrics.slip_steps, "{la}");
+        assert_eq!(cn.metrics.stick_steps, al.metrics.stick_steps, "{la}");
+    }
+}
+
+/// The ρ∞ = 1 runs' distance from CN (energies and W_f over energy_scale, forces over the
+/// largest normal force). Measured: bar2d (Coulomb 0.3, Tresca 0.01) ≤ 8.1e-10 (energy,
+/// Nitsche Θ = 0 with Tresca), the disc ≤ 3.5e-9 (the penalty's f_n; Nitsche ≤ 1.2e-11); W_f
+/// ≤ 2e-11 everywhere, and the same stick/slip point-steps. Rounding of the two right-hand
+/// sides (1e-16 of M u, whose increments are far smaller) is amplified through ~50–300
+/// contact point-steps of a stiff constraint (the penalty κ = E·100/h, Nitsche's 1/γ); 1e-7
+/// leaves a factor 30 over the worst, while any difference in the scheme (f̄_t's weight, the
+/// history term κ_f f_cⁿ, the tangential Θ rows of K_Θ) is a change of the discrete
+/// solution, O(τ²) and not round-off.
+const RHO_ONE_TOL: f64 = 1e-7;
+
+/// [`ALPHA_SPACES`] and Nitsche's skew-symmetric Θ = −1 (its step matrix has +Σ w γ σ σᵀ).
+fn cn_and_rho_one(law: &str) -> String {
+    let skew = r#"space = "nitsche", nitsche_theta = -1.0, nitsche_gamma0 = 0.001"#;
+    ALPHA_SPACES
+        .iter()
+        .chain([&skew])
+        .flat_map(|sp| {
+            [
+                format!("{{ {sp}, scheme = \"crank-nicolson\"{law} }},\n"),
+                format!("{{ {sp}, scheme = \"generalized-alpha\", rho_inf = 1.0{law} }},\n"),
+            ]
+        })
+        .collect()
+}
+
+#[test]
+fn generalized_alpha_rho_one_is_crank_nicolson_with_friction_on_bar2d() {
+    for law in [
+        r#", friction = "coulomb", friction_coefficient = 0.3"#,
+        r#", friction = "tresca", tresca_threshold = 0.01"#,
+    ] {
+        let text = format!(
+            r#"
+name = "bars-friction-cn"
+scene = "bar2d"
+[fixed]
+T = 1.5
+h = 0.05
+dt = 0.0125
+[grid]
+method = [
+{}]
+"#,
+            cn_and_rho_one(law)
+        );
+        let runs = common::outcomes(&text);
+        assert_eq!(runs.len(), 8);
+        rho_one_equals_crank_nicolson("bar2d", &runs, RHO_ONE_TOL);
+    }
+}
+
+#[test]
+fn generalized_alpha_rho_one_is_crank_nicolson_on_the_thrown_disc() {
+    let law = r#", friction = "coulomb", friction_coefficient = 0.3"#;
+    let runs = outcomes_with(
+        &root().join("t.toml"),
+        &disc_with("", &cn_and_rho_one(law), 13.0),
+        0.5,
+    );
+    assert_eq!(runs.len(), 8);
+    rho_one_equals_crank_nicolson("disc", &runs, RHO_ONE_TOL);
+}
+
+/// The allowance on a step's own tangential work −Σ f_t^{n+1}·Δu_t ≥ 0, relative to the run's
+/// |W_f|: the tangential rows are solved to their round-off floor, which at stick on bar2d is
+/// ~1e-7 of the traction (x_n = P_γ ≈ g quantises the penetration, fe_nitsche's
+/// `NEWTON_FLOOR_TOL`). Measured: −2.7e-10 energy scales against |W_f| = 2.3e-3 (ρ∞ = 0.5,
+/// Θ = 0) and −1.9e-9 against 4.5e-2 (CN, Θ = 1): ≤ 1.2e-7 of |W_f|; 1e-6 leaves a factor 8.
+/// The penalty's and backward Euler's minima are 0 exactly (measured).
+const OWN_WORK_ALLOWANCE: f64 = 1e-6;
+
+/// SPEC §2.5 with generalized-α/HHT and Nitsche/penalty (issue 33): on bar2d dropped with
+/// v⁰ = −½ e_d (Γ_C slides outwards on impact, [`friction_does_nonnegative_work_on_the_bars`])
+/// each step's own tangential work −Σ f_t^{n+1}·Δu_t is ≥ 0 (the law's sign; for Nitsche
+/// summed over Γ_C), to [`OWN_WORK_ALLOWANCE`], |f_t| ≤ μ_f f_n, and the
+/// rows are ok — ρ∞ = 0.5 with Nitsche Θ = 0 failed at step 65 before the frictional Newton
+/// left the kinks it stalled on (fe_nitsche). W_f itself is not monotone here: its increment
+/// −Σ f̄_t·Δu_t weighs f_tⁿ by α_f, and where the traction turns within a step the mix has the
+/// other sign (measured: HHT Θ = 0 loses 9.2e-6 of its final W_f 9.8e-5 in one step; ρ∞ = 0.5
+/// Θ = 1 ends at W_f = −9.5e-4). Backward Euler (f̄ = f^{n+1}) has it monotone, above.
+#[test]
+fn friction_does_nonnegative_work_with_generalized_alpha() {
+    let mut methods = String::new();
+    for sp in ALPHA_SPACES {
+        for scheme in [
+            r#"scheme = "hht", hht_alpha = 0.1"#,
+            r#"scheme = "generalized-alpha", rho_inf = 0.5"#,
+        ] {
+            methods += &format!(
+                "{{ {sp}, {scheme}, friction = \"coulomb\", friction_coefficient = 0.3 }},\n"
+            );
+        }
+    }
+    let text = format!(
+        r#"
+name = "bars-friction-alpha"
+scene = "bar2d"
+[fixed]
+T = 1.5
+h = 0.05
+dt = 0.0125
+[grid]
+method = [
+{methods}]
+"#
+    );
+    let runs = common::outcomes(&text);
+    assert_eq!(runs.len(), 6);
+    for (label, o) in &runs {
+        let m = &o.metrics;
+        let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
+        let ft_max = o
+            .series
+            .rows()
+            .filter_map(|r| r.sigma_t_contact)
+            .fold(0.0f64, |a, f| a.max(f.abs()));
+        let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
+        eprintln!(
+            "{label}: W_f {:?}, smallest W_f step {min_inc:.3e}, own work min {:?}, max |Σf_t| {ft_max:.3e}, stick {:?} slip {:?} ratio {:?} balance drift {:?} max rise {:?}",
+            m.friction_work,
+            m.tangential_work_min,
+            m.stick_steps,
+            m.slip_steps,
+            m.friction_ratio_max,
+            m.energy_balance_drift,
+            m.energy_balance_max_increase
+        );
+        assert_eq!(
+            w.len(),
+            o.series.energy.len() - 1,
+            "{label}: W_f every step"
+        );
+        assert!(
+            ft_max > 0.0 && *w.last().unwrap() != 0.0,
+            "{label}: friction acts"
+        );
+        assert!(
+            m.tangential_work_min.unwrap() >= -OWN_WORK_ALLOWANCE * m.friction_work.unwrap().abs(),
+            "{label}: a step's own tangential work {:?}",
+            m.tangential_work_min
+        );
+        assert!(
+            m.stick_steps.unwrap() > 0 && m.slip_steps.unwrap() > 0,
+            "{label}"
+        );
+        assert!(
+            m.friction_ratio_max.unwrap() <= 0.3 * (1.0 + 1e-12),
+            "{label}"
+        );
+        assert!(m.energy_balance_drift.unwrap().is_finite(), "{label}");
+        assert!(m.tangential_velocity_final.is_some(), "{label}");
+    }
+}
+
+/// Regression (fe_nitsche's frictional Newton, `NEWTON_FLOOR_TOL`): bar2d, Crank–Nicolson,
+/// Nitsche Θ = 0 and 1 (γ0 = 1e-3), Coulomb 0.3 failed at step 32 (the impact) with "did not
+/// converge in 100 iterations (residuals 3.6e-16 normal, 1.7e-11 tangential)": every point
+/// stuck, x_n = P_γ ≈ g = 0.2 with a penetration of 1.8e-8, so one ulp of x_n moves a
+/// tangential row (∂G_t/∂x_n ∝ k = 1/(γτ)) by ~1e-11 — above the tolerance 1e-12·0.16, and the
+/// damped Newton's steps of 1e-17 could not lower it. Now accepted at that floor: the runs
+/// end ok, and the accepted forces are those of the undamped solve to the floor (the GetFEM
+/// comparison above, 1e-11, runs the same Newton).
+#[test]
+fn bar2d_stick_newton_stalls_at_its_floor() {
+    let text = r#"
+name = "bars-friction-floor"
+scene = "bar2d"
+[fixed]
+T = 1.5
+h = 0.05
+dt = 0.0125
+scheme = "crank-nicolson"
+friction = "coulomb"
+friction_coefficient = 0.3
+[grid]
+method = [
+  { space = "nitsche", nitsche_theta = 0.0, nitsche_gamma0 = 0.001 },
+  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001 },
+]
+"#;
+    for (label, o) in common::outcomes(text) {
+        let m = &o.metrics;
+        eprintln!(
+            "{label}: steps {}, Newton max {:?}, stick {:?} slip {:?}, own work min {:?}",
+            m.steps, m.iterations_max_step, m.stick_steps, m.slip_steps, m.tangential_work_min
+        );
+        assert_eq!(m.steps, 120, "{label}");
+        assert!(m.iterations_max_step.unwrap() < 100, "{label}");
+        assert!(m.stick_steps.unwrap() > 0, "{label}");
+        assert!(
+            m.tangential_work_min.unwrap() >= -OWN_WORK_ALLOWANCE * m.friction_work.unwrap().abs(),
+            "{label}"
+        );
+    }
+}
+
+/// Regression (fe_nitsche's frictional Newton, the full step where no halving descends):
+/// bar2d with the penalty (γ0 = 100) and Tresca failed at step 34 (backward Euler, s = 0.05:
+/// "residuals 3.7e-3 normal, 4.4e-1 tangential") and at step 32 (Crank–Nicolson, s = 0.02,
+/// 0.05, 0.1; Coulomb 0.3 too). At step 34 every point sat just below its gap (x_n = g − 3e-10,
+/// Λ = 0) while x0 penetrates by 3.7e-3: the inactive Jacobian's step activates the stiff
+/// penalty and raises the merit for every step length, so the damped Newton stayed on the kink
+/// until the iteration cap. Now every run ends ok; with backward Euler (f̄ = f^{n+1}) W_f never
+/// decreases, and no step's own tangential work is negative.
+#[test]
+fn bar2d_penalty_tresca_newton_leaves_the_gap_kink() {
+    let text = r#"
+name = "bars-penalty-tresca"
+scene = "bar2d"
+[fixed]
+T = 1.5
+h = 0.05
+dt = 0.0125
+space = "penalty"
+penalty_gamma0 = 100.0
+friction = "tresca"
+[grid]
+method = [
+  { scheme = "backward-euler" },
+  { scheme = "crank-nicolson" },
+  { scheme = "hht", hht_alpha = 0.1 },
+]
+tresca_threshold = [0.02, 0.05, 0.1]
+"#;
+    let runs = common::outcomes(text);
+    assert_eq!(runs.len(), 9);
+    for (label, o) in &runs {
+        let m = &o.metrics;
+        let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
+        let last = *w.last().unwrap();
+        let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
+        eprintln!(
+            "{label}: Newton max {:?}, W_f {last:.4e}, smallest W_f step {min_inc:.3e}, own work min {:?}, stick {:?} slip {:?}",
+            m.iterations_max_step, m.tangential_work_min, m.stick_steps, m.slip_steps
+        );
+        assert_eq!(m.steps, 120, "{label}");
+        assert!(
+            m.slip_steps.unwrap() > 0 && last != 0.0,
+            "{label}: friction acts"
+        );
+        assert!(m.tangential_work_min.unwrap() >= -1e-12, "{label}");
+        if label.contains("backward-euler") {
+            assert!(
+                last > 0.0 && min_inc >= -1e-12 * last,
+                "{label}: {min_inc:.3e}"
             );
         }
     }

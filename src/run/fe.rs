@@ -1645,15 +1645,16 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         return methods::simulate(cfg, opts, ctx);
     }
     // Friction is solved by Nitsche and the penalty with the Newmark family and θ-schemes
-    // (fe_nitsche header), by the mixed method in [`Stepper`] and in the §3.2 methods' loops.
+    // (fe_nitsche header) and with generalized-α/HHT (fe_methods header, the same frictional
+    // Newton), by the mixed method in [`Stepper`] and in the §3.2 methods' loops.
     let nitsche_solved = cfg.method != ContactMethod::Mixed
-        && matches!(cfg.scheme, Scheme::Newmark(_) | Scheme::Theta(_))
-        && !methods::handles(cfg);
+        && (matches!(cfg.scheme, Scheme::Newmark(_) | Scheme::Theta(_)) && !methods::handles(cfg)
+            || matches!(cfg.scheme, Scheme::GeneralizedAlpha(_)));
     if frictional(cfg) && !mixed_stepper(cfg) && !nitsche_solved {
         return Outcome {
             status: Status::Invalid,
             message: Some(format!(
-                "friction = {} with space = {} and scheme = {} is not implemented yet (issue 33)",
+                "friction = {} with space = {} and scheme = {} has no frictional version (SPEC §2.5)",
                 cfg.friction.kind().name(),
                 cfg.method.name(),
                 cfg.scheme.label()

@@ -48,7 +48,17 @@
 //! Generalized-α with Nitsche/penalty (disc/ball): the linear part K_Θ (Nitsche's Θ-term) sits in
 //! A as for the engine's Newmark steps, the contact force is f_c(u) = Σ_q φ_q(p_q·u) C_q with
 //! f_cⁿ = f_c(uⁿ) (the previous step's Newton values) and f_c^{n+1} solved by the engine's
-//! semismooth Newton with coefficient c ([`super::fe_nitsche`]).
+//! semismooth Newton with coefficient c ([`super::fe_nitsche`]). With friction (SPEC §2.5,
+//! issue 33) the same with the engine's frictional operators and Newton: K_Θ in A holds the
+//! tangential Θ rows −Θ Σ w γ σ_t σ_tᵀ too (the history term −κ_f K_Θ uⁿ and M u^{n+1} =
+//! A u^{n+1} − cK_Θ u^{n+1} use them), f_c(u) = Σ_j λ_j C_j over the d unknowns per point
+//! (C's tangential columns u_t − Θγσ_t), f_cⁿ the previous step's λ (normal and tangential),
+//! and f_c^{n+1} from [`super::fe_nitsche`]'s frictional Newton with coefficient c, its x0 =
+//! P y + k u_tⁿ (the slip (u_t^{n+1} − u_tⁿ)/τ, position level) and its state (u_tⁿ, the
+//! tally). W_f uses f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ, the weight of f_t^{n+1} in the
+//! equation at t^{n+1−α_f}. With ρ∞ = 1 (α_m = α_f = ½) this is the frictional
+//! Crank–Nicolson of the engine: the same matrix, the same right-hand side while the equation
+//! at tⁿ holds, c = τ²/4 and f̄_t = ½(f_tⁿ + f_t^{n+1}) (tests/friction_nitsche.rs: ≤ 3.5e-9).
 //!
 //! The energy E^h = ½vᵀMv + ½uᵀKu − Fᵀu needs Mv and Ku (the schemes whose equation does not
 //! hold at t^{n+1} cannot use Newmark's identity uᵀKu = uᵀ(F + Bᵀλ − Ma)); they are the next
@@ -108,14 +118,16 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, frictional, geometry_key, gravity_load,
-    lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
+    build_geometry, factor, factor_failure, factor_key_friction, factor_key_gap, frictional,
+    geometry_key, gravity_load, lowest_contact, mass_matrix, ref_map, reference_record,
+    tangential_dofs,
 };
 use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
 use crate::contact::{FrictionalContact, Lcp};
 use crate::run::fe_nitsche::{
-    NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
+    FrictionState, NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
+    newton_friction,
 };
 use crate::run::friction_tally::FrictionTally;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
@@ -800,7 +812,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
             // With friction the factor carries the tangential columns (the engine's factor
-            // makes them for a frictional mixed run): not the frictionless entry.
+            // makes them for a frictional run): not the frictionless entry; Nitsche's and the
+            // penalty's tangential rows hold τ itself (k_q = 1/(γ_q τ)), not only c.
             let key = format!(
                 "{}|{:?}|{:?}|{:e}",
                 geometry_key(&cfg.setup),
@@ -808,7 +821,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                 cfg.method,
                 c
             ) + &factor_key_gap(g, cfg)
-                + if frictional(cfg) { "|friction" } else { "" };
+                + if frictional(cfg) { "|friction" } else { "" }
+                + &factor_key_friction(cfg);
             let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
@@ -870,7 +884,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
 
     let n = g.dofs.n_free();
     let nit = fac.as_ref().and_then(|f| f.nitsche.as_ref());
-    let nc = nit.map_or(g.contact.len(), NitscheOps::len);
+    // Contact unknowns: the Γ_C nodes (mixed) or the points' values (d per point with
+    // friction).
+    let nc = nit.map_or(g.contact.len(), NitscheOps::unknowns);
     metrics.contact_dofs = Some(nc as i64);
     let base_gap = if g.gap_in_geometry {
         0.0
@@ -912,12 +928,39 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
         .as_ref()
         .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
     let mut grad_work = GradientWork::new(nit.map_or(0, NitscheOps::len));
-    let mut newton_work = NewtonWork::new(nit.map_or(0, NitscheOps::len));
+    let mut newton_work = match nit {
+        Some(o) if o.friction.is_some() => NewtonWork::frictional(nc, o.per_point()),
+        _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
+    };
     let mut work: Option<StepWork> = fac.as_ref().map(|f| f.chol.work());
     let diag = m.diagonal();
     // Friction (module header): f̄_t's weight of f_t^{n+1} is generalized-α's 1 − α_f, the
     // other methods' force of the step itself.
-    let mut fric = if frictional(cfg) {
+    // Friction with Nitsche/penalty (generalized-α/HHT only; module header): the engine's
+    // frictional state, f̄_t's weight of f_t^{n+1} 1 − α_f, passed per step.
+    let mut nit_fric = match (nit, meth) {
+        (Some(o), Method::Alpha(_)) if o.friction.is_some() => {
+            // M 1_t for the mean tangential velocity (setup only).
+            let mut ones = vec![0.0; n];
+            g.tangential.iter().for_each(|&r| ones[r] = 1.0);
+            let mut m1 = vec![0.0; n];
+            m.matvec_into(&ones, &mut m1);
+            Some(FrictionState::new(o, cfg.friction, &g.tangential, &m1))
+        }
+        (Some(o), _) if o.friction.is_some() => {
+            return fail(
+                Status::Invalid,
+                format!(
+                    "scheme {} has no frictional version with space = {} (SPEC §2.5)",
+                    cfg.scheme.label(),
+                    cfg.method.name()
+                ),
+                metrics,
+            );
+        }
+        _ => None,
+    };
+    let mut fric = if frictional(cfg) && nit.is_none() {
         let weight_new = match meth {
             Method::Alpha(p) => 1.0 - p.alpha_f,
             _ => 1.0,
@@ -1090,13 +1133,19 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let mut newton_max = 0usize;
     let mut observe_timer = SampledTimer::default();
     let t2 = tau * tau;
+    // E of the last observed step (the frictional Nitsche/penalty run's E + W_f balance).
+    let mut e_last = 0.0;
     let stop = (|| -> Result<(), Stop<String>> {
         g.k.matvec_into(&u, &mut ku);
         g.k.matvec_into(&v, &mut kv);
         if let Some(ops) = nit {
             // The state's own contact force at t = 0 (zero unless the body starts in contact).
             let (_, _, f) = ops.energy_terms_and_force(&u);
-            observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err, None).map_err(Stop::Diverged)?;
+            e_last = observe(0, &u, &v, &mv, &ku, f, &mut tmp, &mut err, None)
+                .map_err(Stop::Diverged)?;
+            if let Some(st) = nit_fric.as_mut() {
+                st.start(&mv);
+            }
         } else {
             let fv = fric.as_ref().map(|fr| fr.series(&v));
             let e = observe(0, &u, &v, &mv, &ku, 0.0, &mut tmp, &mut err, fv)
@@ -1271,12 +1320,28 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            for (k, qk) in q.iter_mut().enumerate() {
-                                *qk = ops.apply(&ops.p, k, &y);
-                            }
-                            let it =
+                            let it = if let Some(st) = nit_fric.as_mut() {
+                                // Friction (fe_nitsche header, coefficient c): x0 = P y +
+                                // k u_tⁿ (the slip from uⁿ), λ the previous step's forces
+                                // (the warm start), kept for f̄_t.
+                                st.start_step(ops, &y, &u, &lambda, &mut q);
+                                newton_friction(
+                                    ops,
+                                    st.law,
+                                    &f.h,
+                                    c,
+                                    &q,
+                                    &mut lambda,
+                                    &mut st.slides,
+                                    &mut newton_work,
+                                )
+                            } else {
+                                for (k, qk) in q.iter_mut().enumerate() {
+                                    *qk = ops.apply(&ops.p, k, &y);
+                                }
                                 newton(ops, &f.h, c, &q, &ops.gap, &mut lambda, &mut newton_work)
-                                    .map_err(|e| Stop::Solver(step, e))?;
+                            }
+                            .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
                             add_columns(&f.z, &lambda, c, &mut y);
@@ -1300,7 +1365,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                 ma[i] = man;
                                 mu[i] = sd[i];
                             }
-                            lambda.iter().sum::<f64>()
+                            // The normal forces (d per point with friction).
+                            lambda.iter().step_by(ops.per_point()).sum::<f64>()
                         }
                         Method::Alpha(ga) => {
                             let (km, kf) = ga.history_coefficients(tau);
@@ -1494,7 +1560,13 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             if let Some(fr) = fric.as_mut() {
                 fr.end(&u);
             }
-            let fv = fric.as_ref().map(|fr| fr.series(&v));
+            let mut fv = fric.as_ref().map(|fr| fr.series(&v));
+            if let (Some(st), Some(ops), Method::Alpha(ga)) = (nit_fric.as_mut(), nit, meth) {
+                // W_f with generalized-α's f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ (SPEC §2.5).
+                let t = step as f64 * tau;
+                let (ft, vt, wf) = st.after_step(ops, &u, &mv, &lambda, 1.0 - ga.alpha_f, t, tau);
+                fv = Some([ft, vt, wf]);
+            }
             let e = observe_timer
                 .time(step, || {
                     observe(step, &u, &v, &mv, &ku, force, &mut tmp, &mut err, fv)
@@ -1503,6 +1575,10 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             if let Some(fr) = fric.as_mut() {
                 fr.observed(step, tau, e, &mv);
             }
+            if let Some(st) = nit_fric.as_mut() {
+                st.balance(e_last, e);
+            }
+            e_last = e;
             done = step;
             opts.step_stop(step, CLOCK_EVERY, start)?;
         }
@@ -1528,6 +1604,12 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     metrics.energy_scale = energy_scale.or(metrics.energy_initial);
     if let (Some(fr), Some(scale)) = (&fric, metrics.energy_scale) {
         fr.report(&mut metrics, &mv, scale);
+    }
+    if let Some(st) = &nit_fric {
+        // As the engine's frictional Nitsche/penalty runs ([`super::Stepper`]).
+        let e0 = metrics.energy_initial.unwrap_or(0.0);
+        let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
+        st.finish(&mut metrics, scale, e0, done);
     }
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),
@@ -1563,32 +1645,34 @@ fn add_rows(contact: &[usize], mu: &[f64], s: f64, y: &mut [f64]) {
     }
 }
 
-/// y += s Θ Σ_q w_q γ_q (s_q·x) s_q: the Nitsche Θ-term of −K_Θ x = −Kx + Θ Σ w γ s (s·x),
-/// scaled by s (nothing for the penalty, Θ = 0).
+/// y += s Θ Σ_q w_q γ_q Σ_r (σ_r,q·x) σ_r,q: the Nitsche Θ-term of −K_Θ x = −Kx + Θ Σ w γ
+/// s (s·x) (with friction also the σ_t rows' −Θ∫γ σ_t(u)·σ_t(v), as the step matrix,
+/// [`NitscheOps::sigma_row`]), scaled by s (nothing for the penalty, Θ = 0).
 fn add_theta_term(ops: &NitscheOps, x: &[f64], s: f64, y: &mut [f64]) {
     if ops.theta == 0.0 {
         return;
     }
     for k in 0..ops.len() {
-        let f = s * ops.theta * ops.w[k] * ops.gamma[k] * ops.apply(&ops.s, k, x);
-        for (&gd, &sk) in ops.dofs[k * ops.k..(k + 1) * ops.k]
-            .iter()
-            .zip(&ops.s[k * ops.k..(k + 1) * ops.k])
-        {
-            y[gd] += f * sk;
+        let dofs = &ops.dofs[k * ops.k..(k + 1) * ops.k];
+        for r in 0..ops.per_point() {
+            let row = ops.sigma_row(k, r);
+            let sx: f64 = row.iter().zip(dofs).map(|(a, &g)| a * x[g]).sum();
+            let f = s * ops.theta * ops.w[k] * ops.gamma[k] * sx;
+            for (&gd, &sk) in dofs.iter().zip(row) {
+                y[gd] += f * sk;
+            }
         }
     }
 }
 
-/// y += s Σ_q φ_q C_q: the Nitsche/penalty contact force of the point values φ (C_q = −t_q,
-/// the upward direction of point q on its element's dofs).
+/// y += s Σ_j φ_j C_j: the Nitsche/penalty contact force of the unknowns' values φ (point
+/// forces, d per point with friction) along their columns of C (C_q = −t_q, the upward
+/// direction of point q; with friction also u_t − Θγσ_t, [`NitscheOps::c_row`]).
 fn add_point_columns(ops: &NitscheOps, phi: &[f64], s: f64, y: &mut [f64]) {
-    for (k, p) in phi.iter().enumerate() {
+    for (j, p) in phi.iter().enumerate() {
         if *p != 0.0 {
-            for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
-                .iter()
-                .zip(&ops.c[k * ops.k..(k + 1) * ops.k])
-            {
+            let (row, dofs) = ops.c_row(j);
+            for (&gd, &ck) in dofs.iter().zip(row) {
                 y[gd] += s * p * ck;
             }
         }

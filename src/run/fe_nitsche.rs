@@ -49,6 +49,15 @@ use crate::space::fe::nitsche::ContactPoint;
 /// Semismooth Newton: relative tolerance and iteration cap (SPEC §4).
 pub(crate) const NEWTON_TOL: f64 = 1e-12;
 pub(crate) const NEWTON_MAX_ITER: usize = 100;
+/// The frictional Newton's acceptance at its round-off floor ([`newton_friction`]): where
+/// the line search finds no descent, residuals within 1e-8 of their scales are the floor.
+/// x_n = P_γ holds the gap (|x_n| ≈ g) while the penetration is orders smaller, and a
+/// tangential row's ∂G_t/∂x_n = −cτ² W_tn w/γ carries k = 1/(γτ) from P_t: on bar2d (CN,
+/// Nitsche γ0 = 1e-3, x_n ≈ 0.2, penetration 1.8e-8, all points stuck) one ulp of x_n moves
+/// G_t by ~1e-11, measured 1.7e-11 against the tolerance 1e-12·0.16; the Newton steps were
+/// 1e-17 and the run failed at the iteration cap (`bar2d_stick_newton_stalls_at_its_floor`).
+/// 1e-8 leaves a factor ~100 over that floor and still bounds the forces' relative error.
+pub(crate) const NEWTON_FLOOR_TOL: f64 = 1e-8;
 
 /// The contact rows of one run (γ0 and Θ applied), flat over the points.
 #[derive(Debug)]
@@ -209,6 +218,19 @@ impl NitscheOps {
             (None, _) => unreachable!("one unknown per point without friction"),
         };
         (row, dofs)
+    }
+
+    /// Point q's stress row r: σ_n (r = 0) or, with friction, σ_t along direction r − 1 — the
+    /// rows of the step matrix's Θ-term −Θ Σ w γ (s sᵀ + σ_t σ_tᵀ) (the engine's `factor_nitsche`).
+    pub fn sigma_row(&self, q: usize, r: usize) -> &[f64] {
+        match (&self.friction, r) {
+            (_, 0) => self.row(&self.s, q),
+            (Some(f), r) => {
+                let i = q * f.td + r - 1;
+                &f.st[i * self.k..(i + 1) * self.k]
+            }
+            (None, _) => unreachable!("one stress row per point without friction"),
+        }
     }
 
     fn row<'a, T>(&self, v: &'a [T], q: usize) -> &'a [T] {
@@ -435,7 +457,9 @@ fn evaluate(
 /// derivative in P_t, so a step that flips the sign is not seen coming, and the next flips it
 /// back (measured on the disc thrown obliquely: a 2-cycle from the second contact step). So
 /// each step is damped by backtracking on the merit Σ (G/scale)² (halving up to 30 times):
-/// a shorter step lands in the stick band |P_t| ≤ r, whose Jacobian is exact.
+/// a shorter step lands in the stick band |P_t| ≤ r, whose Jacobian is exact. Where no
+/// halving descends, the iterate is at the round-off floor (accepted within
+/// [`NEWTON_FLOOR_TOL`]) or on a kink of Λ, which the full step leaves.
 /// Returns the iteration count. Allocates nothing.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn newton_friction(
@@ -521,6 +545,7 @@ pub(crate) fn newton_friction(
         }
         work.x_old[..nu].copy_from_slice(&work.s[..nu]);
         let mut alpha = 1.0;
+        let mut descended = false;
         for _ in 0..30 {
             for j in 0..nu {
                 work.s[j] = work.x_old[j] + alpha * work.step[j];
@@ -529,9 +554,29 @@ pub(crate) fn newton_friction(
             (res_n, res_t, scale_t) = (r.0, r.1, r.2);
             if r.3 < merit {
                 merit = r.3;
+                descended = true;
                 break;
             }
             alpha *= 0.5;
+        }
+        // No step along the Newton direction lowers the merit, down to 2⁻²⁹ of it. Either the
+        // residual is at its round-off floor Σ_a |∂G_j/∂x_a| ulp(x_a), which the tolerance
+        // above can miss ([`NEWTON_FLOOR_TOL`]): accepted there. Or the iterate sits on a kink
+        // of Λ whose one-sided Jacobian is not the other side's: measured on bar2d (penalty,
+        // Tresca s = 0.05, backward Euler, step 34) every point just below its gap
+        // (x_n = g − 3e-10, Λ = 0) while x0 penetrates by 3.7e-3; the inactive Jacobian's step
+        // activates the stiff penalty and raises the merit for every α, so the damped Newton
+        // stayed on the kink to the iteration cap. The full step leaves the kink: the next
+        // Jacobian is the active side's (`bar2d_penalty_tresca_newton_leaves_the_gap_kink`).
+        if !descended {
+            if res_n <= NEWTON_FLOOR_TOL * sc.n && res_t <= NEWTON_FLOOR_TOL * scale_t {
+                return Ok(it + 1);
+            }
+            for j in 0..nu {
+                work.s[j] = work.x_old[j] + work.step[j];
+            }
+            let r = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
+            (res_n, res_t, scale_t, merit) = r;
         }
     }
     Err(format!(
@@ -715,8 +760,8 @@ impl FrictionState {
     }
 
     /// After step n's update (u = u^{n+1}, `mv` = M v^{n+1}): W_f −= Σ f̄_t·Δu_t with f̄ =
-    /// (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ; λ_t includes the
-    /// point's weight), the step's tangential work, stick/slip and |f_t|/f_n of the points in
+    /// (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ, generalized-α's
+    /// 1 − α_f; λ_t includes the point's weight), the step's tangential work, stick/slip and |f_t|/f_n of the points in
     /// contact, the mean tangential velocity and its first zero. Returns (Σ λ_t along e_1 —
     /// the total tangential force on the body —, the mean tangential velocity, W_f).
     #[allow(clippy::too_many_arguments)]
@@ -812,6 +857,11 @@ impl FrictionState {
         m.stick_steps = Some(self.stick_steps);
         m.slip_steps = Some(self.slip_steps);
         m.friction_ratio_max = self.ratio_max;
+        m.tangential_work_min = Some(if steps > 0 {
+            self.tangential_work_min / scale
+        } else {
+            0.0
+        });
         m.tangential_velocity_final = Some(self.vt);
         m.stop_time = self.stop_time;
     }

@@ -453,24 +453,6 @@ fn resolve(
                 return Outcome::Inapplicable(why);
             }
         }
-        // What the FE engine solves: every mixed method, Nitsche and the penalty with the
-        // Newmark family and θ. Their generalized-α step with friction is not built: refused
-        // here, before anything runs, rather than left to an invalid row.
-        if scene.fe_dim().is_some()
-            && matches!(scheme, Scheme::GeneralizedAlpha(_))
-            && matches!(space_name.as_str(), "nitsche" | "penalty")
-        {
-            let why = format!(
-                "friction = {} with space = {space_name} and scheme = {} is not implemented yet (issue 33): on the FE scenes Nitsche and the penalty take friction with the newmark and theta families; generalized-alpha and hht take it with space = mixed",
-                friction_kind.name(),
-                scheme.family()
-            );
-            if friction_fixed {
-                issues.push(Issue::at(&origin(Key::Scheme), why));
-            } else {
-                return Outcome::Inapplicable(why);
-            }
-        }
     }
 
     // Applicability (SPEC §3): which keys this run uses.

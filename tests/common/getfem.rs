@@ -20,6 +20,11 @@ pub fn disc_mesh() -> PathBuf {
 /// the scripts' setting) to `t_final` over the grid's `methods` (TOML inline tables, each
 /// followed by a comma).
 pub fn disc_sweep(name: &str, methods: &str, t_final: f64) -> String {
+    disc_sweep_with(name, r#"scheme = "crank-nicolson""#, methods, t_final)
+}
+
+/// [`disc_sweep`] with the fixed line `scheme` (empty: each method sets its scheme).
+pub fn disc_sweep_with(name: &str, scheme: &str, methods: &str, t_final: f64) -> String {
     format!(
         r#"
 name = "{name}"
@@ -33,7 +38,7 @@ gravity = 0.1
 gap = 5.0
 T = {t_final}
 dt = 0.1
-scheme = "crank-nicolson"
+{scheme}
 [grid]
 method = [{methods}]
 "#,
