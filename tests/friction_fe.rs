@@ -344,7 +344,7 @@ fn largest_difference(bar: &[RunRecord], mesh: &[RunRecord]) -> (f64, String) {
 /// consistent mass, Coulomb μ_f = 0.3 — the same columns to the same bound as
 /// `gmsh_bar_reproduces_bar2d_with_friction` (the numberings' round-off carried through the
 /// impacts). Nitsche and the penalty integrate on the same faces with the same rule, whatever
-/// the numbering.
+/// the numbering. Measured: at most 1.5e-12 (Nitsche Θ = 1's energy_drift, relative to E⁰).
 #[test]
 fn gmsh_bar_reproduces_bar2d_with_friction_for_every_method() {
     let body = r#"

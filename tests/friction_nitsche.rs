@@ -435,7 +435,12 @@ fn zero_friction_is_frictionless_with_generalized_alpha() {
             }
         }
     }
-    let runs = outcomes_with(&root().join("t.toml"), &disc_with("", &methods, 13.0), 0.5);
+    let runs = outcomes_with(
+        &root().join("t.toml"),
+        &disc_with("", &methods, 13.0),
+        0.5,
+        &RunContext::default(),
+    );
     assert_eq!(runs.len(), 12);
     for group in runs.chunks(3) {
         let (l0, o0) = &group[0];
@@ -564,6 +569,7 @@ fn generalized_alpha_rho_one_is_crank_nicolson_on_the_thrown_disc() {
         &root().join("t.toml"),
         &disc_with("", &cn_and_rho_one(law), 13.0),
         0.5,
+        &RunContext::default(),
     );
     assert_eq!(runs.len(), 8);
     rho_one_equals_crank_nicolson("disc", &runs, RHO_ONE_TOL);

@@ -544,6 +544,23 @@ pub(crate) fn newton_friction(
             work.step[ji] = work.delta[i];
         }
         work.x_old[..nu].copy_from_slice(&work.s[..nu]);
+        // A Newton step of round-off size (≤ 1e-13 of the iterate) is the floor too, even
+        // where the merit still falls by noise: the iterate cannot move in floating point, and
+        // with J nonsingular |G| ≤ ‖J‖·|step| is round-off. The tangential residual is judged
+        // against the normal scale there: its floor comes from x_n's last bits (module
+        // constant's note), not from the tangential forces, which may be orders smaller.
+        // Measured on bar2d (Nitsche Θ = 1, γ0 = 0.01, Coulomb 0.3, CN, t = 0.4): steps of
+        // 1e-17 at |x| = 0.2 and tangential residuals 8e-13 … 1.6e-12 against a tangential
+        // scale of 5e-5, for 100 iterations whose line searches kept "descending"
+        // (`gmsh_bar_reproduces_bar2d_with_friction_for_every_method`).
+        let step_size = work.step[..nu].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let size = work.x_old[..nu].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if step_size <= 1e-13 * size
+            && res_n <= NEWTON_FLOOR_TOL * sc.n
+            && res_t <= NEWTON_FLOOR_TOL * sc.n.max(scale_t)
+        {
+            return Ok(it + 1);
+        }
         let mut alpha = 1.0;
         let mut descended = false;
         for _ in 0..30 {
