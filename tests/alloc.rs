@@ -162,26 +162,45 @@ method = [
     );
 }
 
-/// The FE engine on bar2d: the modified mass with Crank–Nicolson, the consistent mass with
-/// backward Euler.
+/// The finite-element sweeps' text: `name`, `scene`, the [fixed] lines (T = T_FINAL first) and
+/// the grid's `method` list.
+fn fe_sweep(name: &str, scene: &str, fixed: &str, methods: &[&str]) -> String {
+    let methods: String = methods.iter().map(|m| format!("  {m},\n")).collect();
+    format!(
+        "name = \"{name}\"\nscene = \"{scene}\"\n[fixed]\nT = T_FINAL\n{fixed}\n[grid]\nmethod = [\n{methods}]\n"
+    )
+}
+
+/// The bars' set-up (bar2d: 3 × 21 nodes; bar3d: a 3 × 3 × 21-node box whose contact face has 9
+/// nodes, so the contact problem has several unknowns and switches).
+const BAR: &str = "h = 0.1\ndt = 0.01";
+/// The disc under gravity (Q1, h = 8): inactive before the impact at t ≈ 2, then in contact
+/// for good — one switch is all the short run can show.
+const DISC: &str = "h = 8.0\ndt = 0.1\ngap = 0.05\ndegree = 1";
+
+/// The FE engine on bar2d and bar3d: the modified masses with Crank–Nicolson and backward
+/// Euler, the consistent mass with both.
 #[test]
-fn bar2d_time_loop_allocates_nothing() {
-    assert_loop_allocates_nothing(
-        r#"
-name = "alloc-fe"
-scene = "bar2d"
-[fixed]
-T = T_FINAL
-h = 0.1
-dt = 0.01
-[grid]
-method = [
-  { mass = "mod3", scheme = "crank-nicolson" },
-  { mass = "consistent", scheme = "backward-euler" },
-]
-"#,
-        1.0,
-    );
+fn fe_time_loops_allocate_nothing() {
+    for (scene, methods) in [
+        (
+            "bar2d",
+            &[
+                r#"{ mass = "mod3", scheme = "crank-nicolson" }"#,
+                r#"{ mass = "consistent", scheme = "backward-euler" }"#,
+            ][..],
+        ),
+        (
+            "bar3d",
+            &[
+                r#"{ mass = "mod3", scheme = "crank-nicolson" }"#,
+                r#"{ mass = "consistent", scheme = "crank-nicolson" }"#,
+                r#"{ mass = "mod1", scheme = "backward-euler" }"#,
+            ][..],
+        ),
+    ] {
+        assert_loop_allocates_nothing(&fe_sweep("alloc-fe", scene, BAR, methods), 1.0);
+    }
 }
 
 /// Friction on the FE scenes (SPEC §2.5, issue 33): mixed + Crank–Nicolson and backward Euler
@@ -190,50 +209,14 @@ method = [
 /// allocated.
 #[test]
 fn fe_frictional_time_loops_allocate_nothing() {
-    for (scene, h) in [("bar2d", "0.05"), ("bar3d", "0.1")] {
-        assert_loop_allocates_nothing(
-            &format!(
-                r#"
-name = "alloc-fe-friction"
-scene = "{scene}"
-[fixed]
-T = T_FINAL
-h = {h}
-dt = 0.01
-[grid]
-method = [
-  {{ mass = "consistent", scheme = "crank-nicolson", friction = "coulomb", friction_coefficient = 0.05 }},
-  {{ mass = "mod3", scheme = "backward-euler", friction = "coulomb", friction_coefficient = 0.3 }},
-  {{ mass = "consistent", scheme = "crank-nicolson", friction = "tresca", tresca_threshold = 0.05 }},
-]
-"#
-            ),
-            1.0,
-        );
+    for (scene, fixed) in [("bar2d", "h = 0.05\ndt = 0.01"), ("bar3d", BAR)] {
+        let methods = [
+            r#"{ mass = "consistent", scheme = "crank-nicolson", friction = "coulomb", friction_coefficient = 0.05 }"#,
+            r#"{ mass = "mod3", scheme = "backward-euler", friction = "coulomb", friction_coefficient = 0.3 }"#,
+            r#"{ mass = "consistent", scheme = "crank-nicolson", friction = "tresca", tresca_threshold = 0.05 }"#,
+        ];
+        assert_loop_allocates_nothing(&fe_sweep("alloc-fe-friction", scene, fixed, &methods), 1.0);
     }
-}
-
-/// The FE engine on bar3d (a 3 × 3 × 21-node box at h = 0.1: the contact face has 9 nodes, so
-/// the LCP has several unknowns and switches), both masses and both schemes.
-#[test]
-fn bar3d_time_loop_allocates_nothing() {
-    assert_loop_allocates_nothing(
-        r#"
-name = "alloc-3d"
-scene = "bar3d"
-[fixed]
-T = T_FINAL
-h = 0.1
-dt = 0.01
-[grid]
-method = [
-  { mass = "mod3", scheme = "crank-nicolson" },
-  { mass = "consistent", scheme = "crank-nicolson" },
-  { mass = "mod1", scheme = "backward-euler" },
-]
-"#,
-        1.0,
-    );
 }
 
 /// `solver = "cg"` (issue 24): the step solves by conjugate gradient, warm-started from the
@@ -241,72 +224,36 @@ method = [
 /// with Nitsche's Newton (its step matrix with the Θ-term).
 #[test]
 fn cg_time_loops_allocate_nothing() {
-    assert_loop_allocates_nothing(
-        r#"
-name = "alloc-cg-3d"
-scene = "bar3d"
-[fixed]
-T = T_FINAL
-h = 0.1
-dt = 0.01
-solver = "cg"
-[grid]
-method = [
-  { mass = "mod3", scheme = "crank-nicolson" },
-  { mass = "consistent", scheme = "backward-euler" },
-]
-"#,
-        1.0,
-    );
+    let bar = [
+        r#"{ mass = "mod3", scheme = "crank-nicolson" }"#,
+        r#"{ mass = "consistent", scheme = "backward-euler" }"#,
+    ];
+    let fixed = format!("{BAR}\nsolver = \"cg\"");
+    assert_loop_allocates_nothing(&fe_sweep("alloc-cg-3d", "bar3d", &fixed, &bar), 1.0);
+    let disc = [
+        r#"{ space = "mixed", scheme = "crank-nicolson" }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" }"#,
+    ];
+    let fixed = format!("{DISC}\nsolver = \"cg\"");
     assert_loop_allocates_nothing_with(
-        r#"
-name = "alloc-cg-disc"
-scene = "disc2d"
-[fixed]
-T = T_FINAL
-h = 8.0
-dt = 0.1
-gap = 0.05
-degree = 1
-solver = "cg"
-[grid]
-method = [
-  { space = "mixed", scheme = "crank-nicolson" },
-  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" },
-]
-"#,
+        &fe_sweep("alloc-cg-disc", "disc2d", &fixed, &disc),
         15.0,
         1,
     );
 }
 
 /// The FE engine on the disc under gravity (issue 8): mixed + CN (chatters; also with the
-/// zero-contact mass), Nitsche + CN, Nitsche + hybrid and penalty + hybrid (semismooth Newton, inactive before the impact at t ≈ 2, active after —
-/// the disc then stays in contact, so one switch is all the short run can show).
+/// zero-contact mass), Nitsche + CN, Nitsche + hybrid and penalty + hybrid (semismooth Newton).
 #[test]
 fn disc2d_time_loops_allocate_nothing() {
-    assert_loop_allocates_nothing_with(
-        r#"
-name = "alloc-disc"
-scene = "disc2d"
-[fixed]
-T = T_FINAL
-h = 8.0
-dt = 0.1
-gap = 0.05
-degree = 1
-[grid]
-method = [
-  { space = "mixed", scheme = "crank-nicolson" },
-  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "crank-nicolson" },
-  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" },
-  { space = "penalty", penalty_gamma0 = 20.0, scheme = "hybrid" },
-  { space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" },
-]
-"#,
-        15.0,
-        1,
-    );
+    let methods = [
+        r#"{ space = "mixed", scheme = "crank-nicolson" }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "crank-nicolson" }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hybrid" }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 20.0, scheme = "hybrid" }"#,
+        r#"{ space = "mixed", mass = "zero-contact", scheme = "crank-nicolson" }"#,
+    ];
+    assert_loop_allocates_nothing_with(&fe_sweep("alloc-disc", "disc2d", DISC, &methods), 15.0, 1);
 }
 
 /// The FE engine's SPEC §3.2 methods (run::fe's methods module) on bar2d: kane with the
@@ -314,27 +261,16 @@ method = [
 /// at setup), generalized-α/hht, Moreau–Jean's masked LCP, kinematic central difference.
 #[test]
 fn bar2d_comparison_methods_allocate_nothing() {
-    assert_loop_allocates_nothing(
-        r#"
-name = "alloc-fe-methods"
-scene = "bar2d"
-[fixed]
-T = T_FINAL
-h = 0.1
-dt = 0.01
-[grid]
-method = [
-  { mass = "consistent", scheme = "kane" },
-  { mass = "mod3", scheme = "kane" },
-  { mass = "consistent", scheme = "contact-stabilized-newmark" },
-  { mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5 },
-  { mass = "consistent", scheme = "hht", hht_alpha = 0.1 },
-  { mass = "consistent", scheme = "moreau-jean", restitution = 0.5 },
-  { mass = "lumped", scheme = "central-difference", dt = 0.002 },
-]
-"#,
-        1.0,
-    );
+    let methods = [
+        r#"{ mass = "consistent", scheme = "kane" }"#,
+        r#"{ mass = "mod3", scheme = "kane" }"#,
+        r#"{ mass = "consistent", scheme = "contact-stabilized-newmark" }"#,
+        r#"{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5 }"#,
+        r#"{ mass = "consistent", scheme = "hht", hht_alpha = 0.1 }"#,
+        r#"{ mass = "consistent", scheme = "moreau-jean", restitution = 0.5 }"#,
+        r#"{ mass = "lumped", scheme = "central-difference", dt = 0.002 }"#,
+    ];
+    assert_loop_allocates_nothing(&fe_sweep("alloc-fe-methods", "bar2d", BAR, &methods), 1.0);
 }
 
 /// Friction in the same methods (issue 33): the frictional condensation and the solver's
@@ -346,57 +282,33 @@ method = [
 /// frictional Newton and state (fe_nitsche) are made at setup.
 #[test]
 fn frictional_comparison_methods_allocate_nothing() {
-    for (scene, h) in [("bar2d", 0.05), ("bar3d", 0.1)] {
-        assert_loop_allocates_nothing(
-            &format!(
-                r#"
-name = "alloc-fe-friction"
-scene = "{scene}"
-[fixed]
-T = T_FINAL
-h = {h}
-dt = 0.01
-[grid]
-method = [
-  {{ mass = "consistent", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
-  {{ mass = "mod3", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }},
-  {{ mass = "consistent", scheme = "moreau-jean", friction = "tresca", tresca_threshold = 0.02 }},
-  {{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
-  {{ mass = "lumped", scheme = "central-difference", dt = 0.002, friction = "coulomb", friction_coefficient = 0.05 }},
-  {{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1, friction = "coulomb", friction_coefficient = 0.3 }},
-  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "generalized-alpha", rho_inf = 0.5, friction = "tresca", tresca_threshold = 0.02 }},
-  {{ space = "penalty", penalty_gamma0 = 100.0, scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }},
-]
-"#
-            ),
-            1.0,
-        );
+    let methods = [
+        r#"{ mass = "consistent", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }"#,
+        r#"{ mass = "mod3", scheme = "kane", friction = "coulomb", friction_coefficient = 0.05 }"#,
+        r#"{ mass = "consistent", scheme = "moreau-jean", friction = "tresca", tresca_threshold = 0.02 }"#,
+        r#"{ mass = "lumped", scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }"#,
+        r#"{ mass = "lumped", scheme = "central-difference", dt = 0.002, friction = "coulomb", friction_coefficient = 0.05 }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1, friction = "coulomb", friction_coefficient = 0.3 }"#,
+        r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "generalized-alpha", rho_inf = 0.5, friction = "tresca", tresca_threshold = 0.02 }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 100.0, scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 0.05 }"#,
+    ];
+    for (scene, fixed) in [("bar2d", "h = 0.05\ndt = 0.01"), ("bar3d", BAR)] {
+        assert_loop_allocates_nothing(&fe_sweep("alloc-fe-friction", scene, fixed, &methods), 1.0);
     }
 }
 
 /// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and
-/// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried):
-/// inactive before the impact, active after.
+/// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried).
 #[test]
 fn disc2d_comparison_methods_allocate_nothing() {
+    let methods = [
+        r#"{ space = "penalty", penalty_gamma0 = 20.0, scheme = "discrete-gradient" }"#,
+        r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "discrete-gradient" }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1 }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 20.0, scheme = "generalized-alpha", rho_inf = 0.5 }"#,
+    ];
     assert_loop_allocates_nothing_with(
-        r#"
-name = "alloc-disc-dg"
-scene = "disc2d"
-[fixed]
-T = T_FINAL
-h = 8.0
-dt = 0.1
-gap = 0.05
-degree = 1
-[grid]
-method = [
-  { space = "penalty", penalty_gamma0 = 20.0, scheme = "discrete-gradient" },
-  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "discrete-gradient" },
-  { space = "nitsche", nitsche_gamma0 = 0.001, scheme = "hht", hht_alpha = 0.1 },
-  { space = "penalty", penalty_gamma0 = 20.0, scheme = "generalized-alpha", rho_inf = 0.5 },
-]
-"#,
+        &fe_sweep("alloc-disc-dg", "disc2d", DISC, &methods),
         15.0,
         1,
     );
