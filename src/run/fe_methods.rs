@@ -1150,29 +1150,21 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            let it = if let Some(fr) = fric.as_mut() {
-                                // Slip = TΔu: q_t = Ty.
-                                fr.set_free(
-                                    &y,
-                                    |_| 0.0,
-                                    |j| u[g.contact[j]] + y[g.contact[j]] + gaps[j],
-                                );
-                                let it = fr
-                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
-                                    .map_err(|e| Stop::Solver(step, e))?;
-                                fr.take_forces(0.5);
-                                it
-                            } else {
-                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                    *qi = u[ci] + y[ci] + gi;
-                                }
-                                let it = lcp
-                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                                add_columns(&f.z, &lambda, c, &mut y);
-                                add_rows(&g.contact, &lambda, c, &mut sd);
-                                it
-                            };
+                            // Slip = TΔu: q_t = Ty.
+                            let it = implicit_contact_correction(
+                                fric.as_mut(),
+                                &mut lcp,
+                                f,
+                                &g.contact,
+                                &gaps,
+                                &u,
+                                |_| 0.0,
+                                c,
+                                (&mut q, &mut lambda),
+                                &mut y,
+                                &mut sd,
+                            )
+                            .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
                             // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
@@ -1216,29 +1208,21 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            let it2 = if let Some(fr) = fric.as_mut() {
-                                // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
-                                fr.set_free(
-                                    &y,
-                                    |r| pred[r] - u[r],
-                                    |j| pred[g.contact[j]] + y[g.contact[j]] + gaps[j],
-                                );
-                                let it = fr
-                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
-                                    .map_err(|e| Stop::Solver(step, e))?;
-                                fr.take_forces(0.5);
-                                it
-                            } else {
-                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                    *qi = pred[ci] + y[ci] + gi;
-                                }
-                                let it2 = lcp
-                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                                add_columns(&f.z, &lambda, c, &mut y);
-                                add_rows(&g.contact, &lambda, c, &mut sd);
-                                it2
-                            };
+                            // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
+                            let it2 = implicit_contact_correction(
+                                fric.as_mut(),
+                                &mut lcp,
+                                f,
+                                &g.contact,
+                                &gaps,
+                                &pred,
+                                |r| pred[r] - u[r],
+                                c,
+                                (&mut q, &mut lambda),
+                                &mut y,
+                                &mut sd,
+                            )
+                            .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it + it2);
                             iterations += it2 as i64;
                             g.k.matvec_into(&y, &mut kd);
@@ -1543,6 +1527,45 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
 }
 
 /// y += s Σ_j μ_j Z_j over the columns with μ_j ≠ 0 (Z column-major, n rows).
+/// The contact correction `kane` and `contact-stabilized-newmark` share (one step matrix
+/// S = M + cK, c = τ²/4): `y` = S⁻¹b is the contact-free increment from `base` (uⁿ for
+/// `kane`, u^pred for CSN) and `sd` = b. Frictional: the condensed Coulomb/Tresca problem
+/// with gaps base + y + g and slips off + Ty (off = 0, or u^pred − uⁿ), its forces taken as
+/// the scheme's (μ = 2λ: ½); frictionless: the LCP on the same gaps, Z's columns added to `y`
+/// and the contact rows to `sd` with weight c. `q`, `lambda`: the LCP's gaps and the normal
+/// multipliers (warm start in, solution out). Returns the Newton steps.
+#[allow(clippy::too_many_arguments)]
+fn implicit_contact_correction(
+    fric: Option<&mut Friction>,
+    lcp: &mut Lcp,
+    f: &Factored,
+    contact: &[usize],
+    gaps: &[f64],
+    base: &[f64],
+    off: impl Fn(usize) -> f64,
+    c: f64,
+    (q, lambda): (&mut [f64], &mut [f64]),
+    y: &mut [f64],
+    sd: &mut [f64],
+) -> Result<usize, String> {
+    if let Some(fr) = fric {
+        fr.set_free(y, off, |j| base[contact[j]] + y[contact[j]] + gaps[j]);
+        let it = fr.solve(c, false, y, sd, lambda)?;
+        fr.take_forces(0.5);
+        Ok(it)
+    } else {
+        for ((qi, &ci), gi) in q.iter_mut().zip(contact).zip(gaps) {
+            *qi = base[ci] + y[ci] + gi;
+        }
+        let it = lcp
+            .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
+            .map_err(|e| e.to_string())?;
+        add_columns(&f.z, lambda, c, y);
+        add_rows(contact, lambda, c, sd);
+        Ok(it)
+    }
+}
+
 fn add_columns(z: &[f64], mu: &[f64], s: f64, y: &mut [f64]) {
     let n = y.len();
     for (j, &l) in mu.iter().enumerate() {
