@@ -108,7 +108,7 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_gap, frictional, geometry_key, gravity_load,
+    build_geometry, factor, factor_failure, factor_key, frictional, geometry_key, gravity_load,
     lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
 };
 use crate::contact::friction::FrictionLaw;
@@ -799,23 +799,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let c = step_coefficient(meth, tau);
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
-            // With friction the factor carries the tangential columns (the engine's factor
-            // makes them for a frictional mixed run): not the frictionless entry.
-            let key = format!(
-                "{}|{:?}|{:?}|{:e}",
-                geometry_key(&cfg.setup),
-                cfg.mass,
-                cfg.method,
-                c
-            ) + &factor_key_gap(g, cfg)
-                + if frictional(cfg) { "|friction" } else { "" };
-            let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
+            // The engine's key: with friction the factor carries the tangential columns (not
+            // the frictionless entry), and the solver is part of it (a `cg` entry holds A
+            // itself, not its factor: a direct and a cg run must not share it).
+            let (fac, hit) = FACTORS.get(factor_key(g, cfg, c), || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
                 Err(e) => return fail(factor_failure(&e), e, metrics),
             };
-            metrics.factorizations = i64::from(!hit);
-            metrics.factor_cache_hits = Some(i64::from(hit));
+            // CG factors nothing (the engine's bookkeeping): no factorisation made, none reused.
+            let factored = fac.chol.is_factored();
+            metrics.factorizations = i64::from(!hit && factored);
+            metrics.factor_cache_hits = factored.then_some(i64::from(hit));
             metrics.mass_total = Some(fac.mass_total);
             (Some(fac), None)
         }
