@@ -940,8 +940,10 @@ mod tests {
 
     /// Small 2D problems against the enumeration of every case: where the problem has a
     /// solution the solver finds one of them (to 1e-10: both stop at round-off on O(1)
-    /// data), where it has none (Tresca's bound vanishes when a node opens, so with coupled
-    /// rows a tangential force may open its own node) the solver reports an error.
+    /// data). Where it has none (Tresca's bound vanishes when a node opens, so with coupled
+    /// rows a tangential force may open its own node) the solver may return its closure's
+    /// grazing solution (module header; the enumeration lists the literal law's cases only):
+    /// then the closure's law holds.
     #[test]
     fn small_problems_agree_with_enumeration() {
         let mut rng = Rng(0xdead_beef_cafe_f00d);
@@ -966,7 +968,9 @@ mod tests {
             let r = FrictionalContact::new(m, 2, w.clone())
                 .solve(&law, &weights, &q_n, &q_t, None, &mut f, 100, 1e-12);
             if all.is_empty() {
-                assert!(r.is_err(), "{k}: {f:?} where none exists");
+                if r.is_ok() {
+                    check_law(&w, 2, &law, &weights, &q_n, &q_t, &f, 1e-10);
+                }
                 none += 1;
             } else {
                 r.unwrap_or_else(|e| panic!("{k} ({law:?}, {} solutions): {e}", all.len()));
