@@ -118,9 +118,8 @@ use std::time::Instant;
 
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
-    build_geometry, factor, factor_failure, factor_key_friction, factor_key_gap, frictional,
-    geometry_key, gravity_load, lowest_contact, mass_matrix, ref_map, reference_record,
-    tangential_dofs,
+    build_geometry, factor, factor_failure, factor_key, frictional, geometry_key, gravity_load,
+    lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
 };
 use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -811,25 +810,18 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     let c = step_coefficient(meth, tau);
     let (fac, own_mass): (Option<Arc<Factored>>, Option<SymMatrix>) = match c {
         Some(c) => {
-            // With friction the factor carries the tangential columns (the engine's factor
-            // makes them for a frictional run): not the frictionless entry; Nitsche's and the
-            // penalty's tangential rows hold τ itself (k_q = 1/(γ_q τ)), not only c.
-            let key = format!(
-                "{}|{:?}|{:?}|{:e}",
-                geometry_key(&cfg.setup),
-                cfg.mass,
-                cfg.method,
-                c
-            ) + &factor_key_gap(g, cfg)
-                + if frictional(cfg) { "|friction" } else { "" }
-                + &factor_key_friction(cfg);
-            let (fac, hit) = FACTORS.get(key, || factor(g, cfg, c));
+            // The engine's key: with friction the factor carries the tangential columns (not
+            // the frictionless entry), and the solver is part of it (a `cg` entry holds A
+            // itself, not its factor: a direct and a cg run must not share it).
+            let (fac, hit) = FACTORS.get(factor_key(g, cfg, c), || factor(g, cfg, c));
             let fac = match fac {
                 Ok(f) => f,
                 Err(e) => return fail(factor_failure(&e), e, metrics),
             };
-            metrics.factorizations = i64::from(!hit);
-            metrics.factor_cache_hits = Some(i64::from(hit));
+            // CG factors nothing (the engine's bookkeeping): no factorisation made, none reused.
+            let factored = fac.chol.is_factored();
+            metrics.factorizations = i64::from(!hit && factored);
+            metrics.factor_cache_hits = factored.then_some(i64::from(hit));
             metrics.mass_total = Some(fac.mass_total);
             (Some(fac), None)
         }
@@ -1199,29 +1191,21 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            let it = if let Some(fr) = fric.as_mut() {
-                                // Slip = TΔu: q_t = Ty.
-                                fr.set_free(
-                                    &y,
-                                    |_| 0.0,
-                                    |j| u[g.contact[j]] + y[g.contact[j]] + gaps[j],
-                                );
-                                let it = fr
-                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
-                                    .map_err(|e| Stop::Solver(step, e))?;
-                                fr.take_forces(0.5);
-                                it
-                            } else {
-                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                    *qi = u[ci] + y[ci] + gi;
-                                }
-                                let it = lcp
-                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                                add_columns(&f.z, &lambda, c, &mut y);
-                                add_rows(&g.contact, &lambda, c, &mut sd);
-                                it
-                            };
+                            // Slip = TΔu: q_t = Ty.
+                            let it = implicit_contact_correction(
+                                fric.as_mut(),
+                                &mut lcp,
+                                f,
+                                &g.contact,
+                                &gaps,
+                                &u,
+                                |_| 0.0,
+                                c,
+                                (&mut q, &mut lambda),
+                                &mut y,
+                                &mut sd,
+                            )
+                            .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it);
                             iterations += it as i64;
                             // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
@@ -1265,29 +1249,21 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                             f.chol.solve_in_place(&mut y, work);
                             work.check()
                                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                            let it2 = if let Some(fr) = fric.as_mut() {
-                                // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
-                                fr.set_free(
-                                    &y,
-                                    |r| pred[r] - u[r],
-                                    |j| pred[g.contact[j]] + y[g.contact[j]] + gaps[j],
-                                );
-                                let it = fr
-                                    .solve(c, false, &mut y, &mut sd, &mut lambda)
-                                    .map_err(|e| Stop::Solver(step, e))?;
-                                fr.take_forces(0.5);
-                                it
-                            } else {
-                                for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(&gaps) {
-                                    *qi = pred[ci] + y[ci] + gi;
-                                }
-                                let it2 = lcp
-                                    .solve(&q, &mut lambda, LCP_MAX_ITER, LCP_TOL)
-                                    .map_err(|e| Stop::Solver(step, e.to_string()))?;
-                                add_columns(&f.z, &lambda, c, &mut y);
-                                add_rows(&g.contact, &lambda, c, &mut sd);
-                                it2
-                            };
+                            // Slip = u_t^{n+1} − u_tⁿ = T(u^pred − uⁿ) + TΔ.
+                            let it2 = implicit_contact_correction(
+                                fric.as_mut(),
+                                &mut lcp,
+                                f,
+                                &g.contact,
+                                &gaps,
+                                &pred,
+                                |r| pred[r] - u[r],
+                                c,
+                                (&mut q, &mut lambda),
+                                &mut y,
+                                &mut sd,
+                            )
+                            .map_err(|e| Stop::Solver(step, e))?;
                             newton_max = newton_max.max(it + it2);
                             iterations += it2 as i64;
                             g.k.matvec_into(&y, &mut kd);
@@ -1625,6 +1601,45 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
 }
 
 /// y += s Σ_j μ_j Z_j over the columns with μ_j ≠ 0 (Z column-major, n rows).
+/// The contact correction `kane` and `contact-stabilized-newmark` share (one step matrix
+/// S = M + cK, c = τ²/4): `y` = S⁻¹b is the contact-free increment from `base` (uⁿ for
+/// `kane`, u^pred for CSN) and `sd` = b. Frictional: the condensed Coulomb/Tresca problem
+/// with gaps base + y + g and slips off + Ty (off = 0, or u^pred − uⁿ), its forces taken as
+/// the scheme's (μ = 2λ: ½); frictionless: the LCP on the same gaps, Z's columns added to `y`
+/// and the contact rows to `sd` with weight c. `q`, `lambda`: the LCP's gaps and the normal
+/// multipliers (warm start in, solution out). Returns the Newton steps.
+#[allow(clippy::too_many_arguments)]
+fn implicit_contact_correction(
+    fric: Option<&mut Friction>,
+    lcp: &mut Lcp,
+    f: &Factored,
+    contact: &[usize],
+    gaps: &[f64],
+    base: &[f64],
+    off: impl Fn(usize) -> f64,
+    c: f64,
+    (q, lambda): (&mut [f64], &mut [f64]),
+    y: &mut [f64],
+    sd: &mut [f64],
+) -> Result<usize, String> {
+    if let Some(fr) = fric {
+        fr.set_free(y, off, |j| base[contact[j]] + y[contact[j]] + gaps[j]);
+        let it = fr.solve(c, false, y, sd, lambda)?;
+        fr.take_forces(0.5);
+        Ok(it)
+    } else {
+        for ((qi, &ci), gi) in q.iter_mut().zip(contact).zip(gaps) {
+            *qi = base[ci] + y[ci] + gi;
+        }
+        let it = lcp
+            .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
+            .map_err(|e| e.to_string())?;
+        add_columns(&f.z, lambda, c, y);
+        add_rows(contact, lambda, c, sd);
+        Ok(it)
+    }
+}
+
 fn add_columns(z: &[f64], mu: &[f64], s: f64, y: &mut [f64]) {
     let n = y.len();
     for (j, &l) in mu.iter().enumerate() {
