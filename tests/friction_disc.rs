@@ -8,8 +8,8 @@
 //! 0.5 e_1 and reaches the plane at t = 10 with the normal velocity 1; μ_f = 0.2. The columns
 //! (SPEC §5): E(T) + W_f − E⁰ (`energy_balance_drift`) and its largest one-step rise over
 //! `energy_scale`, W_f(T) (`friction_work`), max |Σf_t|/Σf_n (`friction_ratio_max`; Nitsche's
-//! run takes it per quadrature point, `run::fe_nitsche`), the mean tangential velocity
-//! v̄_1(T) = 1ᵀMv/1ᵀM1, `max_penetration`, stick/slip node-steps and contact phases. Besides
+//! sums over its quadrature points in contact, `run::fe_nitsche`), the mean velocities
+//! v̄_1(T) and v̄_d(T) (1ᵀMv/1ᵀM1 along e_1, e_d), `max_penetration`, stick/slip node-steps and contact phases. Besides
 //! the printed figures, the properties that hold whatever the digits:
 //! - |Σf_t| ≤ μ_f Σf_n at every contact step, for every method;
 //! - kane and moreau-jean (θ = ½) never raise E + W_f (SPEC §2.5);
@@ -36,7 +36,7 @@ const V_T: f64 = 0.5;
 
 /// One row of the doc's table at h = 4 (docs/methods.md, "The disc thrown obliquely"), as
 /// printed there: E(T) − E⁰, E(T) + W_f − E⁰, the largest one-step rise of E + W_f (None where
-/// it is round-off, asserted by the property instead), W_f, v̄_1(T), max_penetration (None where
+/// it is round-off, asserted by the property instead), W_f, v̄_1(T), v̄_d(T), max_penetration (None where
 /// it is round-off), stick and slip node-steps, contact phases.
 struct Row {
     label: &'static str,
@@ -47,6 +47,7 @@ struct Row {
     rise: Option<&'static str>,
     work: &'static str,
     v_t: &'static str,
+    v_d: &'static str,
     penetration: Option<&'static str>,
     stick: i64,
     slip: i64,
@@ -62,6 +63,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("1.908"),
         work: "0.4189",
         v_t: "0.3419",
+        v_d: "0.7019",
         penetration: None,
         stick: 58,
         slip: 290,
@@ -75,6 +77,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("0.009264"),
         work: "0.03621",
         v_t: "0.1433",
+        v_d: "0.4518",
         penetration: Some("0.06735"),
         stick: 611,
         slip: 1097,
@@ -88,6 +91,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("2.385e-6"),
         work: "0.01766",
         v_t: "0.1188",
+        v_d: "0.5258",
         penetration: None,
         stick: 795,
         slip: 380,
@@ -101,6 +105,7 @@ const TABLE_H4: &[Row] = &[
         rise: None,
         work: "0.02221",
         v_t: "0.1255",
+        v_d: "0.4586",
         penetration: None,
         stick: 744,
         slip: 412,
@@ -114,6 +119,7 @@ const TABLE_H4: &[Row] = &[
         rise: None,
         work: "0.02174",
         v_t: "0.1262",
+        v_d: "0.4536",
         penetration: None,
         stick: 755,
         slip: 399,
@@ -127,6 +133,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("0.02516"),
         work: "0.01949",
         v_t: "0.1215",
+        v_d: "0.4621",
         penetration: None,
         stick: 544,
         slip: 433,
@@ -140,6 +147,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("0.3509"),
         work: "0.2074",
         v_t: "0.1546",
+        v_d: "0.4858",
         penetration: None,
         stick: 290,
         slip: 506,
@@ -153,6 +161,7 @@ const TABLE_H4: &[Row] = &[
         rise: None,
         work: "0.02223",
         v_t: "0.1266",
+        v_d: "0.4552",
         penetration: Some("0.08840"),
         stick: 736,
         slip: 427,
@@ -166,6 +175,7 @@ const TABLE_H4: &[Row] = &[
         rise: Some("7.807e-7"),
         work: "0.01601",
         v_t: "0.1318",
+        v_d: "0.4725",
         penetration: None,
         stick: 752,
         slip: 402,
@@ -298,6 +308,10 @@ fn coarse_level_energy_and_friction_table() {
         assert_printed(&what("friction_work"), m.friction_work.unwrap(), row.work);
         let v_t = m.tangential_velocity_final.unwrap();
         assert_printed(&what("tangential_velocity_final"), v_t, row.v_t);
+        let v_d = m
+            .normal_velocity_final
+            .expect("every FE friction run reports v̄_d");
+        assert_printed(&what("normal_velocity_final"), v_d, row.v_d);
         let pen = m.max_penetration.unwrap();
         match row.penetration {
             Some(p) => assert_printed(&what("max_penetration"), pen, p),
@@ -331,20 +345,17 @@ fn coarse_level_energy_and_friction_table() {
             what("")
         );
         assert!(ratio >= MU * (1.0 - 1e-12), "{}: never slid", what(""));
-        // The impulse bound of the header, where the normal velocity is reported (the
-        // Nitsche path reports no normal_velocity_final). Measured: (V − v̄_1)/(v̄_d + gT) =
-        // 0.139–0.154 (CN consistent: 0.059), below μ_f = 0.2 with a margin of 0.046 or more
-        // against sums rounded at ~1e-14.
-        if let Some(v_d) = m.normal_velocity_final {
-            let impulse_t = V_T - v_t;
-            let impulse_n = v_d + g * t_final;
-            assert!(
-                impulse_t <= MU * impulse_n,
-                "{}: tangential impulse {impulse_t:.4} above μ_f × normal {impulse_n:.4}",
-                what("")
-            );
-            assert!(impulse_t > 0.0, "{}: friction must slow the disc", what(""));
-        }
+        // The impulse bound of the header. Measured: (V − v̄_1)/(v̄_d + gT) = 0.139–0.154
+        // (Nitsche 0.145, CN consistent: 0.059), below μ_f = 0.2 with a margin of 0.046 or
+        // more against sums rounded at ~1e-14.
+        let impulse_t = V_T - v_t;
+        let impulse_n = v_d + g * t_final;
+        assert!(
+            impulse_t <= MU * impulse_n,
+            "{}: tangential impulse {impulse_t:.4} above μ_f × normal {impulse_n:.4}",
+            what("")
+        );
+        assert!(impulse_t > 0.0, "{}: friction must slow the disc", what(""));
     }
 }
 
@@ -502,6 +513,7 @@ fn doc_table_prints_the_asserted_figures() {
         }
         assert_eq!(cells[6], row.work, "{}: W_f", row.doc);
         assert_eq!(cells[8], row.v_t, "{}: v̄_1(T)", row.doc);
+        assert_eq!(cells[9], row.v_d, "{}: v̄_d(T)", row.doc);
         if let Some(pen) = row.penetration {
             assert_eq!(cells[10], pen, "{}: max_penetration", row.doc);
         }

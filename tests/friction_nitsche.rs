@@ -46,8 +46,10 @@ fn disc_with(scheme: &str, methods: &str, t_final: f64) -> String {
 }
 
 /// GetFEM's run of the disc thrown obliquely (tests/getfem/disc_nitsche_friction.py): per
-/// step the energy, ∫f_n, ∫f_t, ∫Δu_t, W_f, the mean tangential velocity, the Gauss points of
-/// Γ_C in stick and in slip, the displacement of each Γ_C node (at `contact_xy`); the body's mass.
+/// step the energy, ∫f_n, ∫f_t, ∫Δu_t, W_f, the body's mean tangential velocity 1ᵀMv_x/1ᵀM1_x,
+/// the Γ_C mean of v_x (∫_ΓC v_x/∫_ΓC 1), the Gauss points of Γ_C in stick and in slip, the
+/// displacement of each Γ_C node (at `contact_xy`); the body's mean normal velocity at T and
+/// its mass.
 struct Getfem {
     energy: Vec<f64>,
     force_n: Vec<f64>,
@@ -55,6 +57,8 @@ struct Getfem {
     slip: Vec<f64>,
     work: Vec<f64>,
     vt: Vec<f64>,
+    vt_contact: Vec<f64>,
+    vn_final: f64,
     stick_points: Vec<f64>,
     slip_points: Vec<f64>,
     contact_xy: Vec<[f64; 2]>,
@@ -80,6 +84,8 @@ fn getfem_run(t_final: f64, vt: f64, mu: f64) -> Getfem {
         slip: floats(&v["slip"]),
         work: floats(&v["friction_work"]),
         vt: floats(&v["vt"]),
+        vt_contact: floats(&v["vt_contact"]),
+        vn_final: v["vn_final"].as_f64().unwrap(),
         stick_points: floats(&v["stick_points"]),
         slip_points: floats(&v["slip_points"]),
         contact_xy: pairs(&v["contact_xy"]),
@@ -100,7 +106,14 @@ fn getfem_run(t_final: f64, vt: f64, mu: f64) -> Getfem {
 /// - the energy, in units of energy_scale = m|f|·5 + ½m·V_t² ≈ 785: measured 1.2e-12;
 /// - the normal and tangential contact forces, in units of the phase's largest normal force:
 ///   8.4e-12 and 1.0e-11;
-/// - W_f, in units of energy_scale: 3.5e-13; the mean tangential velocity, in units of V: 6.0e-12;
+/// - W_f, in units of energy_scale: 3.5e-13;
+/// - the series' `v_t_contact`, the Γ_C mean of v_1 over the contact quadrature points
+///   (Σ_q w_q v_1(x_q)/Σ_q w_q), against GetFEM's ∫_ΓC v_x/∫_ΓC 1 on the same face rule, every
+///   step to T, in units of V: 2.3e-11;
+/// - at T, `tangential_velocity_final` and `normal_velocity_final` against GetFEM's body means
+///   1ᵀMv_x/1ᵀM1_x (0.43698) and 1ᵀMv_y/1ᵀM1_y (−0.98200), in units of V: 6.0e-12 and 1.1e-12;
+/// - `friction_ratio_max`, max over the contact steps of |Σf_t|/Σf_n, against GetFEM's
+///   max |∫f_t|/∫f_n: both μ_f = 0.3 (a step where every point in contact slides), 1.1e-16;
 /// - the slip pointwise: Δu_t = u_1^{k} − u_1^{k−1} at each of Γ_C's 33 nodes (vertices and edge
 ///   midpoints, matched to GetFEM's by their coordinates) and each step k ≤ 130, in units of the
 ///   phase's largest |Δu_t| (0.119): 1.0e-10. Larger than the rest because Δu_t is a difference
@@ -161,18 +174,37 @@ fn nitsche_coulomb_equals_getfem_on_the_thrown_p2_disc() {
         if k > 0 {
             ft_err = ft_err.max((r.sigma_t_contact.unwrap() - gf.force_t[k]).abs() / fmax);
             w_err = w_err.max((r.friction_work.unwrap() - gf.work[k]).abs() / scale);
-            v_err = v_err.max((r.v_t_contact.unwrap() - gf.vt[k]).abs() / vt);
+            v_err = v_err.max((r.v_t_contact.unwrap() - gf.vt_contact[k]).abs() / vt);
         }
     }
+    // The run's columns at T: the body's mean velocities 1ᵀMv/1ᵀM1 along e_1 and e_d, in units
+    // of V; the apparent friction coefficient max_k |∫f_t|/∫f_n over GetFEM's contact steps.
+    let m = &o.metrics;
+    let vt_t = *gf.vt.last().unwrap();
+    let vt_final_err = (m.tangential_velocity_final.unwrap() - vt_t).abs() / vt;
+    let vn_final_err = (m.normal_velocity_final.unwrap() - gf.vn_final).abs() / vt;
+    let ratio_gf = gf
+        .force_n
+        .iter()
+        .zip(&gf.force_t)
+        .filter(|(n, _)| **n > 0.0)
+        .fold(0.0f64, |r, (n, t)| r.max(t.abs() / n));
+    let ratio_err = (m.friction_ratio_max.unwrap() - ratio_gf).abs();
     eprintln!(
-        "{label}: steps {first}..{end}, max normal force {fmax:.4}; errors energy {e_err:.2e}, f_n {fn_err:.2e}, f_t {ft_err:.2e}, W_f {w_err:.2e}, v_t {v_err:.2e}"
+        "{label}: steps {first}..{end}, max normal force {fmax:.4}; errors energy {e_err:.2e}, f_n {fn_err:.2e}, f_t {ft_err:.2e}, W_f {w_err:.2e}, Γ_C mean v_t {v_err:.2e}; at T: v̄_t {vt_final_err:.2e}, v̄_d {vn_final_err:.2e} (GetFEM {:.6}, {:.6}); friction_ratio_max {:.6} against GetFEM's {ratio_gf:.6}: {ratio_err:.2e}",
+        vt_t,
+        gf.vn_final,
+        m.friction_ratio_max.unwrap()
     );
     for (what, err) in [
         ("energy", e_err),
         ("normal force", fn_err),
         ("tangential force", ft_err),
         ("friction work", w_err),
-        ("tangential velocity", v_err),
+        ("Γ_C mean tangential velocity", v_err),
+        ("final mean tangential velocity", vt_final_err),
+        ("final mean normal velocity", vn_final_err),
+        ("friction_ratio_max", ratio_err),
     ] {
         assert!(
             err <= 1e-8,

@@ -40,7 +40,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use super::fe_nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
-use super::friction_tally::FrictionTally;
+use super::friction_tally::{FrictionTally, MeanVelocity};
 use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
 use super::reference::ReferenceData;
 use super::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
@@ -1239,6 +1239,13 @@ fn symmetrise(h: &mut [f64], k: usize) {
     }
 }
 
+/// The body's mean velocities per axis (SPEC §5; [`MeanVelocity`]) with the run's mass matrix:
+/// a reduced dof's axis is its global dof's component.
+fn mean_velocity(g: &Geometry, m: &SymMatrix) -> MeanVelocity {
+    let d = g.mesh.dim();
+    MeanVelocity::new(d, m, |r| g.dofs.free[r] % d)
+}
+
 /// The reduced indices of the Γ_C nodes' tangential dofs, node-major (e_1, then e_2 in 3D).
 /// Every Γ_C node's dofs are free (only the clamped face is removed, and it is not Γ_C), so
 /// node i's component c sits d − 1 − c below its vertical one; checked against the DofMap.
@@ -1785,10 +1792,8 @@ struct FrictionStep {
     ut_prev: Vec<f64>,
     du_t: Vec<f64>,
     tally: FrictionTally,
-    /// Reduced dofs of e_1 and e_2 (3D) and e_d of every node, and 1ᵀM1 over each: the mean
-    /// velocities 1ᵀMv/1ᵀM1 from the carried M v.
-    axes: [Vec<usize>; 3],
-    axis_mass: [f64; 3],
+    /// The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v.
+    mean: MeanVelocity,
     /// The last mean velocities (e_1, e_2, e_d).
     mean_v: [f64; 3],
 }
@@ -1903,12 +1908,7 @@ impl<'a> Stepper<'a> {
         fac.m.matvec_into(&v, &mut mv);
         let friction = match nit {
             Some(o) if o.friction.is_some() => {
-                // M 1_t for the mean tangential velocity (setup only).
-                let mut ones = vec![0.0; n];
-                g.tangential.iter().for_each(|&r| ones[r] = 1.0);
-                let mut m1 = vec![0.0; n];
-                fac.m.matvec_into(&ones, &mut m1);
-                let mut f = FrictionState::new(o, cfg.friction, &g.tangential, &m1);
+                let mut f = FrictionState::new(o, cfg.friction, mean_velocity(g, &fac.m));
                 f.start(&mv);
                 Some(f)
             }
@@ -1940,20 +1940,6 @@ impl<'a> Stepper<'a> {
         let fric = fac.friction.as_ref().map(|ff| {
             let d = g.mesh.dim();
             let m = g.contact.len();
-            let axis =
-                |c: usize| -> Vec<usize> { (0..n).filter(|&r| g.dofs.free[r] % d == c).collect() };
-            let axes = [
-                axis(0),
-                if d == 3 { axis(1) } else { Vec::new() },
-                axis(d - 1),
-            ];
-            // 1ᵀM1 over each axis: M applied to the axis' indicator, summed on it.
-            let axis_mass = [0, 1, 2].map(|k| {
-                let mut one = vec![0.0; n];
-                axes[k].iter().for_each(|&r| one[r] = 1.0);
-                fac.m.matvec_into(&one.clone(), &mut one);
-                axes[k].iter().map(|&r| one[r]).sum::<f64>()
-            });
             Box::new(FrictionStep {
                 solver: FrictionalContact::new(m, d, ff.w.clone()),
                 law: cfg.friction,
@@ -1969,8 +1955,7 @@ impl<'a> Stepper<'a> {
                 du_t: vec![0.0; ff.tangential.len()],
                 // f̄ = (1 − γ) fⁿ + γ f^{n+1}: Newmark's γ, the θ-scheme's θ.
                 tally: FrictionTally::new(m, d, cfg.setup.h, gamma),
-                axes,
-                axis_mass,
+                mean: mean_velocity(g, &fac.m),
                 mean_v: [0.0; 3],
             })
         });
@@ -2126,13 +2111,7 @@ impl<'a> Stepper<'a> {
             // The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v; the stop
             // time and E + W_f in the tally; the series' Σf_t along e_1, the Γ_C mean of v_1
             // and W_f (SPEC §5).
-            for k in 0..3 {
-                fr.mean_v[k] = if fr.axes[k].is_empty() {
-                    0.0
-                } else {
-                    fr.axes[k].iter().map(|&r| mv[r]).sum::<f64>() / fr.axis_mass[k]
-                };
-            }
+            fr.mean.means_into(mv, &mut fr.mean_v);
             fr.tally.energy(e);
             fr.tally.velocity(step as f64 * tau, fr.mean_v[0]);
             let t = ff.tangential.len() / g.contact.len();
@@ -2410,6 +2389,7 @@ impl<'a> Stepper<'a> {
             let (ft, vt, wf) = fr.after_step(
                 ops,
                 &self.u,
+                &self.v,
                 &self.mv,
                 &self.lambda,
                 self.gamma,
@@ -2454,14 +2434,9 @@ impl<'a> Stepper<'a> {
         metrics.energy_scale = self.energy_scale.or(metrics.energy_initial);
         if let Some(fr) = self.fric.as_ref() {
             // SPEC §5: the e_1 component in 2D, the tangential norm in 3D.
-            let [v1, v2, vn] = fr.mean_v;
-            let vt = if fr.axes[1].is_empty() {
-                v1
-            } else {
-                (v1 * v1 + v2 * v2).sqrt()
-            };
+            let vt = fr.mean.tangential(&fr.mean_v);
             let scale = metrics.energy_scale.unwrap_or(1.0);
-            fr.tally.finish(metrics, scale, vt, vn);
+            fr.tally.finish(metrics, scale, vt, fr.mean_v[2]);
         }
         if let Some(fr) = &self.friction {
             let e0 = metrics.energy_initial.unwrap_or(0.0);

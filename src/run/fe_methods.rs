@@ -119,7 +119,7 @@ use std::time::Instant;
 use super::{
     CLOCK_EVERY, Cache, FACTORS, Factored, FeConfig, GEOMETRIES, Geometry, LCP_MAX_ITER, LCP_TOL,
     build_geometry, factor, factor_failure, factor_key, frictional, geometry_key, gravity_load,
-    lowest_contact, mass_matrix, ref_map, reference_record, tangential_dofs,
+    lowest_contact, mass_matrix, mean_velocity, ref_map, reference_record, tangential_dofs,
 };
 use crate::contact::friction::FrictionLaw;
 use crate::contact::gradient::{difference_quotient, difference_quotient_slope};
@@ -128,7 +128,7 @@ use crate::run::fe_nitsche::{
     FrictionState, NEWTON_MAX_ITER, NEWTON_TOL, NewtonWork, NitscheOps, lu_solve, newton,
     newton_friction,
 };
-use crate::run::friction_tally::FrictionTally;
+use crate::run::friction_tally::{FrictionTally, MeanVelocity};
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status, Stop};
 use crate::space::fe::SymMatrix;
@@ -380,10 +380,8 @@ struct Friction {
     /// The implicit methods' contact problem (None: kinematic central difference).
     implicit: Option<Implicit>,
     tally: FrictionTally,
-    /// Reduced rows of each direction (e_1, (e_2,) e_d) and their masses 1ᵀM1: the mean
-    /// velocities 1ᵀMv/1ᵀM1 from the carried Mv.
-    dir_rows: Vec<Vec<usize>>,
-    mass_dir: Vec<f64>,
+    /// The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried Mv.
+    mean: MeanVelocity,
 }
 
 /// The implicit methods' frictional contact problem over the step matrix's frictional
@@ -421,22 +419,6 @@ impl Friction {
             .iter()
             .map(|w| w * g.contact_measure)
             .collect();
-        let n = g.dofs.n_free();
-        let dir_rows: Vec<Vec<usize>> = (0..d)
-            .map(|k| (0..n).filter(|&r| g.dofs.free[r] % d == k).collect())
-            .collect();
-        // 1ᵀM1 over each direction: M applied to the direction's indicator, summed on it.
-        let mut one = vec![0.0; n];
-        let mut m1 = vec![0.0; n];
-        let mass_dir = dir_rows
-            .iter()
-            .map(|rows| {
-                one.iter_mut().for_each(|x| *x = 0.0);
-                rows.iter().for_each(|&r| one[r] = 1.0);
-                m.matvec_into(&one, &mut m1);
-                rows.iter().map(|&r| m1[r]).sum()
-            })
-            .collect();
         Ok(Friction {
             law: cfg.friction,
             nt,
@@ -448,8 +430,7 @@ impl Friction {
             du_t: vec![0.0; nc * nt],
             implicit: None,
             tally: FrictionTally::new(nc, d, cfg.setup.h, weight_new),
-            dir_rows,
-            mass_dir,
+            mean: mean_velocity(g, m),
         })
     }
 
@@ -616,11 +597,6 @@ impl Friction {
         self.tally.step(&self.forces, &self.du_t);
     }
 
-    /// The mean velocity 1ᵀMv/1ᵀM1 along direction k, from the carried Mv.
-    fn mean_velocity(&self, mv: &[f64], k: usize) -> f64 {
-        self.dir_rows[k].iter().map(|&r| mv[r]).sum::<f64>() / self.mass_dir[k]
-    }
-
     /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
     /// nodes' trapezoidal weights), W_f.
     fn series(&self, v: &[f64]) -> [f64; 3] {
@@ -638,21 +614,18 @@ impl Friction {
     /// stop time) into the tally.
     fn observed(&mut self, step: usize, tau: f64, energy: f64, mv: &[f64]) {
         self.tally.energy(energy);
-        let v1 = self.mean_velocity(mv, 0);
-        self.tally.velocity(step as f64 * tau, v1);
+        let mut means = [0.0; 3];
+        self.mean.means_into(mv, &mut means);
+        self.tally.velocity(step as f64 * tau, means[0]);
     }
 
     /// The friction columns of SPEC §5 (energies over `scale`): the tally's, and the mean
     /// velocities at T (3D: the tangential norm).
     fn report(&self, metrics: &mut Metrics, mv: &[f64], scale: f64) {
-        let d = self.nt + 1;
-        let vt = if d == 3 {
-            self.mean_velocity(mv, 0).hypot(self.mean_velocity(mv, 1))
-        } else {
-            self.mean_velocity(mv, 0)
-        };
-        let vn = self.mean_velocity(mv, d - 1);
-        self.tally.finish(metrics, scale, vt, vn);
+        let mut means = [0.0; 3];
+        self.mean.means_into(mv, &mut means);
+        self.tally
+            .finish(metrics, scale, self.mean.tangential(&means), means[2]);
     }
 }
 
@@ -932,12 +905,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     // frictional state, f̄_t's weight of f_t^{n+1} 1 − α_f, passed per step.
     let mut nit_fric = match (nit, meth) {
         (Some(o), Method::Alpha(_)) if o.friction.is_some() => {
-            // M 1_t for the mean tangential velocity (setup only).
-            let mut ones = vec![0.0; n];
-            g.tangential.iter().for_each(|&r| ones[r] = 1.0);
-            let mut m1 = vec![0.0; n];
-            m.matvec_into(&ones, &mut m1);
-            Some(FrictionState::new(o, cfg.friction, &g.tangential, &m1))
+            Some(FrictionState::new(o, cfg.friction, mean_velocity(g, m)))
         }
         (Some(o), _) if o.friction.is_some() => {
             return fail(
@@ -1540,7 +1508,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
             if let (Some(st), Some(ops), Method::Alpha(ga)) = (nit_fric.as_mut(), nit, meth) {
                 // W_f with generalized-α's f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ (SPEC §2.5).
                 let t = step as f64 * tau;
-                let (ft, vt, wf) = st.after_step(ops, &u, &mv, &lambda, 1.0 - ga.alpha_f, t, tau);
+                let (ft, vt, wf) =
+                    st.after_step(ops, &u, &v, &mv, &lambda, 1.0 - ga.alpha_f, t, tau);
                 fv = Some([ft, vt, wf]);
             }
             let e = observe_timer

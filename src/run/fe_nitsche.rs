@@ -43,6 +43,7 @@
 //! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
 //! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
 
+use super::friction_tally::{MeanVelocity, ratio_step};
 use crate::contact::friction::FrictionLaw;
 use crate::space::fe::nitsche::ContactPoint;
 
@@ -688,7 +689,10 @@ pub(crate) fn newton(
 
 /// A frictional run's state besides the engine's (SPEC §2.5): the slip's reference u_t^n, the
 /// previous step's forces (for f̄ in W_f), and the friction tally of the run (SPEC §5's
-/// friction columns), all allocated once per run.
+/// friction columns: the apparent coefficient |Σf_t|/Σf_n from the points' summed forces, as
+/// [`FrictionTally`](super::friction_tally::FrictionTally) for nodes; the body's mean
+/// velocities per axis from M v; the series' Γ_C mean of v_1 over the points), all allocated
+/// once per run.
 #[derive(Debug)]
 pub(crate) struct FrictionState {
     pub law: FrictionLaw,
@@ -698,12 +702,12 @@ pub(crate) struct FrictionState {
     pub lambda_prev: Vec<f64>,
     /// Whether each point slides (the disc projection active) at the last step.
     pub slides: Vec<bool>,
-    /// The e_1 dofs and 1_tᵀM1_t: the mean tangential velocity 1_tᵀMv / 1_tᵀM1_t.
-    tangential: Vec<usize>,
-    tangential_mass: f64,
+    /// The body's mean velocities per axis 1ᵀMv/1ᵀM1, and Σ_q w_q (the Γ_C means' divisor).
+    mean: MeanVelocity,
+    weight_sum: f64,
     /// W_f (raw), the last E + W_f, the largest one-step rise of E + W_f, the smallest
     /// one-step tangential work −Σ f_t^{n+1}·Δu_t (raw), point-steps in stick and in slip,
-    /// max |f_t|/f_n over the contact point-steps.
+    /// max over the contact steps of |Σ_q f_t,q|/Σ_q f_n,q.
     pub work: f64,
     balance_prev: f64,
     balance_max_increase: f64,
@@ -711,28 +715,24 @@ pub(crate) struct FrictionState {
     pub stick_steps: i64,
     pub slip_steps: i64,
     pub ratio_max: Option<f64>,
-    /// The mean tangential velocity of the last step, and the first time it reached 0.
+    /// The mean velocities [v̄_1, v̄_2, v̄_d] of the last step; v̄_1 of the one before and the
+    /// first time it reached 0.
+    means: [f64; 3],
     vt_prev: f64,
-    pub vt: f64,
     pub stop_time: Option<f64>,
 }
 
 impl FrictionState {
-    /// For `ops` (with friction) and the run's law; `tangential` the e_1 dofs, `m1` = M 1_t.
-    pub fn new(
-        ops: &NitscheOps,
-        law: FrictionLaw,
-        tangential: &[usize],
-        m1: &[f64],
-    ) -> FrictionState {
+    /// For `ops` (with friction), the run's law and the body's mean velocities `mean`.
+    pub fn new(ops: &NitscheOps, law: FrictionLaw, mean: MeanVelocity) -> FrictionState {
         let td = ops.friction.as_ref().map_or(0, |f| f.td);
         FrictionState {
             law,
             ut_n: vec![0.0; ops.len() * td],
             lambda_prev: vec![0.0; ops.unknowns()],
             slides: vec![false; ops.len()],
-            tangential: tangential.to_vec(),
-            tangential_mass: tangential.iter().map(|&r| m1[r]).sum(),
+            mean,
+            weight_sum: ops.w.iter().sum(),
             work: 0.0,
             balance_prev: f64::NAN,
             balance_max_increase: f64::NEG_INFINITY,
@@ -740,8 +740,8 @@ impl FrictionState {
             stick_steps: 0,
             slip_steps: 0,
             ratio_max: None,
+            means: [f64::NAN; 3],
             vt_prev: f64::NAN,
-            vt: f64::NAN,
             stop_time: None,
         }
     }
@@ -776,16 +776,19 @@ impl FrictionState {
         self.lambda_prev.copy_from_slice(lambda);
     }
 
-    /// After step n's update (u = u^{n+1}, `mv` = M v^{n+1}): W_f −= Σ f̄_t·Δu_t with f̄ =
-    /// (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ, generalized-α's
-    /// 1 − α_f; λ_t includes the point's weight), the step's tangential work, stick/slip and |f_t|/f_n of the points in
-    /// contact, the mean tangential velocity and its first zero. Returns (Σ λ_t along e_1 —
-    /// the total tangential force on the body —, the mean tangential velocity, W_f).
+    /// After step n's update (u = u^{n+1}, v = v^{n+1}, `mv` = M v^{n+1}): W_f −= Σ f̄_t·Δu_t
+    /// with f̄ = (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ,
+    /// generalized-α's 1 − α_f; λ_t includes the point's weight), the step's tangential work,
+    /// stick/slip of the points in contact and |Σλ_t|/Σλ_n over them (SPEC §5; the weights
+    /// make the sums the total forces), the mean velocities and v̄_1's first zero. Returns
+    /// (Σ λ_t along e_1 — the total tangential force on the body —, the Γ_C mean of v_1
+    /// Σ_q w_q v_1(x_q)/Σ_q w_q with v_1(x_q) from the points' e_1 rows, W_f).
     #[allow(clippy::too_many_arguments)]
     pub fn after_step(
         &mut self,
         ops: &NitscheOps,
         u: &[f64],
+        v: &[f64],
         mv: &[f64],
         lambda: &[f64],
         weight: f64,
@@ -798,57 +801,56 @@ impl FrictionState {
             .expect("a frictional run has tangential rows");
         let d = ops.per_point();
         let mut step_work = 0.0;
-        let mut force = 0.0;
+        // Σλ_n, Σλ_t (e_1, e_2) over the points in contact (a point out of contact has λ = 0),
+        // and Σ_q w_q v_1(x_q).
+        let (mut sum_n, mut sum_t, mut wv) = (0.0, [0.0; 2], 0.0);
         for q in 0..ops.len() {
             let dofs = &ops.dofs[q * ops.k..(q + 1) * ops.k];
-            let mut ft2 = 0.0;
+            let ln = lambda[q * d];
             for i in 0..f.td {
                 let r = q * f.td + i;
                 let urow = &f.ut[r * ops.k..(r + 1) * ops.k];
                 let ut = urow.iter().zip(dofs).map(|(a, &g)| a * u[g]).sum::<f64>();
+                if i == 0 {
+                    wv += ops.w[q] * urow.iter().zip(dofs).map(|(a, &g)| a * v[g]).sum::<f64>();
+                }
                 let du = ut - self.ut_n[r];
                 let (l0, l1) = (self.lambda_prev[q * d + 1 + i], lambda[q * d + 1 + i]);
                 self.work -= ((1.0 - weight) * l0 + weight * l1) * du;
                 step_work -= l1 * du;
-                ft2 += l1 * l1;
-                if i == 0 {
-                    force += l1;
+                if ln > 0.0 {
+                    sum_t[i] += l1;
                 }
             }
-            let ln = lambda[q * d];
             if ln > 0.0 {
+                sum_n += ln;
                 if self.slides[q] {
                     self.slip_steps += 1;
                 } else {
                     self.stick_steps += 1;
                 }
-                // |f_t|/f_n: the weights cancel.
-                let r = ft2.sqrt() / ln;
-                self.ratio_max = Some(self.ratio_max.map_or(r, |m| m.max(r)));
             }
         }
+        ratio_step(&mut self.ratio_max, sum_n, sum_t);
         self.tangential_work_min = self.tangential_work_min.min(step_work);
-        let vt = self.mean_velocity(mv);
-        self.vt_prev = self.vt;
-        self.vt = vt;
-        if self.stop_time.is_none() && self.vt_prev != 0.0 && self.vt_prev * vt <= 0.0 {
+        self.vt_prev = self.means[0];
+        self.mean.means_into(mv, &mut self.means);
+        let v1 = self.means[0];
+        if self.stop_time.is_none() && self.vt_prev != 0.0 && self.vt_prev * v1 <= 0.0 {
             // Linear interpolation between the two steps where it changes sign (SPEC §1.8).
-            self.stop_time = Some(t - tau + tau * self.vt_prev / (self.vt_prev - vt));
+            self.stop_time = Some(t - tau + tau * self.vt_prev / (self.vt_prev - v1));
         }
-        (force, vt, self.work)
+        let v_contact = if self.weight_sum > 0.0 {
+            wv / self.weight_sum
+        } else {
+            0.0
+        };
+        (sum_t[0], v_contact, self.work)
     }
 
-    /// 1_tᵀMv / 1_tᵀM1_t (0 without tangential mass).
-    pub fn mean_velocity(&self, mv: &[f64]) -> f64 {
-        if self.tangential_mass == 0.0 {
-            return 0.0;
-        }
-        self.tangential.iter().map(|&r| mv[r]).sum::<f64>() / self.tangential_mass
-    }
-
-    /// Step 0: the initial mean tangential velocity.
+    /// Step 0: the initial mean velocities.
     pub fn start(&mut self, mv: &[f64]) {
-        self.vt = self.mean_velocity(mv);
+        self.mean.means_into(mv, &mut self.means);
     }
 
     /// After step n's observation: the rise of E + W_f from E^n (+ W_f^n) to `energy` E^{n+1}
@@ -879,7 +881,8 @@ impl FrictionState {
         } else {
             0.0
         });
-        m.tangential_velocity_final = Some(self.vt);
+        m.tangential_velocity_final = Some(self.mean.tangential(&self.means));
+        m.normal_velocity_final = Some(self.means[2]);
         m.stop_time = self.stop_time;
     }
 }
@@ -943,6 +946,50 @@ mod tests {
         lu_solve(&mut a, 2, &mut [0; 2], &mut b).unwrap();
         assert_eq!(b, [2.0, 1.0]);
         assert!(lu_solve(&mut [0.0; 4], 2, &mut [0; 2], &mut [1.0, 1.0]).is_err());
+    }
+
+    /// SPEC §5's friction columns of a frictional run, by hand: two penalty points in 2D on two
+    /// nodes (dofs x, y each), weights 1 and 3, u_t = the node's u_x; identity mass. Forces
+    /// λ = w(f_n, f_t) = (1, 0.5) and (3, −1.5): each point on its cone |f_t| = 0.5 f_n, but
+    /// |Σλ_t|/Σλ_n = |0.5 − 1.5|/4 = 0.25, the apparent coefficient. v = (1, 0 | 3, 0): the
+    /// Γ_C mean of v_1 is (1·1 + 3·3)/4 = 2.5, the body's mean (1 + 3)/2 = 2 along e_1 and 0
+    /// along e_d. Binary fractions: exact.
+    #[test]
+    fn friction_state_sums_forces_and_averages_velocities() {
+        use crate::contact::friction::FrictionLaw;
+        use crate::run::friction_tally::MeanVelocity;
+        use crate::space::fe::SymMatrix;
+        let point = |node: usize, weight: f64| ContactPoint {
+            weight,
+            gamma: 1.0,
+            gap: 0.0,
+            dofs: vec![2 * node, 2 * node + 1],
+            un: vec![0.0, -1.0],
+            sn: vec![0.0, 0.0],
+            ut: vec![1.0, 0.0],
+            st: vec![0.0, 0.0],
+        };
+        let points = [point(0, 1.0), point(1, 3.0)];
+        let ops = NitscheOps::penalty(&points, 1.0, 1.0).with_friction(&points, 1.0);
+        let mut eye = vec![0.0; 16];
+        (0..4).for_each(|i| eye[i * 5] = 1.0);
+        let m = SymMatrix::from_dense(4, &eye).unwrap();
+        let law = FrictionLaw::Coulomb { coefficient: 0.5 };
+        let mut st = FrictionState::new(&ops, law, MeanVelocity::new(2, &m, |r| r % 2));
+        let v = [1.0, 0.0, 3.0, 0.0];
+        st.start(&v);
+        let lambda = [1.0, 0.5, 3.0, -1.5];
+        let (ft, v_contact, _) = st.after_step(&ops, &[0.0; 4], &v, &v, &lambda, 0.5, 1.0, 1.0);
+        assert_eq!((ft, v_contact), (-1.0, 2.5));
+        let mut metrics = crate::run::Metrics::default();
+        st.finish(&mut metrics, 1.0, 0.0, 1);
+        assert_eq!(metrics.friction_ratio_max, Some(0.25));
+        assert_eq!(metrics.tangential_velocity_final, Some(2.0));
+        assert_eq!(metrics.normal_velocity_final, Some(0.0));
+        assert_eq!(
+            (metrics.stick_steps, metrics.slip_steps),
+            (Some(2), Some(0))
+        );
     }
 
     #[test]

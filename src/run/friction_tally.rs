@@ -20,8 +20,79 @@
 //!   changes sign; none if it never does or starts at 0.
 //!
 //! Nothing is allocated after [`FrictionTally::new`].
+//!
+//! [`MeanVelocity`] gives the body's mean velocity per axis, v̄_k = 1_kᵀMv/1_kᵀM1_k with 1_k the
+//! indicator of axis k's dofs (the momentum along e_k over the mass along it), from the M v the
+//! engines carry: the stop time's e_1 component and the final `tangential_velocity_final`
+//! (v̄_1 in 2D, √(v̄_1² + v̄_2²) in 3D) and `normal_velocity_final` (v̄_d) of SPEC §5.
 
 use super::Metrics;
+use crate::space::fe::SymMatrix;
+
+/// The body's mean velocity per axis from M v (module header): each axis' reduced dofs and
+/// 1ᵀM1 over them, made once at setup.
+#[derive(Debug, Clone)]
+pub struct MeanVelocity {
+    /// Reduced dofs of e_1, e_2 (empty in 2D) and e_d.
+    axes: [Vec<usize>; 3],
+    /// 1_kᵀM1_k per axis (0 for an empty axis).
+    mass: [f64; 3],
+}
+
+impl MeanVelocity {
+    /// In dimension `d` (2 or 3) with the mass matrix `m` over the reduced dofs, whose
+    /// component (0 ≤ c < d) is `axis_of(r)`.
+    pub fn new(d: usize, m: &SymMatrix, axis_of: impl Fn(usize) -> usize) -> Self {
+        assert!(d == 2 || d == 3, "d = 2 or 3");
+        let n = m.n();
+        let axis = |c: usize| -> Vec<usize> { (0..n).filter(|&r| axis_of(r) == c).collect() };
+        let axes = [
+            axis(0),
+            if d == 3 { axis(1) } else { Vec::new() },
+            axis(d - 1),
+        ];
+        // 1ᵀM1 over each axis: M applied to the axis' indicator, summed on it (setup only).
+        let (mut one, mut m1) = (vec![0.0; n], vec![0.0; n]);
+        let mass = [0, 1, 2].map(|k| {
+            one.iter_mut().for_each(|x| *x = 0.0);
+            axes[k].iter().for_each(|&r| one[r] = 1.0);
+            m.matvec_into(&one, &mut m1);
+            axes[k].iter().map(|&r| m1[r]).sum::<f64>()
+        });
+        MeanVelocity { axes, mass }
+    }
+
+    /// [v̄_1, v̄_2, v̄_d] from `mv` = M v into `out` (v̄_2 = 0 in 2D; 0 on an axis without mass).
+    pub fn means_into(&self, mv: &[f64], out: &mut [f64; 3]) {
+        for (k, o) in out.iter_mut().enumerate() {
+            *o = if self.mass[k] == 0.0 {
+                0.0
+            } else {
+                self.axes[k].iter().map(|&r| mv[r]).sum::<f64>() / self.mass[k]
+            };
+        }
+    }
+
+    /// The tangential value of SPEC §5 from [v̄_1, v̄_2, v̄_d]: v̄_1 in 2D, the norm
+    /// √(v̄_1² + v̄_2²) in 3D.
+    pub fn tangential(&self, means: &[f64; 3]) -> f64 {
+        if self.axes[1].is_empty() {
+            means[0]
+        } else {
+            means[0].hypot(means[1])
+        }
+    }
+}
+
+/// One step's apparent friction coefficient |Σf_t|/Σf_n (the sums over the contact points, the
+/// tangential one a vector in 3D) into the running maximum `ratio_max`; a step without normal
+/// force has none.
+pub(crate) fn ratio_step(ratio_max: &mut Option<f64>, sum_n: f64, sum_t: [f64; 2]) {
+    if sum_n > 0.0 {
+        let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
+        *ratio_max = Some(ratio_max.map_or(r, |m| m.max(r)));
+    }
+}
 
 /// The running friction observables of one run (module header).
 #[derive(Debug, Clone)]
@@ -113,10 +184,7 @@ impl FrictionTally {
         self.work += work;
         self.tangential_work_min = self.tangential_work_min.min(own);
         self.total_t = sum_t;
-        if sum_n > 0.0 {
-            let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
-            self.ratio_max = Some(self.ratio_max.map_or(r, |m| m.max(r)));
-        }
+        ratio_step(&mut self.ratio_max, sum_n, sum_t);
         self.steps += 1;
         self.work
     }
@@ -226,6 +294,37 @@ mod tests {
         assert_eq!(m.energy_balance_max_increase, Some(0.0));
         assert_eq!(m.energy_balance_drift, Some(-0.03125));
         assert_eq!(m.tangential_work_min, Some(0.0));
+    }
+
+    /// The mean velocities from M v: a 3D body of two nodes (dofs node-major x, y, z) with
+    /// the mass M = diag(1, 1, 1, 3, 3, 3) plus the coupling 1 between the nodes' x dofs:
+    /// 1ᵀM1 = 1 + 3 + 2 = 6 along x, 4 along y and z. Binary fractions: exact.
+    #[test]
+    fn mean_velocity_per_axis_from_mv() {
+        let mut a = vec![0.0; 36];
+        for (i, m) in [1.0, 1.0, 1.0, 3.0, 3.0, 3.0].into_iter().enumerate() {
+            a[i * 6 + i] = m;
+        }
+        a[3] = 1.0;
+        a[18] = 1.0;
+        let m = SymMatrix::from_dense(6, &a).unwrap();
+        let mean = MeanVelocity::new(3, &m, |r| r % 3);
+        // v = (1, 2, −1 | 3, 0, 1): M v = (4, 2, −1 | 10, 0, 3).
+        let v = [1.0, 2.0, -1.0, 3.0, 0.0, 1.0];
+        let mut mv = [0.0; 6];
+        m.matvec_into(&v, &mut mv);
+        let mut out = [f64::NAN; 3];
+        mean.means_into(&mv, &mut out);
+        // x: (4 + 10)/6; y: 2/4; z: (−1 + 3)/4.
+        assert_eq!(out, [14.0 / 6.0, 0.5, 0.5]);
+        assert_eq!(mean.tangential(&out), (14.0f64 / 6.0).hypot(0.5));
+        // 2D (the same matrix read as three nodes of two dofs): v̄_2 = 0 and the tangential
+        // value is v̄_1. x = dofs 0, 2, 4: 1ᵀM1 = 1 + 1 + 3 = 5, (4 − 1 + 0)/5; y = dofs
+        // 1, 3, 5: 1 + 3 + 3 = 7 (the coupling joins dof 0, an x dof, to 3), (2 + 10 + 3)/7.
+        let mean = MeanVelocity::new(2, &m, |r| r % 2);
+        mean.means_into(&mv, &mut out);
+        assert_eq!(out, [3.0 / 5.0, 0.0, 15.0 / 7.0]);
+        assert_eq!(mean.tangential(&out), 3.0 / 5.0);
     }
 
     /// The stop time interpolates linearly where the mean velocity changes sign, once; it is

@@ -95,9 +95,10 @@ pub struct Metrics {
     pub energy_balance_max_increase: Option<f64>,
     pub stick_steps: Option<i64>,
     pub slip_steps: Option<i64>,
+    /// max over the contact steps of |Σf_t|/Σf_n (SPEC §5).
     pub friction_ratio_max: Option<f64>,
     /// Mean tangential and normal velocities 1ᵀMv/1ᵀM1 at T (scenes with a tangential
-    /// direction).
+    /// direction; FE: e_1 in 2D, the tangential norm in 3D, and e_d).
     pub tangential_velocity_final: Option<f64>,
     pub normal_velocity_final: Option<f64>,
     /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, SPEC §1.7).
@@ -167,7 +168,8 @@ pub struct SeriesRow {
     pub energy_elastic: Option<f64>,
     pub energy_gravity: Option<f64>,
     pub u_lowest: Option<f64>,
-    /// Friction (SPEC §5): the base's σ_t (1D), the contact node's slip velocity, W_f.
+    /// Friction (SPEC §5): the base's σ_t (1D; 2D/3D the total tangential force), the contact
+    /// node's slip velocity (2D/3D: the Γ_C mean of v_1), W_f.
     pub sigma_t_contact: Option<f64>,
     pub v_t_contact: Option<f64>,
     pub friction_work: Option<f64>,

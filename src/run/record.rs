@@ -220,9 +220,9 @@ schema! {
         energy_balance_max_increase: Option<f64> => "", "friction: max_n of the one-step rise of E + W_f, over energy_scale (≤ 0 up to round-off for kane and moreau-jean θ = ½)";
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
         slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
-        friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |f_t|/f_n, the apparent friction coefficient";
+        friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |Σf_t|/Σf_n (sums over the contact points, 3D: the norm of Σf_t), the apparent friction coefficient";
         tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D)";
-        normal_velocity_final: Option<f64> => "m/s", "friction: the normal component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
+        normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
         err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (SPEC §1.5; 0: frictionless)";
@@ -313,7 +313,7 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "v_t_contact",
         "Option<f64>",
         "m/s",
-        "friction: the contact node's tangential velocity (its slip velocity while in contact)",
+        "friction: the contact node's tangential velocity (its slip velocity while in contact); 2D/3D: the Γ_C mean of v_1 (over the Γ_C nodes, Nitsche/penalty: over the contact quadrature points)",
     ),
     (
         "friction_work",

@@ -22,7 +22,9 @@ face rule (3 Gauss points per face, the engine's rule).
 Reported per step: the energy ½vᵀMv + ½uᵀKu − Fᵀu, the normal force ∫f_n, the tangential
 force ∫f_t (e_x component of the traction on the body, integrated), the slip ∫(u_t − u_t^n),
 the frictional work W_f = −Σ ∫((1−γ)f_t^n + γ f_t^{n+1})(u_t^{n+1} − u_t^n) (SPEC §2.5), the
-mean tangential velocity 1ᵀMv_x / 1ᵀM1_x, the Gauss points of Γ_C in contact (f_n > 0) that
+mean tangential velocity 1ᵀMv_x / 1ᵀM1_x (and, at T, the normal one 1ᵀMv_y / 1ᵀM1_y), the
+Γ_C mean of the tangential velocity ∫_ΓC v_x / ∫_ΓC 1 (on Γ_C's face rule, as the forces;
+SPEC §5's `v_t_contact` for Nitsche), the Gauss points of Γ_C in contact (f_n > 0) that
 stick (|p_t| ≤ μ f_n, p_t the argument of the projection) and that slip, and the displacement
 (u_x, u_y) of every Γ_C node (the vertices and edge midpoints of its faces; their coordinates
 once, as `contact_xy`, since GetFEM numbers its dofs otherwise than the file its nodes).
@@ -57,6 +59,8 @@ md, rhs_brick = disc.nitsche_model(A, GAMMA0, THETA, [
     ('muf', [MUF]), ('tau', [TAU]), ('btau2', [beta * TAU**2])])
 md.add_initialized_fem_data('uo', disc.mfu, disc.U0)
 md.add_initialized_fem_data('uoo', disc.mfu, disc.U0)
+# The velocity v^{n+1}, for its Γ_C mean (data only: no term uses it).
+md.add_initialized_fem_data('vel', disc.mfu, disc.U0)
 
 
 def forces(u, w):
@@ -91,8 +95,14 @@ a = np.linalg.solve(M, F)
 ones_x = np.zeros(n)
 ones_x[0::2] = 1.0
 mx = ones_x @ M @ ones_x
+ones_y = np.zeros(n)
+ones_y[1::2] = 1.0
+my = ones_y @ M @ ones_y
+# |Γ_C| = ∫_ΓC 1 on the face rule, the divisor of the Γ_C mean.
+gamma_c = float(gf.asm('generic', disc.mim_c, 0, '1', c.CONTACT_REGION, md))
 out = {'energy': [0.5 * v @ M @ v], 'force_n': [0.0], 'force_t': [0.0], 'slip': [0.0],
-       'friction_work': [0.0], 'vt': [float(ones_x @ M @ v / mx)], 'iterations': [],
+       'friction_work': [0.0], 'vt': [float(ones_x @ M @ v / mx)], 'vt_contact': [VT],
+       'iterations': [],
        'stick_points': [0], 'slip_points': [0],
        'contact_xy': [[float(x), float(y)] for x, y in xy.T],
        'contact_u': [[[0.0, 0.0] for _ in dx]]}
@@ -131,6 +141,9 @@ for step in range(STEPS):
     u, v, a = c.advance(un, p, v, a, TAU)
     out['energy'].append(c.energy(M, K, F, u, v))
     out['vt'].append(float(ones_x @ M @ v / mx))
+    md.set_variable('vel', v)
+    out['vt_contact'].append(asm('vel(1)') / gamma_c)
+out['vn_final'] = float(ones_y @ M @ v / my)
 out['body_mass'] = float(mx)
 with open(out_path, 'w') as f:
     json.dump(out, f)
