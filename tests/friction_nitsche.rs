@@ -45,6 +45,14 @@ fn disc_with(scheme: &str, methods: &str, t_final: f64) -> String {
     disc_sweep_with("disc-friction", scheme, methods, t_final)
 }
 
+/// A run's W_f series: how many steps report it, its last value and its smallest one-step
+/// change (the steps' tangential work as f̄_t enters W_f).
+fn work_series(o: &Outcome) -> (usize, f64, f64) {
+    let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
+    let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
+    (w.len(), *w.last().expect("a frictional series"), min_inc)
+}
+
 /// GetFEM's run of the disc thrown obliquely (tests/getfem/disc_nitsche_friction.py): per
 /// step the energy, ∫f_n, ∫f_t, ∫Δu_t, W_f, the body's mean tangential velocity 1ᵀMv_x/1ᵀM1_x,
 /// the Γ_C mean of v_x (∫_ΓC v_x/∫_ΓC 1), the Gauss points of Γ_C in stick and in slip, the
@@ -405,9 +413,7 @@ method = [
     assert_eq!(runs.len(), 3);
     for (label, o) in &runs {
         let m = &o.metrics;
-        let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
-        let last = *w.last().unwrap();
-        let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
+        let (_, last, min_inc) = work_series(o);
         eprintln!(
             "{label}: W_f {last:.4e} (relative {:?}), smallest step {min_inc:.3e}, stick {:?} slip {:?} ratio {:?} balance drift {:?} max rise {:?}",
             m.friction_work,
@@ -654,13 +660,12 @@ method = [
     assert_eq!(runs.len(), 6);
     for (label, o) in &runs {
         let m = &o.metrics;
-        let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
+        let (steps, last, min_inc) = work_series(o);
         let ft_max = o
             .series
             .rows()
             .filter_map(|r| r.sigma_t_contact)
             .fold(0.0f64, |a, f| a.max(f.abs()));
-        let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
         eprintln!(
             "{label}: W_f {:?}, smallest W_f step {min_inc:.3e}, own work min {:?}, max |Σf_t| {ft_max:.3e}, stick {:?} slip {:?} ratio {:?} balance drift {:?} max rise {:?}",
             m.friction_work,
@@ -671,15 +676,8 @@ method = [
             m.energy_balance_drift,
             m.energy_balance_max_increase
         );
-        assert_eq!(
-            w.len(),
-            o.series.energy.len() - 1,
-            "{label}: W_f every step"
-        );
-        assert!(
-            ft_max > 0.0 && *w.last().unwrap() != 0.0,
-            "{label}: friction acts"
-        );
+        assert_eq!(steps, o.series.energy.len() - 1, "{label}: W_f every step");
+        assert!(ft_max > 0.0 && last != 0.0, "{label}: friction acts");
         assert!(
             m.tangential_work_min.unwrap() >= -OWN_WORK_ALLOWANCE * m.friction_work.unwrap().abs(),
             "{label}: a step's own tangential work {:?}",
@@ -772,9 +770,7 @@ tresca_threshold = [0.02, 0.05, 0.1]
     assert_eq!(runs.len(), 9);
     for (label, o) in &runs {
         let m = &o.metrics;
-        let w: Vec<f64> = o.series.rows().filter_map(|r| r.friction_work).collect();
-        let last = *w.last().unwrap();
-        let min_inc = w.windows(2).fold(f64::INFINITY, |m, p| m.min(p[1] - p[0]));
+        let (_, last, min_inc) = work_series(o);
         eprintln!(
             "{label}: Newton max {:?}, W_f {last:.4e}, smallest W_f step {min_inc:.3e}, own work min {:?}, stick {:?} slip {:?}",
             m.iterations_max_step, m.tangential_work_min, m.stick_steps, m.slip_steps
