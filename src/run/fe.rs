@@ -1908,7 +1908,14 @@ impl<'a> Stepper<'a> {
         fac.m.matvec_into(&v, &mut mv);
         let friction = match nit {
             Some(o) if o.friction.is_some() => {
-                let mut f = FrictionState::new(o, cfg.friction, mean_velocity(g, &fac.m));
+                // f̄_t's weight of f_t^{n+1}: Newmark's γ, the θ-scheme's θ.
+                let mut f = FrictionState::new(
+                    o,
+                    cfg.friction,
+                    mean_velocity(g, &fac.m),
+                    gamma,
+                    cfg.setup.h,
+                );
                 f.start(&mv);
                 Some(f)
             }
@@ -2227,7 +2234,7 @@ impl<'a> Stepper<'a> {
                     "friction is not defined for the hybrid scheme".into(),
                 ));
             }
-            fr.start_step(ops, y, &self.u, &self.lambda, &mut self.q);
+            fr.start_step(ops, y, &self.u, &mut self.q);
             let it = newton_friction(
                 ops,
                 fr.law,
@@ -2386,16 +2393,7 @@ impl<'a> Stepper<'a> {
         }
         if let (Some(fr), Some(ops)) = (self.friction.as_mut(), self.fac.nitsche.as_ref()) {
             let t = step as f64 * self.tau;
-            let (ft, vt, wf) = fr.after_step(
-                ops,
-                &self.u,
-                &self.v,
-                &self.mv,
-                &self.lambda,
-                self.gamma,
-                t,
-                self.tau,
-            );
+            let (ft, vt, wf) = fr.after_step(ops, &self.u, &self.v, &self.mv, &self.lambda, t);
             self.obs.set_friction(ft, vt, wf);
         }
         let e_prev = self.obs.last_energy();
@@ -2439,9 +2437,8 @@ impl<'a> Stepper<'a> {
             fr.tally.finish(metrics, scale, vt, fr.mean_v[2]);
         }
         if let Some(fr) = &self.friction {
-            let e0 = metrics.energy_initial.unwrap_or(0.0);
             let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
-            fr.finish(metrics, scale, e0, self.done);
+            fr.finish(metrics, scale);
         }
         let reference = match self.record {
             Some((_, data)) if status == Status::Ok => Some(data),

@@ -902,11 +902,15 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     // Friction (module header): f̄_t's weight of f_t^{n+1} is generalized-α's 1 − α_f, the
     // other methods' force of the step itself.
     // Friction with Nitsche/penalty (generalized-α/HHT only; module header): the engine's
-    // frictional state, f̄_t's weight of f_t^{n+1} 1 − α_f, passed per step.
+    // frictional state, f̄_t's weight of f_t^{n+1} 1 − α_f.
     let mut nit_fric = match (nit, meth) {
-        (Some(o), Method::Alpha(_)) if o.friction.is_some() => {
-            Some(FrictionState::new(o, cfg.friction, mean_velocity(g, m)))
-        }
+        (Some(o), Method::Alpha(p)) if o.friction.is_some() => Some(FrictionState::new(
+            o,
+            cfg.friction,
+            mean_velocity(g, m),
+            1.0 - p.alpha_f,
+            cfg.setup.h,
+        )),
         (Some(o), _) if o.friction.is_some() => {
             return fail(
                 Status::Invalid,
@@ -1268,7 +1272,7 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                                 // Friction (fe_nitsche header, coefficient c): x0 = P y +
                                 // k u_tⁿ (the slip from uⁿ), λ the previous step's forces
                                 // (the warm start), kept for f̄_t.
-                                st.start_step(ops, &y, &u, &lambda, &mut q);
+                                st.start_step(ops, &y, &u, &mut q);
                                 newton_friction(
                                     ops,
                                     st.law,
@@ -1505,11 +1509,9 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
                 fr.end(&u);
             }
             let mut fv = fric.as_ref().map(|fr| fr.series(&v));
-            if let (Some(st), Some(ops), Method::Alpha(ga)) = (nit_fric.as_mut(), nit, meth) {
+            if let (Some(st), Some(ops)) = (nit_fric.as_mut(), nit) {
                 // W_f with generalized-α's f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ (SPEC §2.5).
-                let t = step as f64 * tau;
-                let (ft, vt, wf) =
-                    st.after_step(ops, &u, &v, &mv, &lambda, 1.0 - ga.alpha_f, t, tau);
+                let (ft, vt, wf) = st.after_step(ops, &u, &v, &mv, &lambda, step as f64 * tau);
                 fv = Some([ft, vt, wf]);
             }
             let e = observe_timer
@@ -1552,9 +1554,8 @@ pub(super) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> O
     }
     if let Some(st) = &nit_fric {
         // As the engine's frictional Nitsche/penalty runs ([`super::Stepper`]).
-        let e0 = metrics.energy_initial.unwrap_or(0.0);
         let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
-        st.finish(&mut metrics, scale, e0, done);
+        st.finish(&mut metrics, scale);
     }
     let reference = match record {
         Some((_, data)) if status == Status::Ok => Some(data),

@@ -43,7 +43,7 @@
 //! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
 //! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
 
-use super::friction_tally::{MeanVelocity, ratio_step};
+use super::friction_tally::{FrictionTally, MeanVelocity};
 use crate::contact::friction::FrictionLaw;
 use crate::space::fe::nitsche::ContactPoint;
 
@@ -717,75 +717,57 @@ pub(crate) fn newton(
     ))
 }
 
-/// A frictional run's state besides the engine's (SPEC §2.5): the slip's reference u_t^n, the
-/// previous step's forces (for f̄ in W_f), and the friction tally of the run (SPEC §5's
-/// friction columns: the apparent coefficient |Σf_t|/Σf_n from the points' summed forces, as
-/// [`FrictionTally`](super::friction_tally::FrictionTally) for nodes; the body's mean
-/// velocities per axis from M v; the series' Γ_C mean of v_1 over the points), all allocated
-/// once per run.
+/// A frictional run's state besides the engine's (SPEC §2.5): the slip's reference u_t^n,
+/// the points' stick/slip states from the contact solve, and the run's
+/// [`FrictionTally`] over the quadrature points (W_f with the scheme's f̄_t, E + W_f, the
+/// apparent coefficient |Σf_t|/Σf_n, `stop_time` — the mixed engines' accounting, with
+/// Nitsche's stick decided by its cone); the body's mean velocities per axis from M v and the
+/// series' Γ_C mean of v_1 over the points. All allocated once per run.
 #[derive(Debug)]
 pub(crate) struct FrictionState {
     pub law: FrictionLaw,
-    /// u_t,q^n per point and direction, set by the step's contact solve from u^n.
+    /// u_t,q^n per point and direction, set by the step's contact solve from u^n; then Δu_t.
     pub ut_n: Vec<f64>,
-    /// λ of the previous step (point-major, d per point).
-    pub lambda_prev: Vec<f64>,
+    du_t: Vec<f64>,
     /// Whether each point slides (the disc projection active) at the last step.
     pub slides: Vec<bool>,
-    /// The body's mean velocities per axis 1ᵀMv/1ᵀM1, and Σ_q w_q (the Γ_C means' divisor).
+    tally: FrictionTally,
+    /// The body's mean velocities per axis 1ᵀMv/1ᵀM1 (the last step's in `means`), and
+    /// Σ_q w_q (the Γ_C means' divisor).
     mean: MeanVelocity,
-    weight_sum: f64,
-    /// W_f (raw), the last E + W_f, the largest one-step rise of E + W_f, the smallest
-    /// one-step tangential work −Σ f_t^{n+1}·Δu_t (raw), point-steps in stick and in slip,
-    /// max over the contact steps of |Σ_q f_t,q|/Σ_q f_n,q.
-    pub work: f64,
-    balance_prev: f64,
-    balance_max_increase: f64,
-    pub tangential_work_min: f64,
-    pub stick_steps: i64,
-    pub slip_steps: i64,
-    pub ratio_max: Option<f64>,
-    /// The mean velocities [v̄_1, v̄_2, v̄_d] of the last step; v̄_1 of the one before and the
-    /// first time it reached 0.
     means: [f64; 3],
-    vt_prev: f64,
-    pub stop_time: Option<f64>,
+    weight_sum: f64,
+    /// Whether E⁰ is in the tally (the first [`Self::balance`]).
+    balanced: bool,
 }
 
 impl FrictionState {
-    /// For `ops` (with friction), the run's law and the body's mean velocities `mean`.
-    pub fn new(ops: &NitscheOps, law: FrictionLaw, mean: MeanVelocity) -> FrictionState {
+    /// For `ops` (with friction), the run's law, the body's mean velocities `mean` and the
+    /// weight of f_t^{n+1} in f̄_t (SPEC §2.5: the scheme's γ or θ, generalized-α's 1 − α_f);
+    /// `h` the mesh size (the tally's increment rule, unused here: the cone decides).
+    pub fn new(
+        ops: &NitscheOps,
+        law: FrictionLaw,
+        mean: MeanVelocity,
+        weight: f64,
+        h: f64,
+    ) -> FrictionState {
         let td = ops.friction.as_ref().map_or(0, |f| f.td);
         FrictionState {
             law,
             ut_n: vec![0.0; ops.len() * td],
-            lambda_prev: vec![0.0; ops.unknowns()],
+            du_t: vec![0.0; ops.len() * td],
             slides: vec![false; ops.len()],
+            tally: FrictionTally::new(ops.len(), ops.per_point(), h, weight),
             mean,
-            weight_sum: ops.w.iter().sum(),
-            work: 0.0,
-            balance_prev: f64::NAN,
-            balance_max_increase: f64::NEG_INFINITY,
-            tangential_work_min: f64::INFINITY,
-            stick_steps: 0,
-            slip_steps: 0,
-            ratio_max: None,
             means: [f64::NAN; 3],
-            vt_prev: f64::NAN,
-            stop_time: None,
+            weight_sum: ops.w.iter().sum(),
+            balanced: false,
         }
     }
 
-    /// x0 = P y with the tangential rows' k_q u_t^n (module header), u_t^n kept; `lambda`
-    /// (the previous step's forces) saved for W_f.
-    pub fn start_step(
-        &mut self,
-        ops: &NitscheOps,
-        y: &[f64],
-        u_n: &[f64],
-        lambda: &[f64],
-        x0: &mut [f64],
-    ) {
+    /// x0 = P y with the tangential rows' k_q u_t^n (module header), u_t^n kept.
+    pub fn start_step(&mut self, ops: &NitscheOps, y: &[f64], u_n: &[f64], x0: &mut [f64]) {
         let f = ops
             .friction
             .as_ref()
@@ -803,17 +785,12 @@ impl FrictionState {
                 *x += f.kt[q] * ut;
             }
         }
-        self.lambda_prev.copy_from_slice(lambda);
     }
 
-    /// After step n's update (u = u^{n+1}, v = v^{n+1}, `mv` = M v^{n+1}): W_f −= Σ f̄_t·Δu_t
-    /// with f̄ = (1−γ)λ_t^n + γλ_t^{n+1} (SPEC §2.5, `weight` = the scheme's γ or θ,
-    /// generalized-α's 1 − α_f; λ_t includes the point's weight), the step's tangential work,
-    /// stick/slip of the points in contact and |Σλ_t|/Σλ_n over them (SPEC §5; the weights
-    /// make the sums the total forces), the mean velocities and v̄_1's first zero. Returns
-    /// (Σ λ_t along e_1 — the total tangential force on the body —, the Γ_C mean of v_1
-    /// Σ_q w_q v_1(x_q)/Σ_q w_q with v_1(x_q) from the points' e_1 rows, W_f).
-    #[allow(clippy::too_many_arguments)]
+    /// After step n's update (u = u^{n+1}, v = v^{n+1}, `mv` = M v^{n+1}, `lambda` = λ^{n+1},
+    /// point-major [λ_n, λ_t…] with the points' weights): the tally's step over the points'
+    /// Δu_t and states, the mean velocities at `t`. Returns (Σ λ_t along e_1 — the total
+    /// tangential force on the body —, the Γ_C mean of v_1, W_f).
     pub fn after_step(
         &mut self,
         ops: &NitscheOps,
@@ -821,22 +798,15 @@ impl FrictionState {
         v: &[f64],
         mv: &[f64],
         lambda: &[f64],
-        weight: f64,
         t: f64,
-        tau: f64,
     ) -> (f64, f64, f64) {
         let f = ops
             .friction
             .as_ref()
             .expect("a frictional run has tangential rows");
-        let d = ops.per_point();
-        let mut step_work = 0.0;
-        // Σλ_n, Σλ_t (e_1, e_2) over the points in contact (a point out of contact has λ = 0),
-        // and Σ_q w_q v_1(x_q).
-        let (mut sum_n, mut sum_t, mut wv) = (0.0, [0.0; 2], 0.0);
+        let mut wv = 0.0;
         for q in 0..ops.len() {
             let dofs = &ops.dofs[q * ops.k..(q + 1) * ops.k];
-            let ln = lambda[q * d];
             for i in 0..f.td {
                 let r = q * f.td + i;
                 let urow = &f.ut[r * ops.k..(r + 1) * ops.k];
@@ -844,76 +814,40 @@ impl FrictionState {
                 if i == 0 {
                     wv += ops.w[q] * urow.iter().zip(dofs).map(|(a, &g)| a * v[g]).sum::<f64>();
                 }
-                let du = ut - self.ut_n[r];
-                let (l0, l1) = (self.lambda_prev[q * d + 1 + i], lambda[q * d + 1 + i]);
-                self.work -= ((1.0 - weight) * l0 + weight * l1) * du;
-                step_work -= l1 * du;
-                if ln > 0.0 {
-                    sum_t[i] += l1;
-                }
-            }
-            if ln > 0.0 {
-                sum_n += ln;
-                if self.slides[q] {
-                    self.slip_steps += 1;
-                } else {
-                    self.stick_steps += 1;
-                }
+                self.du_t[r] = ut - self.ut_n[r];
             }
         }
-        ratio_step(&mut self.ratio_max, sum_n, sum_t);
-        self.tangential_work_min = self.tangential_work_min.min(step_work);
-        self.vt_prev = self.means[0];
+        let work = self.tally.step_with(lambda, &self.du_t, Some(&self.slides));
         self.mean.means_into(mv, &mut self.means);
-        let v1 = self.means[0];
-        if self.stop_time.is_none() && self.vt_prev != 0.0 && self.vt_prev * v1 <= 0.0 {
-            // Linear interpolation between the two steps where it changes sign (SPEC §1.8).
-            self.stop_time = Some(t - tau + tau * self.vt_prev / (self.vt_prev - v1));
-        }
+        self.tally.velocity(t, self.means[0]);
         let v_contact = if self.weight_sum > 0.0 {
             wv / self.weight_sum
         } else {
             0.0
         };
-        (sum_t[0], v_contact, self.work)
+        (self.tally.total_tangential()[0], v_contact, work)
     }
 
     /// Step 0: the initial mean velocities.
     pub fn start(&mut self, mv: &[f64]) {
         self.mean.means_into(mv, &mut self.means);
+        self.tally.velocity(0.0, self.means[0]);
     }
 
-    /// After step n's observation: the rise of E + W_f from E^n (+ W_f^n) to `energy` E^{n+1}
-    /// (+ W_f^{n+1}); `e_prev` is E^n, used at the first step (W_f⁰ = 0).
+    /// After step n's observation: E^{n+1} = `energy` into the tally (E + W_f's rise); `e_prev`
+    /// is E^n, taken as E⁰ at the first step.
     pub fn balance(&mut self, e_prev: f64, energy: f64) {
-        if self.balance_prev.is_nan() {
-            self.balance_prev = e_prev;
+        if !self.balanced {
+            self.tally.energy(e_prev);
+            self.balanced = true;
         }
-        let b = energy + self.work;
-        self.balance_max_increase = self.balance_max_increase.max(b - self.balance_prev);
-        self.balance_prev = b;
+        self.tally.energy(energy);
     }
 
-    /// The friction columns (SPEC §5), energies over `scale`, the drift of E + W_f from `e0`.
-    pub fn finish(&self, m: &mut super::Metrics, scale: f64, e0: f64, steps: usize) {
-        m.friction_work = Some(self.work / scale);
-        m.energy_balance_drift = Some((self.balance_prev - e0) / scale);
-        m.energy_balance_max_increase = Some(if steps > 0 {
-            self.balance_max_increase / scale
-        } else {
-            0.0
-        });
-        m.stick_steps = Some(self.stick_steps);
-        m.slip_steps = Some(self.slip_steps);
-        m.friction_ratio_max = self.ratio_max;
-        m.tangential_work_min = Some(if steps > 0 {
-            self.tangential_work_min / scale
-        } else {
-            0.0
-        });
-        m.tangential_velocity_final = Some(self.mean.tangential(&self.means));
-        m.normal_velocity_final = Some(self.means[2]);
-        m.stop_time = self.stop_time;
+    /// The friction columns (SPEC §5), energies over `scale`.
+    pub fn finish(&self, m: &mut super::Metrics, scale: f64) {
+        let vt = self.mean.tangential(&self.means);
+        self.tally.finish(m, scale, vt, self.means[2]);
     }
 }
 
@@ -1005,14 +939,14 @@ mod tests {
         (0..4).for_each(|i| eye[i * 5] = 1.0);
         let m = SymMatrix::from_dense(4, &eye).unwrap();
         let law = FrictionLaw::Coulomb { coefficient: 0.5 };
-        let mut st = FrictionState::new(&ops, law, MeanVelocity::new(2, &m, |r| r % 2));
+        let mut st = FrictionState::new(&ops, law, MeanVelocity::new(2, &m, |r| r % 2), 0.5, 1.0);
         let v = [1.0, 0.0, 3.0, 0.0];
         st.start(&v);
         let lambda = [1.0, 0.5, 3.0, -1.5];
-        let (ft, v_contact, _) = st.after_step(&ops, &[0.0; 4], &v, &v, &lambda, 0.5, 1.0, 1.0);
+        let (ft, v_contact, _) = st.after_step(&ops, &[0.0; 4], &v, &v, &lambda, 1.0);
         assert_eq!((ft, v_contact), (-1.0, 2.5));
         let mut metrics = crate::run::Metrics::default();
-        st.finish(&mut metrics, 1.0, 0.0, 1);
+        st.finish(&mut metrics, 1.0);
         assert_eq!(metrics.friction_ratio_max, Some(0.25));
         assert_eq!(metrics.tangential_velocity_final, Some(2.0));
         assert_eq!(metrics.normal_velocity_final, Some(0.0));

@@ -87,7 +87,7 @@ impl MeanVelocity {
 /// One step's apparent friction coefficient |Σf_t|/Σf_n (the sums over the contact points, the
 /// tangential one a vector in 3D) into the running maximum `ratio_max`; a step without normal
 /// force has none.
-pub(crate) fn ratio_step(ratio_max: &mut Option<f64>, sum_n: f64, sum_t: [f64; 2]) {
+fn ratio_step(ratio_max: &mut Option<f64>, sum_n: f64, sum_t: [f64; 2]) {
     if sum_n > 0.0 {
         let r = (sum_t[0] * sum_t[0] + sum_t[1] * sum_t[1]).sqrt() / sum_n;
         *ratio_max = Some(ratio_max.map_or(r, |m| m.max(r)));
@@ -153,6 +153,13 @@ impl FrictionTally {
     /// Step n → n+1: the forces f^{n+1} (`points`·d, node-major) and the increments Δu_t
     /// (`points`·(d − 1), node-major). Returns W_f^{n+1}.
     pub fn step(&mut self, forces: &[f64], du_t: &[f64]) -> f64 {
+        self.step_with(forces, du_t, None)
+    }
+
+    /// [`Self::step`] with each point's stick/slip state given (`slides[i]`: point i slides)
+    /// instead of the increment rule: Nitsche's and the penalty's regularised stick, decided
+    /// by their cone at the quadrature points (the Γ_C contact solve's own state).
+    pub fn step_with(&mut self, forces: &[f64], du_t: &[f64], slides: Option<&[bool]>) -> f64 {
         let (d, t) = (self.d, self.d - 1);
         assert_eq!(forces.len(), self.points * d, "d forces per point");
         assert_eq!(du_t.len(), self.points * t, "d − 1 increments per point");
@@ -174,7 +181,8 @@ impl FrictionTally {
             }
             sum_n += f_n;
             if f_n > 0.0 {
-                if du2.sqrt() <= self.stick_tol {
+                let stuck = slides.map_or(du2.sqrt() <= self.stick_tol, |s| !s[i]);
+                if stuck {
                     self.stick += 1;
                 } else {
                     self.slip += 1;
