@@ -265,16 +265,20 @@ fn num_of(r: &contact_sweep::sweep::RunSpec, k: Key) -> f64 {
     r.params[&k].as_f64().unwrap()
 }
 
+/// The sweep examples of the project's own docs plan verbatim: the guide's (4 schemes × 3 zipped
+/// levels) and the numerical contract's §7 example (two explicit Newmark bundles, backward
+/// Euler, CN and hybrid: 5 schemes × 3 levels), each the first TOML block of its page.
 #[test]
-fn the_example_of_spec_section_7_is_accepted_verbatim() {
-    let spec = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/SPEC.md"))
-        .expect("../shared/SPEC.md beside the checkout");
-    let start = spec.find("```toml\n").expect("a toml block") + "```toml\n".len();
-    let end = start + spec[start..].find("```").unwrap();
-    let p = plan(&spec[start..end]);
-    // 5 schemes (two explicit Newmark bundles, backward Euler, CN, hybrid) × 3 zipped levels.
-    assert_eq!(p.runs.len(), 15);
-    assert_eq!(p.sweep.name, "nitsche-energy");
+fn the_sweep_examples_of_the_docs_are_accepted_verbatim() {
+    for (page, runs) in [("docs/guide.md", 12), ("docs/contract.md", 15)] {
+        let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join(page))
+            .unwrap_or_else(|e| panic!("{page}: {e}"));
+        let start = text.find("```toml\n").expect("a toml block") + "```toml\n".len();
+        let end = start + text[start..].find("```").unwrap();
+        let p = plan(&text[start..end]);
+        assert_eq!(p.runs.len(), runs, "{page}");
+        assert_eq!(p.sweep.name, "nitsche-energy", "{page}");
+    }
 }
 
 fn plan_err(text: &str) -> String {

@@ -14,6 +14,93 @@ fn readme_schema_matches_the_code() {
     );
 }
 
+/// The README's test command: `cargo test --release` behind a virtual environment for the
+/// Python tests (scripts/test.sh), because Debian's and Ubuntu's python3 refuse `pip install`.
+const TEST_COMMAND: &str = "scripts/test.sh";
+
+/// Issue 41: the README's test command is what CI runs — `.ci/run` calls that very string, in a
+/// fresh clone with Debian's python3 first on PATH — and the script it names keeps the
+/// environment in the tree (git-ignored), installs the requirements there, puts it first on
+/// PATH and runs every test.
+#[test]
+fn the_readme_test_command_is_what_ci_runs() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        readme.contains(&format!("```sh\n{TEST_COMMAND}\n```")),
+        "the README's test command is not `{TEST_COMMAND}` alone in its block"
+    );
+    let ci = std::fs::read_to_string(root.join(".ci/run")).unwrap();
+    assert!(
+        ci.contains(&format!("readme_test_command() {{\n    {TEST_COMMAND}\n}}"))
+            && ci.contains("\nreadme_test_command\n"),
+        ".ci/run does not run the README's test command `{TEST_COMMAND}` as printed"
+    );
+    for needle in [
+        "git clone",
+        "/usr/bin/python3",
+        "tests/slurm/start-local-slurm.sh",
+    ] {
+        assert!(ci.contains(needle), ".ci/run lost `{needle}`");
+    }
+    let script = std::fs::read_to_string(root.join(TEST_COMMAND)).unwrap();
+    for needle in [
+        "python3 -m venv",
+        "python3-venv",
+        "-r analysis/requirements.txt",
+        "export PATH=\"$VIRTUAL_ENV/bin:$PATH\"",
+        "cargo test --release",
+    ] {
+        assert!(script.contains(needle), "{TEST_COMMAND} lost `{needle}`");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(root.join(TEST_COMMAND))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert!(mode & 0o111 != 0, "{TEST_COMMAND} is not executable");
+    }
+    let ignore = std::fs::read_to_string(root.join(".gitignore")).unwrap();
+    assert!(
+        ignore.lines().any(|l| l == "/.venv"),
+        ".venv is not ignored"
+    );
+}
+
+/// Issue 41: the project stands on its own — no file of the tree (target, .git and the
+/// virtual environment aside) names a path beside the checkout.
+#[test]
+fn nothing_names_a_path_outside_the_tree() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let needle = concat!("..", "/shared").as_bytes();
+    let mut stack = vec![root.to_path_buf()];
+    let mut hits = Vec::new();
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().into_owned();
+            let path = e.path();
+            if e.file_type().unwrap().is_dir() {
+                if !matches!(name.as_str(), "target" | ".git" | ".venv" | "out") {
+                    stack.push(path);
+                }
+            } else if std::fs::read(&path)
+                .unwrap()
+                .windows(needle.len())
+                .any(|w| w == needle)
+            {
+                hits.push(path.strip_prefix(root).unwrap().display().to_string());
+            }
+        }
+    }
+    assert!(
+        hits.is_empty(),
+        "files naming a path outside the tree: {hits:?}"
+    );
+}
+
 /// Issue 25: a newcomer reaches the two commands within the first screen, the README stays
 /// under 250 lines, and every page of docs/ (and CONTRIBUTING.md) is linked from it; every
 /// relative link of the README and the docs points at a file that exists.
@@ -26,7 +113,7 @@ fn readme_is_short_and_links_every_doc_page() {
     let first_screen = lines[..lines.len().min(50)].join("\n");
     for cmd in [
         "cargo run --release -- run sweeps/quickstart.toml",
-        "python3 -m pip install -r analysis/requirements.txt && cargo test --release",
+        TEST_COMMAND,
     ] {
         assert!(
             first_screen.contains(cmd),
@@ -82,7 +169,7 @@ fn readme_sweep_example_is_a_valid_sweep() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let plan = contact_sweep::sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"));
-    // SPEC §7's example: [zip] h, dt (3 levels) override [fixed] h, dt; × 4 schemes = 12 runs.
+    // The contract's §7 example: [zip] h, dt (3 levels) override [fixed] h, dt; × 4 schemes = 12 runs.
     assert_eq!(plan.runs.len(), 12);
     assert!(
         plan.summary().contains("fixed.h is overridden by [zip]"),

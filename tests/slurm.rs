@@ -1,7 +1,8 @@
 //! A sweep through a real scheduler: `contact-sweep slurm --submit` on the one-node Slurm that
-//! `../shared/slurm/start-local-slurm.sh` brings up (installing slurm-wlm and munge if needed;
-//! needs root, as in CI). Three array tasks write shards into one folder; the dependent summary
-//! job summarizes them.
+//! the project's `tests/slurm/start-local-slurm.sh` brings up (installing slurm-wlm and munge
+//! if needed; needs root, as in CI). Three array tasks write shards into one folder; the
+//! dependent summary job summarizes them. The cluster stays up between tests (the script is
+//! idempotent); `tests/slurm/stop-local-slurm.sh` stops it.
 
 mod common;
 
@@ -27,14 +28,10 @@ method = [
 ]
 "#;
 
-#[test]
-fn a_job_array_runs_the_sweep_in_shards_and_summarizes_it() {
-    let start = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/slurm/start-local-slurm.sh");
-    assert!(
-        start.exists(),
-        "{} not found (shared/ beside the checkout)",
-        start.display()
-    );
+/// Bring up (or find up) the one-node cluster of `tests/slurm/start-local-slurm.sh`; its output
+/// is shown when it fails (the install log and the daemons' logs' tails).
+fn start_local_slurm() {
+    let start = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/slurm/start-local-slurm.sh");
     let up = Command::new("bash")
         .arg(&start)
         .env("SLURM_LOCAL_MIN_JOB_AGE", "600")
@@ -46,6 +43,11 @@ fn a_job_array_runs_the_sweep_in_shards_and_summarizes_it() {
         String::from_utf8_lossy(&up.stdout),
         String::from_utf8_lossy(&up.stderr)
     );
+}
+
+#[test]
+fn a_job_array_runs_the_sweep_in_shards_and_summarizes_it() {
+    start_local_slurm();
 
     let tmp = tempfile::tempdir().unwrap();
     write(tmp.path(), "s.toml", SWEEP);
@@ -137,13 +139,7 @@ fn a_bad_sweep_never_reaches_the_queue() {
 /// tasks depend on it (afterok) and read the stored solution instead of computing it again.
 #[test]
 fn a_reference_job_runs_before_the_array_and_every_task_reuses_it() {
-    let start = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/slurm/start-local-slurm.sh");
-    let up = Command::new("bash")
-        .arg(&start)
-        .env("SLURM_LOCAL_MIN_JOB_AGE", "600")
-        .output()
-        .expect("bash runs");
-    assert!(up.status.success(), "local Slurm did not start");
+    start_local_slurm();
     let tmp = tempfile::tempdir().unwrap();
     write(
         tmp.path(),
@@ -262,13 +258,7 @@ fn rows_without_timing(dir: &Path) -> polars::prelude::DataFrame {
 /// resubmission, which completes the folder with no duplicate.
 #[test]
 fn a_cancelled_task_is_completed_by_the_resubmission_status_prints() {
-    let start = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/slurm/start-local-slurm.sh");
-    let up = Command::new("bash")
-        .arg(&start)
-        .env("SLURM_LOCAL_MIN_JOB_AGE", "600")
-        .output()
-        .expect("bash runs");
-    assert!(up.status.success(), "local Slurm did not start");
+    start_local_slurm();
     let tmp = tempfile::tempdir().unwrap();
     write(tmp.path(), "s.toml", SCALE);
 
