@@ -54,8 +54,10 @@ ensure_venv_module() {
 if ! { [ -x "$venv/bin/python3" ] && "$venv/bin/python3" -m pip --version >/dev/null 2>&1; }; then
     ensure_venv_module
     rm -rf "$venv"
-    say "creating the virtual environment $venv with $(command -v python3) ($(python3 --version 2>&1))"
-    python3 -m venv "$venv"
+    # The interpreter itself, not a link or shim to it, so the environment outlives a PATH entry.
+    py=$(python3 -c 'import os, sys; print(os.path.realpath(sys.executable))')
+    say "creating the virtual environment $venv with $py ($(python3 --version 2>&1))"
+    "$py" -m venv "$venv"
 fi
 
 # Install the requirements when they changed since the last successful install (a stamp of
