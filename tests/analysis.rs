@@ -1,7 +1,8 @@
 //! The analysis/ scripts on a real sweep: every figure is drawn and none is blank.
 //!
-//! Needs python3 with analysis/requirements.txt installed (the README's test command installs
-//! it); a missing interpreter or package fails the test with that instruction.
+//! Needs python3 with analysis/requirements.txt installed: the README's test command,
+//! `scripts/test.sh`, puts a virtual environment holding them first on PATH; a missing
+//! interpreter or package fails the test with that instruction.
 
 mod common;
 
@@ -48,10 +49,10 @@ fn analysis_scripts_draw_every_figure_of_a_small_sweep() {
             .arg("--out")
             .arg(&figs)
             .output()
-            .expect("python3 runs (pip install -r analysis/requirements.txt)");
+            .expect("python3 runs (scripts/test.sh: a venv with analysis/requirements.txt)");
         assert!(
             o.status.success(),
-            "{script} failed — is analysis/requirements.txt installed?\n{}",
+            "{script} failed — is analysis/requirements.txt installed (scripts/test.sh)?\n{}",
             String::from_utf8_lossy(&o.stderr)
         );
     }
@@ -118,11 +119,11 @@ fn energy_impacts_figure_of_a_short_disc_sweep() {
         .arg("--stem")
         .arg("disc_energy")
         .output()
-        .expect("python3 runs (pip install -r analysis/requirements.txt)");
+        .expect("python3 runs (scripts/test.sh: a venv with analysis/requirements.txt)");
     let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
     assert!(
         o.status.success(),
-        "plot_energy_impacts.py failed — is analysis/requirements.txt installed?\n{}",
+        "plot_energy_impacts.py failed — is analysis/requirements.txt installed (scripts/test.sh)?\n{}",
         String::from_utf8_lossy(&o.stderr)
     );
     let runs = contact_sweep::sink::read_runs(&out).unwrap();
@@ -217,7 +218,7 @@ sys.exit(1 if problems else 0)
         .arg(&out)
         .arg(contact_sweep::model::ERROR_COLUMNS.join(","))
         .output()
-        .expect("python3 runs (pip install -r analysis/requirements.txt)");
+        .expect("python3 runs (scripts/test.sh: a venv with analysis/requirements.txt)");
     assert!(
         o.status.success(),
         "{}{}",

@@ -43,7 +43,8 @@ fn readers() {
             .expect("python3 runs");
         assert!(
             o.status.success(),
-            "pip install -r analysis/requirements.txt failed:\n{}",
+            "pip install -r analysis/requirements.txt failed (run the tests with scripts/test.sh: \
+             Debian's and Ubuntu's python3 refuse pip outside a virtual environment):\n{}",
             String::from_utf8_lossy(&o.stderr)
         );
     });
