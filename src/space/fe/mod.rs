@@ -10,9 +10,11 @@
 //!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
 //! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, parsed by [`msh`], the engine's own parser
 //!   that cannot panic) of the `mesh2d`/`mesh3d` scenes: P1/P2 triangles and tetrahedra, Q1/Q2
-//!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s;
-//!   the whole-mesh checks — conformity, coincident nodes, boundary groups, certified det J —
-//!   in `check`), with `h` and the file's content hash;
+//!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s,
+//!   in `gmsh_error`; the whole-mesh checks — conformity, coincident nodes, boundary groups,
+//!   certified det J — in `check`), with `h` and the file's content hash; the facts of the
+//!   reference cells both stand on ([`ElementKind`]: node orders, shape gradients, det J) in
+//!   `element_kind`, below both;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`simplex`]: vector P1/P2 triangle and tetrahedron mass, elasticity stiffness, grad-grad
@@ -29,7 +31,9 @@
 pub mod ball;
 mod check;
 pub mod element;
+mod element_kind;
 pub mod gmsh;
+mod gmsh_error;
 pub mod locate;
 pub mod mesh;
 pub mod msh;
