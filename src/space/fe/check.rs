@@ -518,6 +518,20 @@ impl Hasher for Fx {
     }
 }
 
+/// The corners (lowest, highest coordinate per axis) of the box around the points `c`: the
+/// body's size, which the tolerances of the coincident-node and 2D-plane checks are relative to.
+pub(crate) fn bounding_box(c: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in c {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
 /// Relative distance under which two distinct nodes coincide: far below any cell a mesh
 /// generator makes (a cell that small is refused as degenerate, relative det J 10⁻¹⁰), far
 /// above the rounding of coordinates written with 16 digits.
@@ -526,14 +540,7 @@ pub(crate) const COINCIDENT: f64 = 1e-10;
 /// The first pair of distinct nodes closer than [`COINCIDENT`] × the body's size, with their
 /// distance.
 pub(crate) fn coincident_nodes(dim: usize, coords: &[[f64; 3]]) -> Result<(), (usize, usize, f64)> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in coords {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = bounding_box(coords);
     let size = (0..dim).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     if coords.len() < 2 || size <= 0.0 {
         return Ok(());

@@ -357,7 +357,7 @@ impl Nodes {
     /// A 2D mesh lies in one plane z = const (to 10⁻¹² of its size), then z := 0.
     fn flatten_2d(&mut self, file: &str) -> Result<(), GmshError> {
         let coords = &mut self.coords;
-        let (lo, hi) = bounding_box(coords);
+        let (lo, hi) = check::bounding_box(coords);
         let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max).max(1.0);
         let z0 = coords[0][2];
         if let Some(i) = coords.iter().position(|c| (c[2] - z0).abs() > 1e-12 * size) {
@@ -733,18 +733,6 @@ fn require_contact(file: &str, groups: &[PhysicalGroup]) -> Result<(), GmshError
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
-fn bounding_box(c: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in c {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
 }
 
 /// The `$MeshFormat` header must be the first section and say version 4.1.

@@ -422,12 +422,12 @@ pub fn parse(bytes: &[u8]) -> Result<MshFile, MshError> {
                 "Nodes" => {
                     c.section = "$Nodes";
                     c.binary = out.binary;
-                    out.node_blocks = nodes(&mut c)?;
+                    out.node_blocks = blocks(&mut c, "node", node_block)?;
                 }
                 "Elements" => {
                     c.section = "$Elements";
                     c.binary = out.binary;
-                    out.element_blocks = elements(&mut c)?;
+                    out.element_blocks = blocks(&mut c, "element", element_block)?;
                 }
                 _ => {
                     c.section = "$PartitionedEntities";
@@ -655,17 +655,9 @@ fn blocks<'a, T>(
     Ok(out)
 }
 
-fn nodes(c: &mut Cur) -> Result<Vec<NodeBlock>, MshError> {
-    blocks(c, "node", node_block)
-}
-
 /// One block of `$Nodes` after its entity: the parametric flag, the node tags, then their
 /// coordinates (parametric ones skipped).
-fn node_block(
-    c: &mut Cur,
-    entity_dim: i32,
-    entity_tag: i32,
-) -> Result<(NodeBlock, usize), MshError> {
+fn node_block(c: &mut Cur, entity_dim: i32, tag: i32) -> Result<(NodeBlock, usize), MshError> {
     let parametric = c.int("the parametric flag")?;
     if !(0..=1).contains(&parametric) {
         return Err(c.err(format!("parametric flag {parametric}, expected 0 or 1")));
@@ -698,15 +690,11 @@ fn node_block(
     }
     let block = NodeBlock {
         entity_dim,
-        entity_tag,
+        entity_tag: tag,
         tags,
         coords,
     };
     Ok((block, n))
-}
-
-fn elements(c: &mut Cur) -> Result<Vec<ElementBlock>, MshError> {
-    blocks(c, "element", element_block)
 }
 
 /// One block of `$Elements` after its entity: the element type (supported, of the entity's
