@@ -26,7 +26,8 @@
 //!
 //! Degrees of freedom are node-major interleaved: dof = node·d + component. Constrained dofs
 //! (Dirichlet: clamped face, rollers) are dropped from the assembled matrices by [`DofMap`];
-//! the factorisation of the assembled matrices is [`crate::space::linalg`].
+//! the factorisation of the assembled matrices is the sparse Cholesky of `space/linalg.rs` (which
+//! builds on this folder, not the other way round).
 
 pub mod ball;
 mod check;
@@ -124,7 +125,7 @@ impl DofMap {
 
     /// The free dofs (reduced indices) in the order of `node_order`, components of a node
     /// together: turns a node ordering (e.g. [`BoxMesh::nested_dissection`]) into an elimination
-    /// order for [`crate::space::linalg::SymbolicCholesky::with_ordering`].
+    /// order for `SymbolicCholesky::with_ordering` (`space/linalg.rs`).
     pub fn order_by_nodes(&self, node_order: &[usize], dim: usize) -> Vec<usize> {
         let mut out = Vec::with_capacity(self.n_free());
         for &n in node_order {
