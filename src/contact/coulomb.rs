@@ -481,13 +481,41 @@ impl FrictionalContact {
         q_n: &[f64],
         q_t: &[f64],
     ) -> Result<(), FrictionalContactError> {
-        let (m, d) = (self.m, self.d);
-        let n = m * d;
         let slope = match *law {
             FrictionLaw::Coulomb { coefficient } => coefficient,
             _ => 0.0,
         };
-        // Unknowns: f_n of every closed node, f_t unless eliminated (2D slip).
+        let k = self.number_unknowns();
+        let has_slip3 = self
+            .state
+            .iter()
+            .any(|s| matches!(s, NodeState::Slip3 { .. }));
+        let has_graze = self.extra.iter().any(|x| x.graze.is_some());
+        let reuse = self.lu_valid
+            && !has_slip3
+            && !has_graze
+            && self.lu_slope == slope
+            && self.lu_k == k
+            && self.lu_state == self.state
+            && self.lu_extra == self.extra;
+        self.assemble_rows(law, weights, q_n, q_t, slope, reuse);
+        if !reuse {
+            lu_factor(&mut self.mat[..k * k], k, &mut self.piv[..k])?;
+            self.lu_state.copy_from_slice(&self.state);
+            self.lu_slope = slope;
+            self.lu_k = k;
+            self.lu_extra.copy_from_slice(&self.extra);
+            self.lu_valid = !has_slip3 && !has_graze;
+        }
+        lu_solve(&self.mat[..k * k], k, &self.piv[..k], &mut self.rhs[..k]);
+        self.write_trial(law, weights, slope);
+        Ok(())
+    }
+
+    /// Unknowns: f_n of every closed node, f_t unless eliminated (2D slip); their indices into
+    /// `col`, their number into `k` (returned).
+    fn number_unknowns(&mut self) -> usize {
+        let (m, d) = (self.m, self.d);
         let mut k = 0;
         for i in 0..m {
             for c in 0..d {
@@ -503,20 +531,23 @@ impl FrictionalContact {
             }
         }
         self.k = k;
-        let has_slip3 = self
-            .state
-            .iter()
-            .any(|s| matches!(s, NodeState::Slip3 { .. }));
-        let has_graze = self.extra.iter().any(|x| x.graze.is_some());
-        let reuse = self.lu_valid
-            && !has_slip3
-            && !has_graze
-            && self.lu_slope == slope
-            && self.lu_k == k
-            && self.lu_state == self.state
-            && self.lu_extra == self.extra;
-        // Rows: build each equation over the full f (coefficients into `row`), then reduce
-        // through the unknowns and eliminations.
+        k
+    }
+
+    /// The rows of the Newton system, one per unknown, node by node (the normal row, then
+    /// the tangential ones of the node's state): each equation built over the full f
+    /// (coefficients into `row`), then reduced through the unknowns and eliminations.
+    fn assemble_rows(
+        &mut self,
+        law: &FrictionLaw,
+        weights: &[f64],
+        q_n: &[f64],
+        q_t: &[f64],
+        slope: f64,
+        reuse: bool,
+    ) {
+        let (m, d) = (self.m, self.d);
+        let n = m * d;
         let mut e = 0;
         for i in 0..m {
             let st = self.state[i];
@@ -603,16 +634,13 @@ impl FrictionalContact {
                 }
             }
         }
-        debug_assert_eq!(e, k);
-        if !reuse {
-            lu_factor(&mut self.mat[..k * k], k, &mut self.piv[..k])?;
-            self.lu_state.copy_from_slice(&self.state);
-            self.lu_slope = slope;
-            self.lu_k = k;
-            self.lu_extra.copy_from_slice(&self.extra);
-            self.lu_valid = !has_slip3 && !has_graze;
-        }
-        lu_solve(&self.mat[..k * k], k, &self.piv[..k], &mut self.rhs[..k]);
+        debug_assert_eq!(e, self.k);
+    }
+
+    /// The forces of the solved system into `trial`: open nodes 0, a 2D slipping node's f_t
+    /// from its f_n, every other force its unknown.
+    fn write_trial(&mut self, law: &FrictionLaw, weights: &[f64], slope: f64) {
+        let (m, d) = (self.m, self.d);
         let f = &mut self.trial;
         for i in 0..m {
             match self.state[i] {
@@ -630,7 +658,6 @@ impl FrictionalContact {
                 }
             }
         }
-        Ok(())
     }
 
     /// Reduce the full equation `row`·f = `rhs` into row `e` of the system: unknowns keep their

@@ -31,7 +31,8 @@
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-use super::gmsh::{ElementKind, GmshError, det_from_gradients};
+use super::element_kind::{ElementKind, det_from_gradients};
+use super::gmsh_error::GmshError;
 use super::msh::type_name;
 
 /// A cell's local face: its vertices as a cycle oriented outwards, and all its nodes.
@@ -264,6 +265,13 @@ impl<'a> Topology<'a> {
 
     /// Duplicate cells, conformity and orientation of shared faces, shared midside nodes.
     pub(crate) fn check(&self, file: &str) -> Result<(), GmshError> {
+        self.check_duplicate_cells(file)?;
+        self.check_faces(file)?;
+        self.check_edge_midsides(file)
+    }
+
+    /// A cell listed twice: the same vertex set.
+    fn check_duplicate_cells(&self, file: &str) -> Result<(), GmshError> {
         let f = || file.to_string();
         let ne = self.elements.len() / self.nn;
         let nv = if self.kind.is_simplex() {
@@ -278,7 +286,6 @@ impl<'a> Topology<'a> {
             v
         };
         debug_assert_eq!(vertex_local.len(), nv);
-        // A cell listed twice: the same vertex set.
         let key = |c: usize| Self::sorted(vertex_local.iter().map(|&a| self.cell(c)[a]).collect());
         let cells = Buckets::new(self.node_tags.len(), ne, |c| {
             vertex_local
@@ -305,7 +312,13 @@ impl<'a> Topology<'a> {
                 }
             }
         }
-        // Faces.
+        Ok(())
+    }
+
+    /// Every face shared by at most two cells, which lie on either side of it and list the
+    /// same nodes on it.
+    fn check_faces(&self, file: &str) -> Result<(), GmshError> {
+        let f = || file.to_string();
         let nf = self.faces.len();
         for n in 0..self.node_tags.len() {
             let b = self.buckets.of(n);
@@ -371,7 +384,13 @@ impl<'a> Topology<'a> {
                 s = e;
             }
         }
-        // 3D degree 2: every cell around an edge has its midside node.
+        Ok(())
+    }
+
+    /// 3D degree 2: every cell around an edge has its midside node.
+    fn check_edge_midsides(&self, file: &str) -> Result<(), GmshError> {
+        let f = || file.to_string();
+        let ne = self.elements.len() / self.nn;
         if !self.edges.is_empty() {
             let ned = self.edges.len();
             let ends = |i: usize| {
@@ -499,6 +518,20 @@ impl Hasher for Fx {
     }
 }
 
+/// The corners (lowest, highest coordinate per axis) of the box around the points `c`: the
+/// body's size, which the tolerances of the coincident-node and 2D-plane checks are relative to.
+pub(crate) fn bounding_box(c: &[[f64; 3]]) -> ([f64; 3], [f64; 3]) {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in c {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    (lo, hi)
+}
+
 /// Relative distance under which two distinct nodes coincide: far below any cell a mesh
 /// generator makes (a cell that small is refused as degenerate, relative det J 10⁻¹⁰), far
 /// above the rounding of coordinates written with 16 digits.
@@ -507,14 +540,7 @@ pub(crate) const COINCIDENT: f64 = 1e-10;
 /// The first pair of distinct nodes closer than [`COINCIDENT`] × the body's size, with their
 /// distance.
 pub(crate) fn coincident_nodes(dim: usize, coords: &[[f64; 3]]) -> Result<(), (usize, usize, f64)> {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in coords {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
+    let (lo, hi) = bounding_box(coords);
     let size = (0..dim).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     if coords.len() < 2 || size <= 0.0 {
         return Ok(());
@@ -755,6 +781,106 @@ enum Piece {
     Box([f64; 3], [f64; 3]),
 }
 
+impl Piece {
+    /// The whole reference cell of `kind`.
+    fn root(kind: ElementKind) -> Piece {
+        let d = kind.dim();
+        if kind.is_simplex() {
+            let mut v = vec![[0.0; 3]];
+            for k in 0..d {
+                let mut e = [0.0; 3];
+                e[k] = 1.0;
+                v.push(e);
+            }
+            Piece::Simplex(v)
+        } else {
+            let mut lo = [0.0; 3];
+            let mut hi = [0.0; 3];
+            for k in 0..d {
+                lo[k] = -1.0;
+                hi[k] = 1.0;
+            }
+            Piece::Box(lo, hi)
+        }
+    }
+
+    /// The Bernstein lattice of `bern` mapped onto this piece (reference coordinates).
+    fn lattice(&self, bern: &Bernstein, d: usize) -> Vec<[f64; 3]> {
+        match self {
+            Piece::Simplex(v) => bern
+                .lattice
+                .iter()
+                .map(|p| {
+                    let lam = [1.0 - p[0] - p[1] - p[2], p[0], p[1], p[2]];
+                    let mut q = [0.0; 3];
+                    for (k, vk) in v.iter().enumerate() {
+                        for a in 0..3 {
+                            q[a] += lam[k] * vk[a];
+                        }
+                    }
+                    q
+                })
+                .collect(),
+            Piece::Box(lo, hi) => bern
+                .lattice
+                .iter()
+                .map(|p| {
+                    let mut q = [0.0; 3];
+                    for a in 0..d {
+                        q[a] = lo[a] + 0.5 * (p[a] + 1.0) * (hi[a] - lo[a]);
+                    }
+                    q
+                })
+                .collect(),
+        }
+    }
+
+    /// Cut the piece in two (a simplex: bisection of its longest edge) or 2^d (a box: halving
+    /// along each axis), pushed onto `stack`.
+    fn subdivide(self, d: usize, stack: &mut Vec<Piece>) {
+        match self {
+            Piece::Simplex(v) => {
+                // Bisect the longest edge.
+                let mut best = (0, 1, -1.0);
+                for a in 0..v.len() {
+                    for b in a + 1..v.len() {
+                        let l: f64 = (0..3).map(|k| (v[a][k] - v[b][k]).powi(2)).sum();
+                        if l > best.2 {
+                            best = (a, b, l);
+                        }
+                    }
+                }
+                let (a, b, _) = best;
+                let m = [
+                    0.5 * (v[a][0] + v[b][0]),
+                    0.5 * (v[a][1] + v[b][1]),
+                    0.5 * (v[a][2] + v[b][2]),
+                ];
+                let mut one = v.clone();
+                one[a] = m;
+                let mut two = v;
+                two[b] = m;
+                stack.push(Piece::Simplex(one));
+                stack.push(Piece::Simplex(two));
+            }
+            Piece::Box(lo, hi) => {
+                for m in 0..(1usize << d) {
+                    let (mut l, mut h) = (lo, hi);
+                    for a in 0..d {
+                        let mid = 0.5 * (lo[a] + hi[a]);
+                        if m >> a & 1 == 1 {
+                            l[a] = mid;
+                        } else {
+                            h[a] = mid;
+                        }
+                    }
+                    stack.push(Piece::Box(l, h));
+                }
+            }
+        }
+    }
+}
+
 /// Why a cell's det J is not certified positive.
 pub(crate) enum JacobianFailure {
     Inverted {
@@ -830,23 +956,7 @@ pub(crate) fn certify_jacobians(
     let mut x = vec![[0.0; 3]; nn];
     let mut values = vec![0.0; bern.lattice.len()];
     let mut coefs = Vec::with_capacity(values.len());
-    let root = if kind.is_simplex() {
-        let mut v = vec![[0.0; 3]];
-        for k in 0..d {
-            let mut e = [0.0; 3];
-            e[k] = 1.0;
-            v.push(e);
-        }
-        Piece::Simplex(v)
-    } else {
-        let mut lo = [0.0; 3];
-        let mut hi = [0.0; 3];
-        for k in 0..d {
-            lo[k] = -1.0;
-            hi[k] = 1.0;
-        }
-        Piece::Box(lo, hi)
-    };
+    let root = Piece::root(kind);
     for (c, cell) in elements.chunks_exact(nn).enumerate() {
         for (xa, &n) in x.iter_mut().zip(cell) {
             *xa = coords[n];
@@ -865,33 +975,10 @@ pub(crate) fn certify_jacobians(
         while let Some(piece) = stack.pop() {
             pieces += 1;
             // The lattice of the piece and det J there.
-            let points: Vec<[f64; 3]> = match &piece {
-                _ if pieces == 1 => bern.lattice.clone(),
-                Piece::Simplex(v) => bern
-                    .lattice
-                    .iter()
-                    .map(|p| {
-                        let lam = [1.0 - p[0] - p[1] - p[2], p[0], p[1], p[2]];
-                        let mut q = [0.0; 3];
-                        for (k, vk) in v.iter().enumerate() {
-                            for a in 0..3 {
-                                q[a] += lam[k] * vk[a];
-                            }
-                        }
-                        q
-                    })
-                    .collect(),
-                Piece::Box(lo, hi) => bern
-                    .lattice
-                    .iter()
-                    .map(|p| {
-                        let mut q = [0.0; 3];
-                        for a in 0..d {
-                            q[a] = lo[a] + 0.5 * (p[a] + 1.0) * (hi[a] - lo[a]);
-                        }
-                        q
-                    })
-                    .collect(),
+            let points: Vec<[f64; 3]> = if pieces == 1 {
+                bern.lattice.clone()
+            } else {
+                piece.lattice(&bern, d)
             };
             for (i, &xi) in points.iter().enumerate() {
                 let det = if pieces == 1 {
@@ -925,46 +1012,7 @@ pub(crate) fn certify_jacobians(
                     pieces,
                 });
             }
-            match piece {
-                Piece::Simplex(v) => {
-                    // Bisect the longest edge.
-                    let mut best = (0, 1, -1.0);
-                    for a in 0..v.len() {
-                        for b in a + 1..v.len() {
-                            let l: f64 = (0..3).map(|k| (v[a][k] - v[b][k]).powi(2)).sum();
-                            if l > best.2 {
-                                best = (a, b, l);
-                            }
-                        }
-                    }
-                    let (a, b, _) = best;
-                    let m = [
-                        0.5 * (v[a][0] + v[b][0]),
-                        0.5 * (v[a][1] + v[b][1]),
-                        0.5 * (v[a][2] + v[b][2]),
-                    ];
-                    let mut one = v.clone();
-                    one[a] = m;
-                    let mut two = v;
-                    two[b] = m;
-                    stack.push(Piece::Simplex(one));
-                    stack.push(Piece::Simplex(two));
-                }
-                Piece::Box(lo, hi) => {
-                    for m in 0..(1usize << d) {
-                        let (mut l, mut h) = (lo, hi);
-                        for a in 0..d {
-                            let mid = 0.5 * (lo[a] + hi[a]);
-                            if m >> a & 1 == 1 {
-                                l[a] = mid;
-                            } else {
-                                h[a] = mid;
-                            }
-                        }
-                        stack.push(Piece::Box(l, h));
-                    }
-                }
-            }
+            piece.subdivide(d, &mut stack);
         }
     }
     Ok(())

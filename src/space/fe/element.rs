@@ -195,27 +195,46 @@ pub fn map_at<const D: usize, const NN: usize>(
     xi: [f64; D],
 ) -> ([f64; NN], [[f64; D]; NN], f64) {
     let (n, dn) = shape::<D, NN>(xi);
-    let mut jac = [[0.0; D]; D];
-    for a in 0..NN {
-        for i in 0..D {
-            for j in 0..D {
-                jac[i][j] += x[a][i] * dn[a][j];
-            }
-        }
-    }
-    let (det, jinv) = det_inv(&jac);
+    let (det, jinv) = det_inv(&jacobian(x, &dn));
     assert!(
         det > 0.0,
         "element with det J = {det} ≤ 0 (inverted or degenerate element)"
     );
-    // ∇N_a = J⁻ᵀ ∇_ξ N_a, i.e. g_i = Σ_j (J⁻¹)_ji ∂_ξj N_a.
+    (n, physical_gradients(&jinv, &dn), det)
+}
+
+/// Σ_a x_a ⊗ g_a (`[i][j]` = Σ_a x_a,i g_a,j): with the reference gradients ∇_ξ N_a, the
+/// Jacobian ∂x/∂ξ of the map of the cell with node coordinates `x`; with the physical
+/// gradients and nodal displacements, the displacement gradient ∇u. Every isoparametric kernel
+/// (boxes and simplices) forms it this way.
+pub(crate) fn jacobian<const D: usize, const NN: usize>(
+    x: &[[f64; D]; NN],
+    g: &[[f64; D]; NN],
+) -> [[f64; D]; D] {
+    let mut jac = [[0.0; D]; D];
+    for a in 0..NN {
+        for i in 0..D {
+            for j in 0..D {
+                jac[i][j] += x[a][i] * g[a][j];
+            }
+        }
+    }
+    jac
+}
+
+/// The physical gradients ∇N_a = J⁻ᵀ ∇_ξ N_a, i.e. g_i = Σ_j (J⁻¹)_ji ∂_ξj N_a, from J⁻¹ and
+/// the reference gradients `dn`.
+pub(crate) fn physical_gradients<const D: usize, const NN: usize>(
+    jinv: &[[f64; D]; D],
+    dn: &[[f64; D]; NN],
+) -> [[f64; D]; NN] {
     let mut g = [[0.0; D]; NN];
     for a in 0..NN {
         for i in 0..D {
             g[a][i] = (0..D).map(|j| jinv[j][i] * dn[a][j]).sum();
         }
     }
-    (n, g, det)
+    g
 }
 
 /// Calls `f(N, ∇N, w·det J)` at each Gauss point of the element with node coordinates `x`: the
@@ -248,15 +267,7 @@ fn tensor_node_jacobians<const D: usize, const NN: usize>(
             r /= n1;
         }
         let (_, dn) = shape::<D, NN>(xi);
-        let mut jac = [[0.0; D]; D];
-        for a in 0..NN {
-            for i in 0..D {
-                for j in 0..D {
-                    jac[i][j] += x[a][i] * dn[a][j];
-                }
-            }
-        }
-        jac
+        jacobian(x, &dn)
     })
 }
 
@@ -292,15 +303,7 @@ pub fn q1_gradient_at<const D: usize, const NN: usize>(
     xi: [f64; D],
 ) -> [[f64; D]; D] {
     let (_, g, _) = map_at(x, xi);
-    let mut grad = [[0.0; D]; D];
-    for a in 0..NN {
-        for i in 0..D {
-            for j in 0..D {
-                grad[i][j] += u[a][i] * g[a][j];
-            }
-        }
-    }
-    grad
+    jacobian(u, &g)
 }
 
 /// The element matrix of `op` for the element with node coordinates `x`.
@@ -308,10 +311,58 @@ pub fn element_matrix<const D: usize, const NN: usize, const ND: usize>(
     op: ElementOp,
     x: &[[f64; D]; NN],
 ) -> SMatrix<f64, ND, ND> {
+    const { assert!(ND == D * NN) };
+    let mut m = SMatrix::<f64, ND, ND>::zeros();
+    for_each_point(x, |n, g, dv| add_point_matrix(op, &mut m, n, g, dv));
+    m
+}
+
+/// Adds one quadrature point's share of `op` (shape values N, physical gradients ∇N and
+/// w·det J there) to the element matrix `m`: the one integrand of the box and simplex kernels.
+pub(crate) fn add_point_matrix<const D: usize, const NN: usize, const ND: usize>(
+    op: ElementOp,
+    m: &mut SMatrix<f64, ND, ND>,
+    n: &[f64; NN],
+    g: &[[f64; D]; NN],
+    dv: f64,
+) {
     match op {
-        ElementOp::Mass { rho } => q1_mass(x, rho),
-        ElementOp::Stiffness { lambda, mu } => q1_stiffness(x, lambda, mu),
-        ElementOp::GradGrad => q1_grad_grad(x),
+        ElementOp::Mass { rho } => {
+            for a in 0..NN {
+                for b in 0..NN {
+                    let v = rho * n[a] * n[b] * dv;
+                    for i in 0..D {
+                        m[(a * D + i, b * D + i)] += v;
+                    }
+                }
+            }
+        }
+        ElementOp::Stiffness { lambda, mu } => {
+            for a in 0..NN {
+                for b in 0..NN {
+                    let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
+                    for i in 0..D {
+                        for j in 0..D {
+                            let mut v = lambda * g[a][i] * g[b][j] + mu * g[a][j] * g[b][i];
+                            if i == j {
+                                v += mu * gab;
+                            }
+                            m[(a * D + i, b * D + j)] += v * dv;
+                        }
+                    }
+                }
+            }
+        }
+        ElementOp::GradGrad => {
+            for a in 0..NN {
+                for b in 0..NN {
+                    let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
+                    for i in 0..D {
+                        m[(a * D + i, b * D + i)] += gab * dv;
+                    }
+                }
+            }
+        }
     }
 }
 
@@ -320,19 +371,7 @@ pub fn q1_mass<const D: usize, const NN: usize, const ND: usize>(
     x: &[[f64; D]; NN],
     rho: f64,
 ) -> SMatrix<f64, ND, ND> {
-    const { assert!(ND == D * NN) };
-    let mut m = SMatrix::<f64, ND, ND>::zeros();
-    for_each_point(x, |n, _, dv| {
-        for a in 0..NN {
-            for b in 0..NN {
-                let v = rho * n[a] * n[b] * dv;
-                for i in 0..D {
-                    m[(a * D + i, b * D + i)] += v;
-                }
-            }
-        }
-    });
-    m
+    element_matrix(ElementOp::Mass { rho }, x)
 }
 
 /// Isotropic elasticity stiffness ∫ λ div u div v + 2μ ε(u):ε(v) (plane strain in 2D).
@@ -341,44 +380,14 @@ pub fn q1_stiffness<const D: usize, const NN: usize, const ND: usize>(
     lambda: f64,
     mu: f64,
 ) -> SMatrix<f64, ND, ND> {
-    const { assert!(ND == D * NN) };
-    let mut k = SMatrix::<f64, ND, ND>::zeros();
-    for_each_point(x, |_, g, dv| {
-        for a in 0..NN {
-            for b in 0..NN {
-                let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
-                for i in 0..D {
-                    for j in 0..D {
-                        let mut v = lambda * g[a][i] * g[b][j] + mu * g[a][j] * g[b][i];
-                        if i == j {
-                            v += mu * gab;
-                        }
-                        k[(a * D + i, b * D + j)] += v * dv;
-                    }
-                }
-            }
-        }
-    });
-    k
+    element_matrix(ElementOp::Stiffness { lambda, mu }, x)
 }
 
 /// ∫ ∇u : ∇v, the full vector gradient (δ_ij ∫ ∇N_a·∇N_b).
 pub fn q1_grad_grad<const D: usize, const NN: usize, const ND: usize>(
     x: &[[f64; D]; NN],
 ) -> SMatrix<f64, ND, ND> {
-    const { assert!(ND == D * NN) };
-    let mut k = SMatrix::<f64, ND, ND>::zeros();
-    for_each_point(x, |_, g, dv| {
-        for a in 0..NN {
-            for b in 0..NN {
-                let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
-                for i in 0..D {
-                    k[(a * D + i, b * D + i)] += gab * dv;
-                }
-            }
-        }
-    });
-    k
+    element_matrix(ElementOp::GradGrad, x)
 }
 
 /// Volume load ∫ ρ f·v for a constant body force density f (only the first D components used).
@@ -390,13 +399,25 @@ pub fn q1_load<const D: usize, const NN: usize, const ND: usize>(
     const { assert!(ND == D * NN) };
     let mut r = SVector::<f64, ND>::zeros();
     for_each_point(x, |n, _, dv| {
-        for a in 0..NN {
-            for i in 0..D {
-                r[a * D + i] += rho * f[i] * n[a] * dv;
-            }
-        }
+        add_point_load::<D, NN, ND>(&mut r, rho, f, n, dv)
     });
     r
+}
+
+/// Adds one quadrature point's share of the load ∫ ρ f·v (shape values N and w·det J there)
+/// to `r`: the one integrand of the box and simplex loads.
+pub(crate) fn add_point_load<const D: usize, const NN: usize, const ND: usize>(
+    r: &mut SVector<f64, ND>,
+    rho: f64,
+    f: [f64; 3],
+    n: &[f64; NN],
+    dv: f64,
+) {
+    for a in 0..NN {
+        for i in 0..D {
+            r[a * D + i] += rho * f[i] * n[a] * dv;
+        }
+    }
 }
 
 #[cfg(test)]

@@ -31,7 +31,7 @@
 //!   reported as not in the mesh.
 
 use super::element::shape;
-use super::gmsh::{ElementKind, TET_EDGES, TRI_EDGES};
+use super::element_kind::{ElementKind, TET_EDGES, TRI_EDGES, barycentric};
 use super::mesh::Mesh;
 
 /// Tolerance of "inside the reference element" in reference coordinates.
@@ -92,14 +92,7 @@ pub fn shape_into(
             // Barycentric λ_0 = 1 − Σ ξ_k, λ_k = ξ_k; P2: λ_i(2λ_i − 1) at the vertices and
             // 4 λ_i λ_j at the midpoint of edge (i, j), Gmsh's edge order.
             let d = kind.dim();
-            let mut lam = [0.0; 4];
-            let mut dlam = [[0.0; 3]; 4];
-            lam[0] = 1.0 - xi.iter().take(d).sum::<f64>();
-            for k in 0..d {
-                lam[k + 1] = xi[k];
-                dlam[0][k] = -1.0;
-                dlam[k + 1][k] = 1.0;
-            }
+            let (lam, dlam) = barycentric(d, xi);
             if kind.degree() == 1 {
                 n[..=d].copy_from_slice(&lam[..=d]);
                 dn[..=d].copy_from_slice(&dlam[..=d]);

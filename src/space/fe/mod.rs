@@ -10,9 +10,11 @@
 //!   σ_n(u) of Nitsche's method and the dofs the contact problem condenses onto;
 //! - [`gmsh`]: Gmsh MSH 4.1 meshes (ASCII or binary, parsed by [`msh`], the engine's own parser
 //!   that cannot panic) of the `mesh2d`/`mesh3d` scenes: P1/P2 triangles and tetrahedra, Q1/Q2
-//!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s;
-//!   the whole-mesh checks — conformity, coincident nodes, boundary groups, certified det J —
-//!   in `check`), with `h` and the file's content hash;
+//!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s,
+//!   in `gmsh_error`; the whole-mesh checks — conformity, coincident nodes, boundary groups,
+//!   certified det J — in `check`), with `h` and the file's content hash; the facts of the
+//!   reference cells both stand on ([`ElementKind`]: node orders, shape gradients, det J) in
+//!   `element_kind`, below both;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
 //!   fixed-size matrices, one dimension-generic kernel for 2D and 3D;
 //! - [`simplex`]: vector P1/P2 triangle and tetrahedron mass, elasticity stiffness, grad-grad
@@ -24,12 +26,15 @@
 //!
 //! Degrees of freedom are node-major interleaved: dof = node·d + component. Constrained dofs
 //! (Dirichlet: clamped face, rollers) are dropped from the assembled matrices by [`DofMap`];
-//! the factorisation of the assembled matrices is [`crate::space::linalg`].
+//! the factorisation of the assembled matrices is the sparse Cholesky of `space/linalg.rs` (which
+//! builds on this folder, not the other way round).
 
 pub mod ball;
 mod check;
 pub mod element;
+mod element_kind;
 pub mod gmsh;
+mod gmsh_error;
 pub mod locate;
 pub mod mesh;
 pub mod msh;
@@ -120,7 +125,7 @@ impl DofMap {
 
     /// The free dofs (reduced indices) in the order of `node_order`, components of a node
     /// together: turns a node ordering (e.g. [`BoxMesh::nested_dissection`]) into an elimination
-    /// order for [`crate::space::linalg::SymbolicCholesky::with_ordering`].
+    /// order for `SymbolicCholesky::with_ordering` (`space/linalg.rs`).
     pub fn order_by_nodes(&self, node_order: &[usize], dim: usize) -> Vec<usize> {
         let mut out = Vec::with_capacity(self.n_free());
         for &n in node_order {

@@ -422,12 +422,12 @@ pub fn parse(bytes: &[u8]) -> Result<MshFile, MshError> {
                 "Nodes" => {
                     c.section = "$Nodes";
                     c.binary = out.binary;
-                    out.node_blocks = nodes(&mut c)?;
+                    out.node_blocks = blocks(&mut c, "node", node_block)?;
                 }
                 "Elements" => {
                     c.section = "$Elements";
                     c.binary = out.binary;
-                    out.element_blocks = elements(&mut c)?;
+                    out.element_blocks = blocks(&mut c, "element", element_block)?;
                 }
                 _ => {
                     c.section = "$PartitionedEntities";
@@ -612,14 +612,23 @@ fn entities(c: &mut Cur) -> Result<[Vec<Entity>; 4], MshError> {
     Ok(out)
 }
 
-fn nodes(c: &mut Cur) -> Result<Vec<NodeBlock>, MshError> {
+/// The blocks of `$Nodes` or `$Elements` (`item`: "node" or "element"), each read by `body`
+/// after its entity: the section's header (the number of blocks, checked against the bytes
+/// left, and of items), the blocks, and the header's count against the items the blocks hold.
+/// `body` reads the rest of a block of the entity (dimension, tag) and returns it with its
+/// number of items.
+fn blocks<'a, T>(
+    c: &mut Cur<'a>,
+    item: &str,
+    mut body: impl FnMut(&mut Cur<'a>, i32, i32) -> Result<(T, usize), MshError>,
+) -> Result<Vec<T>, MshError> {
     let nb = c.size("the number of blocks")?;
-    let total = c.size("the number of nodes")?;
+    let total = c.size(&format!("the number of {item}s"))?;
     // The header's tag range is not used: tags are read and kept whatever it says.
-    c.size("the smallest node tag")?;
-    c.size("the largest node tag")?;
+    c.size(&format!("the smallest {item} tag"))?;
+    c.size(&format!("the largest {item} tag"))?;
     let block_min = 3 * c.min_bytes(4) + c.min_bytes(c.size_t);
-    let nb = c.check_count("node blocks", nb, block_min)?;
+    let nb = c.check_count(&format!("{item} blocks"), nb, block_min)?;
     let mut out = Vec::with_capacity(nb);
     let mut read: u64 = 0;
     for b in 0..nb {
@@ -633,126 +642,113 @@ fn nodes(c: &mut Cur) -> Result<Vec<NodeBlock>, MshError> {
         if !(0..=3).contains(&entity_dim) {
             return Err(c.err(format!("entity dimension {entity_dim}, expected 0 to 3")));
         }
-        let parametric = c.int("the parametric flag")?;
-        if !(0..=1).contains(&parametric) {
-            return Err(c.err(format!("parametric flag {parametric}, expected 0 or 1")));
-        }
-        let extra = if parametric == 1 {
-            entity_dim as u64
-        } else {
-            0
-        };
-        let n = c.size("the number of nodes in the block")?;
-        let per = c.min_bytes(c.size_t) + (3 + extra) * c.min_bytes(8);
-        let n = c.check_count("nodes", n, per)?;
-        let mut tags = Vec::with_capacity(n);
-        for _ in 0..n {
-            tags.push(c.size("a node tag")?);
-        }
-        let mut coords = Vec::with_capacity(n);
-        for (i, _) in tags.iter().enumerate() {
-            let mut x = [0.0; 3];
-            for v in &mut x {
-                *v = c.double("a coordinate").map_err(|mut e| {
-                    e.at = format!("{}, node {}", e.at, tags[i]);
-                    e
-                })?;
-            }
-            for _ in 0..extra {
-                c.double("a parametric coordinate")?;
-            }
-            coords.push(x);
-        }
+        let (block, n) = body(c, entity_dim, entity_tag)?;
         read += n as u64;
-        out.push(NodeBlock {
-            entity_dim,
-            entity_tag,
-            tags,
-            coords,
-        });
+        out.push(block);
     }
     c.at.clear();
     if read != total {
         return Err(c.err(format!(
-            "the header announces {total} nodes, the blocks hold {read}"
+            "the header announces {total} {item}s, the blocks hold {read}"
         )));
     }
     Ok(out)
 }
 
-fn elements(c: &mut Cur) -> Result<Vec<ElementBlock>, MshError> {
-    let nb = c.size("the number of blocks")?;
-    let total = c.size("the number of elements")?;
-    c.size("the smallest element tag")?;
-    c.size("the largest element tag")?;
-    let block_min = 3 * c.min_bytes(4) + c.min_bytes(c.size_t);
-    let nb = c.check_count("element blocks", nb, block_min)?;
-    let mut out = Vec::with_capacity(nb);
-    let mut read: u64 = 0;
-    for b in 0..nb {
-        c.at = format!("block {} of {nb}", b + 1);
-        let entity_dim = c.int("the entity dimension")?;
-        let entity_tag = c.int("the entity tag")?;
-        c.at = format!(
-            "block {} of {nb} (entity {entity_tag} of dimension {entity_dim})",
-            b + 1
-        );
-        if !(0..=3).contains(&entity_dim) {
-            return Err(c.err(format!("entity dimension {entity_dim}, expected 0 to 3")));
-        }
-        let element_type = c.int("the element type")?;
-        let n = c.size("the number of elements in the block")?;
-        let Some(k) = nodes_of_type(element_type) else {
-            // The first element's tag names it (its node count is unknown, so the block
-            // cannot be read past it).
-            let first = if n > 0 {
-                c.size("an element tag")
-                    .map(|t| format!("element {t}"))
-                    .unwrap_or_default()
-            } else {
-                String::new()
-            };
-            return Err(c.err(format!(
-                "{first} has Gmsh type {element_type} ({}), not supported (P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, their faces, points)",
-                type_name(element_type)
-            )
-            .trim_start()
-            .to_string()));
-        };
-        let td = dim_of_type(element_type).unwrap_or(0);
-        if td as i32 != entity_dim {
-            return Err(c.err(format!(
-                "{}s (dimension {td}) in a block of an entity of dimension {entity_dim}",
-                type_name(element_type)
-            )));
-        }
-        let n = c.check_count("elements", n, (1 + k as u64) * c.min_bytes(c.size_t))?;
-        let mut tags = Vec::with_capacity(n);
-        let mut nodes = Vec::with_capacity(n * k);
-        for _ in 0..n {
-            let t = c.size("an element tag")?;
-            tags.push(t);
-            for _ in 0..k {
-                nodes.push(c.size("a node tag").map_err(|mut e| {
-                    e.at = format!("{}, element {t}", e.at);
-                    e
-                })?);
-            }
-        }
-        read += n as u64;
-        out.push(ElementBlock {
-            entity_dim,
-            entity_tag,
-            element_type,
-            tags,
-            nodes,
-        });
+/// One block of `$Nodes` after its entity: the parametric flag, the node tags, then their
+/// coordinates (parametric ones skipped).
+fn node_block(c: &mut Cur, entity_dim: i32, tag: i32) -> Result<(NodeBlock, usize), MshError> {
+    let parametric = c.int("the parametric flag")?;
+    if !(0..=1).contains(&parametric) {
+        return Err(c.err(format!("parametric flag {parametric}, expected 0 or 1")));
     }
-    c.at.clear();
-    if read != total {
+    let extra = if parametric == 1 {
+        entity_dim as u64
+    } else {
+        0
+    };
+    let n = c.size("the number of nodes in the block")?;
+    let per = c.min_bytes(c.size_t) + (3 + extra) * c.min_bytes(8);
+    let n = c.check_count("nodes", n, per)?;
+    let mut tags = Vec::with_capacity(n);
+    for _ in 0..n {
+        tags.push(c.size("a node tag")?);
+    }
+    let mut coords = Vec::with_capacity(n);
+    for (i, _) in tags.iter().enumerate() {
+        let mut x = [0.0; 3];
+        for v in &mut x {
+            *v = c.double("a coordinate").map_err(|mut e| {
+                e.at = format!("{}, node {}", e.at, tags[i]);
+                e
+            })?;
+        }
+        for _ in 0..extra {
+            c.double("a parametric coordinate")?;
+        }
+        coords.push(x);
+    }
+    let block = NodeBlock {
+        entity_dim,
+        entity_tag: tag,
+        tags,
+        coords,
+    };
+    Ok((block, n))
+}
+
+/// One block of `$Elements` after its entity: the element type (supported, of the entity's
+/// dimension), then each element's tag and node tags.
+fn element_block(
+    c: &mut Cur,
+    entity_dim: i32,
+    entity_tag: i32,
+) -> Result<(ElementBlock, usize), MshError> {
+    let element_type = c.int("the element type")?;
+    let n = c.size("the number of elements in the block")?;
+    let Some(k) = nodes_of_type(element_type) else {
+        // The first element's tag names it (its node count is unknown, so the block
+        // cannot be read past it).
+        let first = if n > 0 {
+            c.size("an element tag")
+                .map(|t| format!("element {t}"))
+                .unwrap_or_default()
+        } else {
+            String::new()
+        };
         return Err(c.err(format!(
-            "the header announces {total} elements, the blocks hold {read}"
+            "{first} has Gmsh type {element_type} ({}), not supported (P1/P2 triangles and tetrahedra, Q1/Q2 quadrilaterals and hexahedra, their faces, points)",
+            type_name(element_type)
+        )
+        .trim_start()
+        .to_string()));
+    };
+    let td = dim_of_type(element_type).unwrap_or(0);
+    if td as i32 != entity_dim {
+        return Err(c.err(format!(
+            "{}s (dimension {td}) in a block of an entity of dimension {entity_dim}",
+            type_name(element_type)
         )));
     }
-    Ok(out)
+    let n = c.check_count("elements", n, (1 + k as u64) * c.min_bytes(c.size_t))?;
+    let mut tags = Vec::with_capacity(n);
+    let mut nodes = Vec::with_capacity(n * k);
+    for _ in 0..n {
+        let t = c.size("an element tag")?;
+        tags.push(t);
+        for _ in 0..k {
+            nodes.push(c.size("a node tag").map_err(|mut e| {
+                e.at = format!("{}, element {t}", e.at);
+                e
+            })?);
+        }
+    }
+    let block = ElementBlock {
+        entity_dim,
+        entity_tag,
+        element_type,
+        tags,
+        nodes,
+    };
+    Ok((block, n))
 }

@@ -27,7 +27,7 @@
 //! node-to-node distance, the Gmsh mesh's h per cell).
 
 use super::ball::BallMesh;
-use super::element::{det_inv, gauss_legendre, map_at, shape};
+use super::element::{det_inv, gauss_legendre, map_at, physical_gradients, shape};
 use super::gmsh::{GmshMesh, PhysicalGroup};
 use super::mesh::{BoxMesh, Mesh};
 use super::simplex::simplex_shape;
@@ -74,6 +74,40 @@ fn tangential_rows<const D: usize, const NN: usize>(
     (ut, st)
 }
 
+/// The contact point of weight `weight`, γ_h `gamma` and gap `gap` on an element with dofs
+/// `dofs`, its functionals from the shape values `n` and physical gradients `g` there:
+/// u_n = −u_d, σ_n(u) = λ div u + 2μ ∂_d u_d, and the tangential rows.
+fn contact_point<const D: usize, const NN: usize>(
+    n: &[f64; NN],
+    g: &[[f64; D]; NN],
+    (lambda, mu): (f64, f64),
+    dofs: &[usize],
+    weight: f64,
+    gamma: f64,
+    gap: f64,
+) -> ContactPoint {
+    let mut un = vec![0.0; NN * D];
+    let mut sn = vec![0.0; NN * D];
+    for a in 0..NN {
+        un[a * D + D - 1] = -n[a];
+        for i in 0..D {
+            sn[a * D + i] = lambda * g[a][i];
+        }
+        sn[a * D + D - 1] += 2.0 * mu * g[a][D - 1];
+    }
+    let (ut, st) = tangential_rows::<D, NN>(n, g, mu);
+    ContactPoint {
+        weight,
+        gamma,
+        gap,
+        dofs: dofs.to_vec(),
+        un,
+        sn,
+        ut,
+        st,
+    }
+}
+
 /// The contact points of the faces of Γ_C of `mesh` for Lamé (λ, μ) and Nitsche's γ0.
 pub fn contact_points(mesh: &BallMesh, lambda: f64, mu: f64, gamma0: f64) -> Vec<ContactPoint> {
     match (mesh.dim, mesh.degree) {
@@ -105,26 +139,15 @@ fn points_generic<const D: usize, const NN: usize>(
             let mut xi = [0.0; D];
             xi.copy_from_slice(&q.xi[..D]);
             let (n, g, _) = map_at(&x, xi);
-            let mut un = vec![0.0; NN * D];
-            let mut sn = vec![0.0; NN * D];
-            for a in 0..NN {
-                un[a * D + D - 1] = -n[a];
-                for i in 0..D {
-                    sn[a * D + i] = lambda * g[a][i];
-                }
-                sn[a * D + D - 1] += 2.0 * mu * g[a][D - 1];
-            }
-            let (ut, st) = tangential_rows::<D, NN>(&n, &g, mu);
-            out.push(ContactPoint {
-                weight: q.weight,
-                gamma: gamma0 * mesh.diameters[e],
-                gap: q.x[D - 1],
-                dofs: dofs.clone(),
-                un,
-                sn,
-                ut,
-                st,
-            });
+            out.push(contact_point(
+                &n,
+                &g,
+                (lambda, mu),
+                &dofs,
+                q.weight,
+                gamma0 * mesh.diameters[e],
+                q.x[D - 1],
+            ));
         }
     }
     out
@@ -335,32 +358,16 @@ fn faces_generic<const D: usize, const NN: usize>(
                 norm3(cross3(tangent(&dirs[0]), tangent(&dirs[1])))
             };
             let (_, jinv) = det_inv(&jac);
-            let mut un = vec![0.0; NN * D];
-            let mut sn = vec![0.0; NN * D];
-            let mut grads = [[0.0; D]; NN];
-            for a in 0..NN {
-                // ∇N_a = J⁻ᵀ ∇_ξ N_a.
-                let g = &mut grads[a];
-                for (i, gi) in g.iter_mut().enumerate() {
-                    *gi = (0..D).map(|j| jinv[j][i] * dn[a][j]).sum();
-                }
-                un[a * D + D - 1] = -n[a];
-                for i in 0..D {
-                    sn[a * D + i] = lambda * g[i];
-                }
-                sn[a * D + D - 1] += 2.0 * mu * g[D - 1];
-            }
-            let (ut, st) = tangential_rows::<D, NN>(&n, &grads, mu);
-            out.push(ContactPoint {
-                weight: w * area,
-                gamma: gamma0 * diameter,
-                gap: xq[D - 1] - plane,
-                dofs: dofs.clone(),
-                un,
-                sn,
-                ut,
-                st,
-            });
+            let grads = physical_gradients(&jinv, &dn);
+            out.push(contact_point(
+                &n,
+                &grads,
+                (lambda, mu),
+                &dofs,
+                w * area,
+                gamma0 * diameter,
+                xq[D - 1] - plane,
+            ));
         }
     }
     out

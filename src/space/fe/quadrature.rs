@@ -18,8 +18,8 @@
 //! The stiffness on a curved cell is rational (J⁻¹) and no rule is exact; a rule of the mass's
 //! degree brings it within round-off of much higher-order rules (the disc's first contact force
 //! moves by ≤ 1e-11 from degree 6 to 14, measured). Affine cells keep the cheaper rules of
-//! [`super::element`] and [`super::simplex`], which are exact there — so the bars' matrices, and
-//! every straight-sided cell's, are bit for bit those of before.
+//! the element kernels (`element.rs`, `simplex.rs`, which call this file), exact there — so the
+//! bars' matrices, and every straight-sided cell's, are bit for bit those of before.
 //!
 //! The simplex rules are conical products (Stroud; the Duffy collapse): on the reference
 //! triangle ξ = t, η = (1 − t)s with dξdη = (1 − t) dt ds, so a polynomial of degree p becomes a

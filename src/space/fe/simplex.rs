@@ -25,7 +25,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
-use super::element::{ElementOp, det_inv};
+use super::element::{
+    ElementOp, add_point_load, add_point_matrix, det_inv, jacobian, physical_gradients,
+};
+// Edges of the P2 simplices in Gmsh's order: node d + 1 + k is the midpoint of edge k.
+use super::element_kind::{TET_EDGES, TRI_EDGES};
 use super::quadrature::{curved_simplex_rule, is_affine};
 
 /// The P1 triangle matrix (3 nodes × 2 components).
@@ -96,10 +100,6 @@ pub fn simplex_rule(d: usize) -> &'static [([f64; 3], f64)] {
     }
 }
 
-/// Edges of the P2 simplices in Gmsh's order: node d + 1 + k is the midpoint of edge k.
-const TRI_EDGES: [(usize, usize); 3] = [(0, 1), (1, 2), (2, 0)];
-const TET_EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1)];
-
 /// Shape functions (P1 if NN = D + 1, P2 if NN = (D + 1)(D + 2)/2) and their reference
 /// gradients at ξ.
 pub fn simplex_shape<const D: usize, const NN: usize>(xi: [f64; D]) -> ([f64; NN], [[f64; D]; NN]) {
@@ -150,26 +150,12 @@ pub fn simplex_map_at<const D: usize, const NN: usize>(
     xi: [f64; D],
 ) -> ([f64; NN], [[f64; D]; NN], f64) {
     let (n, dn) = simplex_shape::<D, NN>(xi);
-    let mut j = [[0.0; D]; D];
-    for a in 0..NN {
-        for i in 0..D {
-            for k in 0..D {
-                j[i][k] += x[a][i] * dn[a][k];
-            }
-        }
-    }
-    let (det, inv) = det_inv(&j);
+    let (det, inv) = det_inv(&jacobian(x, &dn));
     assert!(
         det > 0.0,
         "simplex with det J = {det} ≤ 0 (inverted or degenerate)"
     );
-    let mut g = [[0.0; D]; NN];
-    for a in 0..NN {
-        for i in 0..D {
-            g[a][i] = (0..D).map(|k| inv[k][i] * dn[a][k]).sum();
-        }
-    }
-    (n, g, det)
+    (n, physical_gradients(&inv, &dn), det)
 }
 
 /// Calls `f(N, ∇N, w·det J)` at each point of the simplex's rule ([`simplex_rule`]).
@@ -203,15 +189,7 @@ fn vertex_jacobians<const D: usize, const NN: usize>(
             xi[v - 1] = 1.0;
         }
         let (_, dn) = simplex_shape::<D, NN>(xi);
-        let mut j = [[0.0; D]; D];
-        for a in 0..NN {
-            for i in 0..D {
-                for k in 0..D {
-                    j[i][k] += x[a][i] * dn[a][k];
-                }
-            }
-        }
-        j
+        jacobian(x, &dn)
     })
 }
 
@@ -222,37 +200,7 @@ pub fn simplex_element_matrix<const D: usize, const NN: usize, const ND: usize>(
 ) -> SMatrix<f64, ND, ND> {
     const { assert!(ND == D * NN) };
     let mut m = SMatrix::<f64, ND, ND>::zeros();
-    simplex_for_each_point(x, |n, g, dv| {
-        for a in 0..NN {
-            for b in 0..NN {
-                let gab: f64 = (0..D).map(|l| g[a][l] * g[b][l]).sum();
-                match op {
-                    ElementOp::Mass { rho } => {
-                        let v = rho * n[a] * n[b] * dv;
-                        for i in 0..D {
-                            m[(a * D + i, b * D + i)] += v;
-                        }
-                    }
-                    ElementOp::GradGrad => {
-                        for i in 0..D {
-                            m[(a * D + i, b * D + i)] += gab * dv;
-                        }
-                    }
-                    ElementOp::Stiffness { lambda, mu } => {
-                        for i in 0..D {
-                            for j in 0..D {
-                                let mut v = lambda * g[a][i] * g[b][j] + mu * g[a][j] * g[b][i];
-                                if i == j {
-                                    v += mu * gab;
-                                }
-                                m[(a * D + i, b * D + j)] += v * dv;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    });
+    simplex_for_each_point(x, |n, g, dv| add_point_matrix(op, &mut m, n, g, dv));
     m
 }
 
@@ -265,11 +213,7 @@ pub fn simplex_load<const D: usize, const NN: usize, const ND: usize>(
     const { assert!(ND == D * NN) };
     let mut r = SVector::<f64, ND>::zeros();
     simplex_for_each_point(x, |n, _, dv| {
-        for a in 0..NN {
-            for i in 0..D {
-                r[a * D + i] += rho * f[i] * n[a] * dv;
-            }
-        }
+        add_point_load::<D, NN, ND>(&mut r, rho, f, n, dv)
     });
     r
 }
