@@ -1307,7 +1307,6 @@ fn reference_of(
         [Key::Dt, Key::Courant],
         [Key::Gap, Key::Obstacle],
     ];
-    let step_keys = pairs[1];
     let replaced = |k: Key| {
         over.iter().any(|o| o.key == k)
             || pairs
@@ -1325,20 +1324,11 @@ fn reference_of(
         combined.retain(|e| super::accepted(ref_scene, e.key));
     }
     combined.extend(over.iter());
-    let at = |keys: &[Key]| {
-        over.iter()
-            .find(|e| keys.contains(&e.key))
-            .map(|e| e.origin.clone())
-            .unwrap_or(Origin {
-                path: "reference".into(),
-                line: None,
-            })
-    };
     let r = match resolve(sweep_dir(sweep), ref_scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
-                &at(&[Key::H, Key::Elements, Key::Mesh]),
+                &reference_origin(over, &[Key::H, Key::Elements, Key::Mesh]),
                 format!("the reference run is meaningless: {why}"),
             )]);
         }
@@ -1352,7 +1342,55 @@ fn reference_of(
                 .collect());
         }
     };
-    if other_scene && let (RunConfig::Fe(a), RunConfig::Fe(b)) = (&run.config, &r.config) {
+    if other_scene {
+        same_problem(sweep, ref_scene, run, &r)?;
+    }
+    // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
+    let nested = !other_scene && sweep.scene.get().nested_meshes();
+    let (sx, st) = strides(over, nested, run, &r)?;
+    let id = r.id(ref_scene, "");
+    let spec = RunSpec {
+        run_id: id,
+        superseded_id: r.superseded_id(ref_scene, "", false),
+        label: if other_scene {
+            format!("reference: {} {}", ref_scene.name(), r.label)
+        } else {
+            format!("reference: {}", r.label)
+        },
+        params: r.params.clone(),
+        scheme_label: r.scheme_label.clone(),
+        config: r.config.clone(),
+        repeats: 1,
+        sample: None,
+        scene: ref_scene,
+        reference: None,
+        search: None,
+    };
+    Ok((spec, sx, st))
+}
+
+/// Where a reference problem is reported: the first of `keys` the reference gives, else
+/// `reference`.
+fn reference_origin(over: &[Entry], keys: &[Key]) -> Origin {
+    over.iter()
+        .find(|e| keys.contains(&e.key))
+        .map(|e| e.origin.clone())
+        .unwrap_or(Origin {
+            path: "reference".into(),
+            line: None,
+        })
+}
+
+/// A reference of another scene (`ref_scene`) must pose the run's problem: the same
+/// density, Lamé constants, gap, gravity and initial velocity, or the errors would compare
+/// two problems.
+fn same_problem(
+    sweep: &SweepFile,
+    ref_scene: SceneKind,
+    run: &Resolved,
+    r: &Resolved,
+) -> Result<(), Vec<Issue>> {
+    if let (RunConfig::Fe(a), RunConfig::Fe(b)) = (&run.config, &r.config) {
         let (a, b) = (&a.setup, &b.setup);
         let differ: Vec<String> = [
             ("density", a.density, b.density),
@@ -1381,13 +1419,25 @@ fn reference_of(
             )]);
         }
     }
+    Ok(())
+}
+
+/// The run's (space, time) refinement ratios against its reference `r`: the reference must be
+/// nested in time (dt_run/dt_ref whole) and last as long; in space nested (h_run/h_ref whole)
+/// where the meshes are (`nested`), otherwise at least as fine (stride 1).
+fn strides(
+    over: &[Entry],
+    nested: bool,
+    run: &Resolved,
+    r: &Resolved,
+) -> Result<(usize, usize), Vec<Issue>> {
+    let at = |keys: &[Key]| reference_origin(over, keys);
+    let step_keys = [Key::Dt, Key::Courant];
     let ratio = |coarse: f64, fine: f64| {
         let q = coarse / fine;
         let n = q.round();
         (n >= 1.0 && (q - n).abs() <= 1e-9 * n).then_some(n as usize)
     };
-    // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
-    let nested = !other_scene && sweep.scene.get().nested_meshes();
     if !nested && r.h > run.h * (1.0 + 1e-12) {
         return Err(vec![Issue::at(
             &at(&[Key::H, Key::Elements, Key::Mesh]),
@@ -1429,25 +1479,7 @@ fn reference_of(
             ),
         )]);
     }
-    let id = r.id(ref_scene, "");
-    let spec = RunSpec {
-        run_id: id,
-        superseded_id: r.superseded_id(ref_scene, "", false),
-        label: if other_scene {
-            format!("reference: {} {}", ref_scene.name(), r.label)
-        } else {
-            format!("reference: {}", r.label)
-        },
-        params: r.params.clone(),
-        scheme_label: r.scheme_label.clone(),
-        config: r.config.clone(),
-        repeats: 1,
-        sample: None,
-        scene: ref_scene,
-        reference: None,
-        search: None,
-    };
-    Ok((spec, sx, st))
+    Ok((sx, st))
 }
 
 impl Resolved {
@@ -1578,6 +1610,80 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
         series_every: Some(limits.series_every.unwrap_or(sweep.series_every)),
         ..*limits
     };
+    check_size(sweep, limits)?;
+    let mut axes: Vec<&Axis> = Vec::new();
+    if let Some(z) = &sweep.zip {
+        axes.push(z);
+    }
+    axes.extend(sweep.grid.iter());
+    let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
+    let combinations: usize = sizes.iter().product();
+    let combos = combinations_of(sweep, &axes, &sizes, combinations);
+    let (work, mut searches) = search_work(sweep, limits, combos);
+    let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
+    let mut ex = Expansion::default();
+    for (owned, search) in &work {
+        let entries: Vec<&Entry> = owned.iter().collect();
+        let outcome = resolve(
+            sweep_dir(sweep),
+            sweep.scene,
+            &entries,
+            allow_unstable,
+            limits,
+        );
+        ex.add(sweep, limits, &entries, search, outcome);
+    }
+    let Expansion {
+        runs,
+        mut issues,
+        excluded_by_filter,
+        inapplicable,
+        collapsed,
+        references,
+        ..
+    } = ex;
+    // A base none of whose probes is a run (meaningless, excluded) is no search.
+    searches.retain(|b| runs.iter().any(|r| r.search.as_deref() == Some(&b.tag)));
+    if !issues.is_empty() {
+        issues.sort();
+        issues.dedup();
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            issues,
+            sets: sweep.sets.clone(),
+        });
+    }
+    if runs.is_empty() {
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            sets: sweep.sets.clone(),
+            issues: vec![Issue {
+                line: None,
+                key: "grid".into(),
+                reason: format!(
+                    "the sweep expands to no runs ({combinations} combinations: {excluded_by_filter} excluded by filters, {} inapplicable)",
+                    inapplicable.values().sum::<usize>()
+                ),
+            }],
+        });
+    }
+    Ok(Plan {
+        sweep: sweep.clone(),
+        limits: *limits,
+        runs,
+        combinations,
+        excluded_by_filter,
+        inapplicable,
+        collapsed,
+        references,
+        searches,
+    })
+}
+
+/// The plan's size, checked from the file alone: a plan above `limits.max_runs` (or above
+/// the memory a plan may hold) is refused before anything is allocated for it, at its longest
+/// axis.
+fn check_size(sweep: &SweepFile, limits: &PlanLimits) -> Result<(), SweepError> {
     let size = PlanSize::of(sweep);
     let plan_bytes = size.combinations as f64 * PLAN_BYTES_PER_RUN;
     let too_big = limits.max_plan_bytes.is_some_and(|b| plan_bytes > b);
@@ -1625,42 +1731,48 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
             }],
         });
     }
-    let mut axes: Vec<&Axis> = Vec::new();
-    if let Some(z) = &sweep.zip {
-        axes.push(z);
-    }
-    axes.extend(sweep.grid.iter());
-    let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
-    let combinations: usize = sizes.iter().product();
-    let mut runs = Vec::new();
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut issues: Vec<Issue> = Vec::new();
-    let mut excluded_by_filter = 0;
-    let mut inapplicable: BTreeMap<String, usize> = BTreeMap::new();
-    let mut collapsed: BTreeMap<String, usize> = BTreeMap::new();
-    let mut references: Vec<ReferencePlan> = Vec::new();
-    let mut searches: Vec<SearchBase> = Vec::new();
-    // A search turns every combination into a base and its two bracket probes.
-    let combos: Vec<Vec<Entry>> = {
-        let mut out = Vec::new();
-        let mut idx = vec![0usize; axes.len()];
-        for _ in 0..combinations {
-            let mut entries: Vec<Entry> = sweep.fixed.clone();
-            for (a, &i) in axes.iter().zip(&idx) {
-                entries.extend(a.items[i].iter().cloned());
-            }
-            out.push(entries);
-            for d in (0..idx.len()).rev() {
-                idx[d] += 1;
-                if idx[d] < sizes[d] {
-                    break;
-                }
-                idx[d] = 0;
-            }
+    Ok(())
+}
+
+/// The entries of every combination: [fixed], then one item of each axis; the first axis
+/// (the zipped lists, if any) varies slowest, the last fastest.
+fn combinations_of(
+    sweep: &SweepFile,
+    axes: &[&Axis],
+    sizes: &[usize],
+    combinations: usize,
+) -> Vec<Vec<Entry>> {
+    let mut out = Vec::new();
+    let mut idx = vec![0usize; axes.len()];
+    for _ in 0..combinations {
+        let mut entries: Vec<Entry> = sweep.fixed.clone();
+        for (a, &i) in axes.iter().zip(&idx) {
+            entries.extend(a.items[i].iter().cloned());
         }
-        out
-    };
-    let mut work: Vec<(Vec<Entry>, Option<String>)> = Vec::new();
+        out.push(entries);
+        for d in (0..idx.len()).rev() {
+            idx[d] += 1;
+            if idx[d] < sizes[d] {
+                break;
+            }
+            idx[d] = 0;
+        }
+    }
+    out
+}
+
+/// The combinations to resolve, each with the tag of its search (probes only).
+type Work = Vec<(Vec<Entry>, Option<String>)>;
+
+/// The combinations to resolve, each with its search tag: as they are, or — with a
+/// `[search]` — every combination a base and its two bracket probes (lo, hi).
+fn search_work(
+    sweep: &SweepFile,
+    limits: &PlanLimits,
+    combos: Vec<Vec<Entry>>,
+) -> (Work, Vec<SearchBase>) {
+    let mut searches: Vec<SearchBase> = Vec::new();
+    let mut work: Work = Vec::new();
     for entries in combos {
         match &sweep.search {
             None => work.push((entries, None)),
@@ -1692,141 +1804,148 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
             }
         }
     }
-    let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
-    for (owned, search) in &work {
-        let entries: Vec<&Entry> = owned.iter().collect();
-        match resolve(
-            sweep_dir(sweep),
-            sweep.scene,
-            &entries,
-            allow_unstable,
-            limits,
-        ) {
-            Outcome::Invalid(mut is) => issues.append(&mut is),
-            Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
+    (work, searches)
+}
+
+/// What the expansion gathers, combination by combination: the runs (by id, the first of
+/// identical ones), the problems, the combinations left out (by reason) and the reference
+/// runs.
+#[derive(Default)]
+struct Expansion {
+    runs: Vec<RunSpec>,
+    seen: HashMap<String, usize>,
+    issues: Vec<Issue>,
+    excluded_by_filter: usize,
+    inapplicable: BTreeMap<String, usize>,
+    collapsed: BTreeMap<String, usize>,
+    references: Vec<ReferencePlan>,
+}
+
+impl Expansion {
+    /// One resolved combination: refused, left out, excluded by a filter, or its runs (with
+    /// their reference) added.
+    fn add(
+        &mut self,
+        sweep: &SweepFile,
+        limits: &PlanLimits,
+        entries: &[&Entry],
+        search: &Option<String>,
+        outcome: Outcome,
+    ) {
+        match outcome {
+            Outcome::Invalid(mut is) => self.issues.append(&mut is),
+            Outcome::Inapplicable(why) => *self.inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
                 if sweep.exclude.iter().any(|f| matches_filter(f, &r)) {
-                    excluded_by_filter += 1;
+                    self.excluded_by_filter += 1;
                 } else {
                     let reference = match &sweep.reference {
                         None => None,
-                        Some(over) => match reference_of(sweep, limits, &entries, over, &r) {
-                            Ok((spec, sx, st)) => {
-                                let id = spec.run_id.clone();
-                                let old = spec.superseded_id.clone();
-                                match references.iter_mut().find(|p| p.spec.run_id == id) {
-                                    Some(p) => {
-                                        p.space_stride = gcd(p.space_stride, sx);
-                                        p.time_stride = gcd(p.time_stride, st);
-                                    }
-                                    None => references.push(ReferencePlan {
-                                        spec,
-                                        space_stride: sx,
-                                        time_stride: st,
-                                    }),
-                                }
-                                Some((id, old))
-                            }
-                            Err(mut is) => {
-                                issues.append(&mut is);
-                                None
-                            }
-                        },
+                        Some(over) => self.reference(sweep, limits, entries, over, &r),
                     };
-                    let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
-                        None => vec![None],
-                        Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
-                    };
-                    for sample in samples {
-                        let mut extra = match (sample, sweep.ensemble) {
-                            (Some((k, p)), Some(e)) => {
-                                format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
-                            }
-                            _ => String::new(),
-                        };
-                        let mut old_extra = extra.clone();
-                        // The errors depend on the reference: a run measured against another
-                        // reference is another run.
-                        if let Some((rid, old)) = &reference {
-                            let _ = writeln!(extra, "reference={rid}");
-                            let _ =
-                                writeln!(old_extra, "reference={}", old.as_ref().unwrap_or(rid));
-                        }
-                        let id = r.id(sweep.scene, &extra);
-                        let superseded_id = r.superseded_id(
-                            sweep.scene,
-                            &old_extra,
-                            reference.as_ref().is_some_and(|(_, old)| old.is_some()),
-                        );
-                        if seen.contains_key(&id) {
-                            let why = if r.dropped.is_empty() {
-                                "identical parameters after alias resolution".to_string()
-                            } else {
-                                r.dropped.join("; ")
-                            };
-                            *collapsed.entry(why).or_default() += 1;
-                            continue;
-                        }
-                        seen.insert(id.clone(), runs.len());
-                        let mut config = r.config.clone();
-                        if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
-                            let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
-                            config.set_perturbation(Some((p, seed)));
-                        }
-                        runs.push(RunSpec {
-                            run_id: id,
-                            label: r.label.clone(),
-                            params: r.params.clone(),
-                            scheme_label: r.scheme_label.clone(),
-                            config,
-                            repeats: sweep.repeats,
-                            sample,
-                            scene: sweep.scene,
-                            reference: reference.as_ref().map(|(rid, _)| rid.clone()),
-                            search: search.clone(),
-                            superseded_id,
-                        });
-                    }
+                    self.add_members(sweep, &r, reference, search);
                 }
             }
         }
     }
-    // A base none of whose probes is a run (meaningless, excluded) is no search.
-    searches.retain(|b| runs.iter().any(|r| r.search.as_deref() == Some(&b.tag)));
-    if !issues.is_empty() {
-        issues.sort();
-        issues.dedup();
-        return Err(SweepError::Invalid {
-            file: sweep.path.clone(),
-            issues,
-            sets: sweep.sets.clone(),
-        });
+
+    /// The reference run of a run (merged with an identical one already planned, its
+    /// strides the greatest common divisor of its consumers'): its id and superseded id.
+    fn reference(
+        &mut self,
+        sweep: &SweepFile,
+        limits: &PlanLimits,
+        entries: &[&Entry],
+        over: &[Entry],
+        r: &Resolved,
+    ) -> Option<(String, Option<String>)> {
+        match reference_of(sweep, limits, entries, over, r) {
+            Ok((spec, sx, st)) => {
+                let id = spec.run_id.clone();
+                let old = spec.superseded_id.clone();
+                match self.references.iter_mut().find(|p| p.spec.run_id == id) {
+                    Some(p) => {
+                        p.space_stride = gcd(p.space_stride, sx);
+                        p.time_stride = gcd(p.time_stride, st);
+                    }
+                    None => self.references.push(ReferencePlan {
+                        spec,
+                        space_stride: sx,
+                        time_stride: st,
+                    }),
+                }
+                Some((id, old))
+            }
+            Err(mut is) => {
+                self.issues.append(&mut is);
+                None
+            }
+        }
     }
-    if runs.is_empty() {
-        return Err(SweepError::Invalid {
-            file: sweep.path.clone(),
-            sets: sweep.sets.clone(),
-            issues: vec![Issue {
-                line: None,
-                key: "grid".into(),
-                reason: format!(
-                    "the sweep expands to no runs ({combinations} combinations: {excluded_by_filter} excluded by filters, {} inapplicable)",
-                    inapplicable.values().sum::<usize>()
-                ),
-            }],
-        });
+
+    /// The runs of a resolved combination: one per ensemble member, each id over its member
+    /// and its reference; a run identical to an earlier one collapses into it.
+    fn add_members(
+        &mut self,
+        sweep: &SweepFile,
+        r: &Resolved,
+        reference: Option<(String, Option<String>)>,
+        search: &Option<String>,
+    ) {
+        let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
+            None => vec![None],
+            Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
+        };
+        for sample in samples {
+            let mut extra = match (sample, sweep.ensemble) {
+                (Some((k, p)), Some(e)) => {
+                    format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
+                }
+                _ => String::new(),
+            };
+            let mut old_extra = extra.clone();
+            // The errors depend on the reference: a run measured against another
+            // reference is another run.
+            if let Some((rid, old)) = &reference {
+                let _ = writeln!(extra, "reference={rid}");
+                let _ = writeln!(old_extra, "reference={}", old.as_ref().unwrap_or(rid));
+            }
+            let id = r.id(sweep.scene, &extra);
+            let superseded_id = r.superseded_id(
+                sweep.scene,
+                &old_extra,
+                reference.as_ref().is_some_and(|(_, old)| old.is_some()),
+            );
+            if self.seen.contains_key(&id) {
+                let why = if r.dropped.is_empty() {
+                    "identical parameters after alias resolution".to_string()
+                } else {
+                    r.dropped.join("; ")
+                };
+                *self.collapsed.entry(why).or_default() += 1;
+                continue;
+            }
+            self.seen.insert(id.clone(), self.runs.len());
+            let mut config = r.config.clone();
+            if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
+                let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
+                config.set_perturbation(Some((p, seed)));
+            }
+            self.runs.push(RunSpec {
+                run_id: id,
+                label: r.label.clone(),
+                params: r.params.clone(),
+                scheme_label: r.scheme_label.clone(),
+                config,
+                repeats: sweep.repeats,
+                sample,
+                scene: sweep.scene,
+                reference: reference.as_ref().map(|(rid, _)| rid.clone()),
+                search: search.clone(),
+                superseded_id,
+            });
+        }
     }
-    Ok(Plan {
-        sweep: sweep.clone(),
-        limits: *limits,
-        runs,
-        combinations,
-        excluded_by_filter,
-        inapplicable,
-        collapsed,
-        references,
-        searches,
-    })
 }
 
 /// A combination's entries with the searched key set to `value`.
