@@ -324,31 +324,9 @@ impl Key {
         }
     }
 
-    /// Value-level range check (independent of the other parameters of a run).
+    /// Value-level range check (independent of the other parameters of a run), by the kind
+    /// of value: a count, a weight list, a word, a number.
     pub fn check(self, v: &Value) -> Result<(), String> {
-        let finite = |x: f64| {
-            if x.is_finite() {
-                Ok(x)
-            } else {
-                Err(format!("must be a finite number, got {x}"))
-            }
-        };
-        let positive = |x: f64| {
-            finite(x)?;
-            if x > 0.0 {
-                Ok(())
-            } else {
-                Err(format!("must be > 0, got {x}"))
-            }
-        };
-        let within = |x: f64, lo: f64, hi: f64| {
-            finite(x)?;
-            if (lo..=hi).contains(&x) {
-                Ok(())
-            } else {
-                Err(format!("must lie in [{lo}, {hi}], got {x}"))
-            }
-        };
         match (self, v) {
             (Key::Elements, Value::Int(i)) => {
                 if *i >= 2 {
@@ -366,14 +344,23 @@ impl Key {
                 }
                 Ok(())
             }
-            (Key::Space, Value::Str(s)) => match s.as_str() {
+            (k, Value::Str(s)) => k.check_word(s),
+            (k, Value::Num(x)) => k.check_number(*x),
+            _ => Err("wrong type".into()),
+        }
+    }
+
+    /// The word of a string key: one of the names it takes (a mesh file: any path).
+    fn check_word(self, s: &str) -> Result<(), String> {
+        match self {
+            Key::Space => match s {
                 "mixed" | "nitsche" | "penalty" => Ok(()),
                 _ => Err(format!(
                     "unknown space `{s}` (expected mixed, nitsche or penalty)"
                 )),
             },
-            (Key::Mass, Value::Str(s)) => {
-                if crate::space::MassVariant::NAMES.contains(&s.as_str()) {
+            Key::Mass => {
+                if crate::space::MassVariant::NAMES.contains(&s) {
                     Ok(())
                 } else {
                     Err(format!(
@@ -382,7 +369,7 @@ impl Key {
                     ))
                 }
             }
-            (Key::ContactInit, Value::Str(s)) => {
+            Key::ContactInit => {
                 if crate::space::ContactInit::from_name(s).is_some() {
                     Ok(())
                 } else {
@@ -391,8 +378,8 @@ impl Key {
                     ))
                 }
             }
-            (Key::Scheme, Value::Str(s)) => {
-                if SCHEME_NAMES.contains(&s.as_str()) {
+            Key::Scheme => {
+                if SCHEME_NAMES.contains(&s) {
                     Ok(())
                 } else {
                     Err(format!(
@@ -401,37 +388,20 @@ impl Key {
                     ))
                 }
             }
-            (Key::T | Key::H | Key::Dt | Key::Courant, Value::Num(x)) => positive(*x),
-            (Key::NitscheGamma0 | Key::PenaltyGamma0, Value::Num(x)) => positive(*x),
-            (Key::Length | Key::Young | Key::Density | Key::Height, Value::Num(x)) => positive(*x),
-            (Key::VelocityTangential, Value::Num(x)) => finite(*x).map(|_| ()),
-            // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
-            // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the
-            // rigid motions.
-            (Key::LameLambda, Value::Num(x)) => {
-                finite(*x)?;
-                if *x >= 0.0 {
-                    Ok(())
-                } else {
-                    Err(format!("must be ≥ 0, got {x}"))
-                }
-            }
-            (Key::LameMu, Value::Num(x)) => positive(*x),
-            (Key::RightEnd, Value::Str(s)) => match s.as_str() {
+            Key::RightEnd => match s {
                 "clamped" | "free" => Ok(()),
                 _ => Err(format!(
                     "unknown right_end `{s}` (expected clamped or free: the bar's end x = L held at u = 0 or traction-free)"
                 )),
             },
-            (Key::Load, Value::Str(s)) => match s.as_str() {
+            Key::Load => match s {
                 "body" | "inertial" => Ok(()),
                 _ => Err(format!(
                     "unknown load `{s}` (expected body — the body force ∫ρ f·φ, SPEC §1.3 — or inertial — M_run f e_d, the weight following the run's modified mass)"
                 )),
             },
-            (Key::PointMass | Key::Stiffness, Value::Num(x)) => positive(*x),
-            (Key::Solver, Value::Str(s)) => {
-                if crate::space::step_solver::Solver::NAMES.contains(&s.as_str()) {
+            Key::Solver => {
+                if crate::space::step_solver::Solver::NAMES.contains(&s) {
                     Ok(())
                 } else {
                     Err(format!(
@@ -439,27 +409,14 @@ impl Key {
                     ))
                 }
             }
-            // A relative residual: at 1 and above CG would stop before iterating. Values below
-            // round-off (≈ 1e-15) are accepted but buy nothing: CG's recursively updated
-            // residual keeps shrinking while the true one stays at round-off, so such a run
-            // iterates longer for the same solution (measured: cg_tol = 1e-18 runs).
-            (Key::CgTol, Value::Num(x)) => {
-                finite(*x)?;
-                if *x > 0.0 && *x < 1.0 {
-                    Ok(())
-                } else {
-                    Err(format!("must lie in (0, 1) (a relative residual), got {x}"))
-                }
-            }
-            (Key::Mesh, Value::Str(s)) => {
+            Key::Mesh => {
                 if s.trim().is_empty() {
                     Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())
                 } else {
                     Ok(())
                 }
             }
-            (Key::Velocity | Key::Force, Value::Num(x)) => finite(*x).map(|_| ()),
-            (Key::Friction, Value::Str(s)) => {
+            Key::Friction => {
                 if crate::contact::friction::FrictionKind::from_name(s).is_some() {
                     Ok(())
                 } else {
@@ -468,14 +425,48 @@ impl Key {
                     ))
                 }
             }
+            _ => Err("wrong type".into()),
+        }
+    }
+
+    /// A number of a real-valued key: finite, and within the key's range.
+    fn check_number(self, x: f64) -> Result<(), String> {
+        match self {
+            Key::T | Key::H | Key::Dt | Key::Courant => positive(x),
+            Key::NitscheGamma0 | Key::PenaltyGamma0 => positive(x),
+            Key::Length | Key::Young | Key::Density | Key::Height => positive(x),
+            Key::VelocityTangential => finite(x).map(|_| ()),
+            // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
+            // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the
+            // rigid motions.
+            Key::LameLambda => {
+                finite(x)?;
+                if x >= 0.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must be ≥ 0, got {x}"))
+                }
+            }
+            Key::LameMu => positive(x),
+            Key::PointMass | Key::Stiffness => positive(x),
+            // A relative residual: at 1 and above CG would stop before iterating. Values below
+            // round-off (≈ 1e-15) are accepted but buy nothing: CG's recursively updated
+            // residual keeps shrinking while the true one stays at round-off, so such a run
+            // iterates longer for the same solution (measured: cg_tol = 1e-18 runs).
+            Key::CgTol => {
+                finite(x)?;
+                if x > 0.0 && x < 1.0 {
+                    Ok(())
+                } else {
+                    Err(format!("must lie in (0, 1) (a relative residual), got {x}"))
+                }
+            }
+            Key::Velocity | Key::Force => finite(x).map(|_| ()),
             // A coefficient and a traction: zero is frictionless (the same numbers as none),
             // a negative bound would push the body along its slip.
-            (
-                Key::FrictionCoefficient | Key::TrescaThreshold | Key::FrictionForce,
-                Value::Num(x),
-            ) => {
-                finite(*x)?;
-                if *x >= 0.0 {
+            Key::FrictionCoefficient | Key::TrescaThreshold | Key::FrictionForce => {
+                finite(x)?;
+                if x >= 0.0 {
                     Ok(())
                 } else {
                     Err(format!(
@@ -483,12 +474,12 @@ impl Key {
                     ))
                 }
             }
-            (Key::ImpactLaw, Value::Num(x)) => within(*x, 0.0, 1.0),
+            Key::ImpactLaw => within(x, 0.0, 1.0),
             // A tilt in degrees: at ±90° the plane is a wall, the weight has no component
             // pressing the body on it (cos α = 0) and the body falls along it, never resting on
             // the plane the scene is about; beyond, gravity pulls the body away from the plane.
-            (Key::Incline, Value::Num(x)) => {
-                finite(*x)?;
+            Key::Incline => {
+                finite(x)?;
                 if x.abs() < 90.0 {
                     Ok(())
                 } else {
@@ -498,27 +489,23 @@ impl Key {
                 }
             }
             // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).
-            (Key::Gap | Key::Amplitude, Value::Num(x)) => {
-                finite(*x)?;
-                if *x >= 0.0 {
+            Key::Gap | Key::Amplitude => {
+                finite(x)?;
+                if x >= 0.0 {
                     Ok(())
                 } else {
                     Err(format!("must be ≥ 0, got {x}"))
                 }
             }
-            (Key::NewmarkBeta, Value::Num(x)) => within(*x, 0.0, 0.5),
-            (Key::NewmarkGamma | Key::ThetaScheme | Key::Restitution, Value::Num(x)) => {
-                within(*x, 0.0, 1.0)
-            }
-            (Key::RhoInf, Value::Num(x)) => within(*x, 0.0, 1.0),
-            (Key::HhtAlpha, Value::Num(x)) => within(*x, 0.0, 1.0 / 3.0),
+            Key::NewmarkBeta => within(x, 0.0, 0.5),
+            Key::NewmarkGamma | Key::ThetaScheme | Key::Restitution => within(x, 0.0, 1.0),
+            Key::RhoInf => within(x, 0.0, 1.0),
+            Key::HhtAlpha => within(x, 0.0, 1.0 / 3.0),
             // A height: any finite value (the planner refuses one above the body's lowest Γ_C
             // node, where the body would start inside the obstacle).
-            (Key::NitscheTheta | Key::Gravity | Key::Obstacle, Value::Num(x)) => {
-                finite(*x).map(|_| ())
-            }
-            (Key::Degree, Value::Num(x)) => {
-                if *x == 1.0 || *x == 2.0 {
+            Key::NitscheTheta | Key::Gravity | Key::Obstacle => finite(x).map(|_| ()),
+            Key::Degree => {
+                if x == 1.0 || x == 2.0 {
                     Ok(())
                 } else {
                     Err(format!("must be 1 or 2 (Q1 or Q2 elements), got {x}"))
@@ -526,6 +513,35 @@ impl Key {
             }
             _ => Err("wrong type".into()),
         }
+    }
+}
+
+/// A finite number, or why not.
+fn finite(x: f64) -> Result<f64, String> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(format!("must be a finite number, got {x}"))
+    }
+}
+
+/// A finite number > 0, or why not.
+fn positive(x: f64) -> Result<(), String> {
+    finite(x)?;
+    if x > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("must be > 0, got {x}"))
+    }
+}
+
+/// A finite number in [lo, hi], or why not.
+fn within(x: f64, lo: f64, hi: f64) -> Result<(), String> {
+    finite(x)?;
+    if (lo..=hi).contains(&x) {
+        Ok(())
+    } else {
+        Err(format!("must lie in [{lo}, {hi}], got {x}"))
     }
 }
 

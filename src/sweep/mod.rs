@@ -597,417 +597,35 @@ impl SweepFile {
     pub fn parse_with(path: &Path, text: &str, sets: &[String]) -> Result<SweepFile, SweepError> {
         let invalid = |issues: Vec<Issue>| invalid_file(path, sets, issues);
         let (top, mut ck) = overridden_tree(path, text, sets)?;
-        let get = |name: &str| top.iter().find(|(k, _, _)| k == name);
-        for (k, line, _) in &top {
-            if !TOP_KEYS.contains(&k.as_str()) {
-                let hint = if Key::from_name(k).is_some() {
-                    " (parameters go in [fixed], [grid] or [zip])".to_string()
-                } else {
-                    suggest(k)
-                };
-                ck.issue(
-                    k,
-                    *line,
-                    format!(
-                        "unknown top-level key{hint}; accepted: {}",
-                        TOP_KEYS.join(", ")
-                    ),
-                );
-            }
-        }
-        let string = |ck: &mut Checker, name: &str| -> Option<(String, usize)> {
-            let (_, line, node) = get(name)?;
-            match &node.kind {
-                Kind::Str(s) => Some((s.clone(), *line)),
-                k => {
-                    ck.issue(
-                        name,
-                        *line,
-                        format!("expected a string, found a {}", k.type_name()),
-                    );
-                    None
-                }
-            }
-        };
-        let name = match string(&mut ck, "name") {
-            Some((n, line)) => {
-                let ok = !n.is_empty()
-                    && n.chars()
-                        .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-                    && !n.starts_with('.');
-                if !ok {
-                    ck.issue(
-                        "name",
-                        line,
-                        "must be a non-empty folder-safe name (letters, digits, - _ .)",
-                    );
-                }
-                n
-            }
-            None => {
-                if get("name").is_none() {
-                    ck.issues.push(Issue {
-                        line: None,
-                        key: "name".into(),
-                        reason: "required key missing (the sweep's name, also its default output folder)".into(),
-                    });
-                }
-                String::new()
-            }
-        };
-        match string(&mut ck, "scene") {
-            Some((s, line)) => match SceneKind::NAMES.iter().find(|(n, _)| *n == s) {
-                Some((_, Some(kind))) => ck.scene = Some(*kind),
-                Some((_, None)) => ck.issue(
-                    "scene",
-                    line,
-                    format!(
-                        "scene `{s}` is specified (SPEC §1) but not implemented in this version"
-                    ),
-                ),
-                None => ck.issue(
-                    "scene",
-                    line,
-                    format!(
-                        "unknown scene `{s}` (expected one of {})",
-                        SceneKind::NAMES.map(|(n, _)| n).join(", ")
-                    ),
-                ),
-            },
-            None => {
-                if get("scene").is_none() {
-                    ck.issues.push(Issue {
-                        line: None,
-                        key: "scene".into(),
-                        reason: format!(
-                            "required key missing (one of {})",
-                            SceneKind::NAMES.map(|(n, _)| n).join(", ")
-                        ),
-                    });
-                }
-            }
-        }
-        let description = string(&mut ck, "description").map(|(s, _)| s);
-        let table = |ck: &mut Checker, name: &str| -> Vec<(String, usize, Node)> {
-            match get(name) {
-                None => Vec::new(),
-                Some((
-                    _,
-                    _,
-                    Node {
-                        kind: Kind::Table(t),
-                        ..
-                    },
-                )) => t.clone(),
-                Some((_, line, node)) => {
-                    ck.issue(
-                        name,
-                        *line,
-                        format!("expected a table, found a {}", node.kind.type_name()),
-                    );
-                    Vec::new()
-                }
-            }
-        };
-        let mut fixed = Vec::new();
-        for (k, line, v) in table(&mut ck, "fixed") {
-            let p = format!("fixed.{k}");
-            if let Some(key) = ck.key(&k, &p, line) {
-                if matches!(v.kind, Kind::Array(_)) && key.value_type() != ValueType::FloatList {
-                    ck.issue(
-                        &p,
-                        line,
-                        "[fixed] takes one value; put lists in [grid] or [zip]",
-                    );
-                } else if let Some(e) = ck.value(key, &v, &p) {
-                    fixed.push(e);
-                }
-            }
-        }
-        let mut grid = Vec::new();
-        for (k, line, v) in table(&mut ck, "grid") {
-            if let Some(ax) = ck.axis("grid", &k, line, &v) {
-                grid.push(ax);
-            }
-        }
-        let zip_entries = table(&mut ck, "zip");
-        let mut zip_axes = Vec::new();
-        for (k, line, v) in &zip_entries {
-            if let Some(ax) = ck.axis("zip", k, *line, v) {
-                zip_axes.push((ax, *line));
-            }
-        }
-        let zip = if zip_axes.is_empty() {
-            None
-        } else {
-            let n = zip_axes[0].0.items.len();
-            for (ax, line) in &zip_axes[1..] {
-                if ax.items.len() != n {
-                    ck.issue(
-                        &format!("zip.{}", ax.name),
-                        *line,
-                        format!(
-                            "has {} values but zip.{} has {n}: zipped lists must have equal lengths",
-                            ax.items.len(),
-                            zip_axes[0].0.name
-                        ),
-                    );
-                }
-            }
-            let items = (0..n)
-                .map(|i| {
-                    zip_axes
-                        .iter()
-                        .flat_map(|(ax, _)| ax.items.get(i).cloned().unwrap_or_default())
-                        .collect()
-                })
-                .collect();
-            let names: Vec<&str> = zip_axes.iter().map(|(a, _)| a.name.as_str()).collect();
-            Some(Axis {
-                name: names.join("+"),
-                items,
-            })
-        };
-        let mut exclude = Vec::new();
-        if let Some((_, line, node)) = get("exclude") {
-            match &node.kind {
-                Kind::Array(items) => {
-                    for (i, it) in items.iter().enumerate() {
-                        let p = format!("exclude[{i}]");
-                        match &it.kind {
-                            Kind::Table(t) if !t.is_empty() => exclude.push(ck.bundle(t, &p)),
-                            _ => ck.issue(&p, it.line, "expected a non-empty inline table of parameters, e.g. { space = \"mixed\", scheme = \"hybrid\" }"),
-                        }
-                    }
-                }
-                k => ck.issue(
-                    "exclude",
-                    *line,
-                    format!(
-                        "expected a list of inline tables, found a {}",
-                        k.type_name()
-                    ),
-                ),
-            }
-        }
-        let int = |ck: &mut Checker, path: &str, node: &Node, min: i64| -> Option<i64> {
-            match node.kind {
-                Kind::Int(i) if i >= min => Some(i),
-                Kind::Int(i) => {
-                    ck.issue(
-                        path,
-                        node.line,
-                        format!("must be an integer ≥ {min}, got {i}"),
-                    );
-                    None
-                }
-                ref k => {
-                    ck.issue(
-                        path,
-                        node.line,
-                        format!("expected an integer, found a {}", k.type_name()),
-                    );
-                    None
-                }
-            }
-        };
-        let repeats = get("repeats")
-            .and_then(|(_, _, n)| int(&mut ck, "repeats", n, 1))
+        ck.top_keys(&top);
+        let name = ck.name(&top);
+        ck.read_scene(&top);
+        let description = ck.string(&top, "description").map(|(s, _)| s);
+        let fixed = ck.fixed(&top);
+        let grid = ck.grid(&top);
+        let zip = ck.zip(&top);
+        let exclude = ck.exclude(&top);
+        let repeats = top_entry(&top, "repeats")
+            .and_then(|(_, _, n)| ck.int("repeats", n, 1))
             .unwrap_or(1) as usize;
-        let series_every = get("series_every")
-            .and_then(|(_, _, n)| int(&mut ck, "series_every", n, 0))
+        let series_every = top_entry(&top, "series_every")
+            .and_then(|(_, _, n)| ck.int("series_every", n, 0))
             .unwrap_or(1) as usize;
-        let mut ensemble = None;
-        if let Some((_, line, node)) = get("ensemble") {
-            if let Kind::Table(t) = &node.kind {
-                let (mut pert, mut samples, mut seed) = (None, None, Some(0));
-                for (k, kl, v) in t {
-                    let p = format!("ensemble.{k}");
-                    match k.as_str() {
-                        "perturbation" => match v.kind {
-                            Kind::Float(x) if x >= 0.0 && x.is_finite() => pert = Some(x),
-                            Kind::Int(i) if i >= 0 => pert = Some(i as f64),
-                            _ => ck.issue(&p, *kl, "expected a finite number ≥ 0 (relative amplitude of the perturbation of u⁰)"),
-                        },
-                        "samples" => samples = int(&mut ck, &p, v, 1),
-                        "seed" => seed = int(&mut ck, &p, v, 0),
-                        _ => ck.issue(&p, *kl, "unknown key (expected perturbation, samples, seed)"),
-                    }
-                }
-                match (pert, samples, seed) {
-                    (Some(perturbation), Some(samples), Some(seed)) => {
-                        ensemble = Some(Ensemble {
-                            perturbation,
-                            samples: samples as usize,
-                            seed: seed as u64,
-                        })
-                    }
-                    _ => ck.issue(
-                        "ensemble",
-                        *line,
-                        "needs perturbation and samples (seed optional)",
-                    ),
-                }
-            } else {
-                ck.issue(
-                    "ensemble",
-                    *line,
-                    "expected an inline table { perturbation, samples, seed }",
-                );
-            }
-        }
-        let summary = match get("summary") {
+        let ensemble = ck.ensemble(&top);
+        let summary = match top_entry(&top, "summary") {
             Some((_, line, node)) => ck.summary(*line, node),
             None => SummaryOptions::default(),
         };
-        let mut reference = None;
-        let mut reference_scene = None;
-        if let Some((_, line, node)) = get("reference") {
-            let uses_reference = ck.scene.map(|s| {
-                let scene = s.get();
-                let defaults = crate::scene::Physics(
-                    scene
-                        .physics()
-                        .iter()
-                        .map(|k| (k.name, k.default))
-                        .collect(),
-                );
-                scene.error_source(&defaults) == Some(crate::scene::ErrorSource::ReferenceRun)
-            });
-            match (&node.kind, uses_reference) {
-                (_, Some(false)) => ck.issue(
-                    "reference",
-                    *line,
-                    format!(
-                        "scene {} has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
-                        ck.scene.map(|s| s.name()).unwrap_or_default()
-                    ),
-                ),
-                (Kind::Table(t), _) if !t.is_empty() => {
-                    // `scene` names the reference's scene; the other keys are that scene's
-                    // parameters, checked against it rather than against the sweep's.
-                    let (scene_entries, rest): (Vec<_>, Vec<_>) =
-                        t.iter().cloned().partition(|(k, _, _)| k == "scene");
-                    if let Some((_, sl, node)) = scene_entries.first() {
-                        match (&node.kind, ck.scene) {
-                            (Kind::Str(name), Some(own)) => {
-                                match reference_scene_of(own, name) {
-                                    Ok(kind) => reference_scene = Some(kind),
-                                    Err(why) => ck.issue("reference.scene", *sl, why),
-                                }
-                            }
-                            (Kind::Str(_), None) => {}
-                            (k, _) => ck.issue(
-                                "reference.scene",
-                                *sl,
-                                format!("expected a scene name, found a {}", k.type_name()),
-                            ),
-                        }
-                    }
-                    let own = ck.scene;
-                    if reference_scene.is_some() {
-                        ck.scene = reference_scene;
-                    }
-                    let entries = ck.bundle(&rest, "reference");
-                    ck.scene = own;
-                    if !scene_entries.is_empty() && rest.is_empty() {
-                        ck.issue(
-                            "reference",
-                            *line,
-                            "a reference of another scene needs its mesh and step (h or elements, dt or courant)",
-                        );
-                    }
-                    reference = Some(entries);
-                }
-                (k, _) => ck.issue(
-                    "reference",
-                    *line,
-                    format!(
-                        "expected a non-empty inline table of parameters, e.g. {{ h = 0.0015625, dt = 0.00078125, mass = \"mod3\", scheme = \"crank-nicolson\" }}, found a {}",
-                        k.type_name()
-                    ),
-                ),
-            }
-        }
-        let allow_unstable = match get("allow_unstable") {
-            None => false,
-            Some((
-                _,
-                _,
-                Node {
-                    kind: Kind::Bool(b),
-                    ..
-                },
-            )) => *b,
-            Some((_, line, node)) => {
-                ck.issue(
-                    "allow_unstable",
-                    *line,
-                    format!("expected true or false, found a {}", node.kind.type_name()),
-                );
-                false
-            }
-        };
-        let search = match get("search") {
+        let (reference, reference_scene) = ck.reference(&top);
+        let allow_unstable = ck.allow_unstable(&top);
+        let search = match top_entry(&top, "search") {
             None => None,
             Some((_, line, node)) => parse_search(&mut ck, *line, node),
         };
         if let Some(sr) = &search {
-            let set_elsewhere = fixed
-                .iter()
-                .chain(grid.iter().flat_map(|a| a.items.iter().flatten()))
-                .chain(zip.iter().flat_map(|a| a.items.iter().flatten()))
-                .find(|e| e.key == sr.key);
-            if let Some(e) = set_elsewhere {
-                ck.issues.push(Issue::at(
-                    &e.origin,
-                    format!(
-                        "`{}` is the key of [search]: the search sets it, remove it here",
-                        sr.key.name()
-                    ),
-                ));
-            }
-            if ensemble.is_some() {
-                ck.issue(
-                    "search",
-                    *line_of_search(&top),
-                    "a [search] cannot be combined with an ensemble (each probe would be a whole ensemble)",
-                );
-            }
+            ck.search_conflicts(&top, sr, (&fixed, &grid, zip.as_ref()), ensemble.is_some());
         }
-        // [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
-        // in both [fixed] and [zip]); two axes setting one parameter would be ambiguous.
-        let mut sources: Vec<(Key, Origin, String)> = Vec::new();
-        let mut overridden: Vec<String> = Vec::new();
-        let axes = grid
-            .iter()
-            .map(|a| (a, format!("[grid] {}", a.name)))
-            .chain(zip.iter().map(|a| (a, "[zip]".to_string())));
-        for (ax, source) in axes {
-            for e in ax.items.iter().flatten() {
-                if let Some((_, o, _)) =
-                    sources.iter().find(|(k, _, s)| *k == e.key && *s != source)
-                {
-                    ck.issues.push(Issue::at(
-                        &e.origin,
-                        format!(
-                            "`{}` is also set by {} ({}): two axes may not set one parameter",
-                            e.key.name(),
-                            o.path,
-                            line_ref(o.line, &ck.sets)
-                        ),
-                    ));
-                } else if !sources.iter().any(|(k, _, s)| *k == e.key && *s == source) {
-                    sources.push((e.key, e.origin.clone(), source.clone()));
-                }
-                if let Some(f) = fixed.iter().find(|f| f.key == e.key) {
-                    let note = format!("{} is overridden by {}", f.origin.path, source);
-                    if !overridden.contains(&note) {
-                        overridden.push(note);
-                    }
-                }
-            }
-        }
+        let overridden = ck.overridden(&fixed, &grid, zip.as_ref());
         if ck.issues.is_empty() {
             Ok(SweepFile {
                 path: path.to_path_buf(),
@@ -1036,6 +654,482 @@ impl SweepFile {
             issues.dedup();
             Err(invalid(issues))
         }
+    }
+}
+
+/// A top-level entry of a sweep text by its key.
+fn top_entry<'a>(
+    top: &'a [(String, usize, Node)],
+    name: &str,
+) -> Option<&'a (String, usize, Node)> {
+    top.iter().find(|(k, _, _)| k == name)
+}
+
+/// The top-level sections of a sweep file, one method each, in the order
+/// [`SweepFile::parse_with`] checks them.
+impl Checker {
+    /// Keys that are no section of a sweep file (a parameter written outside its table is
+    /// told where it goes).
+    fn top_keys(&mut self, top: &[(String, usize, Node)]) {
+        for (k, line, _) in top {
+            if !TOP_KEYS.contains(&k.as_str()) {
+                let hint = if Key::from_name(k).is_some() {
+                    " (parameters go in [fixed], [grid] or [zip])".to_string()
+                } else {
+                    suggest(k)
+                };
+                self.issue(
+                    k,
+                    *line,
+                    format!(
+                        "unknown top-level key{hint}; accepted: {}",
+                        TOP_KEYS.join(", ")
+                    ),
+                );
+            }
+        }
+    }
+
+    /// A top-level string and its line; None when absent or not a string.
+    fn string(&mut self, top: &[(String, usize, Node)], name: &str) -> Option<(String, usize)> {
+        let (_, line, node) = top_entry(top, name)?;
+        match &node.kind {
+            Kind::Str(s) => Some((s.clone(), *line)),
+            k => {
+                self.issue(
+                    name,
+                    *line,
+                    format!("expected a string, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    }
+
+    /// `name`: required, folder-safe (it names the default output folder).
+    fn name(&mut self, top: &[(String, usize, Node)]) -> String {
+        match self.string(top, "name") {
+            Some((n, line)) => {
+                let ok = !n.is_empty()
+                    && n.chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+                    && !n.starts_with('.');
+                if !ok {
+                    self.issue(
+                        "name",
+                        line,
+                        "must be a non-empty folder-safe name (letters, digits, - _ .)",
+                    );
+                }
+                n
+            }
+            None => {
+                if top_entry(top, "name").is_none() {
+                    self.issues.push(Issue {
+                        line: None,
+                        key: "name".into(),
+                        reason: "required key missing (the sweep's name, also its default output folder)".into(),
+                    });
+                }
+                String::new()
+            }
+        }
+    }
+
+    /// `scene`: required, one implemented; the parameters after it are checked against it.
+    fn read_scene(&mut self, top: &[(String, usize, Node)]) {
+        match self.string(top, "scene") {
+            Some((s, line)) => match SceneKind::NAMES.iter().find(|(n, _)| *n == s) {
+                Some((_, Some(kind))) => self.scene = Some(*kind),
+                Some((_, None)) => self.issue(
+                    "scene",
+                    line,
+                    format!(
+                        "scene `{s}` is specified (SPEC §1) but not implemented in this version"
+                    ),
+                ),
+                None => self.issue(
+                    "scene",
+                    line,
+                    format!(
+                        "unknown scene `{s}` (expected one of {})",
+                        SceneKind::NAMES.map(|(n, _)| n).join(", ")
+                    ),
+                ),
+            },
+            None => {
+                if top_entry(top, "scene").is_none() {
+                    self.issues.push(Issue {
+                        line: None,
+                        key: "scene".into(),
+                        reason: format!(
+                            "required key missing (one of {})",
+                            SceneKind::NAMES.map(|(n, _)| n).join(", ")
+                        ),
+                    });
+                }
+            }
+        }
+    }
+
+    /// A top-level table's entries; empty when absent or not a table.
+    fn table(&mut self, top: &[(String, usize, Node)], name: &str) -> Vec<(String, usize, Node)> {
+        match top_entry(top, name) {
+            None => Vec::new(),
+            Some((
+                _,
+                _,
+                Node {
+                    kind: Kind::Table(t),
+                    ..
+                },
+            )) => t.clone(),
+            Some((_, line, node)) => {
+                self.issue(
+                    name,
+                    *line,
+                    format!("expected a table, found a {}", node.kind.type_name()),
+                );
+                Vec::new()
+            }
+        }
+    }
+
+    /// `[fixed]`: one value per parameter.
+    fn fixed(&mut self, top: &[(String, usize, Node)]) -> Vec<Entry> {
+        let mut fixed = Vec::new();
+        for (k, line, v) in self.table(top, "fixed") {
+            let p = format!("fixed.{k}");
+            if let Some(key) = self.key(&k, &p, line) {
+                if matches!(v.kind, Kind::Array(_)) && key.value_type() != ValueType::FloatList {
+                    self.issue(
+                        &p,
+                        line,
+                        "[fixed] takes one value; put lists in [grid] or [zip]",
+                    );
+                } else if let Some(e) = self.value(key, &v, &p) {
+                    fixed.push(e);
+                }
+            }
+        }
+        fixed
+    }
+
+    /// `[grid]`: one axis per key, in file order.
+    fn grid(&mut self, top: &[(String, usize, Node)]) -> Vec<Axis> {
+        let mut grid = Vec::new();
+        for (k, line, v) in self.table(top, "grid") {
+            if let Some(ax) = self.axis("grid", &k, line, &v) {
+                grid.push(ax);
+            }
+        }
+        grid
+    }
+
+    /// `[zip]`: lists of equal lengths advanced together, as one axis named `a+b+…`.
+    fn zip(&mut self, top: &[(String, usize, Node)]) -> Option<Axis> {
+        let zip_entries = self.table(top, "zip");
+        let mut zip_axes = Vec::new();
+        for (k, line, v) in &zip_entries {
+            if let Some(ax) = self.axis("zip", k, *line, v) {
+                zip_axes.push((ax, *line));
+            }
+        }
+        if zip_axes.is_empty() {
+            return None;
+        }
+        let n = zip_axes[0].0.items.len();
+        for (ax, line) in &zip_axes[1..] {
+            if ax.items.len() != n {
+                self.issue(
+                    &format!("zip.{}", ax.name),
+                    *line,
+                    format!(
+                        "has {} values but zip.{} has {n}: zipped lists must have equal lengths",
+                        ax.items.len(),
+                        zip_axes[0].0.name
+                    ),
+                );
+            }
+        }
+        let items = (0..n)
+            .map(|i| {
+                zip_axes
+                    .iter()
+                    .flat_map(|(ax, _)| ax.items.get(i).cloned().unwrap_or_default())
+                    .collect()
+            })
+            .collect();
+        let names: Vec<&str> = zip_axes.iter().map(|(a, _)| a.name.as_str()).collect();
+        Some(Axis {
+            name: names.join("+"),
+            items,
+        })
+    }
+
+    /// `exclude = [{…}, …]`: filters, each a non-empty bundle of parameters.
+    fn exclude(&mut self, top: &[(String, usize, Node)]) -> Vec<Vec<Entry>> {
+        let mut exclude = Vec::new();
+        if let Some((_, line, node)) = top_entry(top, "exclude") {
+            match &node.kind {
+                Kind::Array(items) => {
+                    for (i, it) in items.iter().enumerate() {
+                        let p = format!("exclude[{i}]");
+                        match &it.kind {
+                            Kind::Table(t) if !t.is_empty() => exclude.push(self.bundle(t, &p)),
+                            _ => self.issue(&p, it.line, "expected a non-empty inline table of parameters, e.g. { space = \"mixed\", scheme = \"hybrid\" }"),
+                        }
+                    }
+                }
+                k => self.issue(
+                    "exclude",
+                    *line,
+                    format!(
+                        "expected a list of inline tables, found a {}",
+                        k.type_name()
+                    ),
+                ),
+            }
+        }
+        exclude
+    }
+
+    /// An integer ≥ `min` (`repeats`, `series_every`, the ensemble's counts).
+    fn int(&mut self, path: &str, node: &Node, min: i64) -> Option<i64> {
+        match node.kind {
+            Kind::Int(i) if i >= min => Some(i),
+            Kind::Int(i) => {
+                self.issue(
+                    path,
+                    node.line,
+                    format!("must be an integer ≥ {min}, got {i}"),
+                );
+                None
+            }
+            ref k => {
+                self.issue(
+                    path,
+                    node.line,
+                    format!("expected an integer, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    }
+
+    /// `ensemble = { perturbation, samples, seed }`.
+    fn ensemble(&mut self, top: &[(String, usize, Node)]) -> Option<Ensemble> {
+        let (_, line, node) = top_entry(top, "ensemble")?;
+        let Kind::Table(t) = &node.kind else {
+            self.issue(
+                "ensemble",
+                *line,
+                "expected an inline table { perturbation, samples, seed }",
+            );
+            return None;
+        };
+        let (mut pert, mut samples, mut seed) = (None, None, Some(0));
+        for (k, kl, v) in t {
+            let p = format!("ensemble.{k}");
+            match k.as_str() {
+                "perturbation" => match v.kind {
+                    Kind::Float(x) if x >= 0.0 && x.is_finite() => pert = Some(x),
+                    Kind::Int(i) if i >= 0 => pert = Some(i as f64),
+                    _ => self.issue(&p, *kl, "expected a finite number ≥ 0 (relative amplitude of the perturbation of u⁰)"),
+                },
+                "samples" => samples = self.int(&p, v, 1),
+                "seed" => seed = self.int(&p, v, 0),
+                _ => self.issue(&p, *kl, "unknown key (expected perturbation, samples, seed)"),
+            }
+        }
+        match (pert, samples, seed) {
+            (Some(perturbation), Some(samples), Some(seed)) => Some(Ensemble {
+                perturbation,
+                samples: samples as usize,
+                seed: seed as u64,
+            }),
+            _ => {
+                self.issue(
+                    "ensemble",
+                    *line,
+                    "needs perturbation and samples (seed optional)",
+                );
+                None
+            }
+        }
+    }
+
+    /// `reference = {…}`: the parameters that turn a run into its reference run, and the
+    /// reference's scene when it names another (`scene = …`), for scenes whose errors come
+    /// from a reference run.
+    fn reference(
+        &mut self,
+        top: &[(String, usize, Node)],
+    ) -> (Option<Vec<Entry>>, Option<SceneKind>) {
+        let mut reference = None;
+        let mut reference_scene = None;
+        let Some((_, line, node)) = top_entry(top, "reference") else {
+            return (reference, reference_scene);
+        };
+        let uses_reference = self.scene.map(|s| {
+            let scene = s.get();
+            let defaults = crate::scene::Physics(
+                scene
+                    .physics()
+                    .iter()
+                    .map(|k| (k.name, k.default))
+                    .collect(),
+            );
+            scene.error_source(&defaults) == Some(crate::scene::ErrorSource::ReferenceRun)
+        });
+        match (&node.kind, uses_reference) {
+            (_, Some(false)) => self.issue(
+                "reference",
+                *line,
+                format!(
+                    "scene {} has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+                    self.scene.map(|s| s.name()).unwrap_or_default()
+                ),
+            ),
+            (Kind::Table(t), _) if !t.is_empty() => {
+                // `scene` names the reference's scene; the other keys are that scene's
+                // parameters, checked against it rather than against the sweep's.
+                let (scene_entries, rest): (Vec<_>, Vec<_>) =
+                    t.iter().cloned().partition(|(k, _, _)| k == "scene");
+                if let Some((_, sl, node)) = scene_entries.first() {
+                    match (&node.kind, self.scene) {
+                        (Kind::Str(name), Some(own)) => match reference_scene_of(own, name) {
+                            Ok(kind) => reference_scene = Some(kind),
+                            Err(why) => self.issue("reference.scene", *sl, why),
+                        },
+                        (Kind::Str(_), None) => {}
+                        (k, _) => self.issue(
+                            "reference.scene",
+                            *sl,
+                            format!("expected a scene name, found a {}", k.type_name()),
+                        ),
+                    }
+                }
+                let own = self.scene;
+                if reference_scene.is_some() {
+                    self.scene = reference_scene;
+                }
+                let entries = self.bundle(&rest, "reference");
+                self.scene = own;
+                if !scene_entries.is_empty() && rest.is_empty() {
+                    self.issue(
+                        "reference",
+                        *line,
+                        "a reference of another scene needs its mesh and step (h or elements, dt or courant)",
+                    );
+                }
+                reference = Some(entries);
+            }
+            (k, _) => self.issue(
+                "reference",
+                *line,
+                format!(
+                    "expected a non-empty inline table of parameters, e.g. {{ h = 0.0015625, dt = 0.00078125, mass = \"mod3\", scheme = \"crank-nicolson\" }}, found a {}",
+                    k.type_name()
+                ),
+            ),
+        }
+        (reference, reference_scene)
+    }
+
+    /// `allow_unstable = true|false` (default false).
+    fn allow_unstable(&mut self, top: &[(String, usize, Node)]) -> bool {
+        match top_entry(top, "allow_unstable") {
+            None => false,
+            Some((
+                _,
+                _,
+                Node {
+                    kind: Kind::Bool(b),
+                    ..
+                },
+            )) => *b,
+            Some((_, line, node)) => {
+                self.issue(
+                    "allow_unstable",
+                    *line,
+                    format!("expected true or false, found a {}", node.kind.type_name()),
+                );
+                false
+            }
+        }
+    }
+
+    /// What a `[search]` cannot share the file with: its key set elsewhere (the search sets
+    /// it) or an ensemble (each probe would be a whole ensemble). `set` is ([fixed], [grid],
+    /// [zip]).
+    fn search_conflicts(
+        &mut self,
+        top: &[(String, usize, Node)],
+        sr: &Search,
+        set: (&[Entry], &[Axis], Option<&Axis>),
+        ensemble: bool,
+    ) {
+        let (fixed, grid, zip) = set;
+        let set_elsewhere = fixed
+            .iter()
+            .chain(grid.iter().flat_map(|a| a.items.iter().flatten()))
+            .chain(zip.iter().flat_map(|a| a.items.iter().flatten()))
+            .find(|e| e.key == sr.key);
+        if let Some(e) = set_elsewhere {
+            self.issues.push(Issue::at(
+                &e.origin,
+                format!(
+                    "`{}` is the key of [search]: the search sets it, remove it here",
+                    sr.key.name()
+                ),
+            ));
+        }
+        if ensemble {
+            self.issue(
+                "search",
+                *line_of_search(top),
+                "a [search] cannot be combined with an ensemble (each probe would be a whole ensemble)",
+            );
+        }
+    }
+
+    /// [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
+    /// in both [fixed] and [zip]); two axes setting one parameter would be ambiguous. Returns
+    /// the notes of the [fixed] values overridden.
+    fn overridden(&mut self, fixed: &[Entry], grid: &[Axis], zip: Option<&Axis>) -> Vec<String> {
+        let mut sources: Vec<(Key, Origin, String)> = Vec::new();
+        let mut overridden: Vec<String> = Vec::new();
+        let axes = grid
+            .iter()
+            .map(|a| (a, format!("[grid] {}", a.name)))
+            .chain(zip.iter().map(|a| (*a, "[zip]".to_string())));
+        for (ax, source) in axes {
+            for e in ax.items.iter().flatten() {
+                if let Some((_, o, _)) =
+                    sources.iter().find(|(k, _, s)| *k == e.key && *s != source)
+                {
+                    self.issues.push(Issue::at(
+                        &e.origin,
+                        format!(
+                            "`{}` is also set by {} ({}): two axes may not set one parameter",
+                            e.key.name(),
+                            o.path,
+                            line_ref(o.line, &self.sets)
+                        ),
+                    ));
+                } else if !sources.iter().any(|(k, _, s)| *k == e.key && *s == source) {
+                    sources.push((e.key, e.origin.clone(), source.clone()));
+                }
+                if let Some(f) = fixed.iter().find(|f| f.key == e.key) {
+                    let note = format!("{} is overridden by {}", f.origin.path, source);
+                    if !overridden.contains(&note) {
+                        overridden.push(note);
+                    }
+                }
+            }
+        }
+        overridden
     }
 }
 
@@ -1146,6 +1240,21 @@ fn line_of_search(top: &[(String, usize, Node)]) -> &usize {
         .expect("called when [search] exists")
 }
 
+/// The fields of a `[search]` table as written, each of its type (unset: None, or the
+/// default name and relative tolerance).
+struct SearchFields {
+    name: String,
+    key: Option<Key>,
+    lo: Option<f64>,
+    hi: Option<f64>,
+    criterion: Option<String>,
+    tol: Option<f64>,
+    eps: Option<f64>,
+    column: Option<String>,
+    rel_tol: f64,
+    scale: Option<String>,
+}
+
 /// Check a `[search]` table.
 fn parse_search(ck: &mut Checker, line: usize, node: &Node) -> Option<Search> {
     let Kind::Table(t) = &node.kind else {
@@ -1157,87 +1266,8 @@ fn parse_search(ck: &mut Checker, line: usize, node: &Node) -> Option<Search> {
         return None;
     };
     let before = ck.issues.len();
-    let mut name = "search".to_string();
-    let (mut key, mut lo, mut hi, mut criterion) = (None, None, None, None);
-    let (mut tol, mut eps, mut column) = (None, None, None::<String>);
-    let mut rel_tol = 1e-3;
-    let mut scale: Option<String> = None;
-    let number = |ck: &mut Checker, p: &str, v: &Node| -> Option<f64> {
-        match v.kind {
-            Kind::Float(x) if x.is_finite() => Some(x),
-            Kind::Int(i) => Some(i as f64),
-            ref k => {
-                ck.issue(
-                    p,
-                    v.line,
-                    format!("expected a number, found a {}", k.type_name()),
-                );
-                None
-            }
-        }
-    };
-    let text = |ck: &mut Checker, p: &str, v: &Node| -> Option<String> {
-        match &v.kind {
-            Kind::Str(s) => Some(s.clone()),
-            k => {
-                ck.issue(
-                    p,
-                    v.line,
-                    format!("expected a string, found a {}", k.type_name()),
-                );
-                None
-            }
-        }
-    };
-    for (k, kl, v) in t {
-        let p = format!("search.{k}");
-        match k.as_str() {
-            "name" => {
-                if let Some(n) = text(ck, &p, v) {
-                    name = n;
-                }
-            }
-            "key" => {
-                if let Some(n) = text(ck, &p, v) {
-                    match Key::from_name(&n) {
-                        Some(kk)
-                            if kk.value_type() == ValueType::Float
-                                && !matches!(kk, Key::H | Key::Elements) =>
-                        {
-                            key = Some(kk)
-                        }
-                        Some(_) => ck.issue(
-                            &p,
-                            *kl,
-                            format!("`{n}` cannot be searched: the key must be a real-valued parameter other than h (e.g. courant, dt, nitsche_gamma0)"),
-                        ),
-                        None => ck.issue(&p, *kl, format!("unknown parameter `{n}`{}", suggest(&n))),
-                    }
-                }
-            }
-            "lo" => lo = number(ck, &p, v),
-            "hi" => hi = number(ck, &p, v),
-            "tol" => tol = number(ck, &p, v),
-            "eps" => eps = number(ck, &p, v),
-            "rel_tol" => {
-                if let Some(x) = number(ck, &p, v) {
-                    if x > 0.0 && x < 1.0 {
-                        rel_tol = x;
-                    } else {
-                        ck.issue(&p, *kl, format!("must lie in (0, 1), got {x}"));
-                    }
-                }
-            }
-            "error" => column = text(ck, &p, v),
-            "scale" => scale = text(ck, &p, v),
-            "criterion" => criterion = text(ck, &p, v),
-            _ => ck.issue(
-                &p,
-                *kl,
-                "unknown key (expected name, key, lo, hi, criterion, tol, eps, error, rel_tol, scale)",
-            ),
-        }
-    }
+    let f = ck.search_fields(t);
+    let (key, lo, hi) = (f.key, f.lo, f.hi);
     let missing = |ck: &mut Checker, what: &str| {
         ck.issue("search", line, format!("needs `{what}`"));
     };
@@ -1249,7 +1279,7 @@ fn parse_search(ck: &mut Checker, line: usize, node: &Node) -> Option<Search> {
         (Some(a), Some(b)) => ck.issue("search.hi", line, format!("must exceed lo ({a}), got {b}")),
         _ => missing(ck, "lo and hi"),
     }
-    let log = match scale.as_deref() {
+    let log = match f.scale.as_deref() {
         None | Some("log") => lo.is_some_and(|a| a > 0.0),
         Some("linear") => false,
         Some(other) => {
@@ -1261,70 +1291,176 @@ fn parse_search(ck: &mut Checker, line: usize, node: &Node) -> Option<Search> {
             false
         }
     };
-    if scale.as_deref() == Some("log") && lo.is_some_and(|a| a <= 0.0) {
+    if f.scale.as_deref() == Some("log") && lo.is_some_and(|a| a <= 0.0) {
         ck.issue("search.scale", line, "a log scale needs lo > 0");
     }
-    let criterion = match criterion.as_deref() {
-        Some("no-divergence") => Some(Criterion::NoDivergence),
-        Some("energy-ratio-below") => match tol {
-            Some(t) if t >= 0.0 => Some(Criterion::EnergyRatioBelow(t)),
-            _ => {
-                ck.issue(
-                    "search.tol",
-                    line,
-                    "energy-ratio-below needs tol ≥ 0 (holds when E(T)/E⁰ ≤ 1 + tol)",
-                );
-                None
-            }
-        },
-        Some("error-below") => {
-            let column = column.unwrap_or_else(|| "err_u_l2h1".into());
-            if !search_error_columns().any(|c| c == column) {
-                let valid: Vec<&str> = search_error_columns().collect();
-                ck.issue(
-                    "search.error",
-                    line,
-                    format!(
-                        "unknown error column `{column}` (one of {})",
-                        valid.join(", ")
-                    ),
-                );
-            }
-            match eps {
-                Some(e) if e > 0.0 => Some(Criterion::ErrorBelow { column, eps: e }),
-                _ => {
-                    ck.issue("search.eps", line, "error-below needs eps > 0");
-                    None
-                }
-            }
-        }
-        Some(other) => {
-            ck.issue(
-                "search.criterion",
-                line,
-                format!(
-                    "unknown criterion `{other}` (no-divergence, energy-ratio-below, error-below)"
-                ),
-            );
-            None
-        }
-        None => {
-            missing(ck, "criterion");
-            None
-        }
-    };
+    let criterion = ck.search_criterion(line, &f);
     if ck.issues.len() > before {
         return None;
     }
     Some(Search {
-        name,
+        name: f.name,
         key: key?,
         lo: lo?,
         hi: hi?,
         criterion: criterion?,
-        rel_tol,
+        rel_tol: f.rel_tol,
         log,
     })
+}
+
+/// The parts of a `[search]` table.
+impl Checker {
+    /// A number of the `[search]` table.
+    fn search_number(&mut self, p: &str, v: &Node) -> Option<f64> {
+        match v.kind {
+            Kind::Float(x) if x.is_finite() => Some(x),
+            Kind::Int(i) => Some(i as f64),
+            ref k => {
+                self.issue(
+                    p,
+                    v.line,
+                    format!("expected a number, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    }
+
+    /// A string of the `[search]` table.
+    fn search_text(&mut self, p: &str, v: &Node) -> Option<String> {
+        match &v.kind {
+            Kind::Str(s) => Some(s.clone()),
+            k => {
+                self.issue(
+                    p,
+                    v.line,
+                    format!("expected a string, found a {}", k.type_name()),
+                );
+                None
+            }
+        }
+    }
+
+    /// The `[search]` table's fields, each checked for its type (and `key` for being a
+    /// real-valued parameter, `rel_tol` for its range).
+    fn search_fields(&mut self, t: &[(String, usize, Node)]) -> SearchFields {
+        let mut f = SearchFields {
+            name: "search".to_string(),
+            key: None,
+            lo: None,
+            hi: None,
+            criterion: None,
+            tol: None,
+            eps: None,
+            column: None,
+            rel_tol: 1e-3,
+            scale: None,
+        };
+        for (k, kl, v) in t {
+            let p = format!("search.{k}");
+            match k.as_str() {
+                "name" => {
+                    if let Some(n) = self.search_text(&p, v) {
+                        f.name = n;
+                    }
+                }
+                "key" => {
+                    if let Some(n) = self.search_text(&p, v) {
+                        match Key::from_name(&n) {
+                            Some(kk)
+                                if kk.value_type() == ValueType::Float
+                                    && !matches!(kk, Key::H | Key::Elements) =>
+                            {
+                                f.key = Some(kk)
+                            }
+                            Some(_) => self.issue(
+                                &p,
+                                *kl,
+                                format!("`{n}` cannot be searched: the key must be a real-valued parameter other than h (e.g. courant, dt, nitsche_gamma0)"),
+                            ),
+                            None => self.issue(&p, *kl, format!("unknown parameter `{n}`{}", suggest(&n))),
+                        }
+                    }
+                }
+                "lo" => f.lo = self.search_number(&p, v),
+                "hi" => f.hi = self.search_number(&p, v),
+                "tol" => f.tol = self.search_number(&p, v),
+                "eps" => f.eps = self.search_number(&p, v),
+                "rel_tol" => {
+                    if let Some(x) = self.search_number(&p, v) {
+                        if x > 0.0 && x < 1.0 {
+                            f.rel_tol = x;
+                        } else {
+                            self.issue(&p, *kl, format!("must lie in (0, 1), got {x}"));
+                        }
+                    }
+                }
+                "error" => f.column = self.search_text(&p, v),
+                "scale" => f.scale = self.search_text(&p, v),
+                "criterion" => f.criterion = self.search_text(&p, v),
+                _ => self.issue(
+                    &p,
+                    *kl,
+                    "unknown key (expected name, key, lo, hi, criterion, tol, eps, error, rel_tol, scale)",
+                ),
+            }
+        }
+        f
+    }
+
+    /// The `[search]` criterion with its threshold (`tol`, or `error` and `eps`).
+    fn search_criterion(&mut self, line: usize, f: &SearchFields) -> Option<Criterion> {
+        match f.criterion.as_deref() {
+            Some("no-divergence") => Some(Criterion::NoDivergence),
+            Some("energy-ratio-below") => match f.tol {
+                Some(t) if t >= 0.0 => Some(Criterion::EnergyRatioBelow(t)),
+                _ => {
+                    self.issue(
+                        "search.tol",
+                        line,
+                        "energy-ratio-below needs tol ≥ 0 (holds when E(T)/E⁰ ≤ 1 + tol)",
+                    );
+                    None
+                }
+            },
+            Some("error-below") => {
+                let column = f.column.clone().unwrap_or_else(|| "err_u_l2h1".into());
+                if !search_error_columns().any(|c| c == column) {
+                    let valid: Vec<&str> = search_error_columns().collect();
+                    self.issue(
+                        "search.error",
+                        line,
+                        format!(
+                            "unknown error column `{column}` (one of {})",
+                            valid.join(", ")
+                        ),
+                    );
+                }
+                match f.eps {
+                    Some(e) if e > 0.0 => Some(Criterion::ErrorBelow { column, eps: e }),
+                    _ => {
+                        self.issue("search.eps", line, "error-below needs eps > 0");
+                        None
+                    }
+                }
+            }
+            Some(other) => {
+                self.issue(
+                    "search.criterion",
+                    line,
+                    format!(
+                        "unknown criterion `{other}` (no-divergence, energy-ratio-below, error-below)"
+                    ),
+                );
+                None
+            }
+            None => {
+                self.issue("search", line, "needs `criterion`");
+                None
+            }
+        }
+    }
 }
 
 impl Criterion {

@@ -23,7 +23,7 @@
 //! line has the id of the same run given by a file.
 
 use super::tree::{self, Kind, Node};
-use super::{Key, ValueType};
+use crate::model::{Key, ValueType};
 
 /// Lines of override nodes start here: far beyond any sweep file, so that a line number alone
 /// tells a file line from an override (override `i` has line `SET_LINE + i`).

@@ -23,7 +23,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::contact::friction::{FrictionKind, FrictionLaw};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
-use crate::scene::{Physics, Scene, SceneKind};
+use crate::scene::{MeshChoice, Physics, Scene, SceneKind, SceneSetup};
 use crate::space::step_solver::Solver;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{
@@ -214,6 +214,74 @@ fn gap_from_obstacle(
     Ok(Some(gap))
 }
 
+/// The values one combination gives (its entries and where they were written), with the
+/// scene's defaults behind them: what every phase of [`resolve`] reads.
+struct Given {
+    scene: &'static dyn Scene,
+    user: BTreeMap<Key, (Value, Origin)>,
+}
+
+impl Given {
+    fn new(scene: &'static dyn Scene, entries: &[&Entry]) -> Given {
+        let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
+        for e in entries {
+            user.insert(e.key, (e.value.clone(), e.origin.clone()));
+        }
+        Given { scene, user }
+    }
+
+    /// The value of `k`: the combination's, else its default.
+    fn get(&self, k: Key) -> Option<Value> {
+        self.user
+            .get(&k)
+            .map(|(v, _)| v.clone())
+            .or_else(|| default_of(self.scene, k))
+    }
+
+    fn num(&self, k: Key) -> Option<f64> {
+        self.get(k).and_then(|v| v.as_f64())
+    }
+
+    /// The word of a key that always has one (`space`, `mass`, `scheme`: defaulted, checked).
+    fn word(&self, k: Key) -> String {
+        self.get(k)
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap()
+    }
+
+    /// Where `k` was set; `(default k)` for a default.
+    fn origin(&self, k: Key) -> Origin {
+        self.user.get(&k).map(|(_, o)| o.clone()).unwrap_or(Origin {
+            path: format!("(default {})", k.name()),
+            line: None,
+        })
+    }
+
+    fn has(&self, k: Key) -> bool {
+        self.user.contains_key(&k)
+    }
+
+    /// Whether `k` varies along an axis (`[grid]`, `[zip]`): a value that rules a run out is
+    /// then one meaningless combination, not a mistake in the file.
+    fn on_axis(&self, k: Key) -> bool {
+        self.user
+            .get(&k)
+            .is_some_and(|(_, o)| o.path.starts_with("grid") || o.path.starts_with("zip"))
+    }
+}
+
+/// What a combination's method keys resolve to (SPEC §2–§3): contact treatment, mass variant,
+/// time scheme and friction law, with the words they were named by.
+struct Method {
+    space_name: String,
+    contact: ContactMethod,
+    mass_name: String,
+    mass: MassVariant,
+    scheme: Scheme,
+    friction_kind: FrictionKind,
+    friction: FrictionLaw,
+}
+
 /// Resolve one combination of entries for `scene`; a run whose estimated memory exceeds
 /// `limits.max_run_bytes` is invalid (refused before anything is allocated for it).
 fn resolve(
@@ -223,31 +291,183 @@ fn resolve(
     allow_unstable: bool,
     limits: &PlanLimits,
 ) -> Outcome {
-    let scene = scene_kind.get();
-    let mut issues = Vec::new();
-    let mut user: BTreeMap<Key, (Value, Origin)> = BTreeMap::new();
-    for e in entries {
-        user.insert(e.key, (e.value.clone(), e.origin.clone()));
+    let given = Given::new(scene_kind.get(), entries);
+    match resolve_given(sweep_dir, &given, allow_unstable, limits) {
+        Ok(r) => Outcome::Run(Box::new(r)),
+        Err(outcome) => outcome,
     }
-    let get = |k: Key| {
-        user.get(&k)
-            .map(|(v, _)| v.clone())
-            .or_else(|| default_of(scene, k))
-    };
-    let num = |k: Key| get(k).and_then(|v| v.as_f64());
-    let origin = |k: Key| {
-        user.get(&k).map(|(_, o)| o.clone()).unwrap_or(Origin {
-            path: format!("(default {})", k.name()),
-            line: None,
-        })
-    };
-    let mut dropped = Vec::new();
-    let mut params: BTreeMap<Key, Value> = BTreeMap::new();
+}
 
-    // Scheme: family and its parameters (aliases fix them).
-    let scheme_name = get(Key::Scheme)
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap();
+/// [`resolve`]'s phases in order: the method, the keys that do not apply to it, the
+/// meaningless combinations, physics, mesh and step, the memory and CFL checks, then the
+/// columns, the canonical text and the label. `Err` is the outcome of a combination that is
+/// no run.
+fn resolve_given(
+    sweep_dir: &Path,
+    given: &Given,
+    allow_unstable: bool,
+    limits: &PlanLimits,
+) -> Result<Resolved, Outcome> {
+    let scene = given.scene;
+    let mut issues = Vec::new();
+    let mut dropped = Vec::new();
+    let m = method_of(given, &mut dropped, &mut issues)?;
+    for k in given.user.keys() {
+        if let Err(why) = applies(*k, &m, scene) {
+            dropped.push(format!("{} {why}", k.name()));
+        }
+    }
+    if let Some(why) = meaningless(&m) {
+        return Err(Outcome::Inapplicable(why));
+    }
+    let massless = m.mass.massless_contact();
+    let contact_init = given
+        .get(Key::ContactInit)
+        .and_then(|v| v.as_str().and_then(ContactInit::from_name))
+        .expect("checked");
+
+    // Physics, mesh and time step: the scene's.
+    let mut physics = physics_of(given, &m.scheme)?;
+    let c0 = scene.wave_speed(&physics);
+    let mut mesh_file: Option<MeshFile> = None;
+    let mut file_setup = None;
+    if scene.takes_mesh_file() {
+        (mesh_file, file_setup) = read_mesh_file(sweep_dir, given, &mut physics, &mut issues);
+        if !issues.is_empty() {
+            return Err(Outcome::Invalid(issues));
+        }
+    }
+    let mesh = mesh_of(
+        given,
+        &physics,
+        file_setup.as_ref().map(|(c, _)| *c),
+        &mut issues,
+    );
+    let dt = dt_of(given, mesh.map(|m| m.h), c0, &mut issues);
+    let t_final = given.num(Key::T).unwrap();
+    if !issues.is_empty() {
+        return Err(Outcome::Invalid(issues));
+    }
+    let (mesh, dt) = (mesh.unwrap(), dt.unwrap());
+    let h = mesh.h;
+    let dt_origin = given.origin(if given.has(Key::Dt) {
+        Key::Dt
+    } else {
+        Key::Courant
+    });
+    let steps = steps_of(t_final, dt, &dt_origin)?;
+    let courant = c0 * dt / h;
+    let setup = match file_setup {
+        Some((_, setup)) => setup,
+        None => scene.setup(&physics, mesh),
+    };
+    let revision = setup.id_revision();
+    let scheme = m.scheme;
+    let config = RunConfig::new(setup, m.contact, m.mass.clone(), scheme, dt, steps)
+        .with_friction(m.friction)
+        .with_contact_init(if massless && scene.contact_init_matters() {
+            contact_init
+        } else {
+            ContactInit::Consistent
+        });
+    let fe = matches!(config, RunConfig::Fe(_));
+    let solver = solver_of(given, fe, &mut dropped);
+    let config = config.with_solver(solver);
+    check_memory(given, limits, &config, fe, solver)?;
+
+    // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
+    // assembled operators (contact-free and contact-active stiffness).
+    match config.explicit_dt_limit() {
+        Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) && !allow_unstable => {
+            return Err(Outcome::Invalid(vec![Issue::at(
+                &dt_origin,
+                format!(
+                    "dt = {dt:.6e} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
+                    scheme.label(),
+                    c0 * dt_max / h
+                ),
+            )]));
+        }
+        Ok(_) => {}
+        Err((key, e)) => {
+            let k = Key::from_name(key).expect("engines name sweep keys");
+            return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), e)]));
+        }
+    }
+
+    // Columns and canonical text.
+    let mut columns = Columns::new(scene);
+    columns.put(Key::T, Value::Num(t_final), false);
+    columns.put(Key::Elements, Value::Int(mesh.elements as i64), true);
+    columns.put(Key::Dt, Value::Num(dt), true);
+    columns.put_method(&m, contact_init);
+    columns.put_physics(given, &physics, &mut dropped);
+    columns.put_friction(&m);
+    columns.put_solver(solver, fe);
+    columns.put_mesh_file(mesh_file.as_ref(), &physics);
+    let Columns {
+        mut params,
+        canonical,
+        ..
+    } = columns;
+    params.insert(Key::H, Value::Num(h));
+    params.insert(Key::Courant, Value::Num(courant));
+
+    let scheme_label = scheme.label();
+    Ok(Resolved {
+        params,
+        canonical,
+        revision,
+        label: run_label(&m, contact_init, &scheme_label),
+        scheme_names: [scheme.family().to_string(), scheme_label.clone()],
+        scheme_label,
+        config,
+        dropped,
+        h,
+        dt,
+        t_final,
+    })
+}
+
+/// The method keys of a combination: scheme, contact treatment and mass variant (the scene
+/// must implement the three together), then the friction law. A missing parameter joins
+/// `issues`; `Err` is a combination refused or left out outright.
+fn method_of(
+    given: &Given,
+    dropped: &mut Vec<String>,
+    issues: &mut Vec<Issue>,
+) -> Result<Method, Outcome> {
+    let scheme = scheme_of(given, dropped, issues)?;
+    let (space_name, contact) = contact_method_of(given, issues);
+    let (mass_name, mass) = mass_of(given, issues);
+    if let Err((key, why)) = given
+        .scene
+        .supports(&space_name, &mass_name, scheme.family())
+    {
+        let k = Key::from_name(key).expect("scenes name sweep keys");
+        return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
+    }
+    let (friction_kind, friction) = friction_of(given, &scheme, issues)?;
+    Ok(Method {
+        space_name,
+        contact,
+        mass_name,
+        mass,
+        scheme,
+        friction_kind,
+        friction,
+    })
+}
+
+/// The scheme: family and its parameters (aliases fix them, and a parameter given beside an
+/// alias is dropped with the reason).
+fn scheme_of(
+    given: &Given,
+    dropped: &mut Vec<String>,
+    issues: &mut Vec<Issue>,
+) -> Result<Scheme, Outcome> {
+    let num = |k: Key| given.num(k);
+    let scheme_name = given.word(Key::Scheme);
     let preset: Option<(Scheme, &[Key])> = match scheme_name.as_str() {
         "crank-nicolson" => Some((
             Scheme::Newmark(NewmarkParams::crank_nicolson()),
@@ -267,10 +487,10 @@ fn resolve(
         )),
         _ => None,
     };
-    let scheme = match (preset, scheme_name.as_str()) {
+    Ok(match (preset, scheme_name.as_str()) {
         (Some((s, fixed_keys)), _) => {
             for k in fixed_keys {
-                if user.contains_key(k) {
+                if given.has(*k) {
                     dropped.push(format!("{} is fixed by scheme = {scheme_name}", k.name()));
                 }
             }
@@ -282,15 +502,15 @@ fn resolve(
         }),
         (None, "theta") => match num(Key::ThetaScheme) {
             Some(0.0) => {
-                return Outcome::Invalid(vec![Issue::at(
-                    &origin(Key::ThetaScheme),
+                return Err(Outcome::Invalid(vec![Issue::at(
+                    &given.origin(Key::ThetaScheme),
                     "theta_scheme = 0 is forward Euler, unstable for every dt on the undamped wave equation",
-                )]);
+                )]));
             }
             Some(theta) => Scheme::Theta(ThetaParams { theta }),
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Scheme),
+                    &given.origin(Key::Scheme),
                     "scheme = theta needs theta_scheme (θ ∈ (0, 1]); backward-euler is θ = 1",
                 ));
                 Scheme::Theta(ThetaParams::backward_euler())
@@ -309,7 +529,7 @@ fn resolve(
             Some(alpha) => Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(alpha)),
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Scheme),
+                    &given.origin(Key::Scheme),
                     "scheme = hht needs hht_alpha (α ∈ [0, ⅓]; α = 0 is Crank–Nicolson)",
                 ));
                 Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(0.0))
@@ -317,22 +537,26 @@ fn resolve(
         },
         // Moreau–Jean's own defaults (SPEC §3.2): θ = ½, e = 0 — not Paoli–Schatzman's e = 1.
         (None, "moreau-jean") => Scheme::MoreauJean(MoreauJeanParams {
-            theta: user
+            theta: given
+                .user
                 .get(&Key::ThetaScheme)
                 .and_then(|(v, _)| v.as_f64())
                 .unwrap_or(0.5),
-            restitution: user
+            restitution: given
+                .user
                 .get(&Key::Restitution)
                 .and_then(|(v, _)| v.as_f64())
                 .unwrap_or(0.0),
         }),
         (None, "discrete-gradient") => Scheme::DiscreteGradient,
         (None, _) => Scheme::Hybrid,
-    };
+    })
+}
 
-    let space_name = get(Key::Space)
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap();
+/// The contact treatment (`space`) and its parameters.
+fn contact_method_of(given: &Given, issues: &mut Vec<Issue>) -> (String, ContactMethod) {
+    let num = |k: Key| given.num(k);
+    let space_name = given.word(Key::Space);
     let method = match space_name.as_str() {
         "nitsche" => match num(Key::NitscheGamma0) {
             Some(gamma0) => ContactMethod::Nitsche {
@@ -341,7 +565,7 @@ fn resolve(
             },
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Space),
+                    &given.origin(Key::Space),
                     "space = nitsche needs nitsche_gamma0 (γ0 > 0; the papers use 1e-6 … 1)",
                 ));
                 ContactMethod::Nitsche {
@@ -354,7 +578,7 @@ fn resolve(
             Some(gamma0) => ContactMethod::Penalty { gamma0 },
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Space),
+                    &given.origin(Key::Space),
                     "space = penalty needs penalty_gamma0 (κ = E·penalty_gamma0/h)",
                 ));
                 ContactMethod::Penalty { gamma0: 1.0 }
@@ -362,15 +586,18 @@ fn resolve(
         },
         _ => ContactMethod::Mixed,
     };
-    let mass_name = get(Key::Mass)
-        .and_then(|v| v.as_str().map(String::from))
-        .unwrap();
+    (space_name, method)
+}
+
+/// The mass variant (`mass`; `weights` takes its list from `mass_weights`).
+fn mass_of(given: &Given, issues: &mut Vec<Issue>) -> (String, MassVariant) {
+    let mass_name = given.word(Key::Mass);
     let mass = if mass_name == "weights" {
-        match get(Key::MassWeights) {
+        match given.get(Key::MassWeights) {
             Some(Value::List(w)) => MassVariant::Weights(w),
             _ => {
                 issues.push(Issue::at(
-                    &origin(Key::Mass),
+                    &given.origin(Key::Mass),
                     "mass = weights needs mass_weights = [w1, w2, …]",
                 ));
                 MassVariant::Mod1
@@ -379,52 +606,54 @@ fn resolve(
     } else {
         MassVariant::from_name(&mass_name).expect("checked")
     };
-    if let Err((key, why)) = scene.supports(&space_name, &mass_name, scheme.family()) {
-        let k = Key::from_name(key).expect("scenes name sweep keys");
-        return Outcome::Invalid(vec![Issue::at(&origin(k), why)]);
-    }
+    (mass_name, mass)
+}
 
-    // Friction (SPEC §2.5): the law and its parameter; `none` is today's engine (no key of
-    // it enters the id). A bound given while friction is fixed at `none` (by default or in
-    // [fixed]) is a mistake, refused; across a `friction` axis it applies to its law only and
-    // the frictionless runs collapse, as every other key.
-    let friction_kind = get(Key::Friction)
+/// Friction (SPEC §2.5): the law and its parameter; `none` is today's engine (no key of
+/// it enters the id). A bound given while friction is fixed at `none` (by default or in
+/// [fixed]) is a mistake, refused; across a `friction` axis it applies to its law only and
+/// the frictionless runs collapse, as every other key.
+fn friction_of(
+    given: &Given,
+    scheme: &Scheme,
+    issues: &mut Vec<Issue>,
+) -> Result<(FrictionKind, FrictionLaw), Outcome> {
+    let friction_kind = given
+        .get(Key::Friction)
         .and_then(|v| v.as_str().and_then(FrictionKind::from_name))
         .expect("checked");
-    let friction_fixed = user
-        .get(&Key::Friction)
-        .is_none_or(|(_, o)| !(o.path.starts_with("grid") || o.path.starts_with("zip")));
+    let friction_fixed = !given.on_axis(Key::Friction);
     let friction = match friction_kind {
         FrictionKind::None => {
             for k in [Key::FrictionCoefficient, Key::TrescaThreshold] {
-                if user.contains_key(&k) && friction_fixed {
+                if given.has(k) && friction_fixed {
                     issues.push(Issue::at(
-                        &origin(k),
+                        &given.origin(k),
                         format!(
                             "{} sets a friction bound but friction = \"none\"{} for this run: set friction = \"coulomb\" (with friction_coefficient) or \"tresca\" (with tresca_threshold)",
                             k.name(),
-                            if user.contains_key(&Key::Friction) { "" } else { " (the default)" }
+                            if given.has(Key::Friction) { "" } else { " (the default)" }
                         ),
                     ));
                 }
             }
             FrictionLaw::None
         }
-        FrictionKind::Coulomb => match num(Key::FrictionCoefficient) {
+        FrictionKind::Coulomb => match given.num(Key::FrictionCoefficient) {
             Some(coefficient) => FrictionLaw::Coulomb { coefficient },
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Friction),
+                    &given.origin(Key::Friction),
                     "friction = coulomb needs friction_coefficient (μ_f ≥ 0: |f_t| ≤ μ_f f_n)",
                 ));
                 FrictionLaw::None
             }
         },
-        FrictionKind::Tresca => match num(Key::TrescaThreshold) {
+        FrictionKind::Tresca => match given.num(Key::TrescaThreshold) {
             Some(threshold) => FrictionLaw::Tresca { threshold },
             None => {
                 issues.push(Issue::at(
-                    &origin(Key::Friction),
+                    &given.origin(Key::Friction),
                     "friction = tresca needs tresca_threshold (s ≥ 0, a traction: |f_t| ≤ s while in contact)",
                 ));
                 FrictionLaw::None
@@ -432,8 +661,8 @@ fn resolve(
         },
     };
     if friction_kind != FrictionKind::None {
-        if let Err(why) = scene.supports_friction() {
-            issues.push(Issue::at(&origin(Key::Friction), why));
+        if let Err(why) = given.scene.supports_friction() {
+            issues.push(Issue::at(&given.origin(Key::Friction), why));
         }
         // Where the literature defines no frictional version (SPEC §2.5).
         let undefined = match scheme {
@@ -448,84 +677,82 @@ fn resolve(
                 friction_kind.name()
             );
             if friction_fixed {
-                issues.push(Issue::at(&origin(Key::Scheme), why));
+                issues.push(Issue::at(&given.origin(Key::Scheme), why));
             } else {
-                return Outcome::Inapplicable(why);
+                return Err(Outcome::Inapplicable(why));
             }
         }
     }
+    Ok((friction_kind, friction))
+}
 
-    // Applicability (SPEC §3): which keys this run uses.
-    let applies = |k: Key| -> Result<(), &'static str> {
-        let ok = match k {
-            Key::FrictionCoefficient => friction_kind == FrictionKind::Coulomb,
-            Key::TrescaThreshold => friction_kind == FrictionKind::Tresca,
-            Key::NitscheTheta | Key::NitscheGamma0 => space_name == "nitsche",
-            Key::PenaltyGamma0 => space_name == "penalty",
-            Key::NewmarkBeta => matches!(scheme, Scheme::Newmark(_) | Scheme::PaoliSchatzman(_)),
-            Key::NewmarkGamma => matches!(scheme, Scheme::Newmark(_)),
-            Key::ThetaScheme => matches!(scheme, Scheme::Theta(_) | Scheme::MoreauJean(_)),
-            Key::Restitution => {
-                matches!(scheme, Scheme::PaoliSchatzman(_) | Scheme::MoreauJean(_))
-            }
-            Key::RhoInf => matches!(
-                scheme,
-                Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
-                    preset: AlphaPreset::RhoInf(_),
-                    ..
-                })
-            ),
-            Key::HhtAlpha => matches!(
-                scheme,
-                Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
-                    preset: AlphaPreset::Hht(_),
-                    ..
-                })
-            ),
-            Key::MassWeights => mass_name == "weights",
-            Key::ContactInit => mass.massless_contact() && scene.contact_init_matters(),
-            _ => true,
-        };
-        if ok {
-            return Ok(());
+/// Applicability (SPEC §3): whether a run of method `m` uses key `k`; `Err` says why not (the
+/// key is then dropped from the run, and runs that differ only by it merge).
+fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
+    let scheme = m.scheme;
+    let ok = match k {
+        Key::FrictionCoefficient => m.friction_kind == FrictionKind::Coulomb,
+        Key::TrescaThreshold => m.friction_kind == FrictionKind::Tresca,
+        Key::NitscheTheta | Key::NitscheGamma0 => m.space_name == "nitsche",
+        Key::PenaltyGamma0 => m.space_name == "penalty",
+        Key::NewmarkBeta => matches!(scheme, Scheme::Newmark(_) | Scheme::PaoliSchatzman(_)),
+        Key::NewmarkGamma => matches!(scheme, Scheme::Newmark(_)),
+        Key::ThetaScheme => matches!(scheme, Scheme::Theta(_) | Scheme::MoreauJean(_)),
+        Key::Restitution => {
+            matches!(scheme, Scheme::PaoliSchatzman(_) | Scheme::MoreauJean(_))
         }
-        Err(match k {
-            Key::NitscheTheta | Key::NitscheGamma0 => "applies to space = nitsche only",
-            Key::PenaltyGamma0 => "applies to space = penalty only",
-            Key::NewmarkBeta => "applies to newmark and paoli-schatzman only",
-            Key::NewmarkGamma => "applies to newmark only",
-            Key::ThetaScheme => "applies to the theta scheme (and moreau-jean) only",
-            Key::Restitution => "applies to paoli-schatzman (and moreau-jean) only",
-            Key::RhoInf => "applies to generalized-alpha only",
-            Key::HhtAlpha => "applies to hht only",
-            Key::FrictionCoefficient => "applies to friction = coulomb only",
-            Key::TrescaThreshold => "applies to friction = tresca only",
-            Key::ContactInit => {
-                if scene.contact_init_matters() {
-                    "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
-                } else {
-                    "changes nothing in this scene (its contact nodes start at rest or in free flight, where the quasi-static and interpolant starts coincide)"
-                }
-            }
-            _ => "applies to mass = weights only",
-        })
+        Key::RhoInf => matches!(
+            scheme,
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                preset: AlphaPreset::RhoInf(_),
+                ..
+            })
+        ),
+        Key::HhtAlpha => matches!(
+            scheme,
+            Scheme::GeneralizedAlpha(GeneralizedAlphaParams {
+                preset: AlphaPreset::Hht(_),
+                ..
+            })
+        ),
+        Key::MassWeights => m.mass_name == "weights",
+        Key::ContactInit => m.mass.massless_contact() && scene.contact_init_matters(),
+        _ => true,
     };
-    for (k, _) in user.iter() {
-        if let Err(why) = applies(*k) {
-            dropped.push(format!("{} {why}", k.name()));
-        }
+    if ok {
+        return Ok(());
     }
+    Err(match k {
+        Key::NitscheTheta | Key::NitscheGamma0 => "applies to space = nitsche only",
+        Key::PenaltyGamma0 => "applies to space = penalty only",
+        Key::NewmarkBeta => "applies to newmark and paoli-schatzman only",
+        Key::NewmarkGamma => "applies to newmark only",
+        Key::ThetaScheme => "applies to the theta scheme (and moreau-jean) only",
+        Key::Restitution => "applies to paoli-schatzman (and moreau-jean) only",
+        Key::RhoInf => "applies to generalized-alpha only",
+        Key::HhtAlpha => "applies to hht only",
+        Key::FrictionCoefficient => "applies to friction = coulomb only",
+        Key::TrescaThreshold => "applies to friction = tresca only",
+        Key::ContactInit => {
+            if scene.contact_init_matters() {
+                "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+            } else {
+                "changes nothing in this scene (its contact nodes start at rest or in free flight, where the quasi-static and interpolant starts coincide)"
+            }
+        }
+        _ => "applies to mass = weights only",
+    })
+}
 
-    // Meaningless combinations (SPEC §3).
-    let massless = mass.massless_contact();
-    let contact_init = get(Key::ContactInit)
-        .and_then(|v| v.as_str().and_then(ContactInit::from_name))
-        .expect("checked");
+/// Meaningless combinations (SPEC §3): why method `m` is no method at all, if it is not.
+fn meaningless(m: &Method) -> Option<String> {
+    let (scheme, method) = (m.scheme, m.contact);
+    let massless = m.mass.massless_contact();
     if matches!(scheme, Scheme::PaoliSchatzman(_)) && method != ContactMethod::Mixed {
-        return Outcome::Inapplicable("paoli-schatzman is defined for space = mixed only".into());
+        return Some("paoli-schatzman is defined for space = mixed only".into());
     }
     if matches!(scheme, Scheme::Hybrid) && method == ContactMethod::Mixed && !massless {
-        return Outcome::Inapplicable(
+        return Some(
             "hybrid with space = mixed needs a massless contact node (mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)".into(),
         );
     }
@@ -536,22 +763,22 @@ fn resolve(
         Scheme::Kane | Scheme::ContactStabilizedNewmark | Scheme::MoreauJean(_)
     ) && method != ContactMethod::Mixed
     {
-        return Outcome::Inapplicable(format!("{family} is defined for space = mixed only"));
+        return Some(format!("{family} is defined for space = mixed only"));
     }
     if scheme.needs_contact_mass() && massless {
-        return Outcome::Inapplicable(format!(
+        return Some(format!(
             "{family} needs inertia on the contact dof (mass = consistent or lumped)"
         ));
     }
     if scheme == Scheme::DiscreteGradient {
         match method {
             ContactMethod::Mixed => {
-                return Outcome::Inapplicable(
+                return Some(
                     "discrete-gradient needs a contact potential (space = penalty, or nitsche with Θ = 1)".into(),
                 );
             }
             ContactMethod::Nitsche { theta, .. } if theta != 1.0 => {
-                return Outcome::Inapplicable(
+                return Some(
                     "discrete-gradient with space = nitsche needs nitsche_theta = 1 (only then is the Nitsche term a potential)".into(),
                 );
             }
@@ -560,15 +787,22 @@ fn resolve(
     }
     // Central difference with `mixed` and a diagonal mass: kinematic contact (SPEC §3.2).
     let kinematic = scheme == Scheme::Newmark(NewmarkParams::central_difference())
-        && mass == MassVariant::Lumped;
+        && m.mass == MassVariant::Lumped;
     if scheme.is_explicit() && method == ContactMethod::Mixed && !massless && !kinematic {
-        return Outcome::Inapplicable(
+        return Some(
             "an explicit scheme cannot enforce the multiplier constraint on a contact node with mass".into(),
         );
     }
+    None
+}
 
-    // Physics, mesh and time step: the scene's.
-    let mut physics = Physics(
+/// The scene's physics values of a combination (a choice key's word as its index, a key not
+/// given at its default). A physics value that rules out this scheme (the oscillator's dry
+/// friction) is refused where the value is fixed, skipped as a meaningless combination across
+/// an axis.
+fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
+    let scene = given.scene;
+    let physics = Physics(
         scene
             .physics()
             .iter()
@@ -580,87 +814,102 @@ fn resolve(
                 };
                 (
                     k.name,
-                    num(key)
-                        .or_else(|| get(key).and_then(word))
+                    given
+                        .num(key)
+                        .or_else(|| given.get(key).and_then(word))
                         .unwrap_or(k.default),
                 )
             })
             .collect(),
     );
-    // A physics value that rules out this scheme (the oscillator's dry friction): refused
-    // where the value is fixed, skipped as a meaningless combination across an axis.
-    if let Err((key, why)) = scene.supports_physics(&physics, &scheme) {
+    if let Err((key, why)) = scene.supports_physics(&physics, scheme) {
         let k = Key::from_name(key).expect("scenes name sweep keys");
-        match user.get(&k) {
-            Some((_, o)) if o.path.starts_with("grid") || o.path.starts_with("zip") => {
-                return Outcome::Inapplicable(why);
-            }
-            _ => return Outcome::Invalid(vec![Issue::at(&origin(k), why)]),
+        if given.on_axis(k) {
+            return Err(Outcome::Inapplicable(why));
         }
+        return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
     }
-    let c0 = scene.wave_speed(&physics);
-    // A mesh scene's body: the file of the `mesh` key, read and validated before any run.
+    Ok(physics)
+}
+
+/// A mesh scene's body: the file of the `mesh` key, read and validated before any run, with
+/// the scene's setup of it (`obstacle` sets the gap it names in `physics`). Its problems join
+/// `issues`.
+fn read_mesh_file(
+    sweep_dir: &Path,
+    given: &Given,
+    physics: &mut Physics,
+    issues: &mut Vec<Issue>,
+) -> (Option<MeshFile>, Option<(MeshChoice, SceneSetup)>) {
+    let scene = given.scene;
     let mut mesh_file: Option<MeshFile> = None;
     let mut file_setup = None;
-    if scene.takes_mesh_file() {
-        for k in [Key::H, Key::Elements] {
-            if let Some((_, o)) = user.get(&k) {
-                issues.push(Issue::at(
-                    o,
-                    format!(
-                        "scene {} takes its mesh from the `mesh` key (h is the file's largest element diameter), not from `{}`",
-                        scene.name(),
-                        k.name()
-                    ),
-                ));
-            }
-        }
-        match user.get(&Key::Mesh) {
-            None => issues.push(Issue {
-                line: None,
-                key: "mesh".into(),
-                reason: format!(
-                    "required: scene {} needs `mesh = \"FILE.msh\"` (a Gmsh MSH 4.1 file, relative to the sweep file) in [fixed], [grid] or [zip]",
-                    scene.name()
+    for k in [Key::H, Key::Elements] {
+        if let Some((_, o)) = given.user.get(&k) {
+            issues.push(Issue::at(
+                o,
+                format!(
+                    "scene {} takes its mesh from the `mesh` key (h is the file's largest element diameter), not from `{}`",
+                    scene.name(),
+                    k.name()
                 ),
-            }),
-            Some((v, o)) => {
-                let written = v.as_str().unwrap_or_default().to_string();
-                // Absolute, so the runs find it from any working directory (a cluster job's).
-                let joined = sweep_dir.join(&written);
-                let path = std::path::absolute(&joined).unwrap_or(joined);
-                let read = crate::space::fe::GmshMesh::read_shared(&path)
-                    .map_err(|e| Issue::at(o, e.to_string()))
-                    .and_then(|m| {
-                        // `obstacle` is the gap under another name (SPEC §1.6).
-                        if let Some(gap) = gap_from_obstacle(&m, &user)? {
-                            physics.set("gap", gap);
-                        }
-                        Ok(m)
-                    });
-                match read {
-                    Err(issue) => issues.push(issue),
-                    Ok(m) => match scene.setup_from_file(&physics, &path, &m) {
-                        Err(why) => issues.push(Issue::at(o, why)),
-                        Ok((choice, setup)) => {
-                            file_setup = Some((choice, setup));
-                            mesh_file = Some((written, path, m));
-                        }
-                    },
-                }
-            }
-        }
-        if !issues.is_empty() {
-            return Outcome::Invalid(issues);
+            ));
         }
     }
-    let mesh = match (user.get(&Key::H), user.get(&Key::Elements)) {
-        _ if file_setup.is_some() => file_setup.as_ref().map(|(c, _)| *c),
+    match given.user.get(&Key::Mesh) {
+        None => issues.push(Issue {
+            line: None,
+            key: "mesh".into(),
+            reason: format!(
+                "required: scene {} needs `mesh = \"FILE.msh\"` (a Gmsh MSH 4.1 file, relative to the sweep file) in [fixed], [grid] or [zip]",
+                scene.name()
+            ),
+        }),
+        Some((v, o)) => {
+            let written = v.as_str().unwrap_or_default().to_string();
+            // Absolute, so the runs find it from any working directory (a cluster job's).
+            let joined = sweep_dir.join(&written);
+            let path = std::path::absolute(&joined).unwrap_or(joined);
+            let read = crate::space::fe::GmshMesh::read_shared(&path)
+                .map_err(|e| Issue::at(o, e.to_string()))
+                .and_then(|m| {
+                    // `obstacle` is the gap under another name (SPEC §1.6).
+                    if let Some(gap) = gap_from_obstacle(&m, &given.user)? {
+                        physics.set("gap", gap);
+                    }
+                    Ok(m)
+                });
+            match read {
+                Err(issue) => issues.push(issue),
+                Ok(m) => match scene.setup_from_file(physics, &path, &m) {
+                    Err(why) => issues.push(Issue::at(o, why)),
+                    Ok((choice, setup)) => {
+                        file_setup = Some((choice, setup));
+                        mesh_file = Some((written, path, m));
+                    }
+                },
+            }
+        }
+    }
+    (mesh_file, file_setup)
+}
+
+/// The mesh: a mesh file's (`from_file`), else from `h` or `elements` (one of the two), else
+/// the scene's default; a missing or refused size joins `issues`.
+fn mesh_of(
+    given: &Given,
+    physics: &Physics,
+    from_file: Option<MeshChoice>,
+    issues: &mut Vec<Issue>,
+) -> Option<MeshChoice> {
+    let scene = given.scene;
+    match (given.user.get(&Key::H), given.user.get(&Key::Elements)) {
+        _ if from_file.is_some() => from_file,
         (Some(_), Some((_, o))) => {
             issues.push(Issue::at(o, "give either h or elements, not both"));
             None
         }
-        (Some((v, o)), None) => match scene.mesh_from_h(&physics, v.as_f64().unwrap()) {
+        (Some((v, o)), None) => match scene.mesh_from_h(physics, v.as_f64().unwrap()) {
             Ok(m) => Some(m),
             Err(why) => {
                 issues.push(Issue::at(o, why));
@@ -668,7 +917,7 @@ fn resolve(
             }
         },
         (None, Some((v, o))) => match v {
-            Value::Int(i) => match scene.mesh_from_elements(&physics, *i as usize) {
+            Value::Int(i) => match scene.mesh_from_elements(physics, *i as usize) {
                 Ok(m) => Some(m),
                 Err(why) => {
                     issues.push(Issue::at(o, why));
@@ -688,9 +937,13 @@ fn resolve(
             });
             None
         }
-    };
-    let h = mesh.map(|m| m.h);
-    let dt = match (user.get(&Key::Dt), user.get(&Key::Courant), h) {
+    }
+}
+
+/// The time step: `dt`, or `courant` ν as dt = ν h / c0 (one of the two); a missing one joins
+/// `issues`.
+fn dt_of(given: &Given, h: Option<f64>, c0: f64, issues: &mut Vec<Issue>) -> Option<f64> {
+    match (given.user.get(&Key::Dt), given.user.get(&Key::Courant), h) {
         (Some(_), Some((_, o)), _) => {
             issues.push(Issue::at(o, "give either dt or courant, not both"));
             None
@@ -708,18 +961,12 @@ fn resolve(
             });
             None
         }
-    };
-    let t_final = num(Key::T).unwrap();
-    if !issues.is_empty() {
-        return Outcome::Invalid(issues);
     }
-    let (mesh, dt) = (mesh.unwrap(), dt.unwrap());
-    let h = mesh.h;
-    let dt_origin = origin(if user.contains_key(&Key::Dt) {
-        Key::Dt
-    } else {
-        Key::Courant
-    });
+}
+
+/// The number of steps to T: T/dt when whole within round-off, else rounded up; refused
+/// outside 1 … 1e8 (at `dt_origin`).
+fn steps_of(t_final: f64, dt: f64, dt_origin: &Origin) -> Result<usize, Outcome> {
     let ratio = t_final / dt;
     let steps = if (ratio - ratio.round()).abs() <= 1e-9 * ratio {
         ratio.round() as usize
@@ -727,249 +974,267 @@ fn resolve(
         ratio.ceil() as usize
     };
     if steps == 0 || steps > 100_000_000 {
-        return Outcome::Invalid(vec![Issue::at(
-            &dt_origin,
+        return Err(Outcome::Invalid(vec![Issue::at(
+            dt_origin,
             format!("T/dt = {ratio:.3e} steps is out of range (1 … 1e8)"),
-        )]);
+        )]));
     }
-    let courant = c0 * dt / h;
-    let setup = match file_setup {
-        Some((_, setup)) => setup,
-        None => scene.setup(&physics, mesh),
-    };
-    let revision = setup.id_revision();
-    let config = RunConfig::new(setup, method, mass.clone(), scheme, dt, steps)
-        .with_friction(friction)
-        .with_contact_init(if massless && scene.contact_init_matters() {
-            contact_init
-        } else {
-            ContactInit::Consistent
-        });
-    // The step solver (SPEC §4) is the finite-element engine's choice; the 1D engines solve
-    // tridiagonal systems, and drop the keys.
-    let fe = matches!(config, RunConfig::Fe(_));
-    let solver = match get(Key::Solver).as_ref().and_then(Value::as_str) {
+    Ok(steps)
+}
+
+/// The step solver (SPEC §4) is the finite-element engine's choice (`fe`); the 1D engines
+/// solve tridiagonal systems, and drop the keys.
+fn solver_of(given: &Given, fe: bool, dropped: &mut Vec<String>) -> Solver {
+    let solver = match given.get(Key::Solver).as_ref().and_then(Value::as_str) {
         Some("cg") if fe => Solver::Cg {
-            tol: num(Key::CgTol).expect("cg_tol has a default"),
+            tol: given.num(Key::CgTol).expect("cg_tol has a default"),
         },
         _ => Solver::Direct,
     };
-    if user.contains_key(&Key::Solver) && !fe {
+    if given.has(Key::Solver) && !fe {
         dropped.push(
             "solver applies to the finite-element scenes only (their sparse step matrix)".into(),
         );
     }
-    if user.contains_key(&Key::CgTol) && solver == Solver::Direct {
+    if given.has(Key::CgTol) && solver == Solver::Direct {
         dropped.push("cg_tol applies to solver = cg only".into());
     }
-    let config = config.with_solver(solver);
+    solver
+}
 
-    // Memory before anything is built (the CFL check below assembles the operators).
-    if let Some(budget) = limits.max_run_bytes {
-        let series_every = limits.series_every.unwrap_or(1);
-        let est = config.estimate(series_every);
-        if est.bytes() > budget {
-            let mesh_key = if scene.takes_mesh_file() {
-                Key::Mesh
-            } else if user.contains_key(&Key::Elements) {
-                Key::Elements
-            } else {
-                Key::H
-            };
-            // Fewer unknowns is the cure: fewer elements, a larger h, a coarser mesh file.
-            let advice = match mesh_key {
-                Key::Mesh => "use a coarser mesh file".to_string(),
-                Key::Elements => "lower `elements`".to_string(),
-                _ => "raise `h`".to_string(),
-            };
-            let (at, advice) = if est.state_bytes >= est.series_bytes {
-                // Without a factor the same run may fit: say so, with its figure.
-                let cg = (fe && solver == Solver::Direct).then(|| {
-                    config
-                        .clone()
-                        .with_solver(Solver::Cg {
-                            tol: Solver::DEFAULT_CG_TOL,
-                        })
-                        .estimate(series_every)
-                        .bytes()
-                });
-                let advice = match cg {
-                    Some(b) => format!(
-                        "{advice}, or set solver = \"cg\" (conjugate gradient, no factor: an estimated {}{})",
-                        human_bytes(b),
-                        if b > budget {
-                            ", also above the budget"
-                        } else {
-                            ""
-                        }
-                    ),
-                    None => advice,
-                };
-                (origin(mesh_key), advice)
-            } else {
-                (
-                    Origin {
-                        path: "series_every".into(),
-                        line: None,
-                    },
-                    format!(
-                        "raise `series_every` (now {series_every}) or `dt` ({} steps)",
-                        config.steps()
-                    ),
-                )
-            };
-            return Outcome::Invalid(vec![Issue::at(
-                &at,
-                format!(
-                    "the run needs an estimated {} ({:.3e} unknowns, {} steps: {} of operators and state, {} of kept series), above the per-run memory budget of {} (--max-run-memory): {advice}",
-                    human_bytes(est.bytes()),
-                    est.unknowns,
-                    config.steps(),
-                    human_bytes(est.state_bytes),
-                    human_bytes(est.series_bytes),
-                    human_bytes(budget),
-                ),
-            )]);
-        }
-    }
-
-    // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
-    // assembled operators (contact-free and contact-active stiffness).
-    match config.explicit_dt_limit() {
-        Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) && !allow_unstable => {
-            return Outcome::Invalid(vec![Issue::at(
-                &dt_origin,
-                format!(
-                    "dt = {dt:.6e} is above the CFL limit of {} for this mesh, mass and contact (dt ≤ {dt_max:.6e}, courant ≤ {:.6})",
-                    scheme.label(),
-                    c0 * dt_max / h
-                ),
-            )]);
-        }
-        Ok(_) => {}
-        Err((key, e)) => {
-            let k = Key::from_name(key).expect("engines name sweep keys");
-            return Outcome::Invalid(vec![Issue::at(&origin(k), e)]);
-        }
-    }
-
-    // Columns and canonical text.
-    let mut canonical = BTreeMap::new();
-    let mut put = |k: Key, v: Value, always: bool| {
-        let is_default = default_of(scene, k).is_some_and(|d| same(&d, &v));
-        if always || !is_default {
-            canonical.insert(k, v.canonical());
-        }
-        params.insert(k, v);
+/// Memory before anything is built (the CFL check assembles the operators): a run above
+/// `limits.max_run_bytes` is refused at the key whose change cures it, with the cure.
+fn check_memory(
+    given: &Given,
+    limits: &PlanLimits,
+    config: &RunConfig,
+    fe: bool,
+    solver: Solver,
+) -> Result<(), Outcome> {
+    let Some(budget) = limits.max_run_bytes else {
+        return Ok(());
     };
-    put(Key::T, Value::Num(t_final), false);
-    put(Key::Elements, Value::Int(mesh.elements as i64), true);
-    put(Key::Dt, Value::Num(dt), true);
-    put(Key::Space, Value::Str(space_name.clone()), false);
-    put(Key::Mass, Value::Str(mass_name.clone()), false);
-    put(Key::Scheme, Value::Str(scheme.family().into()), true);
-    if let MassVariant::Weights(w) = &mass {
-        put(Key::MassWeights, Value::List(w.clone()), true);
+    let series_every = limits.series_every.unwrap_or(1);
+    let est = config.estimate(series_every);
+    if est.bytes() > budget {
+        let mesh_key = if given.scene.takes_mesh_file() {
+            Key::Mesh
+        } else if given.has(Key::Elements) {
+            Key::Elements
+        } else {
+            Key::H
+        };
+        // Fewer unknowns is the cure: fewer elements, a larger h, a coarser mesh file.
+        let advice = match mesh_key {
+            Key::Mesh => "use a coarser mesh file".to_string(),
+            Key::Elements => "lower `elements`".to_string(),
+            _ => "raise `h`".to_string(),
+        };
+        let (at, advice) = if est.state_bytes >= est.series_bytes {
+            // Without a factor the same run may fit: say so, with its figure.
+            let cg = (fe && solver == Solver::Direct).then(|| {
+                config
+                    .clone()
+                    .with_solver(Solver::Cg {
+                        tol: Solver::DEFAULT_CG_TOL,
+                    })
+                    .estimate(series_every)
+                    .bytes()
+            });
+            let advice = match cg {
+                Some(b) => format!(
+                    "{advice}, or set solver = \"cg\" (conjugate gradient, no factor: an estimated {}{})",
+                    human_bytes(b),
+                    if b > budget {
+                        ", also above the budget"
+                    } else {
+                        ""
+                    }
+                ),
+                None => advice,
+            };
+            (given.origin(mesh_key), advice)
+        } else {
+            (
+                Origin {
+                    path: "series_every".into(),
+                    line: None,
+                },
+                format!(
+                    "raise `series_every` (now {series_every}) or `dt` ({} steps)",
+                    config.steps()
+                ),
+            )
+        };
+        return Err(Outcome::Invalid(vec![Issue::at(
+            &at,
+            format!(
+                "the run needs an estimated {} ({:.3e} unknowns, {} steps: {} of operators and state, {} of kept series), above the per-run memory budget of {} (--max-run-memory): {advice}",
+                human_bytes(est.bytes()),
+                est.unknowns,
+                config.steps(),
+                human_bytes(est.state_bytes),
+                human_bytes(est.series_bytes),
+                human_bytes(budget),
+            ),
+        )]));
     }
-    if massless && scene.contact_init_matters() {
-        put(
-            Key::ContactInit,
-            Value::Str(contact_init.name().into()),
-            false,
-        );
-    }
-    match method {
-        ContactMethod::Nitsche { theta, gamma0 } => {
-            put(Key::NitscheTheta, Value::Num(theta), false);
-            put(Key::NitscheGamma0, Value::Num(gamma0), true);
-        }
-        ContactMethod::Penalty { gamma0 } => put(Key::PenaltyGamma0, Value::Num(gamma0), true),
-        ContactMethod::Mixed => {}
-    }
-    match scheme {
-        Scheme::Newmark(p) => {
-            put(Key::NewmarkBeta, Value::Num(p.beta), false);
-            put(Key::NewmarkGamma, Value::Num(p.gamma), false);
-        }
-        Scheme::Theta(p) => put(Key::ThetaScheme, Value::Num(p.theta), true),
-        Scheme::PaoliSchatzman(p) => {
-            put(Key::NewmarkBeta, Value::Num(p.beta), false);
-            put(Key::Restitution, Value::Num(p.restitution), false);
-        }
-        Scheme::Hybrid
-        | Scheme::Kane
-        | Scheme::ContactStabilizedNewmark
-        | Scheme::DiscreteGradient => {}
-        // New schemes: their parameters always in the id (their defaults are their own).
-        Scheme::GeneralizedAlpha(p) => match p.preset {
-            AlphaPreset::RhoInf(r) => put(Key::RhoInf, Value::Num(r), true),
-            AlphaPreset::Hht(a) => put(Key::HhtAlpha, Value::Num(a), true),
-        },
-        Scheme::MoreauJean(p) => {
-            put(Key::ThetaScheme, Value::Num(p.theta), true);
-            put(Key::Restitution, Value::Num(p.restitution), true);
-        }
-    }
-    // `load` says how gravity enters (SPEC §1.3): without gravity it changes nothing, so it is
-    // no parameter of the run (null column, never in the id) and both values are one run.
-    let weightless = physics.0.iter().any(|(n, g)| *n == "gravity" && *g == 0.0);
-    for (name, value) in &physics.0 {
-        let key = Key::from_name(name).unwrap();
-        if key == Key::Load && weightless {
-            if user.contains_key(&Key::Load) {
-                dropped.push("load applies only with gravity ≠ 0".into());
-            }
-            continue;
-        }
-        put(key, physics_value(key, *value), false);
-    }
-    // The friction column where a law can act (null on the scenes that take none); `none`
-    // is the default and never enters the id.
-    if scene.supports_friction().is_ok() {
-        put(
-            Key::Friction,
-            Value::Str(friction_kind.name().into()),
-            false,
-        );
-    }
-    match friction {
-        FrictionLaw::None => {}
-        FrictionLaw::Coulomb { coefficient } => {
-            put(Key::FrictionCoefficient, Value::Num(coefficient), true)
-        }
-        FrictionLaw::Tresca { threshold } => put(Key::TrescaThreshold, Value::Num(threshold), true),
-    }
-    // `direct` is the default: its runs keep the ids they had before the key existed.
-    match solver {
-        Solver::Cg { tol } => {
-            put(Key::Solver, Value::Str(solver.name().into()), false);
-            put(Key::CgTol, Value::Num(tol), false);
-        }
-        Solver::Direct if fe => put(Key::Solver, Value::Str(solver.name().into()), false),
-        Solver::Direct => {}
-    }
-    // The mesh file: its content is its identity (a moved or renamed file keeps its runs'
-    // ids), the column shows the path as written.
-    if let Some((written, _, m)) = &mesh_file {
-        canonical.insert(Key::Mesh, format!("sha256:{}", m.content_hash));
-        params.insert(Key::Mesh, Value::Str(written.clone()));
-    }
-    // Derived columns, not part of the identity: a mesh run's plane x_d = `obstacle` whether the
-    // sweep gave it or `gap` (SPEC §1.6), so filters and the plan table see both.
-    if let Some((_, _, m)) = &mesh_file
-        && let Some(floor) = m.contact_floor()
-    {
-        params.insert(Key::Obstacle, Value::Num(floor - physics.get("gap")));
-    }
-    params.insert(Key::H, Value::Num(h));
-    params.insert(Key::Courant, Value::Num(courant));
+    Ok(())
+}
 
-    let space_label = match method {
+/// A run's columns (`params`) and the canonical text of its id (`canonical`): a parameter
+/// enters the text when it is always part of the identity or differs from its default.
+struct Columns {
+    scene: &'static dyn Scene,
+    params: BTreeMap<Key, Value>,
+    canonical: BTreeMap<Key, String>,
+}
+
+impl Columns {
+    fn new(scene: &'static dyn Scene) -> Columns {
+        Columns {
+            scene,
+            params: BTreeMap::new(),
+            canonical: BTreeMap::new(),
+        }
+    }
+
+    fn put(&mut self, k: Key, v: Value, always: bool) {
+        let is_default = default_of(self.scene, k).is_some_and(|d| same(&d, &v));
+        if always || !is_default {
+            self.canonical.insert(k, v.canonical());
+        }
+        self.params.insert(k, v);
+    }
+
+    /// The method's keys: space, mass and scheme family, and the parameters of each.
+    fn put_method(&mut self, m: &Method, contact_init: ContactInit) {
+        self.put(Key::Space, Value::Str(m.space_name.clone()), false);
+        self.put(Key::Mass, Value::Str(m.mass_name.clone()), false);
+        self.put(Key::Scheme, Value::Str(m.scheme.family().into()), true);
+        if let MassVariant::Weights(w) = &m.mass {
+            self.put(Key::MassWeights, Value::List(w.clone()), true);
+        }
+        if m.mass.massless_contact() && self.scene.contact_init_matters() {
+            self.put(
+                Key::ContactInit,
+                Value::Str(contact_init.name().into()),
+                false,
+            );
+        }
+        match m.contact {
+            ContactMethod::Nitsche { theta, gamma0 } => {
+                self.put(Key::NitscheTheta, Value::Num(theta), false);
+                self.put(Key::NitscheGamma0, Value::Num(gamma0), true);
+            }
+            ContactMethod::Penalty { gamma0 } => {
+                self.put(Key::PenaltyGamma0, Value::Num(gamma0), true)
+            }
+            ContactMethod::Mixed => {}
+        }
+        match m.scheme {
+            Scheme::Newmark(p) => {
+                self.put(Key::NewmarkBeta, Value::Num(p.beta), false);
+                self.put(Key::NewmarkGamma, Value::Num(p.gamma), false);
+            }
+            Scheme::Theta(p) => self.put(Key::ThetaScheme, Value::Num(p.theta), true),
+            Scheme::PaoliSchatzman(p) => {
+                self.put(Key::NewmarkBeta, Value::Num(p.beta), false);
+                self.put(Key::Restitution, Value::Num(p.restitution), false);
+            }
+            Scheme::Hybrid
+            | Scheme::Kane
+            | Scheme::ContactStabilizedNewmark
+            | Scheme::DiscreteGradient => {}
+            // New schemes: their parameters always in the id (their defaults are their own).
+            Scheme::GeneralizedAlpha(p) => match p.preset {
+                AlphaPreset::RhoInf(r) => self.put(Key::RhoInf, Value::Num(r), true),
+                AlphaPreset::Hht(a) => self.put(Key::HhtAlpha, Value::Num(a), true),
+            },
+            Scheme::MoreauJean(p) => {
+                self.put(Key::ThetaScheme, Value::Num(p.theta), true);
+                self.put(Key::Restitution, Value::Num(p.restitution), true);
+            }
+        }
+    }
+
+    /// The scene's physics values. `load` says how gravity enters (SPEC §1.3): without
+    /// gravity it changes nothing, so it is no parameter of the run (null column, never in
+    /// the id) and both values are one run.
+    fn put_physics(&mut self, given: &Given, physics: &Physics, dropped: &mut Vec<String>) {
+        let weightless = physics.0.iter().any(|(n, g)| *n == "gravity" && *g == 0.0);
+        for (name, value) in &physics.0 {
+            let key = Key::from_name(name).unwrap();
+            if key == Key::Load && weightless {
+                if given.has(Key::Load) {
+                    dropped.push("load applies only with gravity ≠ 0".into());
+                }
+                continue;
+            }
+            self.put(key, physics_value(key, *value), false);
+        }
+    }
+
+    /// The friction column where a law can act (null on the scenes that take none); `none`
+    /// is the default and never enters the id.
+    fn put_friction(&mut self, m: &Method) {
+        if self.scene.supports_friction().is_ok() {
+            self.put(
+                Key::Friction,
+                Value::Str(m.friction_kind.name().into()),
+                false,
+            );
+        }
+        match m.friction {
+            FrictionLaw::None => {}
+            FrictionLaw::Coulomb { coefficient } => {
+                self.put(Key::FrictionCoefficient, Value::Num(coefficient), true)
+            }
+            FrictionLaw::Tresca { threshold } => {
+                self.put(Key::TrescaThreshold, Value::Num(threshold), true)
+            }
+        }
+    }
+
+    /// `direct` is the default: its runs keep the ids they had before the key existed.
+    fn put_solver(&mut self, solver: Solver, fe: bool) {
+        match solver {
+            Solver::Cg { tol } => {
+                self.put(Key::Solver, Value::Str(solver.name().into()), false);
+                self.put(Key::CgTol, Value::Num(tol), false);
+            }
+            Solver::Direct if fe => self.put(Key::Solver, Value::Str(solver.name().into()), false),
+            Solver::Direct => {}
+        }
+    }
+
+    /// The mesh file: its content is its identity (a moved or renamed file keeps its runs'
+    /// ids), the column shows the path as written. Derived, not part of the identity: a mesh
+    /// run's plane x_d = `obstacle` whether the sweep gave it or `gap` (SPEC §1.6), so
+    /// filters and the plan table see both.
+    fn put_mesh_file(&mut self, mesh_file: Option<&MeshFile>, physics: &Physics) {
+        if let Some((written, _, m)) = mesh_file {
+            self.canonical
+                .insert(Key::Mesh, format!("sha256:{}", m.content_hash));
+            self.params.insert(Key::Mesh, Value::Str(written.clone()));
+        }
+        if let Some((_, _, m)) = mesh_file
+            && let Some(floor) = m.contact_floor()
+        {
+            self.params
+                .insert(Key::Obstacle, Value::Num(floor - physics.get("gap")));
+        }
+    }
+}
+
+/// A run's label: `space · mass · scheme[ · friction]`, each with its parameters.
+fn run_label(m: &Method, contact_init: ContactInit, scheme_label: &str) -> String {
+    let space_label = match m.contact {
         ContactMethod::Mixed => "mixed".to_string(),
         ContactMethod::Nitsche { theta, gamma0 } => format!("nitsche(Θ={theta}, γ0={gamma0:e})"),
         ContactMethod::Penalty { gamma0 } => format!("penalty(γ0={gamma0:e})"),
     };
-    let mass_label = match &mass {
+    let mass_label = match &m.mass {
         MassVariant::Weights(w) => format!(
             "weights[{}]",
             w.iter()
@@ -979,29 +1244,16 @@ fn resolve(
         ),
         other => other.name().to_string(),
     };
-    let mass_label = match (massless, contact_init) {
+    let mass_label = match (m.mass.massless_contact(), contact_init) {
         (true, ContactInit::Interpolant) => format!("{mass_label} (interpolant start)"),
         _ => mass_label,
     };
-    let scheme_label = scheme.label();
-    let friction_label = match friction {
+    let friction_label = match m.friction {
         FrictionLaw::None => String::new(),
         FrictionLaw::Coulomb { coefficient } => format!(" · coulomb(μ_f={coefficient})"),
         FrictionLaw::Tresca { threshold } => format!(" · tresca(s={threshold})"),
     };
-    Outcome::Run(Box::new(Resolved {
-        params,
-        canonical,
-        revision,
-        label: format!("{space_label} · {mass_label} · {scheme_label}{friction_label}"),
-        scheme_names: [scheme.family().to_string(), scheme_label.clone()],
-        scheme_label,
-        config,
-        dropped,
-        h,
-        dt,
-        t_final,
-    }))
+    format!("{space_label} · {mass_label} · {scheme_label}{friction_label}")
 }
 
 /// Whether an exclude filter matches a resolved run.
@@ -1055,7 +1307,6 @@ fn reference_of(
         [Key::Dt, Key::Courant],
         [Key::Gap, Key::Obstacle],
     ];
-    let step_keys = pairs[1];
     let replaced = |k: Key| {
         over.iter().any(|o| o.key == k)
             || pairs
@@ -1073,20 +1324,11 @@ fn reference_of(
         combined.retain(|e| super::accepted(ref_scene, e.key));
     }
     combined.extend(over.iter());
-    let at = |keys: &[Key]| {
-        over.iter()
-            .find(|e| keys.contains(&e.key))
-            .map(|e| e.origin.clone())
-            .unwrap_or(Origin {
-                path: "reference".into(),
-                line: None,
-            })
-    };
     let r = match resolve(sweep_dir(sweep), ref_scene, &combined, false, limits) {
         Outcome::Run(r) => r,
         Outcome::Inapplicable(why) => {
             return Err(vec![Issue::at(
-                &at(&[Key::H, Key::Elements, Key::Mesh]),
+                &reference_origin(over, &[Key::H, Key::Elements, Key::Mesh]),
                 format!("the reference run is meaningless: {why}"),
             )]);
         }
@@ -1100,7 +1342,55 @@ fn reference_of(
                 .collect());
         }
     };
-    if other_scene && let (RunConfig::Fe(a), RunConfig::Fe(b)) = (&run.config, &r.config) {
+    if other_scene {
+        same_problem(sweep, ref_scene, run, &r)?;
+    }
+    // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
+    let nested = !other_scene && sweep.scene.get().nested_meshes();
+    let (sx, st) = strides(over, nested, run, &r)?;
+    let id = r.id(ref_scene, "");
+    let spec = RunSpec {
+        run_id: id,
+        superseded_id: r.superseded_id(ref_scene, "", false),
+        label: if other_scene {
+            format!("reference: {} {}", ref_scene.name(), r.label)
+        } else {
+            format!("reference: {}", r.label)
+        },
+        params: r.params.clone(),
+        scheme_label: r.scheme_label.clone(),
+        config: r.config.clone(),
+        repeats: 1,
+        sample: None,
+        scene: ref_scene,
+        reference: None,
+        search: None,
+    };
+    Ok((spec, sx, st))
+}
+
+/// Where a reference problem is reported: the first of `keys` the reference gives, else
+/// `reference`.
+fn reference_origin(over: &[Entry], keys: &[Key]) -> Origin {
+    over.iter()
+        .find(|e| keys.contains(&e.key))
+        .map(|e| e.origin.clone())
+        .unwrap_or(Origin {
+            path: "reference".into(),
+            line: None,
+        })
+}
+
+/// A reference of another scene (`ref_scene`) must pose the run's problem: the same
+/// density, Lamé constants, gap, gravity and initial velocity, or the errors would compare
+/// two problems.
+fn same_problem(
+    sweep: &SweepFile,
+    ref_scene: SceneKind,
+    run: &Resolved,
+    r: &Resolved,
+) -> Result<(), Vec<Issue>> {
+    if let (RunConfig::Fe(a), RunConfig::Fe(b)) = (&run.config, &r.config) {
         let (a, b) = (&a.setup, &b.setup);
         let differ: Vec<String> = [
             ("density", a.density, b.density),
@@ -1129,13 +1419,25 @@ fn reference_of(
             )]);
         }
     }
+    Ok(())
+}
+
+/// The run's (space, time) refinement ratios against its reference `r`: the reference must be
+/// nested in time (dt_run/dt_ref whole) and last as long; in space nested (h_run/h_ref whole)
+/// where the meshes are (`nested`), otherwise at least as fine (stride 1).
+fn strides(
+    over: &[Entry],
+    nested: bool,
+    run: &Resolved,
+    r: &Resolved,
+) -> Result<(usize, usize), Vec<Issue>> {
+    let at = |keys: &[Key]| reference_origin(over, keys);
+    let step_keys = [Key::Dt, Key::Courant];
     let ratio = |coarse: f64, fine: f64| {
         let q = coarse / fine;
         let n = q.round();
         (n >= 1.0 && (q - n).abs() <= 1e-9 * n).then_some(n as usize)
     };
-    // Meshes that are not nested: any reference at least as fine, stored whole (stride 1).
-    let nested = !other_scene && sweep.scene.get().nested_meshes();
     if !nested && r.h > run.h * (1.0 + 1e-12) {
         return Err(vec![Issue::at(
             &at(&[Key::H, Key::Elements, Key::Mesh]),
@@ -1177,25 +1479,7 @@ fn reference_of(
             ),
         )]);
     }
-    let id = r.id(ref_scene, "");
-    let spec = RunSpec {
-        run_id: id,
-        superseded_id: r.superseded_id(ref_scene, "", false),
-        label: if other_scene {
-            format!("reference: {} {}", ref_scene.name(), r.label)
-        } else {
-            format!("reference: {}", r.label)
-        },
-        params: r.params.clone(),
-        scheme_label: r.scheme_label.clone(),
-        config: r.config.clone(),
-        repeats: 1,
-        sample: None,
-        scene: ref_scene,
-        reference: None,
-        search: None,
-    };
-    Ok((spec, sx, st))
+    Ok((sx, st))
 }
 
 impl Resolved {
@@ -1326,6 +1610,80 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
         series_every: Some(limits.series_every.unwrap_or(sweep.series_every)),
         ..*limits
     };
+    check_size(sweep, limits)?;
+    let mut axes: Vec<&Axis> = Vec::new();
+    if let Some(z) = &sweep.zip {
+        axes.push(z);
+    }
+    axes.extend(sweep.grid.iter());
+    let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
+    let combinations: usize = sizes.iter().product();
+    let combos = combinations_of(sweep, &axes, &sizes, combinations);
+    let (work, mut searches) = search_work(sweep, limits, combos);
+    let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
+    let mut ex = Expansion::default();
+    for (owned, search) in &work {
+        let entries: Vec<&Entry> = owned.iter().collect();
+        let outcome = resolve(
+            sweep_dir(sweep),
+            sweep.scene,
+            &entries,
+            allow_unstable,
+            limits,
+        );
+        ex.add(sweep, limits, &entries, search, outcome);
+    }
+    let Expansion {
+        runs,
+        mut issues,
+        excluded_by_filter,
+        inapplicable,
+        collapsed,
+        references,
+        ..
+    } = ex;
+    // A base none of whose probes is a run (meaningless, excluded) is no search.
+    searches.retain(|b| runs.iter().any(|r| r.search.as_deref() == Some(&b.tag)));
+    if !issues.is_empty() {
+        issues.sort();
+        issues.dedup();
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            issues,
+            sets: sweep.sets.clone(),
+        });
+    }
+    if runs.is_empty() {
+        return Err(SweepError::Invalid {
+            file: sweep.path.clone(),
+            sets: sweep.sets.clone(),
+            issues: vec![Issue {
+                line: None,
+                key: "grid".into(),
+                reason: format!(
+                    "the sweep expands to no runs ({combinations} combinations: {excluded_by_filter} excluded by filters, {} inapplicable)",
+                    inapplicable.values().sum::<usize>()
+                ),
+            }],
+        });
+    }
+    Ok(Plan {
+        sweep: sweep.clone(),
+        limits: *limits,
+        runs,
+        combinations,
+        excluded_by_filter,
+        inapplicable,
+        collapsed,
+        references,
+        searches,
+    })
+}
+
+/// The plan's size, checked from the file alone: a plan above `limits.max_runs` (or above
+/// the memory a plan may hold) is refused before anything is allocated for it, at its longest
+/// axis.
+fn check_size(sweep: &SweepFile, limits: &PlanLimits) -> Result<(), SweepError> {
     let size = PlanSize::of(sweep);
     let plan_bytes = size.combinations as f64 * PLAN_BYTES_PER_RUN;
     let too_big = limits.max_plan_bytes.is_some_and(|b| plan_bytes > b);
@@ -1373,42 +1731,48 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
             }],
         });
     }
-    let mut axes: Vec<&Axis> = Vec::new();
-    if let Some(z) = &sweep.zip {
-        axes.push(z);
-    }
-    axes.extend(sweep.grid.iter());
-    let sizes: Vec<usize> = axes.iter().map(|a| a.items.len()).collect();
-    let combinations: usize = sizes.iter().product();
-    let mut runs = Vec::new();
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut issues: Vec<Issue> = Vec::new();
-    let mut excluded_by_filter = 0;
-    let mut inapplicable: BTreeMap<String, usize> = BTreeMap::new();
-    let mut collapsed: BTreeMap<String, usize> = BTreeMap::new();
-    let mut references: Vec<ReferencePlan> = Vec::new();
-    let mut searches: Vec<SearchBase> = Vec::new();
-    // A search turns every combination into a base and its two bracket probes.
-    let combos: Vec<Vec<Entry>> = {
-        let mut out = Vec::new();
-        let mut idx = vec![0usize; axes.len()];
-        for _ in 0..combinations {
-            let mut entries: Vec<Entry> = sweep.fixed.clone();
-            for (a, &i) in axes.iter().zip(&idx) {
-                entries.extend(a.items[i].iter().cloned());
-            }
-            out.push(entries);
-            for d in (0..idx.len()).rev() {
-                idx[d] += 1;
-                if idx[d] < sizes[d] {
-                    break;
-                }
-                idx[d] = 0;
-            }
+    Ok(())
+}
+
+/// The entries of every combination: [fixed], then one item of each axis; the first axis
+/// (the zipped lists, if any) varies slowest, the last fastest.
+fn combinations_of(
+    sweep: &SweepFile,
+    axes: &[&Axis],
+    sizes: &[usize],
+    combinations: usize,
+) -> Vec<Vec<Entry>> {
+    let mut out = Vec::new();
+    let mut idx = vec![0usize; axes.len()];
+    for _ in 0..combinations {
+        let mut entries: Vec<Entry> = sweep.fixed.clone();
+        for (a, &i) in axes.iter().zip(&idx) {
+            entries.extend(a.items[i].iter().cloned());
         }
-        out
-    };
-    let mut work: Vec<(Vec<Entry>, Option<String>)> = Vec::new();
+        out.push(entries);
+        for d in (0..idx.len()).rev() {
+            idx[d] += 1;
+            if idx[d] < sizes[d] {
+                break;
+            }
+            idx[d] = 0;
+        }
+    }
+    out
+}
+
+/// The combinations to resolve, each with the tag of its search (probes only).
+type Work = Vec<(Vec<Entry>, Option<String>)>;
+
+/// The combinations to resolve, each with its search tag: as they are, or — with a
+/// `[search]` — every combination a base and its two bracket probes (lo, hi).
+fn search_work(
+    sweep: &SweepFile,
+    limits: &PlanLimits,
+    combos: Vec<Vec<Entry>>,
+) -> (Work, Vec<SearchBase>) {
+    let mut searches: Vec<SearchBase> = Vec::new();
+    let mut work: Work = Vec::new();
     for entries in combos {
         match &sweep.search {
             None => work.push((entries, None)),
@@ -1440,141 +1804,148 @@ pub fn expand_with(sweep: &SweepFile, limits: &PlanLimits) -> Result<Plan, Sweep
             }
         }
     }
-    let allow_unstable = sweep.allow_unstable || sweep.search.is_some();
-    for (owned, search) in &work {
-        let entries: Vec<&Entry> = owned.iter().collect();
-        match resolve(
-            sweep_dir(sweep),
-            sweep.scene,
-            &entries,
-            allow_unstable,
-            limits,
-        ) {
-            Outcome::Invalid(mut is) => issues.append(&mut is),
-            Outcome::Inapplicable(why) => *inapplicable.entry(why).or_default() += 1,
+    (work, searches)
+}
+
+/// What the expansion gathers, combination by combination: the runs (by id, the first of
+/// identical ones), the problems, the combinations left out (by reason) and the reference
+/// runs.
+#[derive(Default)]
+struct Expansion {
+    runs: Vec<RunSpec>,
+    seen: HashMap<String, usize>,
+    issues: Vec<Issue>,
+    excluded_by_filter: usize,
+    inapplicable: BTreeMap<String, usize>,
+    collapsed: BTreeMap<String, usize>,
+    references: Vec<ReferencePlan>,
+}
+
+impl Expansion {
+    /// One resolved combination: refused, left out, excluded by a filter, or its runs (with
+    /// their reference) added.
+    fn add(
+        &mut self,
+        sweep: &SweepFile,
+        limits: &PlanLimits,
+        entries: &[&Entry],
+        search: &Option<String>,
+        outcome: Outcome,
+    ) {
+        match outcome {
+            Outcome::Invalid(mut is) => self.issues.append(&mut is),
+            Outcome::Inapplicable(why) => *self.inapplicable.entry(why).or_default() += 1,
             Outcome::Run(r) => {
                 if sweep.exclude.iter().any(|f| matches_filter(f, &r)) {
-                    excluded_by_filter += 1;
+                    self.excluded_by_filter += 1;
                 } else {
                     let reference = match &sweep.reference {
                         None => None,
-                        Some(over) => match reference_of(sweep, limits, &entries, over, &r) {
-                            Ok((spec, sx, st)) => {
-                                let id = spec.run_id.clone();
-                                let old = spec.superseded_id.clone();
-                                match references.iter_mut().find(|p| p.spec.run_id == id) {
-                                    Some(p) => {
-                                        p.space_stride = gcd(p.space_stride, sx);
-                                        p.time_stride = gcd(p.time_stride, st);
-                                    }
-                                    None => references.push(ReferencePlan {
-                                        spec,
-                                        space_stride: sx,
-                                        time_stride: st,
-                                    }),
-                                }
-                                Some((id, old))
-                            }
-                            Err(mut is) => {
-                                issues.append(&mut is);
-                                None
-                            }
-                        },
+                        Some(over) => self.reference(sweep, limits, entries, over, &r),
                     };
-                    let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
-                        None => vec![None],
-                        Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
-                    };
-                    for sample in samples {
-                        let mut extra = match (sample, sweep.ensemble) {
-                            (Some((k, p)), Some(e)) => {
-                                format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
-                            }
-                            _ => String::new(),
-                        };
-                        let mut old_extra = extra.clone();
-                        // The errors depend on the reference: a run measured against another
-                        // reference is another run.
-                        if let Some((rid, old)) = &reference {
-                            let _ = writeln!(extra, "reference={rid}");
-                            let _ =
-                                writeln!(old_extra, "reference={}", old.as_ref().unwrap_or(rid));
-                        }
-                        let id = r.id(sweep.scene, &extra);
-                        let superseded_id = r.superseded_id(
-                            sweep.scene,
-                            &old_extra,
-                            reference.as_ref().is_some_and(|(_, old)| old.is_some()),
-                        );
-                        if seen.contains_key(&id) {
-                            let why = if r.dropped.is_empty() {
-                                "identical parameters after alias resolution".to_string()
-                            } else {
-                                r.dropped.join("; ")
-                            };
-                            *collapsed.entry(why).or_default() += 1;
-                            continue;
-                        }
-                        seen.insert(id.clone(), runs.len());
-                        let mut config = r.config.clone();
-                        if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
-                            let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
-                            config.set_perturbation(Some((p, seed)));
-                        }
-                        runs.push(RunSpec {
-                            run_id: id,
-                            label: r.label.clone(),
-                            params: r.params.clone(),
-                            scheme_label: r.scheme_label.clone(),
-                            config,
-                            repeats: sweep.repeats,
-                            sample,
-                            scene: sweep.scene,
-                            reference: reference.as_ref().map(|(rid, _)| rid.clone()),
-                            search: search.clone(),
-                            superseded_id,
-                        });
-                    }
+                    self.add_members(sweep, &r, reference, search);
                 }
             }
         }
     }
-    // A base none of whose probes is a run (meaningless, excluded) is no search.
-    searches.retain(|b| runs.iter().any(|r| r.search.as_deref() == Some(&b.tag)));
-    if !issues.is_empty() {
-        issues.sort();
-        issues.dedup();
-        return Err(SweepError::Invalid {
-            file: sweep.path.clone(),
-            issues,
-            sets: sweep.sets.clone(),
-        });
+
+    /// The reference run of a run (merged with an identical one already planned, its
+    /// strides the greatest common divisor of its consumers'): its id and superseded id.
+    fn reference(
+        &mut self,
+        sweep: &SweepFile,
+        limits: &PlanLimits,
+        entries: &[&Entry],
+        over: &[Entry],
+        r: &Resolved,
+    ) -> Option<(String, Option<String>)> {
+        match reference_of(sweep, limits, entries, over, r) {
+            Ok((spec, sx, st)) => {
+                let id = spec.run_id.clone();
+                let old = spec.superseded_id.clone();
+                match self.references.iter_mut().find(|p| p.spec.run_id == id) {
+                    Some(p) => {
+                        p.space_stride = gcd(p.space_stride, sx);
+                        p.time_stride = gcd(p.time_stride, st);
+                    }
+                    None => self.references.push(ReferencePlan {
+                        spec,
+                        space_stride: sx,
+                        time_stride: st,
+                    }),
+                }
+                Some((id, old))
+            }
+            Err(mut is) => {
+                self.issues.append(&mut is);
+                None
+            }
+        }
     }
-    if runs.is_empty() {
-        return Err(SweepError::Invalid {
-            file: sweep.path.clone(),
-            sets: sweep.sets.clone(),
-            issues: vec![Issue {
-                line: None,
-                key: "grid".into(),
-                reason: format!(
-                    "the sweep expands to no runs ({combinations} combinations: {excluded_by_filter} excluded by filters, {} inapplicable)",
-                    inapplicable.values().sum::<usize>()
-                ),
-            }],
-        });
+
+    /// The runs of a resolved combination: one per ensemble member, each id over its member
+    /// and its reference; a run identical to an earlier one collapses into it.
+    fn add_members(
+        &mut self,
+        sweep: &SweepFile,
+        r: &Resolved,
+        reference: Option<(String, Option<String>)>,
+        search: &Option<String>,
+    ) {
+        let samples: Vec<Option<(usize, f64)>> = match sweep.ensemble {
+            None => vec![None],
+            Some(e) => (0..e.samples).map(|k| Some((k, e.perturbation))).collect(),
+        };
+        for sample in samples {
+            let mut extra = match (sample, sweep.ensemble) {
+                (Some((k, p)), Some(e)) => {
+                    format!("ensemble={},{},{k}\n", canonical_number(p), e.seed)
+                }
+                _ => String::new(),
+            };
+            let mut old_extra = extra.clone();
+            // The errors depend on the reference: a run measured against another
+            // reference is another run.
+            if let Some((rid, old)) = &reference {
+                let _ = writeln!(extra, "reference={rid}");
+                let _ = writeln!(old_extra, "reference={}", old.as_ref().unwrap_or(rid));
+            }
+            let id = r.id(sweep.scene, &extra);
+            let superseded_id = r.superseded_id(
+                sweep.scene,
+                &old_extra,
+                reference.as_ref().is_some_and(|(_, old)| old.is_some()),
+            );
+            if self.seen.contains_key(&id) {
+                let why = if r.dropped.is_empty() {
+                    "identical parameters after alias resolution".to_string()
+                } else {
+                    r.dropped.join("; ")
+                };
+                *self.collapsed.entry(why).or_default() += 1;
+                continue;
+            }
+            self.seen.insert(id.clone(), self.runs.len());
+            let mut config = r.config.clone();
+            if let (Some((k, p)), Some(e)) = (sample, sweep.ensemble) {
+                let seed = e.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (k as u64 + 1);
+                config.set_perturbation(Some((p, seed)));
+            }
+            self.runs.push(RunSpec {
+                run_id: id,
+                label: r.label.clone(),
+                params: r.params.clone(),
+                scheme_label: r.scheme_label.clone(),
+                config,
+                repeats: sweep.repeats,
+                sample,
+                scene: sweep.scene,
+                reference: reference.as_ref().map(|(rid, _)| rid.clone()),
+                search: search.clone(),
+                superseded_id,
+            });
+        }
     }
-    Ok(Plan {
-        sweep: sweep.clone(),
-        limits: *limits,
-        runs,
-        combinations,
-        excluded_by_filter,
-        inapplicable,
-        collapsed,
-        references,
-        searches,
-    })
 }
 
 /// A combination's entries with the searched key set to `value`.
