@@ -333,18 +333,7 @@ pub fn decimate(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64)> {
     let size = points.len().div_ceil(buckets);
     let mut out = Vec::with_capacity(2 * buckets);
     for chunk in points.chunks(size) {
-        let lo = chunk
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
-        let hi = chunk
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.1.total_cmp(&b.1.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
+        let (lo, hi) = extremes(chunk);
         let (a, b) = if lo <= hi { (lo, hi) } else { (hi, lo) };
         out.push(chunk[a]);
         if b != a {
@@ -352,6 +341,21 @@ pub fn decimate(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64)> {
         }
     }
     out
+}
+
+/// The indices of a chunk's first minimum and last maximum, in the order of `f64::total_cmp`
+/// (those `Iterator::min_by` and `max_by` pick).
+fn extremes(chunk: &[(f64, f64)]) -> (usize, usize) {
+    let (mut lo, mut hi) = (0, 0);
+    for (i, p) in chunk.iter().enumerate().skip(1) {
+        if p.1.total_cmp(&chunk[lo].1).is_lt() {
+            lo = i;
+        }
+        if p.1.total_cmp(&chunk[hi].1).is_ge() {
+            hi = i;
+        }
+    }
+    (lo, hi)
 }
 
 /// The linear (t, y) axes of a time-series panel holding `curves`.
@@ -481,6 +485,26 @@ mod tests {
         assert!(d.len() <= 200);
         assert!(d.iter().any(|p| p.1 == -1.0) && d.iter().any(|p| p.1 == 1.0));
         assert!(d.windows(2).all(|w| w[0].0 < w[1].0), "time order kept");
+    }
+
+    #[test]
+    fn the_extremes_are_those_min_by_and_max_by_pick() {
+        let chunk = [
+            (0.0, 1.0),
+            (1.0, -0.0),
+            (2.0, 3.0),
+            (3.0, 0.0),
+            (4.0, 3.0),
+            (5.0, -0.0),
+        ];
+        let by = |f: fn(std::slice::Iter<'_, (f64, f64)>) -> Option<&(f64, f64)>| {
+            let p = f(chunk.iter()).unwrap();
+            chunk.iter().position(|q| std::ptr::eq(q, p)).unwrap()
+        };
+        let min = by(|i| i.min_by(|a, b| a.1.total_cmp(&b.1)));
+        let max = by(|i| i.max_by(|a, b| a.1.total_cmp(&b.1)));
+        assert_eq!(extremes(&chunk), (min, max));
+        assert_eq!((min, max), (1, 4), "the first −0, the last 3");
     }
 
     #[test]
