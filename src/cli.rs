@@ -442,41 +442,7 @@ fn summarize_options(dir: &Path, errors: Option<&[String]>) -> Result<summary::S
 fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     let plan = &cfg.plan;
     let dir = &cfg.out;
-    let had_results = dir.join("runs").is_dir();
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let found = match Manifest::inspect(dir)? {
-        ManifestState::Sweep(found) => found,
-        ManifestState::Missing => {
-            if had_results {
-                eprintln!(
-                    "warning: {} has no manifest.json: rebuilt from {}",
-                    dir.display(),
-                    plan.sweep.path.display()
-                );
-            }
-            None
-        }
-        ManifestState::MovedAside { to, reason } => {
-            eprintln!(
-                "warning: {} is damaged ({reason}): moved aside to {}, rebuilt from {}",
-                dir.join("manifest.json").display(),
-                to.display(),
-                plan.sweep.path.display()
-            );
-            None
-        }
-    };
-    if let Some(found) = found
-        && found != plan.sweep.name
-        && !cfg.resume
-    {
-        return Err(SinkError::ForeignSweep {
-            path: dir.clone(),
-            found,
-            expected: plan.sweep.name.clone(),
-        }
-        .into());
-    }
+    check_folder(dir, plan, cfg.resume)?;
     if cfg.references_only {
         let all: Vec<&sweep::RunSpec> = plan.runs.iter().collect();
         let refs = exec::references::ensure(dir, plan, &all, &cfg.exec.run)?;
@@ -487,62 +453,9 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         );
         return Ok(ExitCode::SUCCESS);
     }
-    let (sink, done) = Sink::open(dir, cfg.batch)?;
-    for d in &sink.damaged {
-        eprintln!("warning: {}", d.warning());
-    }
-    if !sink.migrated.is_empty() {
-        eprintln!(
-            "note: {} runs part(s) written by an older version given this version's columns (new columns null), so that every reader sees one schema",
-            sink.migrated.len()
-        );
-    }
-    if !sink.migrated_series.is_empty() {
-        eprintln!(
-            "note: {} series part(s) written by an older version given this version's columns (new columns null)",
-            sink.migrated_series.len()
-        );
-    }
-    for p in &sink.legacy_damaged {
-        eprintln!(
-            "note: moved {} (a damaged part set aside by an older version) out of the parts' folder",
-            p.display()
-        );
-    }
-    // Shards balanced by estimated work (exec::shard): every task computes the same split.
-    let mine: Vec<&sweep::RunSpec> = match &cfg.shard {
-        None => plan.runs.iter().collect(),
-        Some(spec) => {
-            let of = exec::shard::assign(&plan.runs, spec.of);
-            plan.runs
-                .iter()
-                .zip(of)
-                .filter(|(_, s)| spec.contains(*s))
-                .map(|(r, _)| r)
-                .collect()
-        }
-    };
-    // Rows of these runs under their ids of before a definition change (issue 34): their
-    // numbers are not this version's, and new rows beside them would make two answers to one
-    // question in every table.
-    let superseded: Vec<&sweep::RunSpec> = mine
-        .iter()
-        .copied()
-        .filter(|r| {
-            r.superseded_id
-                .as_ref()
-                .is_some_and(|old| done.contains(old))
-        })
-        .collect();
-    if let Some(first) = superseded.first() {
-        return Err(SinkError::Superseded {
-            path: dir.clone(),
-            count: superseded.len(),
-            example: first.superseded_id.clone().unwrap_or_default(),
-            now: first.run_id.clone(),
-        }
-        .into());
-    }
+    let (sink, done) = open_sink(dir, cfg.batch)?;
+    let mine = shard_runs(plan, cfg.shard.as_ref());
+    refuse_superseded(dir, &mine, &done)?;
     let todo: Vec<&sweep::RunSpec> = mine
         .iter()
         .copied()
@@ -585,9 +498,165 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             mine.len()
         );
     }
-    // The bar advances by each run's estimated work (steps × unknowns × repeats, the plan's
-    // cost model), so its ETA is weighted: the last level of a ladder costs ~1000× the first,
-    // and an ETA counting runs would be wrong by that factor for most of the sweep.
+    let outcome = execute(&cfg, &sink, &todo, threads)?;
+    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
+    let stats = sink.stats();
+    manifest.finish(
+        dir,
+        stats.written,
+        interrupted
+            || outcome.result.is_err()
+            || outcome.flushed.is_err()
+            || outcome.searched.is_err(),
+    )?;
+    outcome.result?;
+    outcome.flushed?;
+    outcome.searched?;
+    if interrupted {
+        eprintln!(
+            "interrupted: {} finished runs committed to {}; the runs in flight were dropped — run the same command to resume",
+            stats.written,
+            dir.display()
+        );
+        return Ok(ExitCode::from(130));
+    }
+    eprintln!(
+        "{} runs written to {} ({} failed, {} diverged)",
+        stats.written,
+        dir.display(),
+        outcome.failed,
+        outcome.diverged
+    );
+    eprintln!("{}", cost_line(&stats, sweep_start.elapsed().as_secs_f64()));
+    show_results(&cfg, &mine)?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuse an output folder holding another sweep (unless `--resume` adds to it), after
+/// saying what became of a missing or damaged manifest.
+fn check_folder(dir: &Path, plan: &Plan, resume: bool) -> Result<()> {
+    let had_results = dir.join("runs").is_dir();
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let found = match Manifest::inspect(dir)? {
+        ManifestState::Sweep(found) => found,
+        ManifestState::Missing => {
+            if had_results {
+                eprintln!(
+                    "warning: {} has no manifest.json: rebuilt from {}",
+                    dir.display(),
+                    plan.sweep.path.display()
+                );
+            }
+            None
+        }
+        ManifestState::MovedAside { to, reason } => {
+            eprintln!(
+                "warning: {} is damaged ({reason}): moved aside to {}, rebuilt from {}",
+                dir.join("manifest.json").display(),
+                to.display(),
+                plan.sweep.path.display()
+            );
+            None
+        }
+    };
+    if let Some(found) = found
+        && found != plan.sweep.name
+        && !resume
+    {
+        return Err(SinkError::ForeignSweep {
+            path: dir.to_path_buf(),
+            found,
+            expected: plan.sweep.name.clone(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// Open the folder's sink (the ids of the runs it holds beside it), saying what it repaired.
+fn open_sink(dir: &Path, batch: BatchPolicy) -> Result<(Sink, HashSet<String>)> {
+    let (sink, done) = Sink::open(dir, batch)?;
+    for d in &sink.damaged {
+        eprintln!("warning: {}", d.warning());
+    }
+    if !sink.migrated.is_empty() {
+        eprintln!(
+            "note: {} runs part(s) written by an older version given this version's columns (new columns null), so that every reader sees one schema",
+            sink.migrated.len()
+        );
+    }
+    if !sink.migrated_series.is_empty() {
+        eprintln!(
+            "note: {} series part(s) written by an older version given this version's columns (new columns null)",
+            sink.migrated_series.len()
+        );
+    }
+    for p in &sink.legacy_damaged {
+        eprintln!(
+            "note: moved {} (a damaged part set aside by an older version) out of the parts' folder",
+            p.display()
+        );
+    }
+    Ok((sink, done))
+}
+
+/// This session's runs: the plan's, or its shard's (balanced by estimated work,
+/// exec::shard: every task computes the same split).
+fn shard_runs<'p>(plan: &'p Plan, shard: Option<&ShardSpec>) -> Vec<&'p sweep::RunSpec> {
+    match shard {
+        None => plan.runs.iter().collect(),
+        Some(spec) => {
+            let of = exec::shard::assign(&plan.runs, spec.of);
+            plan.runs
+                .iter()
+                .zip(of)
+                .filter(|(_, s)| spec.contains(*s))
+                .map(|(r, _)| r)
+                .collect()
+        }
+    }
+}
+
+/// Refuse to run when the folder holds rows of these runs under their ids of before a
+/// definition change (issue 34): their numbers are not this version's, and new rows beside
+/// them would make two answers to one question in every table.
+fn refuse_superseded(dir: &Path, mine: &[&sweep::RunSpec], done: &HashSet<String>) -> Result<()> {
+    let superseded: Vec<&sweep::RunSpec> = mine
+        .iter()
+        .copied()
+        .filter(|r| {
+            r.superseded_id
+                .as_ref()
+                .is_some_and(|old| done.contains(old))
+        })
+        .collect();
+    if let Some(first) = superseded.first() {
+        return Err(SinkError::Superseded {
+            path: dir.to_path_buf(),
+            count: superseded.len(),
+            example: first.superseded_id.clone().unwrap_or_default(),
+            now: first.run_id.clone(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// What executing the runs came to: each step's result, kept until the manifest records
+/// whether the session completed, and the runs' failures.
+struct Outcome {
+    result: std::result::Result<(), SinkError>,
+    flushed: std::result::Result<(), SinkError>,
+    searched: Result<()>,
+    failed: usize,
+    diverged: usize,
+}
+
+/// The progress bar of `todo`, advancing by each run's estimated work (steps × unknowns ×
+/// repeats, the plan's cost model), so its ETA is weighted: the last level of a ladder costs
+/// ~1000× the first, and an ETA counting runs would be wrong by that factor for most of the
+/// sweep. Hidden when stderr is not a terminal.
+fn progress_bar<'a>(todo: &[&'a sweep::RunSpec]) -> (ProgressBar, HashMap<&'a str, u64>) {
     let work_of = |r: &sweep::RunSpec| (r.config.work() * r.repeats as u64).max(1);
     let works: HashMap<&str, u64> = todo
         .iter()
@@ -602,6 +671,20 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
     } else {
         bar.set_draw_target(ProgressDrawTarget::hidden());
     }
+    (bar, works)
+}
+
+/// Run `todo` into the sink with the bar drawn, commit, and bisect the sweep's searches;
+/// errors of the runs, the commit and the search are kept in the [`Outcome`] (the manifest
+/// records them first), a failed reference run is returned at once.
+fn execute(
+    cfg: &RunConfig,
+    sink: &Sink,
+    todo: &[&sweep::RunSpec],
+    threads: usize,
+) -> Result<Outcome> {
+    let (plan, dir) = (&cfg.plan, &cfg.out);
+    let (bar, works) = progress_bar(todo);
     let (total_runs, mut done_runs) = (todo.len(), 0usize);
     // A second signal is left to the default action: the user can still kill a stuck process.
     if let Err(e) = ctrlc::set_handler(|| {
@@ -612,12 +695,12 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
         eprintln!("warning: no signal handler ({e}); an interrupt loses the batch in flight");
     }
     let (mut failed, mut diverged) = (0usize, 0usize);
-    let refs = exec::references::ensure(dir, plan, &todo, &cfg.exec.run)?;
+    let refs = exec::references::ensure(dir, plan, todo, &cfg.exec.run)?;
     // Each run's output is encoded by the worker that ran it (`Sink::push`); this thread
     // only counts and draws the bar.
     let result = exec::execute_with(
         &plan.sweep.name,
-        &todo,
+        todo,
         &refs,
         &ExecOptions {
             threads,
@@ -650,38 +733,25 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
                 "(a shard runs only the bracket ends of the [search]; run the sweep without --shard to bisect)"
             );
         } else {
-            searched = bisect(dir, plan, &refs, &cfg.exec, threads, &sink);
+            searched = bisect(dir, plan, &refs, &cfg.exec, threads, sink);
             if searched.is_ok() {
                 flushed = sink.flush();
             }
         }
     }
-    let interrupted = INTERRUPTED.load(Ordering::SeqCst);
-    let stats = sink.stats();
-    manifest.finish(
-        dir,
-        stats.written,
-        interrupted || result.is_err() || flushed.is_err() || searched.is_err(),
-    )?;
-    result?;
-    flushed?;
-    searched?;
-    if interrupted {
-        eprintln!(
-            "interrupted: {} finished runs committed to {}; the runs in flight were dropped — run the same command to resume",
-            stats.written,
-            dir.display()
-        );
-        return Ok(ExitCode::from(130));
-    }
-    eprintln!(
-        "{} runs written to {} ({} failed, {} diverged)",
-        stats.written,
-        dir.display(),
+    Ok(Outcome {
+        result,
+        flushed,
+        searched,
         failed,
-        diverged
-    );
-    eprintln!("{}", cost_line(&stats, sweep_start.elapsed().as_secs_f64()));
+        diverged,
+    })
+}
+
+/// The result table (run by run, or with the summary group by group) and, unless a shard or
+/// `--no-summary`, the summary tables and the report.
+fn show_results(cfg: &RunConfig, mine: &[&sweep::RunSpec]) -> Result<()> {
+    let (plan, dir) = (&cfg.plan, &cfg.out);
     let mut ids: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
     let probes = searched_ids(dir, plan)?;
     ids.extend(probes.iter().map(String::as_str));
@@ -707,35 +777,40 @@ fn run(cfg: RunConfig, sweep_start: Instant) -> Result<ExitCode> {
             dir.display()
         );
     } else if cfg.summary {
-        // The sections are computed once for the tables and the report (the report alone,
-        // `contact-sweep report DIR`, reads the [summary] choice stored in the manifest: this
-        // session's, i.e. plan.sweep.summary).
-        match summary::Sections::compute(dir, &plan.sweep.summary) {
-            Ok(sections) => {
-                // Tables and report from the same sections, side by side: both only read them,
-                // and the sweep's workers are done, so the cores are free.
-                let (tables, report) = std::thread::scope(|scope| {
-                    let tables = scope.spawn(|| sections.write(dir));
-                    let report = crate::report::write_with(dir, None, &sections);
-                    (tables.join(), report)
-                });
-                match tables {
-                    Ok(Ok(s)) => say(&s.terminal),
-                    Ok(Err(e)) => eprintln!("summary not written: {e:#}"),
-                    Err(_) => eprintln!("summary not written: its writer panicked"),
-                }
-                match report {
-                    Ok(r) => say(&format!(
-                        "report: {} — open it in a browser: figures and every table\n",
-                        r.path.display()
-                    )),
-                    Err(e) => eprintln!("report not written: {e:#}"),
-                }
-            }
-            Err(e) => eprintln!("summary and report not written: {e:#}"),
-        }
+        summarize_and_report(dir, plan);
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(())
+}
+
+/// The summary tables and the report of `dir`, a failure of either said and not an error
+/// (the runs are committed). The sections are computed once for both (the report alone,
+/// `contact-sweep report DIR`, reads the [summary] choice stored in the manifest: this
+/// session's, i.e. plan.sweep.summary).
+fn summarize_and_report(dir: &Path, plan: &Plan) {
+    match summary::Sections::compute(dir, &plan.sweep.summary) {
+        Ok(sections) => {
+            // Tables and report from the same sections, side by side: both only read them,
+            // and the sweep's workers are done, so the cores are free.
+            let (tables, report) = std::thread::scope(|scope| {
+                let tables = scope.spawn(|| sections.write(dir));
+                let report = crate::report::write_with(dir, None, &sections);
+                (tables.join(), report)
+            });
+            match tables {
+                Ok(Ok(s)) => say(&s.terminal),
+                Ok(Err(e)) => eprintln!("summary not written: {e:#}"),
+                Err(_) => eprintln!("summary not written: its writer panicked"),
+            }
+            match report {
+                Ok(r) => say(&format!(
+                    "report: {} — open it in a browser: figures and every table\n",
+                    r.path.display()
+                )),
+                Err(e) => eprintln!("report not written: {e:#}"),
+            }
+        }
+        Err(e) => eprintln!("summary and report not written: {e:#}"),
+    }
 }
 
 /// Print `run`'s results to stdout, ignoring a reader that went away (`run … | head`): the

@@ -7,7 +7,7 @@
 //!   least-squares slope p: the fitted line log e = c + p log x is e = exp(c) x^p, and the
 //!   triangle sits under it (shifted down by a constant factor, so it never hides the data),
 //!   over one interval between levels, a different one per curve so that they do not pile up.
-//! - Work-precision: error against wall time in log-log, every ok run coloured by group, the
+//! - Work-precision: error against wall time in log-log, every ok run marked by group, the
 //!   Pareto front (no run both faster and more accurate) as a black staircase.
 //! - Time series: contact displacement, contact pressure and energy in units of `energy_scale`
 //!   (E/E⁰ for the bars) against t for one run per group, with the exact (closed-form) solution
@@ -17,8 +17,18 @@
 //! - Frictional runs: the energy balance (E, W_f and E + W_f against t in one panel: a scheme
 //!   whose E + W_f stays flat while E falls lost only the friction's work) and the slip velocity
 //!   v_t of the contact node.
+//!
+//! Every curve carries its group's colour and marker ([`super::style`]: distinct for up to 60
+//! groups); the time-series curves, too dense for a marker per point, carry a dozen markers
+//! along them. Every panel is one [`panel`]: the canvas, caption, axes and labels set up once,
+//! the log axes labelled as [`super::ticks`] says.
 
+use plotters::coord::combinators::WithKeyPoints;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::prelude::*;
+
+use super::style::{self, Marker};
+use super::ticks::{LogSpan, lin_range, log_range, log_ticks, tick};
 
 /// A figure that could not be drawn (plotters' message).
 #[derive(Debug, thiserror::Error)]
@@ -28,29 +38,13 @@ pub struct FigureError {
     pub message: String,
 }
 
-/// One curve: its name, points and colour (an index into [`color`]: the method group's, so
-/// that a group has one colour in every figure and one HTML legend serves them all).
+/// One curve: its name, points and method group (its colour and marker, [`style`]: the same
+/// in every figure, so that one HTML legend serves them all).
 #[derive(Debug, Clone)]
 pub struct Curve {
     pub name: String,
     pub points: Vec<(f64, f64)>,
-    pub color: usize,
-}
-
-/// The colour of curve `i`: a qualitative palette (Okabe–Ito, readable by colour-blind
-/// readers), cycling after eight.
-pub fn color(i: usize) -> RGBColor {
-    const P: [RGBColor; 8] = [
-        RGBColor(0, 114, 178),
-        RGBColor(213, 94, 0),
-        RGBColor(0, 158, 115),
-        RGBColor(204, 121, 167),
-        RGBColor(230, 159, 0),
-        RGBColor(86, 180, 233),
-        RGBColor(120, 94, 240),
-        RGBColor(160, 32, 32),
-    ];
-    P[i % P.len()]
+    pub group: usize,
 }
 
 const W: u32 = 760;
@@ -63,59 +57,179 @@ fn err(figure: &str) -> impl Fn(String) -> FigureError + '_ {
     }
 }
 
-/// The positive finite range of values, widened by a factor on each side (log axes).
-fn log_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-    if !(lo.is_finite() && hi > 0.0) {
-        return None;
-    }
-    let (lo, hi) = if hi / lo < 1.0001 {
-        (lo / 2.0, hi * 2.0)
-    } else {
-        (lo, hi)
-    };
-    let pad = (hi / lo).powf(0.06);
-    Some((lo / pad, hi * pad))
-}
-
-fn lin_range(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-    if !(lo.is_finite() && hi.is_finite()) {
-        return None;
-    }
-    let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 };
-    Some((lo - pad, hi + pad))
-}
-
-/// Tick labels: the terminal's engineering format without trailing zeros (`0.1`, `1e-3`).
-fn tick(x: &f64) -> String {
-    let s = crate::summary::eng(*x);
-    let (mantissa, exp) = match s.split_once('e') {
-        Some((m, e)) => (m.to_string(), format!("e{e}")),
-        None => (s.clone(), String::new()),
-    };
-    let mantissa = if mantissa.contains('.') {
-        mantissa
-            .trim_end_matches('0')
-            .trim_end_matches('.')
-            .to_string()
-    } else {
-        mantissa
-    };
-    format!("{mantissa}{exp}")
-}
-
 /// Grid lines: the bold ones at the labelled ticks only (a log axis's minor lines would shade
 /// the plot grey).
 const MINOR: RGBAColor = RGBAColor(0, 0, 0, 0.0);
+
+/// The canvas and type sizes of a panel: the log-log figures are large (they are read
+/// closely, slopes and all), the time series short (three or five of them side by side).
+struct Layout {
+    height: u32,
+    caption: u32,
+    margin: u32,
+    x_area: u32,
+}
+
+const LOG_LOG: Layout = Layout {
+    height: H,
+    caption: 18,
+    margin: 12,
+    x_area: 42,
+};
+
+const TIME: Layout = Layout {
+    height: 300,
+    caption: 16,
+    margin: 10,
+    x_area: 36,
+};
+
+/// The chart a panel's drawing gets.
+type Chart<'a, 'b, X, Y> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>;
+
+/// A log axis over `span`, labelled at [`log_ticks`].
+fn log_axis(span: LogSpan) -> WithKeyPoints<LogCoord<f64>> {
+    (span.axis.0..span.axis.1)
+        .log_scale()
+        .with_key_points(log_ticks(span.axis, span.data))
+}
+
+/// One panel as SVG: the white canvas, the caption `title`, the axes `x` and `y` named
+/// `names`, the mesh at the labelled ticks; then `draw` draws the data into the chart, and
+/// with `labels` (a font size) the legend box of its labelled series (the Pareto front, the
+/// exact solution: the method groups have the HTML legend) goes in the upper right corner.
+fn panel<X, Y>(
+    title: &str,
+    layout: &Layout,
+    names: (&str, &str),
+    x: X,
+    y: Y,
+    labels: Option<u32>,
+    draw: impl FnOnce(&mut Chart<'_, '_, X::CoordDescType, Y::CoordDescType>) -> Result<(), String>,
+) -> Result<String, FigureError>
+where
+    X: AsRangedCoord<Value = f64>,
+    Y: AsRangedCoord<Value = f64>,
+    X::CoordDescType: ValueFormatter<f64>,
+    Y::CoordDescType: ValueFormatter<f64>,
+{
+    let e = err(title);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (W, layout.height)).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", layout.caption))
+            .margin(layout.margin)
+            .x_label_area_size(layout.x_area)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x, y)
+            .map_err(|x| e(x.to_string()))?;
+        chart
+            .configure_mesh()
+            .x_desc(names.0)
+            .y_desc(names.1)
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(MINOR)
+            .draw()
+            .map_err(|x| e(x.to_string()))?;
+        draw(&mut chart).map_err(&e)?;
+        if let Some(font) = labels {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(180, 180, 180))
+                .label_font(("sans-serif", font))
+                .draw()
+                .map_err(|x| e(x.to_string()))?;
+        }
+        root.present().map_err(|x| e(x.to_string()))?;
+    }
+    Ok(svg)
+}
+
+/// A polyline through `points`.
+fn line<X, Y>(
+    chart: &mut Chart<'_, '_, X, Y>,
+    points: &[(f64, f64)],
+    style: ShapeStyle,
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    chart
+        .draw_series(LineSeries::new(points.to_vec(), style))
+        .map(|_| ())
+        .map_err(|x| x.to_string())
+}
+
+/// Group `group`'s marker at each of `points`, filled with `style`'s colour.
+fn markers<X, Y>(
+    chart: &mut Chart<'_, '_, X, Y>,
+    points: &[(f64, f64)],
+    group: usize,
+    style: ShapeStyle,
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let style = style.filled();
+    match style::marker(group).outline() {
+        None => chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| Circle::new(p, Marker::RADIUS, style)),
+            )
+            .map(|_| ()),
+        Some(outline) => chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| EmptyElement::at(p) + Polygon::new(outline.to_vec(), style)),
+            )
+            .map(|_| ()),
+    }
+    .map_err(|x| x.to_string())
+}
+
+/// Markers along a time series: at a dozen times evenly spread over its span, shifted by a
+/// fraction of the spacing that differs between groups, so that curves lying on each other
+/// (an exact scheme and the exact solution) do not hide each other's markers.
+fn along(points: &[(f64, f64)], group: usize) -> Vec<(f64, f64)> {
+    const MARKS: usize = 12;
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return Vec::new();
+    };
+    // The golden ratio's fractional parts: well spread for any number of groups.
+    let phase = (group as f64 * 0.618_033_988_75).fract();
+    let mut out: Vec<(f64, f64)> = (0..MARKS)
+        .filter_map(|j| {
+            let t = first.0 + (j as f64 + phase) / MARKS as f64 * (last.0 - first.0);
+            points.get(points.partition_point(|p| p.0 < t)).copied()
+        })
+        .collect();
+    out.dedup_by(|a, b| a.0 == b.0);
+    out
+}
+
+/// A time-series curve: its line in `style` and its group's markers along it.
+fn time_curve<X, Y>(
+    chart: &mut Chart<'_, '_, X, Y>,
+    c: &Curve,
+    style: ShapeStyle,
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    line(chart, &c.points, style)?;
+    markers(chart, &along(&c.points, c.group), c.group, style)
+}
 
 /// A convergence figure: `curves[i]` = (x, error) of group i's main path, `slopes[i]` its
 /// least-squares (p, c) of log e = c + p log x.
@@ -126,45 +240,20 @@ pub fn convergence(
     curves: &[Curve],
     slopes: &[Option<(f64, f64)>],
 ) -> Result<String, FigureError> {
-    let e = err(title);
     let xr = log_range(curves.iter().flat_map(|c| c.points.iter().map(|p| p.0)));
     let yr = log_range(curves.iter().flat_map(|c| c.points.iter().map(|p| p.1)));
-    let (Some((x0, x1)), Some((y0, y1))) = (xr, yr) else {
-        return Err(e("no positive values to plot".into()));
+    let (Some(xr), Some(mut yr)) = (xr, yr) else {
+        return Err(err(title)("no positive values to plot".into()));
     };
     // The triangles sit below the data: extend the y range to hold them.
     let shift = 0.5;
-    let y0 = y0 * shift * shift;
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc(x_name)
-            .y_desc(y_name)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .x_labels(8)
-            .y_labels(8)
-            .light_line_style(MINOR)
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
+    yr.axis.0 *= shift * shift;
+    let (x, y) = (log_axis(xr), log_axis(yr));
+    panel(title, &LOG_LOG, (x_name, y_name), x, y, None, |chart| {
         for (i, c) in curves.iter().enumerate() {
-            let col = color(c.color);
-            chart
-                .draw_series(LineSeries::new(c.points.clone(), col.stroke_width(2)))
-                .map_err(|x| e(x.to_string()))?;
-            chart
-                .draw_series(c.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                .map_err(|x| e(x.to_string()))?;
+            let col = style::color(c.group);
+            line(chart, &c.points, col.stroke_width(2))?;
+            markers(chart, &c.points, c.group, col.into())?;
             // The slope triangle over interval (i mod (levels − 1)), 60 % of its width (in log x).
             if let Some(Some((p, cst))) = slopes.get(i) {
                 let mut xs: Vec<f64> = c.points.iter().map(|q| q.0).collect();
@@ -174,12 +263,11 @@ pub fn convergence(
                     let (a, b) = (xs[k], xs[k] * (xs[k + 1] / xs[k]).powf(0.6));
                     let f = |x: f64| cst.exp() * x.powf(*p) * shift;
                     let (ya, yb) = (f(a), f(b));
-                    chart
-                        .draw_series(std::iter::once(PathElement::new(
-                            vec![(a, ya), (b, ya), (b, yb), (a, ya)],
-                            col.stroke_width(1),
-                        )))
-                        .map_err(|x| e(x.to_string()))?;
+                    line(
+                        chart,
+                        &[(a, ya), (b, ya), (b, yb), (a, ya)],
+                        col.stroke_width(1),
+                    )?;
                     let label = format!("{p:.2}");
                     chart
                         .draw_series(std::iter::once(Text::new(
@@ -187,16 +275,15 @@ pub fn convergence(
                             (b, (ya * yb).sqrt()),
                             ("sans-serif", 13).into_font().color(&col),
                         )))
-                        .map_err(|x| e(x.to_string()))?;
+                        .map_err(|x| x.to_string())?;
                 }
             }
         }
-        root.present().map_err(|x| e(x.to_string()))?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }
 
-/// A work-precision figure: every ok run as a point (wall time, error) coloured by its group
+/// A work-precision figure: every ok run as a point (wall time, error) marked by its group
 /// (`groups[i]`), and the Pareto front as a staircase with its points circled.
 pub fn work_precision(
     title: &str,
@@ -204,34 +291,14 @@ pub fn work_precision(
     groups: &[Curve],
     front: &[(f64, f64)],
 ) -> Result<String, FigureError> {
-    let e = err(title);
     let xr = log_range(groups.iter().flat_map(|c| c.points.iter().map(|p| p.0)));
     let yr = log_range(groups.iter().flat_map(|c| c.points.iter().map(|p| p.1)));
-    let (Some((x0, x1)), Some((y0, y1))) = (xr, yr) else {
-        return Err(e("no positive values to plot".into()));
+    let (Some(xr), Some(yr)) = (xr, yr) else {
+        return Err(err(title)("no positive values to plot".into()));
     };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc("wall time [s]")
-            .y_desc(y_name)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .x_labels(8)
-            .y_labels(8)
-            .light_line_style(MINOR)
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
+    let (x, y) = (log_axis(xr), log_axis(yr));
+    let names = ("wall time [s]", y_name);
+    panel(title, &LOG_LOG, names, x, y, Some(12), |chart| {
         // The front: from the cheapest point, right then down to each more accurate one.
         let mut f: Vec<(f64, f64)> = front.to_vec();
         f.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -244,29 +311,17 @@ pub fn work_precision(
         }
         chart
             .draw_series(LineSeries::new(stair, BLACK.stroke_width(1)))
-            .map_err(|x| e(x.to_string()))?
+            .map_err(|x| x.to_string())?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
         for c in groups {
-            let col = color(c.color);
-            chart
-                .draw_series(c.points.iter().map(|&p| Circle::new(p, 3, col.filled())))
-                .map_err(|x| e(x.to_string()))?;
+            markers(chart, &c.points, c.group, style::color(c.group).into())?;
         }
         chart
             .draw_series(f.iter().map(|&p| Circle::new(p, 5, BLACK.stroke_width(1))))
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(180, 180, 180))
-            .label_font(("sans-serif", 12))
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
-        root.present().map_err(|x| e(x.to_string()))?;
-    }
-    Ok(svg)
+            .map_err(|x| x.to_string())
+            .map(|_| ())
+    })
 }
 
 /// At most `2 × buckets` points with the same envelope: the minimum and the maximum of each
@@ -278,18 +333,7 @@ pub fn decimate(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64)> {
     let size = points.len().div_ceil(buckets);
     let mut out = Vec::with_capacity(2 * buckets);
     for chunk in points.chunks(size) {
-        let lo = chunk
-            .iter()
-            .enumerate()
-            .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
-        let hi = chunk
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.1.total_cmp(&b.1.1))
-            .map(|(i, _)| i)
-            .unwrap_or(0);
+        let (lo, hi) = extremes(chunk);
         let (a, b) = if lo <= hi { (lo, hi) } else { (hi, lo) };
         out.push(chunk[a]);
         if b != a {
@@ -299,6 +343,75 @@ pub fn decimate(points: &[(f64, f64)], buckets: usize) -> Vec<(f64, f64)> {
     out
 }
 
+/// The indices of a chunk's first minimum and last maximum, in the order of `f64::total_cmp`
+/// (those `Iterator::min_by` and `max_by` pick).
+fn extremes(chunk: &[(f64, f64)]) -> (usize, usize) {
+    let (mut lo, mut hi) = (0, 0);
+    for (i, p) in chunk.iter().enumerate().skip(1) {
+        if p.1.total_cmp(&chunk[lo].1).is_lt() {
+            lo = i;
+        }
+        if p.1.total_cmp(&chunk[hi].1).is_ge() {
+            hi = i;
+        }
+    }
+    (lo, hi)
+}
+
+/// The linear (t, y) axes of a time-series panel holding `curves`.
+fn time_axes<'a>(
+    curves: impl Iterator<Item = &'a Curve> + Clone,
+) -> Option<((f64, f64), (f64, f64))> {
+    let all = || curves.clone().flat_map(|c| c.points.iter().copied());
+    Some((
+        lin_range(all().map(|p| p.0))?,
+        lin_range(all().map(|p| p.1))?,
+    ))
+}
+
+/// The exact solution dashed in black, labelled for the panel's legend box: dashes of about 1 % of the
+/// time range `t`, drawn as separate segments.
+fn dashed_exact<X, Y>(
+    chart: &mut Chart<'_, '_, X, Y>,
+    ex: &Curve,
+    t: (f64, f64),
+) -> Result<(), String>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    let dash = (t.1 - t.0) / 120.0;
+    let mut segments: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    let mut on_since = ex.points.first().map(|p| p.0).unwrap_or(0.0);
+    for &p in &ex.points {
+        if p.0 - on_since > 2.0 * dash {
+            on_since = p.0;
+        }
+        if p.0 - on_since <= dash {
+            cur.push(p);
+        } else if !cur.is_empty() {
+            segments.push(std::mem::take(&mut cur));
+        }
+    }
+    if !cur.is_empty() {
+        segments.push(cur);
+    }
+    let mut first = true;
+    for s in segments {
+        let drawn = chart
+            .draw_series(LineSeries::new(s, BLACK.stroke_width(2)))
+            .map_err(|x| x.to_string())?;
+        if first {
+            drawn
+                .label(ex.name.clone())
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 7, y)], BLACK.stroke_width(2)));
+            first = false;
+        }
+    }
+    Ok(())
+}
+
 /// A time-series panel: one curve per run, the exact solution (if any) dashed black.
 pub fn series(
     title: &str,
@@ -306,147 +419,56 @@ pub fn series(
     curves: &[Curve],
     exact: Option<&Curve>,
 ) -> Result<String, FigureError> {
-    let e = err(title);
-    let all = || {
-        curves
-            .iter()
-            .chain(exact)
-            .flat_map(|c| c.points.iter().copied())
+    let Some((t, y)) = time_axes(curves.iter().chain(exact)) else {
+        return Err(err(title)("no values to plot".into()));
     };
-    let (Some((x0, x1)), Some((y0, y1))) =
-        (lin_range(all().map(|p| p.0)), lin_range(all().map(|p| p.1)))
-    else {
-        return Err(e("no values to plot".into()));
-    };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (W, 300)).into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(36)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc("t")
-            .y_desc(y_name)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(MINOR)
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
-        for c in curves {
-            let col = color(c.color);
-            chart
-                .draw_series(LineSeries::new(c.points.clone(), col.stroke_width(1)))
-                .map_err(|x| e(x.to_string()))?;
-        }
-        if let Some(ex) = exact {
-            // Dashes of about 1 % of the time range: drawn as separate segments.
-            let dash = (x1 - x0) / 120.0;
-            let mut segments: Vec<Vec<(f64, f64)>> = Vec::new();
-            let mut cur: Vec<(f64, f64)> = Vec::new();
-            let mut on_since = ex.points.first().map(|p| p.0).unwrap_or(0.0);
-            for &p in &ex.points {
-                if p.0 - on_since > 2.0 * dash {
-                    on_since = p.0;
-                }
-                if p.0 - on_since <= dash {
-                    cur.push(p);
-                } else if !cur.is_empty() {
-                    segments.push(std::mem::take(&mut cur));
-                }
+    let labels = exact.map(|_| 11);
+    panel(
+        title,
+        &TIME,
+        ("t", y_name),
+        t.0..t.1,
+        y.0..y.1,
+        labels,
+        |chart| {
+            for c in curves {
+                time_curve(chart, c, style::color(c.group).stroke_width(1))?;
             }
-            if !cur.is_empty() {
-                segments.push(cur);
+            match exact {
+                Some(ex) => dashed_exact(chart, ex, t),
+                None => Ok(()),
             }
-            let mut first = true;
-            for s in segments {
-                let drawn = chart
-                    .draw_series(LineSeries::new(s, BLACK.stroke_width(2)))
-                    .map_err(|x| e(x.to_string()))?;
-                if first {
-                    drawn.label(ex.name.clone()).legend(|(x, y)| {
-                        PathElement::new(vec![(x, y), (x + 7, y)], BLACK.stroke_width(2))
-                    });
-                    first = false;
-                }
-            }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .label_font(("sans-serif", 11))
-                .draw()
-                .map_err(|x| e(x.to_string()))?;
-        }
-        root.present().map_err(|x| e(x.to_string()))?;
-    }
-    Ok(svg)
+        },
+    )
 }
 
-/// The energy-balance panel of frictional runs: per run (one colour each, as elsewhere) E thin,
-/// W_f faded and E + W_f thick, so that the three quantities of several runs stay apart without
-/// a legend per curve (the caption states the line styles).
+/// The energy-balance panel of frictional runs: per run (its group's colour and marker, as
+/// elsewhere) E thin, W_f faded and E + W_f thick, so that the three quantities of several
+/// runs stay apart without a legend per curve (the caption states the line styles).
 pub fn balance(
     title: &str,
     energy: &[Curve],
     work: &[Curve],
     total: &[Curve],
 ) -> Result<String, FigureError> {
-    let e = err(title);
-    let all = || {
-        energy
-            .iter()
-            .chain(work)
-            .chain(total)
-            .flat_map(|c| c.points.iter().copied())
+    let Some((t, y)) = time_axes(energy.iter().chain(work).chain(total)) else {
+        return Err(err(title)("no values to plot".into()));
     };
-    let (Some((x0, x1)), Some((y0, y1))) =
-        (lin_range(all().map(|p| p.0)), lin_range(all().map(|p| p.1)))
-    else {
-        return Err(e("no values to plot".into()));
-    };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (W, 300)).into_drawing_area();
-        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 16))
-            .margin(10)
-            .x_label_area_size(36)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(x.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc("t")
-            .y_desc("energy / energy_scale")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(MINOR)
-            .draw()
-            .map_err(|x| e(x.to_string()))?;
+    let names = ("t", "energy / energy_scale");
+    panel(title, &TIME, names, t.0..t.1, y.0..y.1, None, |chart| {
         for (curves, width, faded) in [(work, 1, true), (energy, 1, false), (total, 3, false)] {
             for c in curves {
-                let col = color(c.color);
+                let col = style::color(c.group);
                 let style = if faded {
                     col.mix(0.45).stroke_width(width)
                 } else {
                     col.stroke_width(width)
                 };
-                chart
-                    .draw_series(LineSeries::new(c.points.clone(), style))
-                    .map_err(|x| e(x.to_string()))?;
+                time_curve(chart, c, style)?;
             }
         }
-        root.present().map_err(|x| e(x.to_string()))?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }
 
 #[cfg(test)]
@@ -466,14 +488,80 @@ mod tests {
     }
 
     #[test]
+    fn the_extremes_are_those_min_by_and_max_by_pick() {
+        let chunk = [
+            (0.0, 1.0),
+            (1.0, -0.0),
+            (2.0, 3.0),
+            (3.0, 0.0),
+            (4.0, 3.0),
+            (5.0, -0.0),
+        ];
+        let by = |f: fn(std::slice::Iter<'_, (f64, f64)>) -> Option<&(f64, f64)>| {
+            let p = f(chunk.iter()).unwrap();
+            chunk.iter().position(|q| std::ptr::eq(q, p)).unwrap()
+        };
+        let min = by(|i| i.min_by(|a, b| a.1.total_cmp(&b.1)));
+        let max = by(|i| i.max_by(|a, b| a.1.total_cmp(&b.1)));
+        assert_eq!(extremes(&chunk), (min, max));
+        assert_eq!((min, max), (1, 4), "the first −0, the last 3");
+    }
+
+    #[test]
     fn a_convergence_figure_is_svg_with_its_curve() {
         let c = Curve {
             name: "g".into(),
             points: vec![(0.1, 0.01), (0.05, 0.0025), (0.025, 0.000625)],
-            color: 0,
+            group: 0,
         };
         let svg = convergence("t", "h", "e", &[c], &[Some((2.0, 0.0))]).unwrap();
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("<polyline") && svg.contains("2.00"), "{svg}");
+    }
+
+    /// The text of the SVG's `<text>` elements.
+    fn texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|s| {
+                Some(
+                    s.split_once('>')?
+                        .1
+                        .split_once("</text>")?
+                        .0
+                        .trim()
+                        .to_string(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn log_axes_are_labelled_at_every_decade_and_at_the_ends_within_one() {
+        // x = h over [1, 4] (the disc's h = 4, 2, 1), y = errors over [1e-6, 1e-2].
+        let c = Curve {
+            name: "g".into(),
+            points: vec![(4.0, 1e-2), (2.0, 1e-4), (1.0, 1e-6)],
+            group: 0,
+        };
+        let svg = work_precision("t", "e", &[c], &[]).unwrap();
+        let t = texts(&svg);
+        for label in ["1", "2", "4", "1e-6", "1e-5", "1e-4", "1e-3", "0.01"] {
+            assert!(t.iter().any(|x| x == label), "no tick `{label}` in {t:?}");
+        }
+    }
+
+    #[test]
+    fn a_time_series_carries_markers_along_it() {
+        let pts: Vec<(f64, f64)> = (0..1000).map(|i| (i as f64 * 1e-3, 1.0)).collect();
+        let c = Curve {
+            name: "g".into(),
+            points: pts,
+            group: 1,
+        };
+        assert_eq!(along(&c.points, 1).len(), 12);
+        let svg = series("t", "y", &[c], None).unwrap();
+        // Group 1's marker is the square: a four-point polygon.
+        assert!(svg.matches("<polygon").count() >= 12, "{svg}");
     }
 }
