@@ -90,6 +90,10 @@ pub enum SceneSetup {
     Layer1d { layer: LayerParams, elements: usize },
 }
 
+/// What [`Scene::setup_from_file`] gives for a mesh file: the mesh choice and the run's setup
+/// (a name the planner can hold without naming the scenes' setup type).
+pub type FileSetup = (MeshChoice, SceneSetup);
+
 impl SceneSetup {
     /// Lines every id of this run carries for definition changes that moved its numbers
     /// ([`FeSetup::id_revision`]); empty for the runs no change touched, whose ids stay.

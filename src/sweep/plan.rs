@@ -23,7 +23,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::contact::friction::{FrictionKind, FrictionLaw};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
-use crate::scene::{MeshChoice, Physics, Scene, SceneKind, SceneSetup};
+use crate::scene::{FileSetup, MeshChoice, Physics, Scene, SceneKind};
 use crate::space::step_solver::Solver;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{
@@ -840,7 +840,7 @@ fn read_mesh_file(
     given: &Given,
     physics: &mut Physics,
     issues: &mut Vec<Issue>,
-) -> (Option<MeshFile>, Option<(MeshChoice, SceneSetup)>) {
+) -> (Option<MeshFile>, Option<FileSetup>) {
     let scene = given.scene;
     let mut mesh_file: Option<MeshFile> = None;
     let mut file_setup = None;
