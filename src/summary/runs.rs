@@ -719,7 +719,24 @@ impl RunColumns {
         let get_i = |name: &str| -> anyhow::Result<Vec<Option<i64>>> {
             Ok(i64s(df, name)?.unwrap_or_else(|| vec![None; n]))
         };
-        let (params, param_values) = param_columns(df)?;
+        let params: Vec<(&'static str, Kind)> = PARAMS
+            .iter()
+            .filter(|(name, _)| df.column(name).is_ok())
+            .copied()
+            .collect();
+        let mut param_values: Vec<Vec<Cell>> = Vec::with_capacity(params.len());
+        for (name, kind) in &params {
+            let v: Vec<Cell> = match kind {
+                Kind::F64 => get_f(name)?.into_iter().map(Cell::F64).collect(),
+                Kind::I64 => get_i(name)?.into_iter().map(Cell::I64).collect(),
+                _ => strs(df, name)?
+                    .unwrap_or_else(|| vec![None; n])
+                    .into_iter()
+                    .map(Cell::Str)
+                    .collect(),
+            };
+            param_values.push(v);
+        }
         let mut errors: Vec<&'static str> = Vec::new();
         let mut error_values: Vec<Vec<Option<f64>>> = Vec::new();
         for e in ERRORS {
@@ -899,39 +916,6 @@ impl RunColumns {
             }
         })
     }
-}
-
-/// The parameter columns `df` has, in [`PARAMS`] order, and their values (aligned).
-#[allow(clippy::type_complexity)]
-fn param_columns(df: &DataFrame) -> anyhow::Result<(Vec<(&'static str, Kind)>, Vec<Vec<Cell>>)> {
-    let n = df.height();
-    let params: Vec<(&'static str, Kind)> = PARAMS
-        .iter()
-        .filter(|(name, _)| df.column(name).is_ok())
-        .copied()
-        .collect();
-    let mut param_values: Vec<Vec<Cell>> = Vec::with_capacity(params.len());
-    for (name, kind) in &params {
-        let v: Vec<Cell> = match kind {
-            Kind::F64 => f64s(df, name)?
-                .unwrap_or_else(|| vec![None; n])
-                .into_iter()
-                .map(Cell::F64)
-                .collect(),
-            Kind::I64 => i64s(df, name)?
-                .unwrap_or_else(|| vec![None; n])
-                .into_iter()
-                .map(Cell::I64)
-                .collect(),
-            _ => strs(df, name)?
-                .unwrap_or_else(|| vec![None; n])
-                .into_iter()
-                .map(Cell::Str)
-                .collect(),
-        };
-        param_values.push(v);
-    }
-    Ok((params, param_values))
 }
 
 /// Group the runs and find the refinement paths of every group.
