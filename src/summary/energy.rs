@@ -47,8 +47,9 @@
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt::Write as _;
 
+use super::columns::columns;
 use super::runs::{Run, Runs};
-use super::table::{self, Table, TextTable, columns, text_columns};
+use super::table::{self, Table, TextTable, text_columns};
 
 /// A one-step increase of a provably non-increasing functional above this fraction of its
 /// initial value is growth. SPEC §6: the schemes that provably do not gain energy stay below
@@ -467,10 +468,39 @@ fn range(lo: Option<f64>, hi: Option<f64>) -> String {
 
 /// Build the energy section.
 pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Section> {
+    let series = series_of_older_rows(dir, runs)?;
+    let found = impacts_table(runs, &series);
+    let classes: Vec<EnergyClass> = runs.runs.iter().map(|r| classify(runs, r)).collect();
+    let per_run = per_run_table(runs, &classes, &found.run_impacts);
+    let per_group = per_group_table(runs, &classes);
+    let status = series.as_ref().map(|_| ()).map_err(String::as_str);
+    let md = markdown(runs, status, &found, per_group.rows, per_run.rows);
+    let terminal = terminal(
+        runs,
+        status,
+        &found,
+        &per_run.counts,
+        &per_group.class_lines,
+    );
+    Ok(Section {
+        runs: per_run.table,
+        groups: per_group.table,
+        impacts: found.table,
+        markdown: md,
+        terminal,
+    })
+}
+
+/// The series of the rows without online phases (rows of older versions), keyed by run_id;
+/// `Err(reason)` when none could be found and no run has online phases.
+fn series_of_older_rows(
+    dir: &std::path::Path,
+    runs: &Runs,
+) -> anyhow::Result<Result<HashMap<String, Series>, String>> {
     // Runs of a version without the online phases fall back to their series.
     let need: Vec<&Run> = runs.runs.iter().filter(|r| !r.impacts_stored).collect();
     let online = runs.runs.len() - need.len();
-    let series = if need.is_empty() {
+    Ok(if need.is_empty() {
         Ok(HashMap::new())
     } else {
         match read_series(dir, &need)? {
@@ -479,7 +509,131 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             Err(_) if online > 0 => Ok(HashMap::new()),
             other => other,
         }
+    })
+}
+
+/// The impacts table and what the other tables say of it.
+struct Impacts {
+    table: Table,
+    /// Per run: (number of impacts, total relative loss over complete phases, series
+    /// decimated, series stride); None for a run without phases.
+    run_impacts: Vec<Option<(usize, f64, bool, i64)>>,
+    /// Contact phases over every run.
+    impact_count: usize,
+    /// Runs with phases (online or from their series).
+    runs_with_series: usize,
+    /// Runs whose phases come from a decimated series.
+    decimated_runs: usize,
+}
+
+/// One row per contact phase of every run.
+fn impacts_table(runs: &Runs, series: &Result<HashMap<String, Series>, String>) -> Impacts {
+    // One row per contact phase: tens of thousands of rows on a large sweep, so the run's
+    // parameters are not repeated on each (25 columns, half of impacts.csv's 7.9 MB and of its
+    // encoding time on issue 12's sweep); they are one join away, on `run_id`, in the energy
+    // table or `runs/`.
+    let mut out = Impacts {
+        table: Table::new(&table::owned(&columns![
+            group: I64, group_title: Str, run_id: Str, label: Str, status: Str, h: F64, dt: F64,
+            impact: I64, step_first: I64, step_last: I64, t_first: F64, t_last: F64,
+            step_before: I64, step_after: I64, energy_e0: F64, energy_before: F64,
+            energy_after: F64, energy_loss_rel: F64, energy_theta_before: F64,
+            energy_theta_after: F64, energy_theta_loss_rel: F64, phase_complete: Bool,
+            series_decimated: Bool, series_stride: I64,
+        ])),
+        run_impacts: vec![None; runs.runs.len()],
+        impact_count: 0,
+        runs_with_series: 0,
+        decimated_runs: 0,
     };
+    for (ri, r) in runs.runs.iter().enumerate() {
+        let Some(found) = phases_of(r, series) else {
+            continue;
+        };
+        out.runs_with_series += 1;
+        let decimated = found.stride > 1;
+        out.decimated_runs += decimated as usize;
+        let mut total = 0.0;
+        for (k, ph) in found.list.iter().enumerate() {
+            if let Some(l) = impact_row(&mut out.table, runs, r, k, ph, &found) {
+                total += l;
+            }
+        }
+        out.impact_count += found.list.len();
+        out.run_impacts[ri] = Some((found.list.len(), total, decimated, found.stride));
+    }
+    out
+}
+
+/// The impacts table's row of phase `k` of run `r`; returns its relative loss (None when an
+/// energy or E⁰ is missing).
+fn impact_row(
+    impacts: &mut Table,
+    runs: &Runs,
+    r: &Run,
+    k: usize,
+    ph: &PhaseRow,
+    found: &RunPhases,
+) -> Option<f64> {
+    let (stride, e0, e0_theta) = (found.stride, found.e0, found.e0_theta);
+    let decimated = stride > 1;
+    let complete = ph.step_before.is_some() && ph.step_after.is_some();
+    let (eb, ea) = (ph.energy_before, ph.energy_after);
+    let loss = match (eb, ea, e0) {
+        (Some(b), Some(a), Some(e0)) => Some((b - a) / e0),
+        _ => None,
+    };
+    let (tb, ta) = (ph.theta_before, ph.theta_after);
+    let tloss = match (tb, ta, e0_theta) {
+        (Some(b), Some(a), Some(e0)) if e0 != 0.0 => Some((b - a) / e0),
+        _ => None,
+    };
+    impacts.run_group(runs, r);
+    impacts.run_identity(r);
+    impacts.f64("h", r.h);
+    impacts.f64("dt", r.dt);
+    impacts.i64("impact", Some(k as i64 + 1));
+    impacts.i64("step_first", Some(ph.step_first));
+    impacts.i64("step_last", Some(ph.step_last));
+    impacts.f64("t_first", ph.t_first);
+    impacts.f64("t_last", ph.t_last);
+    impacts.i64("step_before", ph.step_before);
+    impacts.i64("step_after", ph.step_after);
+    // The energy across the phase: E^h, and E_Θ where the scheme has it.
+    let energies = [
+        ("energy_e0", e0),
+        ("energy_before", eb),
+        ("energy_after", ea),
+    ];
+    let theta = [("energy_theta_before", tb), ("energy_theta_after", ta)];
+    for (name, v) in energies {
+        impacts.f64(name, v);
+    }
+    impacts.f64("energy_loss_rel", loss);
+    for (name, v) in theta {
+        impacts.f64(name, v);
+    }
+    impacts.f64("energy_theta_loss_rel", tloss);
+    impacts.bool("phase_complete", Some(complete));
+    impacts.bool("series_decimated", Some(decimated));
+    impacts.i64("series_stride", Some(stride));
+    impacts.end_row();
+    loss
+}
+
+/// The per-run energy table, its Markdown rows and the number of runs of each class.
+struct PerRun<'a> {
+    table: Table,
+    rows: Vec<Vec<String>>,
+    counts: BTreeMap<&'a str, usize>,
+}
+
+/// One row per run: its energies, its class and its impacts.
+fn per_run_table<'a>(
+    runs: &Runs,
+    classes: &'a [EnergyClass],
+    run_impacts: &[Option<(usize, f64, bool, i64)>],
+) -> PerRun<'a> {
     let mut per_run = Table::new(&table::with_params(
         &columns![
             group: I64, group_title: Str, run_id: Str, label: Str, status: Str, search: Str,
@@ -493,92 +647,8 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         ],
         runs,
     ));
-    // One row per contact phase: tens of thousands of rows on a large sweep, so the run's
-    // parameters are not repeated on each (25 columns, half of impacts.csv's 7.9 MB and of its
-    // encoding time on issue 12's sweep); they are one join away, on `run_id`, in the energy
-    // table or `runs/`.
-    let mut impacts = Table::new(&table::owned(&columns![
-        group: I64, group_title: Str, run_id: Str, label: Str, status: Str, h: F64, dt: F64,
-        impact: I64, step_first: I64, step_last: I64, t_first: F64, t_last: F64, step_before: I64,
-        step_after: I64, energy_e0: F64, energy_before: F64, energy_after: F64,
-        energy_loss_rel: F64, energy_theta_before: F64, energy_theta_after: F64,
-        energy_theta_loss_rel: F64, phase_complete: Bool, series_decimated: Bool,
-        series_stride: I64,
-    ]));
-
     let mut run_rows_md: Vec<Vec<String>> = Vec::new();
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
-    let mut decimated_runs = 0usize;
-    let mut impact_count = 0usize;
-    let mut runs_with_series = 0usize;
-    // Per run: (number of impacts, total relative loss over complete phases).
-    let mut run_impacts: Vec<Option<(usize, f64, bool, i64)>> = vec![None; runs.runs.len()];
-
-    for (ri, r) in runs.runs.iter().enumerate() {
-        let Some(found) = phases_of(r, &series) else {
-            continue;
-        };
-        let RunPhases {
-            list,
-            stride,
-            e0,
-            e0_theta,
-        } = found;
-        runs_with_series += 1;
-        let decimated = stride > 1;
-        decimated_runs += decimated as usize;
-        let mut total = 0.0;
-        for (k, ph) in list.iter().enumerate() {
-            let complete = ph.step_before.is_some() && ph.step_after.is_some();
-            let (eb, ea) = (ph.energy_before, ph.energy_after);
-            let loss = match (eb, ea, e0) {
-                (Some(b), Some(a), Some(e0)) => Some((b - a) / e0),
-                _ => None,
-            };
-            if let Some(l) = loss {
-                total += l;
-            }
-            let (tb, ta) = (ph.theta_before, ph.theta_after);
-            let tloss = match (tb, ta, e0_theta) {
-                (Some(b), Some(a), Some(e0)) if e0 != 0.0 => Some((b - a) / e0),
-                _ => None,
-            };
-            impacts.run_group(runs, r);
-            impacts.run_identity(r);
-            impacts.f64("h", r.h);
-            impacts.f64("dt", r.dt);
-            impacts.i64("impact", Some(k as i64 + 1));
-            impacts.i64("step_first", Some(ph.step_first));
-            impacts.i64("step_last", Some(ph.step_last));
-            impacts.f64("t_first", ph.t_first);
-            impacts.f64("t_last", ph.t_last);
-            impacts.i64("step_before", ph.step_before);
-            impacts.i64("step_after", ph.step_after);
-            // The energy across the phase: E^h, and E_Θ where the scheme has it.
-            let energies = [
-                ("energy_e0", e0),
-                ("energy_before", eb),
-                ("energy_after", ea),
-            ];
-            let theta = [("energy_theta_before", tb), ("energy_theta_after", ta)];
-            for (name, v) in energies {
-                impacts.f64(name, v);
-            }
-            impacts.f64("energy_loss_rel", loss);
-            for (name, v) in theta {
-                impacts.f64(name, v);
-            }
-            impacts.f64("energy_theta_loss_rel", tloss);
-            impacts.bool("phase_complete", Some(complete));
-            impacts.bool("series_decimated", Some(decimated));
-            impacts.i64("series_stride", Some(stride));
-            impacts.end_row();
-        }
-        impact_count += list.len();
-        run_impacts[ri] = Some((list.len(), total, decimated, stride));
-    }
-
-    let classes: Vec<EnergyClass> = runs.runs.iter().map(|r| classify(runs, r)).collect();
     for (ri, r) in runs.runs.iter().enumerate() {
         let c = &classes[ri];
         let b = c.class.as_deref();
@@ -633,9 +703,23 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             .unwrap_or_default(),
         ]);
     }
+    PerRun {
+        table: per_run,
+        rows: run_rows_md,
+        counts,
+    }
+}
 
-    // Per group, across refinement: ranges over the ok runs (a diverged run's energy is
-    // where it stopped, not a property of the method).
+/// The per-group energy table, its Markdown rows and the terminal's line per group.
+struct PerGroup {
+    table: Table,
+    rows: Vec<Vec<String>>,
+    class_lines: Vec<String>,
+}
+
+/// One row per group, across refinement: ranges over the ok runs (a diverged run's energy is
+/// where it stopped, not a property of the method) and the count of each class.
+fn per_group_table(runs: &Runs, classes: &[EnergyClass]) -> PerGroup {
     let mut groups = Table::new(&table::with_params(
         &columns![
             group: I64, group_title: Str, label: Str, runs: I64, ok_runs: I64,
@@ -708,7 +792,27 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         ]);
         class_lines.push(format!("  {:<60} {summary}", g.title));
     }
+    PerGroup {
+        table: groups,
+        rows: group_rows_md,
+        class_lines,
+    }
+}
 
+/// `energy.md`: what the columns and classes mean, the per-group table, then the per-run one.
+/// `series` is `Err(reason)` when the impacts could not be computed.
+fn markdown(
+    runs: &Runs,
+    series: Result<(), &str>,
+    found: &Impacts,
+    group_rows_md: Vec<Vec<String>>,
+    run_rows_md: Vec<Vec<String>>,
+) -> String {
+    let (impact_count, runs_with_series, decimated_runs) = (
+        found.impact_count,
+        found.runs_with_series,
+        found.decimated_runs,
+    );
     let mut md = String::from("# Energy\n\n");
     let _ = writeln!(
         md,
@@ -742,7 +846,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     ]);
     md.push_str(&per_group.with_rows(group_rows_md).markdown());
     md.push_str("\n## Per run\n\n");
-    match &series {
+    match series {
         Ok(_) => {
             let _ = writeln!(
                 md,
@@ -773,7 +877,24 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
         "impact loss" => Right, "decimated" => Left,
     ]);
     md.push_str(&run_text.with_rows(run_rows_md).markdown());
+    md
+}
 
+/// The terminal's lines: the count of each class, one line per group, the largest one-step
+/// gain and the impacts found. `series` is `Err(reason)` when the impacts could not be
+/// computed.
+fn terminal(
+    runs: &Runs,
+    series: Result<(), &str>,
+    found: &Impacts,
+    counts: &BTreeMap<&str, usize>,
+    class_lines: &[String],
+) -> String {
+    let (impact_count, runs_with_series, decimated_runs) = (
+        found.impact_count,
+        found.runs_with_series,
+        found.decimated_runs,
+    );
     let mut terminal = format!(
         "energy classes (scheme's functional, δ = max(1, ν)·h/L): {} runs —",
         runs.runs.len()
@@ -781,7 +902,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
     let parts: Vec<String> = counts.iter().map(|(k, v)| format!(" {v} {k}")).collect();
     terminal.push_str(&parts.join(","));
     terminal.push('\n');
-    for l in &class_lines {
+    for l in class_lines {
         terminal.push_str(l.trim_end());
         terminal.push('\n');
     }
@@ -806,7 +927,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             table::eng_opt(worst.dt)
         );
     }
-    match &series {
+    match series {
         Ok(_) => {
             let _ = writeln!(
                 terminal,
@@ -822,13 +943,7 @@ pub(crate) fn section(dir: &std::path::Path, runs: &Runs) -> anyhow::Result<Sect
             let _ = writeln!(terminal, "  impacts: not computed ({why})");
         }
     }
-    Ok(Section {
-        runs: per_run,
-        groups,
-        impacts,
-        markdown: md,
-        terminal,
-    })
+    terminal
 }
 
 /// "10 conservative, 2 growing" in the order of [`CLASSES`], then the other statuses.

@@ -30,8 +30,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use super::columns::{Kind, columns};
 use super::runs::{Cell, Run, Runs, float_key};
-use super::table::{self, Kind, Table, TextTable, columns, text_columns};
+use super::table::{self, Table, TextTable, text_columns};
 
 /// The relative spread above which an ensemble is sensitive, for perturbations of relative
 /// size `eps` (see the module header).
@@ -114,6 +115,25 @@ pub(crate) struct Section {
 /// Build the ensemble section (empty tables when the folder holds no ensemble).
 pub(crate) fn section(runs: &Runs) -> Section {
     let energy = energy_metrics();
+    let mut t = Table::new(&ensemble_columns(runs, &energy));
+    let mut out = Vec::new();
+    let mut md_rows: Vec<Vec<String>> = Vec::new();
+    for ((g, _, _), members) in ensembles(runs) {
+        let (verdict, row) = ensemble_row(&mut t, runs, &energy, g, &members);
+        md_rows.push(row);
+        out.push(verdict);
+    }
+    let (markdown, terminal) = texts(&out, md_rows);
+    Section {
+        table: t,
+        markdown,
+        terminal,
+    }
+}
+
+/// The ensemble table's columns: its own, min/median/max/spread of every energy metric and
+/// error column, then the parameters.
+fn ensemble_columns(runs: &Runs, energy: &[Metric]) -> Vec<(String, Kind)> {
     let mut columns: Vec<(String, Kind)> = table::owned(&columns![
         group: I64, group_title: Str, label: Str, h: F64, dt: F64, courant: F64,
         perturbation: F64, members: I64, ok_members: I64, statuses: Str, tolerance: F64,
@@ -130,9 +150,12 @@ pub(crate) fn section(runs: &Runs) -> Section {
         }
     }
     columns.extend(runs.param_columns());
-    let mut t = Table::new(&columns);
+    columns
+}
 
-    // Members: same group (every parameter but the sample index) and same level.
+/// The ensembles of the folder: members of the same group (every parameter but the sample
+/// index) and the same level, keyed by (group, h, dt).
+fn ensembles(runs: &Runs) -> BTreeMap<(usize, String, String), Vec<usize>> {
     let mut by_key: BTreeMap<(usize, String, String), Vec<usize>> = BTreeMap::new();
     for (i, r) in runs.runs.iter().enumerate() {
         if r.ensemble_sample.is_none() {
@@ -144,115 +167,129 @@ pub(crate) fn section(runs: &Runs) -> Section {
             .or_default()
             .push(i);
     }
-    let mut out = Vec::new();
-    let mut md_rows: Vec<Vec<String>> = Vec::new();
-    for ((g, _, _), members) in by_key {
-        let rs: Vec<&Run> = members.iter().map(|&i| &runs.runs[i]).collect();
-        let ok: Vec<&Run> = rs.iter().copied().filter(|r| r.ok()).collect();
-        let first = rs[0];
-        let eps = first
-            .params
-            .iter()
-            .zip(&runs.params)
-            .find(|(_, (n, _))| *n == "ensemble_perturbation")
-            .and_then(|(c, _)| match c {
-                Cell::F64(x) => *x,
-                _ => None,
-            })
-            .unwrap_or(0.0);
-        let tol = sensitive_tol(eps);
-        let mut statuses: BTreeMap<&str, usize> = BTreeMap::new();
-        for r in &rs {
-            *statuses.entry(r.status.as_str()).or_default() += 1;
-        }
-        let status_text = statuses
-            .iter()
-            .map(|(s, n)| format!("{n} {s}"))
-            .collect::<Vec<_>>()
-            .join(", ");
-        let mut reasons = Vec::new();
-        if statuses.len() > 1 {
-            reasons.push(format!("statuses differ ({status_text})"));
-        }
-        t.i64("group", Some(g as i64 + 1));
-        t.str("group_title", Some(&runs.groups[g].title));
-        t.str("label", Some(&first.label));
-        t.f64("h", first.h);
-        t.f64("dt", first.dt);
-        t.f64("courant", first.courant);
-        t.f64("perturbation", Some(eps));
-        t.i64("members", Some(rs.len() as i64));
-        t.i64("ok_members", Some(ok.len() as i64));
-        t.str("statuses", Some(&status_text));
-        t.f64("tolerance", Some(tol));
-        let mut ratio = None;
-        let mut shown: Vec<String> = Vec::new();
-        let mut record = |t: &mut Table, name: &str, vals: Vec<f64>, flags: bool| {
-            let st = stats(vals);
-            let spread = st.map(rel_spread);
-            if let Some((lo, med, hi)) = st {
-                t.f64(&format!("{name}_min"), Some(lo));
-                t.f64(&format!("{name}_median"), Some(med));
-                t.f64(&format!("{name}_max"), Some(hi));
-            } else {
-                t.f64(&format!("{name}_min"), None);
-                t.f64(&format!("{name}_median"), None);
-                t.f64(&format!("{name}_max"), None);
-            }
-            t.f64(&format!("{name}_spread"), spread.filter(|s| s.is_finite()));
-            if flags && spread.is_some_and(|s| s > tol) {
-                reasons.push(format!("{name} spread {}", table::sci(spread)));
-            }
-            st
-        };
-        for m in &energy {
-            let st = record(
-                &mut t,
-                m.name,
-                ok.iter().filter_map(|r| (m.get)(r)).collect(),
-                m.flags,
-            );
-            if m.name == "energy_ratio" {
-                ratio = st;
-            }
-        }
-        for (j, e) in runs.errors.iter().enumerate() {
-            let st = record(
-                &mut t,
-                e,
-                ok.iter().filter_map(|r| r.errors[j]).collect(),
-                true,
-            );
-            if *e == "err_u_l2h1" {
-                shown.push(spread_text(st));
-            }
-        }
-        let sensitive = !reasons.is_empty();
-        t.bool("sensitive", Some(sensitive));
-        t.str("sensitive_columns", Some(&reasons.join("; ")));
-        for ((n, _), c) in runs.params.iter().zip(&first.params) {
-            if *n != "ensemble_sample" {
-                t.cell(n, c);
-            }
-        }
-        t.end_row();
-        md_rows.push(vec![
-            (g + 1).to_string(),
-            runs.groups[g].title.clone(),
-            table::sci(first.h),
-            table::sci(first.dt),
-            format!("{}/{}", ok.len(), rs.len()),
-            spread_text(ratio),
-            ratio
-                .map(|r| table::sci(Some(rel_spread(r))))
-                .unwrap_or_default(),
-            shown.pop().unwrap_or_default(),
-            if sensitive { "**sensitive**" } else { "no" }.to_string(),
-            reasons.join("; "),
-        ]);
-        out.push(Ensemble { sensitive, reasons });
-    }
+    by_key
+}
 
+/// One ensemble's row of the table (group `g`, runs `members`); returns its verdict and its
+/// Markdown row.
+fn ensemble_row(
+    t: &mut Table,
+    runs: &Runs,
+    energy: &[Metric],
+    g: usize,
+    members: &[usize],
+) -> (Ensemble, Vec<String>) {
+    let rs: Vec<&Run> = members.iter().map(|&i| &runs.runs[i]).collect();
+    let ok: Vec<&Run> = rs.iter().copied().filter(|r| r.ok()).collect();
+    let first = rs[0];
+    let eps = first
+        .params
+        .iter()
+        .zip(&runs.params)
+        .find(|(_, (n, _))| *n == "ensemble_perturbation")
+        .and_then(|(c, _)| match c {
+            Cell::F64(x) => *x,
+            _ => None,
+        })
+        .unwrap_or(0.0);
+    let tol = sensitive_tol(eps);
+    let mut statuses: BTreeMap<&str, usize> = BTreeMap::new();
+    for r in &rs {
+        *statuses.entry(r.status.as_str()).or_default() += 1;
+    }
+    let status_text = statuses
+        .iter()
+        .map(|(s, n)| format!("{n} {s}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut reasons = Vec::new();
+    if statuses.len() > 1 {
+        reasons.push(format!("statuses differ ({status_text})"));
+    }
+    t.i64("group", Some(g as i64 + 1));
+    t.str("group_title", Some(&runs.groups[g].title));
+    t.str("label", Some(&first.label));
+    t.f64("h", first.h);
+    t.f64("dt", first.dt);
+    t.f64("courant", first.courant);
+    t.f64("perturbation", Some(eps));
+    t.i64("members", Some(rs.len() as i64));
+    t.i64("ok_members", Some(ok.len() as i64));
+    t.str("statuses", Some(&status_text));
+    t.f64("tolerance", Some(tol));
+    let mut ratio = None;
+    let mut shown: Vec<String> = Vec::new();
+    for m in energy {
+        let vals = ok.iter().filter_map(|r| (m.get)(r)).collect();
+        let st = record(t, m.name, vals, m.flags, tol, &mut reasons);
+        if m.name == "energy_ratio" {
+            ratio = st;
+        }
+    }
+    for (j, e) in runs.errors.iter().enumerate() {
+        let vals = ok.iter().filter_map(|r| r.errors[j]).collect();
+        let st = record(t, e, vals, true, tol, &mut reasons);
+        if *e == "err_u_l2h1" {
+            shown.push(spread_text(st));
+        }
+    }
+    let sensitive = !reasons.is_empty();
+    t.bool("sensitive", Some(sensitive));
+    t.str("sensitive_columns", Some(&reasons.join("; ")));
+    for ((n, _), c) in runs.params.iter().zip(&first.params) {
+        if *n != "ensemble_sample" {
+            t.cell(n, c);
+        }
+    }
+    t.end_row();
+    let row = vec![
+        (g + 1).to_string(),
+        runs.groups[g].title.clone(),
+        table::sci(first.h),
+        table::sci(first.dt),
+        format!("{}/{}", ok.len(), rs.len()),
+        spread_text(ratio),
+        ratio
+            .map(|r| table::sci(Some(rel_spread(r))))
+            .unwrap_or_default(),
+        shown.pop().unwrap_or_default(),
+        if sensitive { "**sensitive**" } else { "no" }.to_string(),
+        reasons.join("; "),
+    ];
+    (Ensemble { sensitive, reasons }, row)
+}
+
+/// One column's min, median, max and spread over the ok members, into the current row of
+/// `t`; a spread above `tol` of a flagging column (`flags`) adds a reason. Returns the stats.
+fn record(
+    t: &mut Table,
+    name: &str,
+    vals: Vec<f64>,
+    flags: bool,
+    tol: f64,
+    reasons: &mut Vec<String>,
+) -> Option<(f64, f64, f64)> {
+    let st = stats(vals);
+    let spread = st.map(rel_spread);
+    if let Some((lo, med, hi)) = st {
+        t.f64(&format!("{name}_min"), Some(lo));
+        t.f64(&format!("{name}_median"), Some(med));
+        t.f64(&format!("{name}_max"), Some(hi));
+    } else {
+        t.f64(&format!("{name}_min"), None);
+        t.f64(&format!("{name}_median"), None);
+        t.f64(&format!("{name}_max"), None);
+    }
+    t.f64(&format!("{name}_spread"), spread.filter(|s| s.is_finite()));
+    if flags && spread.is_some_and(|s| s > tol) {
+        reasons.push(format!("{name} spread {}", table::sci(spread)));
+    }
+    st
+}
+
+/// `ensemble.md` and the terminal's lines from the verdicts and Markdown rows of the
+/// ensembles.
+fn texts(out: &[Ensemble], md_rows: Vec<Vec<String>>) -> (String, String) {
     let mut md = String::from("# Round-off ensembles\n\n");
     let mut terminal = String::new();
     if out.is_empty() {
@@ -281,7 +318,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
             n_sens,
             out.len()
         );
-        for (row, e) in text.rows().iter().zip(&out) {
+        for (row, e) in text.rows().iter().zip(out) {
             let _ = writeln!(
                 terminal,
                 "  {:<9} {} (h = {}, dt = {}): E(T)/E⁰ {}{}",
@@ -298,11 +335,7 @@ pub(crate) fn section(runs: &Runs) -> Section {
             );
         }
     }
-    Section {
-        table: t,
-        markdown: md,
-        terminal,
-    }
+    (md, terminal)
 }
 
 fn spread_text(st: Option<(f64, f64, f64)>) -> String {

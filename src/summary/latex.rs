@@ -32,10 +32,10 @@
 
 use std::fmt::Write as _;
 
-use super::convergence::{Fit, LevelMarks, PRE_ASYMPTOTIC_SPREAD, STAGNATION_SLOPE};
-use super::options::SummaryOptions;
+use super::rates::{Fit, LevelMarks, PRE_ASYMPTOTIC_SPREAD, STAGNATION_SLOPE};
 use super::runs::{Fixed, RefPath, Runs};
 use super::table;
+use crate::model::SummaryOptions;
 
 /// The LaTeX tables' marks: an excluded level's value in parentheses alone (the caption says
 /// why), a rate against a level further back with a dagger.

@@ -17,10 +17,11 @@
 //!
 //! Written as `methods.{parquet,csv,md,tex}`; the legend states the thresholds.
 
-use super::convergence::lsq_slope;
+use super::columns::{Kind, columns};
 use super::energy::{FRICTION_ACCOUNTED, classify, frictional};
+use super::rates::lsq_slope;
 use super::runs::{Fixed, Runs};
-use super::table::{self, Kind, Table, TextTable, columns, text_columns};
+use super::table::{self, Table, TextTable, text_columns};
 
 /// Largest `pressure_oscillation` read as a smooth pressure.
 pub const SMOOTH_PRESSURE: f64 = 5.0;

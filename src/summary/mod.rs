@@ -61,6 +61,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 
+mod columns;
 pub mod convergence;
 pub mod energy;
 pub mod ensemble;
@@ -69,6 +70,7 @@ pub mod methods;
 /// The column choice of the text tables: plain data, one layer down ([`crate::model`]) so the
 /// planner can parse it without importing the summaries.
 pub use crate::model::summary_options as options;
+mod rates;
 pub(crate) mod runs;
 mod search;
 pub mod stability;

@@ -12,7 +12,7 @@ use std::path::Path;
 use anyhow::{Context as _, bail};
 use polars::prelude::*;
 
-use super::table::{Kind, columns};
+use super::columns::{Kind, columns};
 
 /// Parameter columns (SPEC §7, §8) that identify a method group, in output order. The
 /// refinement axes ([`REFINEMENT`]) and the derived `label` are not among them: `label` is a
@@ -580,6 +580,44 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             dir.display()
         );
     }
+    let (df, ignored) = read_runs_frame(dir)?;
+    let n = df.height();
+    let cols = RunColumns::read(&df)?;
+    let mut seen: HashSet<String> = HashSet::new();
+    let mut duplicates = 0;
+    let mut runs = Vec::with_capacity(n);
+    for i in 0..n {
+        // A run without an id (another version) still counts; it gets its row number.
+        let id = cols
+            .run_id
+            .as_ref()
+            .and_then(|v| v[i].clone())
+            .unwrap_or_else(|| format!("row-{i}"));
+        if !seen.insert(id.clone()) {
+            // The same run committed twice (two shards, a re-run): same id, same parameters.
+            duplicates += 1;
+            continue;
+        }
+        runs.push(cols.run(i, id));
+    }
+    let mut out = Runs {
+        params: cols.params,
+        errors: cols.errors,
+        runs,
+        groups: Vec::new(),
+        paths: Vec::new(),
+        ignored,
+        duplicates,
+        status_assumed: cols.status_assumed,
+    };
+    group(&mut out);
+    Ok(out)
+}
+
+/// The committed parts of `DIR/runs` as one frame of the known columns and the impact lists,
+/// and the stored columns neither this version's schema nor the summary knows. Errors: no
+/// committed part.
+fn read_runs_frame(dir: &Path) -> anyhow::Result<(DataFrame, Vec<String>)> {
     let known: Vec<(&'static str, Kind)> = MEASURED
         .iter()
         .chain(PARAMS)
@@ -612,111 +650,244 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
             dir.join("runs").display()
         );
     }
-    let n = df.height();
+    Ok((df, ignored))
+}
 
-    let run_id = strs(&df, "run_id")?;
-    let label = strs(&df, "label")?;
-    let status = strs(&df, "status")?;
-    let status_assumed = status.is_none();
-    let message = strs(&df, "message")?;
-    let get_f = |name: &str| -> anyhow::Result<Vec<Option<f64>>> {
-        Ok(f64s(&df, name)?.unwrap_or_else(|| vec![None; n]))
-    };
-    let get_i = |name: &str| -> anyhow::Result<Vec<Option<i64>>> {
-        Ok(i64s(&df, name)?.unwrap_or_else(|| vec![None; n]))
-    };
+/// A finite value (NaN and ±∞ read as missing).
+fn finite(x: Option<f64>) -> Option<f64> {
+    x.filter(|x| x.is_finite())
+}
 
-    let params: Vec<(&'static str, Kind)> = PARAMS
-        .iter()
-        .filter(|(name, _)| df.column(name).is_ok())
-        .copied()
-        .collect();
-    let mut param_values: Vec<Vec<Cell>> = Vec::with_capacity(params.len());
-    for (name, kind) in &params {
-        let v: Vec<Cell> = match kind {
-            Kind::F64 => get_f(name)?.into_iter().map(Cell::F64).collect(),
-            Kind::I64 => get_i(name)?.into_iter().map(Cell::I64).collect(),
-            _ => strs(&df, name)?
-                .unwrap_or_else(|| vec![None; n])
-                .into_iter()
-                .map(Cell::Str)
-                .collect(),
+/// The columns of the runs frame the summary reads, one value per row (a column the folder
+/// lacks: None in every row; a text column: None as a whole).
+struct RunColumns {
+    run_id: Option<Vec<Option<String>>>,
+    label: Option<Vec<Option<String>>>,
+    status: Option<Vec<Option<String>>>,
+    status_assumed: bool,
+    message: Option<Vec<Option<String>>>,
+    /// The parameter columns present, and their values (aligned).
+    params: Vec<(&'static str, Kind)>,
+    param_values: Vec<Vec<Cell>>,
+    /// The error columns with a value, and their values (aligned).
+    errors: Vec<&'static str>,
+    error_values: Vec<Vec<Option<f64>>>,
+    h: Vec<Option<f64>>,
+    elements: Vec<Option<i64>>,
+    dt: Vec<Option<f64>>,
+    courant: Vec<Option<f64>>,
+    wt: Vec<Option<f64>>,
+    wt_min: Vec<Option<f64>>,
+    wt_max: Vec<Option<f64>>,
+    repeats: Vec<Option<i64>>,
+    steps: Vec<Option<i64>>,
+    dofs: Vec<Option<i64>>,
+    theta_drift: Vec<Option<f64>>,
+    theta_initial: Vec<Option<f64>>,
+    length_scale: Vec<Option<f64>>,
+    energy_scale: Vec<Option<f64>>,
+    max_pen: Vec<Option<f64>>,
+    press_osc: Vec<Option<f64>>,
+    w_f: Vec<Option<f64>>,
+    balance_drift: Vec<Option<f64>>,
+    balance_inc: Vec<Option<f64>>,
+    sample: Vec<Option<i64>>,
+    search: Option<Vec<Option<String>>>,
+    e_init: Vec<Option<f64>>,
+    e_fin: Vec<Option<f64>>,
+    drift: Vec<Option<f64>>,
+    max_dev: Vec<Option<f64>>,
+    max_inc: Vec<Option<f64>>,
+    theta_inc: Vec<Option<f64>>,
+    part: Option<Vec<Option<String>>>,
+    impacts: Option<Vec<Option<Vec<crate::run::impacts::Phase>>>>,
+    stored: Option<Vec<Option<bool>>>,
+}
+
+impl RunColumns {
+    /// Read every column of `df` the summary uses, each cast to the type this version expects.
+    fn read(df: &DataFrame) -> anyhow::Result<RunColumns> {
+        let n = df.height();
+        let run_id = strs(df, "run_id")?;
+        let label = strs(df, "label")?;
+        let status = strs(df, "status")?;
+        let status_assumed = status.is_none();
+        let message = strs(df, "message")?;
+        let get_f = |name: &str| -> anyhow::Result<Vec<Option<f64>>> {
+            Ok(f64s(df, name)?.unwrap_or_else(|| vec![None; n]))
         };
-        param_values.push(v);
-    }
-    let mut errors: Vec<&'static str> = Vec::new();
-    let mut error_values: Vec<Vec<Option<f64>>> = Vec::new();
-    for e in ERRORS {
-        if let Some(v) = f64s(&df, e)?
-            && v.iter().any(|x| x.is_some_and(|x| !x.is_nan()))
-        {
-            errors.push(e);
-            error_values.push(v);
+        let get_i = |name: &str| -> anyhow::Result<Vec<Option<i64>>> {
+            Ok(i64s(df, name)?.unwrap_or_else(|| vec![None; n]))
+        };
+        let params: Vec<(&'static str, Kind)> = PARAMS
+            .iter()
+            .filter(|(name, _)| df.column(name).is_ok())
+            .copied()
+            .collect();
+        let mut param_values: Vec<Vec<Cell>> = Vec::with_capacity(params.len());
+        for (name, kind) in &params {
+            let v: Vec<Cell> = match kind {
+                Kind::F64 => get_f(name)?.into_iter().map(Cell::F64).collect(),
+                Kind::I64 => get_i(name)?.into_iter().map(Cell::I64).collect(),
+                _ => strs(df, name)?
+                    .unwrap_or_else(|| vec![None; n])
+                    .into_iter()
+                    .map(Cell::Str)
+                    .collect(),
+            };
+            param_values.push(v);
         }
+        let mut errors: Vec<&'static str> = Vec::new();
+        let mut error_values: Vec<Vec<Option<f64>>> = Vec::new();
+        for e in ERRORS {
+            if let Some(v) = f64s(df, e)?
+                && v.iter().any(|x| x.is_some_and(|x| !x.is_nan()))
+            {
+                errors.push(e);
+                error_values.push(v);
+            }
+        }
+        let (h, elements, dt, courant) = (
+            get_f("h")?,
+            get_i("elements")?,
+            get_f("dt")?,
+            get_f("courant")?,
+        );
+        let (wt, wt_min, wt_max) = (
+            get_f("wall_time_s")?,
+            get_f("wall_time_min_s")?,
+            get_f("wall_time_max_s")?,
+        );
+        let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
+        let theta_drift = get_f("energy_theta_drift")?;
+        let theta_initial = get_f("energy_theta_initial")?;
+        let length_scale = get_f("length_scale")?;
+        let energy_scale = get_f("energy_scale")?;
+        let (max_pen, press_osc) = (get_f("max_penetration")?, get_f("pressure_oscillation")?);
+        let (w_f, balance_drift, balance_inc) = (
+            get_f("friction_work")?,
+            get_f("energy_balance_drift")?,
+            get_f("energy_balance_max_increase")?,
+        );
+        let sample = get_i("ensemble_sample")?;
+        let search = strs(df, "search")?;
+        let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
+            get_f("energy_initial")?,
+            get_f("energy_final")?,
+            get_f("energy_drift")?,
+            get_f("energy_max_dev")?,
+            get_f("energy_max_increase")?,
+            get_f("energy_theta_max_increase")?,
+        );
+        let part = strs(df, PART_COLUMN)?;
+        let impacts = impact_lists(df)?;
+        let stored: Option<Vec<Option<bool>>> = df
+            .column(LISTS_COLUMN)
+            .ok()
+            .map(|c| c.bool().map(|b| b.iter().collect()))
+            .transpose()?;
+        Ok(RunColumns {
+            run_id,
+            label,
+            status,
+            status_assumed,
+            message,
+            params,
+            param_values,
+            errors,
+            error_values,
+            h,
+            elements,
+            dt,
+            courant,
+            wt,
+            wt_min,
+            wt_max,
+            repeats,
+            steps,
+            dofs,
+            theta_drift,
+            theta_initial,
+            length_scale,
+            energy_scale,
+            max_pen,
+            press_osc,
+            w_f,
+            balance_drift,
+            balance_inc,
+            sample,
+            search,
+            e_init,
+            e_fin,
+            drift,
+            max_dev,
+            max_inc,
+            theta_inc,
+            part,
+            impacts,
+            stored,
+        })
     }
-    let (h, elements, dt, courant) = (
-        get_f("h")?,
-        get_i("elements")?,
-        get_f("dt")?,
-        get_f("courant")?,
-    );
-    let (wt, wt_min, wt_max) = (
-        get_f("wall_time_s")?,
-        get_f("wall_time_min_s")?,
-        get_f("wall_time_max_s")?,
-    );
-    let (repeats, steps, dofs) = (get_i("repeats")?, get_i("steps")?, get_i("dofs")?);
-    let theta_drift = get_f("energy_theta_drift")?;
-    let theta_initial = get_f("energy_theta_initial")?;
-    let length_scale = get_f("length_scale")?;
-    let energy_scale = get_f("energy_scale")?;
-    let (max_pen, press_osc) = (get_f("max_penetration")?, get_f("pressure_oscillation")?);
-    let (w_f, balance_drift, balance_inc) = (
-        get_f("friction_work")?,
-        get_f("energy_balance_drift")?,
-        get_f("energy_balance_max_increase")?,
-    );
-    let sample = get_i("ensemble_sample")?;
-    let search = strs(&df, "search")?;
-    let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
-        get_f("energy_initial")?,
-        get_f("energy_final")?,
-        get_f("energy_drift")?,
-        get_f("energy_max_dev")?,
-        get_f("energy_max_increase")?,
-        get_f("energy_theta_max_increase")?,
-    );
-    let finite = |x: Option<f64>| x.filter(|x| x.is_finite());
-    let part = strs(&df, PART_COLUMN)?;
-    let impacts = impact_lists(&df)?;
-    let stored: Option<Vec<Option<bool>>> = df
-        .column(LISTS_COLUMN)
-        .ok()
-        .map(|c| c.bool().map(|b| b.iter().collect()))
-        .transpose()?;
 
-    let mut seen: HashSet<String> = HashSet::new();
-    let mut duplicates = 0;
-    let mut runs = Vec::with_capacity(n);
-    for i in 0..n {
-        // A run without an id (another version) still counts; it gets its row number.
-        let id = run_id
-            .as_ref()
-            .and_then(|v| v[i].clone())
-            .unwrap_or_else(|| format!("row-{i}"));
-        if !seen.insert(id.clone()) {
-            // The same run committed twice (two shards, a re-run): same id, same parameters.
-            duplicates += 1;
-            continue;
+    /// Row `i` as a run named `id` (group 0 until [`group`] assigns it).
+    fn run(&self, i: usize, id: String) -> Run {
+        let params_i: Vec<Cell> = self.param_values.iter().map(|v| v[i].clone()).collect();
+        let lbl = self.label_of(i, &params_i);
+        let h_i = self.h_of(i, &params_i);
+        Run {
+            run_id: id,
+            label: lbl,
+            status: match &self.status {
+                Some(v) => v[i].clone().unwrap_or_else(|| "unknown".into()),
+                None => "ok".into(),
+            },
+            message: self.message.as_ref().and_then(|v| v[i].clone()),
+            params: params_i,
+            h: h_i,
+            elements: self.elements[i].filter(|m| *m > 0),
+            dt: finite(self.dt[i]).filter(|x| *x > 0.0),
+            courant: finite(self.courant[i]).filter(|x| *x > 0.0),
+            errors: self.error_values.iter().map(|v| v[i]).collect(),
+            wall_time_s: finite(self.wt[i]),
+            wall_time_min_s: finite(self.wt_min[i]),
+            wall_time_max_s: finite(self.wt_max[i]),
+            repeats: self.repeats[i],
+            steps: self.steps[i],
+            dofs: self.dofs[i],
+            energy_initial: self.e_init[i],
+            energy_final: self.e_fin[i],
+            energy_drift: self.drift[i],
+            energy_max_dev: self.max_dev[i],
+            energy_max_increase: self.max_inc[i],
+            energy_theta_max_increase: self.theta_inc[i],
+            energy_theta_drift: self.theta_drift[i],
+            energy_theta_initial: self.theta_initial[i],
+            length_scale: finite(self.length_scale[i]).filter(|l| *l > 0.0),
+            energy_scale: finite(self.energy_scale[i]).filter(|e| *e > 0.0),
+            ensemble_sample: self.sample[i],
+            max_penetration: finite(self.max_pen[i]),
+            pressure_oscillation: finite(self.press_osc[i]),
+            friction_work: self.w_f[i],
+            energy_balance_drift: self.balance_drift[i],
+            energy_balance_max_increase: self.balance_inc[i],
+            search: self.search.as_ref().and_then(|v| v[i].clone()),
+            part: self.part.as_ref().and_then(|v| v[i].clone()),
+            impacts: self.impacts.as_ref().and_then(|v| v[i].clone()),
+            impacts_stored: self.stored.as_ref().and_then(|v| v[i]).unwrap_or(false),
+            group: 0,
         }
-        let params_i: Vec<Cell> = param_values.iter().map(|v| v[i].clone()).collect();
-        let lbl = label
+    }
+
+    /// Row `i`'s label; without a label column, one composed from the method parameters that
+    /// exist (`params_i`: the row's parameter values).
+    fn label_of(&self, i: usize, params_i: &[Cell]) -> String {
+        self.label
             .as_ref()
             .and_then(|v| v[i].clone())
             .unwrap_or_else(|| {
                 // No label column: compose one from the method parameters that exist.
                 let pick = |name: &str| {
-                    params
+                    self.params
                         .iter()
                         .position(|(n, _)| *n == name)
                         .and_then(|j| params_i[j].show())
@@ -730,72 +901,21 @@ pub(crate) fn load(dir: &Path) -> anyhow::Result<Runs> {
                 .flatten()
                 .collect::<Vec<_>>()
                 .join(" · ")
-            });
-        // h is always filled by this version (SPEC §8); an older row with only `elements`
-        // gets h = length / elements.
-        let h_i = finite(h[i]).filter(|x| *x > 0.0).or_else(|| {
-            let m = elements[i].filter(|m| *m > 0)? as f64;
-            let j = params.iter().position(|(n, _)| *n == "length")?;
+            })
+    }
+
+    /// Row `i`'s h: h is always filled by this version (SPEC §8); an older row with only
+    /// `elements` gets h = length / elements.
+    fn h_of(&self, i: usize, params_i: &[Cell]) -> Option<f64> {
+        finite(self.h[i]).filter(|x| *x > 0.0).or_else(|| {
+            let m = self.elements[i].filter(|m| *m > 0)? as f64;
+            let j = self.params.iter().position(|(n, _)| *n == "length")?;
             match params_i[j] {
                 Cell::F64(Some(l)) if l > 0.0 => Some(l / m),
                 _ => None,
             }
-        });
-        runs.push(Run {
-            run_id: id,
-            label: lbl,
-            status: match &status {
-                Some(v) => v[i].clone().unwrap_or_else(|| "unknown".into()),
-                None => "ok".into(),
-            },
-            message: message.as_ref().and_then(|v| v[i].clone()),
-            params: params_i,
-            h: h_i,
-            elements: elements[i].filter(|m| *m > 0),
-            dt: finite(dt[i]).filter(|x| *x > 0.0),
-            courant: finite(courant[i]).filter(|x| *x > 0.0),
-            errors: error_values.iter().map(|v| v[i]).collect(),
-            wall_time_s: finite(wt[i]),
-            wall_time_min_s: finite(wt_min[i]),
-            wall_time_max_s: finite(wt_max[i]),
-            repeats: repeats[i],
-            steps: steps[i],
-            dofs: dofs[i],
-            energy_initial: e_init[i],
-            energy_final: e_fin[i],
-            energy_drift: drift[i],
-            energy_max_dev: max_dev[i],
-            energy_max_increase: max_inc[i],
-            energy_theta_max_increase: theta_inc[i],
-            energy_theta_drift: theta_drift[i],
-            energy_theta_initial: theta_initial[i],
-            length_scale: finite(length_scale[i]).filter(|l| *l > 0.0),
-            energy_scale: finite(energy_scale[i]).filter(|e| *e > 0.0),
-            ensemble_sample: sample[i],
-            max_penetration: finite(max_pen[i]),
-            pressure_oscillation: finite(press_osc[i]),
-            friction_work: w_f[i],
-            energy_balance_drift: balance_drift[i],
-            energy_balance_max_increase: balance_inc[i],
-            search: search.as_ref().and_then(|v| v[i].clone()),
-            part: part.as_ref().and_then(|v| v[i].clone()),
-            impacts: impacts.as_ref().and_then(|v| v[i].clone()),
-            impacts_stored: stored.as_ref().and_then(|v| v[i]).unwrap_or(false),
-            group: 0,
-        });
+        })
     }
-    let mut out = Runs {
-        params,
-        errors,
-        runs,
-        groups: Vec::new(),
-        paths: Vec::new(),
-        ignored,
-        duplicates,
-        status_assumed,
-    };
-    group(&mut out);
-    Ok(out)
 }
 
 /// Group the runs and find the refinement paths of every group.

@@ -11,8 +11,9 @@
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
+use super::columns::columns;
 use super::runs::{Run, Runs};
-use super::table::{self, Table, TextTable, columns, text_columns};
+use super::table::{self, Table, TextTable, text_columns};
 use crate::sweep::{Search, SearchState};
 
 /// The search section's outputs.

@@ -22,9 +22,10 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
+use super::columns::columns;
 use super::energy::classify;
 use super::runs::{Run, Runs};
-use super::table::{Align, Table, TextTable, columns};
+use super::table::{Align, Table, TextTable};
 
 /// Cell states, worst first.
 pub const STATES: [&str; 6] = [
@@ -140,132 +141,15 @@ pub(crate) fn section(runs: &Runs) -> Section {
     let mut maps = 0usize;
     let mut terminal_lines: Vec<(String, Vec<String>)> = Vec::new();
     for (m, idx) in &by_method {
-        let distinct = |axis: &str| -> BTreeSet<String> {
-            idx.iter()
-                .filter_map(|&i| axis_value(runs, &runs.runs[i], axis))
-                .map(super::runs::float_key)
-                .collect()
-        };
-        let mut axes: Vec<(&str, usize)> = axes()
-            .map(|a| (a, distinct(a).len()))
-            .filter(|(_, n)| *n >= 2)
-            .collect();
-        let mesh: Vec<(&str, usize)> = axes
-            .iter()
-            .copied()
-            .filter(|(a, _)| ["h", "dt", "courant"].contains(a))
-            .collect();
-        if mesh.len() == 3 {
-            // Drop the derived one (most values; dt on a tie).
-            let drop = mesh
-                .iter()
-                .max_by_key(|(a, n)| (*n, usize::from(*a == "dt")))
-                .map(|(a, _)| *a)
-                .expect("three");
-            axes.retain(|(a, _)| *a != drop);
-        } else if mesh.len() == 2 {
-            // The third is fixed, so the two are one axis (ν = c0·dt/h): keep courant, else h.
-            let keep = ["courant", "h", "dt"]
-                .into_iter()
-                .find(|k| mesh.iter().any(|(a, _)| a == k))
-                .expect("two");
-            axes.retain(|(a, _)| !["h", "dt", "courant"].contains(a) || *a == keep);
-        }
-        // Axes that move together (bundled in one grid item, e.g. { h, T }) are one axis: an
-        // axis in one-to-one correspondence with an earlier one is dropped.
-        let key_of =
-            |i: usize, a: &str| axis_value(runs, &runs.runs[i], a).map(super::runs::float_key);
-        let mut kept: Vec<(&str, usize)> = Vec::new();
-        for &(b, n) in &axes {
-            let tied = kept.iter().any(|&(a, _)| {
-                let mut fwd: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
-                let mut back: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
-                for &i in idx {
-                    let (ka, kb) = (key_of(i, a), key_of(i, b));
-                    fwd.entry(ka.clone()).or_default().insert(kb.clone());
-                    back.entry(kb).or_default().insert(ka);
-                }
-                fwd.values().all(|v| v.len() == 1) && back.values().all(|v| v.len() == 1)
-            });
-            if !tied {
-                kept.push((b, n));
-            }
-        }
-        let axes = kept;
+        let axes = map_axes(runs, idx);
         for (ai, &(xa, _)) in axes.iter().enumerate() {
             for &(ya, _) in &axes[ai + 1..] {
                 maps += 1;
-                let mut cells: BTreeMap<(String, String), (f64, f64, Vec<usize>)> = BTreeMap::new();
-                for &i in idx {
-                    let r = &runs.runs[i];
-                    if let (Some(x), Some(y)) = (axis_value(runs, r, xa), axis_value(runs, r, ya)) {
-                        let k = (super::runs::float_key(x), super::runs::float_key(y));
-                        cells.entry(k).or_insert((x, y, Vec::new())).2.push(i);
-                    }
-                }
-                let mut xs: Vec<f64> = Vec::new();
-                let mut ys: Vec<f64> = Vec::new();
-                let mut grid: BTreeMap<(String, String), String> = BTreeMap::new();
-                let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
-                for (k, (x, y, members)) in &cells {
-                    let worst = members
-                        .iter()
-                        .min_by_key(|&&i| STATES.iter().position(|s| *s == states[i]))
-                        .copied()
-                        .expect("a cell has a run");
-                    let st = states[worst];
-                    let n = |s: &str| members.iter().filter(|&&i| states[i] == s).count() as i64;
-                    let uniform = members.iter().all(|&i| states[i] == st);
-                    t.str("method", Some(m));
-                    t.str("x_axis", Some(xa));
-                    t.str("y_axis", Some(ya));
-                    t.f64("x", Some(*x));
-                    t.f64("y", Some(*y));
-                    t.str("state", Some(st));
-                    t.bool("uniform", Some(uniform));
-                    t.i64("runs", Some(members.len() as i64));
-                    t.i64("stable", Some(n("stable")));
-                    t.i64("growing", Some(n("growing")));
-                    t.i64("diverged", Some(n("diverged")));
-                    t.i64("solver_failed", Some(n("solver-failed")));
-                    t.i64("timeout", Some(n("timeout")));
-                    t.i64("invalid", Some(n("invalid")));
-                    let w = &runs.runs[worst];
-                    t.i64("steps", w.steps);
-                    t.str("message", w.message.as_deref());
-                    t.str("run_id", Some(&w.run_id));
-                    t.end_row();
-                    *counts.entry(st).or_default() += 1;
-                    if !xs.contains(x) {
-                        xs.push(*x);
-                    }
-                    if !ys.contains(y) {
-                        ys.push(*y);
-                    }
-                    grid.insert(k.clone(), format!("{st}{}", if uniform { "" } else { "*" }));
-                }
-                xs.sort_by(f64::total_cmp);
-                ys.sort_by(f64::total_cmp);
-                let _ = writeln!(md, "## {m}: {ya} (rows) × {xa} (columns)\n");
-                let mut header = vec![format!("{ya} \\ {xa}")];
-                header.extend(xs.iter().map(|x| num(*x)));
-                let rows: Vec<Vec<String>> = ys
-                    .iter()
-                    .map(|y| {
-                        let mut row = vec![num(*y)];
-                        row.extend(xs.iter().map(|x| {
-                            let k = (super::runs::float_key(*x), super::runs::float_key(*y));
-                            grid.get(&k).cloned().unwrap_or_else(|| "—".into())
-                        }));
-                        row
-                    })
-                    .collect();
-                let map = TextTable::new(header.into_iter().map(|h| (h, Align::Right)));
-                md.push_str(&map.with_rows(rows).markdown());
-                md.push('\n');
+                let cells = map_cells(&mut t, runs, &states, m, idx, (xa, ya));
+                map_markdown(&mut md, m, (xa, ya), &cells);
                 let summary: Vec<String> = STATES
                     .iter()
-                    .filter_map(|s| counts.get(s).map(|n| format!("{n} {s}")))
+                    .filter_map(|s| cells.counts.get(s).map(|n| format!("{n} {s}")))
                     .collect();
                 let key = format!("{ya} × {xa}: {}", summary.join(", "));
                 match terminal_lines.iter_mut().find(|(k, _)| *k == key) {
@@ -295,4 +179,161 @@ pub(crate) fn section(runs: &Runs) -> Section {
         markdown: md,
         terminal,
     }
+}
+
+/// The axes a method's runs `idx` are swept along (≥ 2 distinct values), with their number of
+/// values, in the order of [`axes`]: of h, dt and courant only the independent ones, and of
+/// axes that move together only the first.
+fn map_axes(runs: &Runs, idx: &[usize]) -> Vec<(&'static str, usize)> {
+    let distinct = |axis: &str| -> BTreeSet<String> {
+        idx.iter()
+            .filter_map(|&i| axis_value(runs, &runs.runs[i], axis))
+            .map(super::runs::float_key)
+            .collect()
+    };
+    let mut axes: Vec<(&str, usize)> = axes()
+        .map(|a| (a, distinct(a).len()))
+        .filter(|(_, n)| *n >= 2)
+        .collect();
+    let mesh: Vec<(&str, usize)> = axes
+        .iter()
+        .copied()
+        .filter(|(a, _)| ["h", "dt", "courant"].contains(a))
+        .collect();
+    if mesh.len() == 3 {
+        // Drop the derived one (most values; dt on a tie).
+        let drop = mesh
+            .iter()
+            .max_by_key(|(a, n)| (*n, usize::from(*a == "dt")))
+            .map(|(a, _)| *a)
+            .expect("three");
+        axes.retain(|(a, _)| *a != drop);
+    } else if mesh.len() == 2 {
+        // The third is fixed, so the two are one axis (ν = c0·dt/h): keep courant, else h.
+        let keep = ["courant", "h", "dt"]
+            .into_iter()
+            .find(|k| mesh.iter().any(|(a, _)| a == k))
+            .expect("two");
+        axes.retain(|(a, _)| !["h", "dt", "courant"].contains(a) || *a == keep);
+    }
+    // Axes that move together (bundled in one grid item, e.g. { h, T }) are one axis: an
+    // axis in one-to-one correspondence with an earlier one is dropped.
+    let key_of = |i: usize, a: &str| axis_value(runs, &runs.runs[i], a).map(super::runs::float_key);
+    let mut kept: Vec<(&str, usize)> = Vec::new();
+    for &(b, n) in &axes {
+        let tied = kept.iter().any(|&(a, _)| {
+            let mut fwd: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
+            let mut back: BTreeMap<Option<String>, BTreeSet<Option<String>>> = BTreeMap::new();
+            for &i in idx {
+                let (ka, kb) = (key_of(i, a), key_of(i, b));
+                fwd.entry(ka.clone()).or_default().insert(kb.clone());
+                back.entry(kb).or_default().insert(ka);
+            }
+            fwd.values().all(|v| v.len() == 1) && back.values().all(|v| v.len() == 1)
+        });
+        if !tied {
+            kept.push((b, n));
+        }
+    }
+    kept
+}
+
+/// The cells of one map: the x and y values (sorted), each cell's state text by (x, y) key,
+/// and how many cells are in each state.
+struct MapCells {
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    grid: BTreeMap<(String, String), String>,
+    counts: BTreeMap<&'static str, usize>,
+}
+
+/// The rows of method `m`'s map over the axes `(xa, ya)`, one per cell: the worst state of
+/// its runs (`states`, per run), whether they agree, and the worst run.
+fn map_cells(
+    t: &mut Table,
+    runs: &Runs,
+    states: &[&'static str],
+    m: &str,
+    idx: &[usize],
+    (xa, ya): (&str, &str),
+) -> MapCells {
+    let mut cells: BTreeMap<(String, String), (f64, f64, Vec<usize>)> = BTreeMap::new();
+    for &i in idx {
+        let r = &runs.runs[i];
+        if let (Some(x), Some(y)) = (axis_value(runs, r, xa), axis_value(runs, r, ya)) {
+            let k = (super::runs::float_key(x), super::runs::float_key(y));
+            cells.entry(k).or_insert((x, y, Vec::new())).2.push(i);
+        }
+    }
+    let mut xs: Vec<f64> = Vec::new();
+    let mut ys: Vec<f64> = Vec::new();
+    let mut grid: BTreeMap<(String, String), String> = BTreeMap::new();
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    for (k, (x, y, members)) in &cells {
+        let worst = members
+            .iter()
+            .min_by_key(|&&i| STATES.iter().position(|s| *s == states[i]))
+            .copied()
+            .expect("a cell has a run");
+        let st = states[worst];
+        let n = |s: &str| members.iter().filter(|&&i| states[i] == s).count() as i64;
+        let uniform = members.iter().all(|&i| states[i] == st);
+        t.str("method", Some(m));
+        t.str("x_axis", Some(xa));
+        t.str("y_axis", Some(ya));
+        t.f64("x", Some(*x));
+        t.f64("y", Some(*y));
+        t.str("state", Some(st));
+        t.bool("uniform", Some(uniform));
+        t.i64("runs", Some(members.len() as i64));
+        t.i64("stable", Some(n("stable")));
+        t.i64("growing", Some(n("growing")));
+        t.i64("diverged", Some(n("diverged")));
+        t.i64("solver_failed", Some(n("solver-failed")));
+        t.i64("timeout", Some(n("timeout")));
+        t.i64("invalid", Some(n("invalid")));
+        let w = &runs.runs[worst];
+        t.i64("steps", w.steps);
+        t.str("message", w.message.as_deref());
+        t.str("run_id", Some(&w.run_id));
+        t.end_row();
+        *counts.entry(st).or_default() += 1;
+        if !xs.contains(x) {
+            xs.push(*x);
+        }
+        if !ys.contains(y) {
+            ys.push(*y);
+        }
+        grid.insert(k.clone(), format!("{st}{}", if uniform { "" } else { "*" }));
+    }
+    xs.sort_by(f64::total_cmp);
+    ys.sort_by(f64::total_cmp);
+    MapCells {
+        xs,
+        ys,
+        grid,
+        counts,
+    }
+}
+
+/// Method `m`'s map over `(xa, ya)` as a Markdown grid: y down the rows, x across.
+fn map_markdown(md: &mut String, m: &str, (xa, ya): (&str, &str), cells: &MapCells) {
+    let (xs, ys, grid) = (&cells.xs, &cells.ys, &cells.grid);
+    let _ = writeln!(md, "## {m}: {ya} (rows) × {xa} (columns)\n");
+    let mut header = vec![format!("{ya} \\ {xa}")];
+    header.extend(xs.iter().map(|x| num(*x)));
+    let rows: Vec<Vec<String>> = ys
+        .iter()
+        .map(|y| {
+            let mut row = vec![num(*y)];
+            row.extend(xs.iter().map(|x| {
+                let k = (super::runs::float_key(*x), super::runs::float_key(*y));
+                grid.get(&k).cloned().unwrap_or_else(|| "—".into())
+            }));
+            row
+        })
+        .collect();
+    let map = TextTable::new(header.into_iter().map(|h| (h, Align::Right)));
+    md.push_str(&map.with_rows(rows).markdown());
+    md.push('\n');
 }

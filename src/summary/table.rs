@@ -12,26 +12,8 @@ use std::path::{Path, PathBuf};
 use anyhow::Context as _;
 use polars::prelude::*;
 
+use super::columns::Kind;
 use super::runs::{Cell, Run, Runs};
-
-/// The type of a declared column.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Kind {
-    F64,
-    I64,
-    Str,
-    Bool,
-}
-
-/// A table's declared columns, several to a line: `columns![run_id: Str, h: F64, …]` — each
-/// column's name with its [`Kind`] — as the `&[(&str, Kind)]` that [`Table::new`] and
-/// [`owned`] take.
-macro_rules! columns {
-    ($($name:ident : $kind:ident),* $(,)?) => {
-        [$((stringify!($name), $crate::summary::table::Kind::$kind)),*]
-    };
-}
-pub(crate) use columns;
 
 /// A text table's declared columns, several to a line: `text_columns!["#" => Right, "label" =>
 /// Left, …]` — each header with its [`Align`] — as [`TextTable::new`] takes them.
