@@ -7,8 +7,8 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::gradient_newton::GradientWork;
 use super::friction::Friction;
+use super::gradient_newton::GradientWork;
 use super::mass_inverse::{MASS_INVERSES, MassInverse, mass_inverse};
 use super::state::{Method, REFRESH, method, step_coefficient};
 use crate::contact::Lcp;
