@@ -24,7 +24,8 @@
 //! The estimates are within a factor of about 2 of what a run uses; they decide refusals only
 //! for runs that are far from fitting (the message states the figure).
 
-use super::{RunConfig, SeriesRow};
+use super::config::RunConfig;
+use super::observe::SeriesRow;
 use crate::scene::FeGeometry;
 use crate::space::step_solver::Solver;
 use crate::time::Scheme;

@@ -26,7 +26,7 @@
 //! engines carry: the stop time's e_1 component and the final `tangential_velocity_final`
 //! (v̄_1 in 2D, √(v̄_1² + v̄_2²) in 3D) and `normal_velocity_final` (v̄_d) of SPEC §5.
 
-use super::Metrics;
+use super::observe::Metrics;
 use crate::space::fe::SymMatrix;
 
 /// The body's mean velocity per axis from M v (module header): each axis' reduced dofs and

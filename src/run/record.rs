@@ -5,9 +5,18 @@
 
 use std::collections::BTreeMap;
 
-use super::Outcome;
-use super::RunSpec;
+use super::observe::Series;
+use super::outcome::Outcome;
+use super::spec::RunSpec;
 use crate::model::{Key, Value};
+
+/// A finished run: its row and its (possibly decimated) time series — what the executor hands
+/// the sink.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub record: RunRecord,
+    pub series: Series,
+}
 
 /// A typed column ready for the sink.
 #[derive(Debug, Clone, PartialEq)]
@@ -481,7 +490,10 @@ impl RunRecord {
 }
 
 /// One field of every contact phase of a run, as a list column value.
-fn phase_list<T>(m: &super::Metrics, f: impl Fn(&super::impacts::Phase) -> T) -> Option<Vec<T>> {
+fn phase_list<T>(
+    m: &super::observe::Metrics,
+    f: impl Fn(&super::impacts::Phase) -> T,
+) -> Option<Vec<T>> {
     m.impacts.as_ref().map(|ps| ps.iter().map(f).collect())
 }
 

@@ -8,7 +8,7 @@
 
 use std::collections::BTreeMap;
 
-use super::RunConfig;
+use super::config::RunConfig;
 use crate::model::{Key, Value};
 use crate::scene::SceneKind;
 

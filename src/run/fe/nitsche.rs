@@ -43,8 +43,8 @@
 //! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
 //! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
 
-use super::friction_tally::{FrictionTally, MeanVelocity};
 use crate::contact::friction::FrictionLaw;
+use crate::run::friction_tally::{FrictionTally, MeanVelocity};
 use crate::space::fe::nitsche::ContactPoint;
 
 /// Semismooth Newton: relative tolerance and iteration cap (SPEC §4).
@@ -845,7 +845,7 @@ impl FrictionState {
     }
 
     /// The friction columns (SPEC §5), energies over `scale`.
-    pub fn finish(&self, m: &mut super::Metrics, scale: f64) {
+    pub fn finish(&self, m: &mut crate::run::Metrics, scale: f64) {
         let vt = self.mean.tangential(&self.means);
         self.tally.finish(m, scale, vt, self.means[2]);
     }

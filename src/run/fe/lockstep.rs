@@ -8,7 +8,7 @@
 //! condensed contact set: the members of a round-off ensemble, runs differing only in the gap,
 //! the initial velocity, γ at fixed β or T.
 //!
-//! Each member keeps its own state, contact solve, observer and outcome ([`Stepper`]); what the
+//! Each member keeps its own state, contact solve, observer and outcome ([`super::newmark::Stepper`]); what the
 //! members share is every read of a shared operator: the solve, Z's columns, and the products
 //! with M and K (each matrix read once per 8 vectors — in 3D the members' own products were
 //! most of a group's step: sphere3d Q2, 4 503 dofs, made K u twice and M u, M v per member and
@@ -26,8 +26,11 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use super::{Factored, FeConfig, Stepper, methods};
-use crate::run::{Outcome, RunContext, RunOptions, Stop};
+use super::cache::geometry_key;
+use super::config::{FeConfig, frictional, handles};
+use super::factor::Factored;
+use super::newmark::Stepper;
+use crate::run::{Outcome, Stop};
 use crate::space::fe::SymMatrix;
 use crate::space::step_solver::Solver;
 
@@ -36,14 +39,14 @@ use crate::space::step_solver::Solver;
 /// method puts it into the operators). `None`: the run steps alone — the methods of SPEC §3.2
 /// (their own loops), CG runs (nothing factored to share), invalid schemes.
 pub fn lockstep_key(cfg: &FeConfig) -> Option<String> {
-    if methods::handles(cfg) || cfg.solver != Solver::Direct || super::frictional(cfg) {
+    if handles(cfg) || cfg.solver != Solver::Direct || frictional(cfg) {
         return None;
     }
     let (_, c, _) = cfg.coefficients().ok()?;
     let c_tau2 = c * cfg.dt * cfg.dt;
     Some(format!(
         "{}|{:?}|{:?}|{:e}|gap {:e}",
-        super::geometry_key(&cfg.setup),
+        geometry_key(&cfg.setup),
         cfg.mass,
         cfg.method,
         c_tau2,
@@ -53,38 +56,6 @@ pub fn lockstep_key(cfg: &FeConfig) -> Option<String> {
             cfg.setup.gap
         }
     ))
-}
-
-/// Run `cfgs` (which share a [`lockstep_key`]) in lockstep, each with its context; the
-/// outcomes in the order of `cfgs`. The caller times the whole group; each member's
-/// `stepping_time_s` is the group's stepping time divided among the members.
-pub fn simulate_group(cfgs: &[&FeConfig], opts: &RunOptions, ctxs: &[RunContext]) -> Vec<Outcome> {
-    assert_eq!(cfgs.len(), ctxs.len(), "one context per member");
-    let mut outcomes: Vec<Option<Outcome>> = vec![None; cfgs.len()];
-    // Members set up, by their shared factor.
-    let mut groups: Vec<Vec<(usize, Stepper)>> = Vec::new();
-    for (i, (cfg, ctx)) in cfgs.iter().zip(ctxs).enumerate() {
-        if methods::handles(cfg) {
-            outcomes[i] = Some(super::simulate(cfg, opts, ctx));
-            continue;
-        }
-        match Stepper::new(cfg, opts, ctx) {
-            Err(out) => outcomes[i] = Some(*out),
-            Ok(s) => match groups.iter_mut().find(|g| Arc::ptr_eq(&g[0].1.fac, &s.fac)) {
-                Some(g) => g.push((i, s)),
-                None => groups.push(vec![(i, s)]),
-            },
-        }
-    }
-    for group in groups {
-        for (i, out) in step_together(group) {
-            outcomes[i] = Some(out);
-        }
-    }
-    outcomes
-        .into_iter()
-        .map(|o| o.expect("every member has an outcome"))
-        .collect()
 }
 
 /// Most vectors of one joint product with M or K (accumulators kept in registers).

@@ -1,0 +1,167 @@
+//! The volume load of a run with gravity (SPEC §1.3, §1.8): F, the consistent initial
+//! acceleration a⁰ and the free-fall quantities the observers compare the centre of mass with.
+
+use super::config::FeConfig;
+use super::geometry::Geometry;
+use crate::scene::LoadModel;
+use crate::space::MassVariant;
+use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
+use crate::space::fe::{DofMap, SymMatrix, assemble_load};
+
+/// The volume load of a run with gravity (SPEC §1.3, §1.8) and what its time loop needs of it.
+#[derive(Debug)]
+pub(super) struct GravityLoad {
+    /// F on the free dofs: ∫ρ f·φ (`load = "body"`) or M_run f (`"inertial"`), with
+    /// f = gravity·(sin α e_1 − cos α e_d) (α the `incline`, 0 but on the mesh scenes).
+    pub(super) force: Vec<f64>,
+    /// a⁰ with M a⁰ = F − K u⁰ = F on the dofs with inertia (u⁰ = 0, no contact at t = 0; 003
+    /// Remark 2.1), 0 on the massless ones (their rows are quasi-static: they never use it).
+    pub(super) a0: Vec<f64>,
+    /// M e_d (the run's M), for the centre of mass e_dᵀ M u / e_dᵀ M e_d.
+    pub(super) m_ed: Vec<f64>,
+    /// e_dᵀ M e_d.
+    pub(super) vertical_mass: f64,
+    /// The unit relative energies are measured in, the same for every mass variant (m = ∫ρ the
+    /// body's mass, |f| = gravity whatever the incline): m·|f|·gap, the work of the weight
+    /// over the gap (SPEC §1.3), plus ½·m·V_t², the kinetic energy of the initial tangential
+    /// velocity (SPEC §1.8; 0 unless `velocity_tangential` is given, so every earlier run keeps
+    /// its scale). A body that starts on the plane at rest (both 0) would have no unit at all:
+    /// it is measured in m·|f|·H, H its height along e_d, the work of its weight over its own
+    /// size.
+    pub(super) energy_scale: f64,
+}
+
+/// The load of `cfg`'s gravity on `g` with the run's mass matrix `m` (None without gravity).
+///
+/// The load per unit mass is f = gravity·(sin α e_1 − cos α e_d) (SPEC §1.8: a plane tilted by
+/// the `incline` α, seen in the plane's frame; α = 0 is f = −gravity e_d bit for bit, sin 0 = 0
+/// and cos 0 = 1). With `load = "body"` (the papers' model) and a mass variant that keeps
+/// 1ᵀM = ∫ρφ (consistent, lumped), F = M f in exact arithmetic (per component) and a⁰ = f
+/// exactly: the body moves rigidly. A redistributed or removed mass keeps F but not M, so
+/// a⁰ = M⁻¹F is no longer uniform (the body strains in free fall, SPEC §1.3): it is solved on
+/// the dofs with inertia by conjugate gradients on M (κ = O(1), a few dozen iterations to
+/// round-off).
+pub(super) fn gravity_load(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+) -> Result<Option<GravityLoad>, String> {
+    let s = &cfg.setup;
+    let fall = -s.gravity;
+    if fall == 0.0 {
+        return Ok(None);
+    }
+    if g.mesh.as_box().is_some() {
+        return Err(format!(
+            "scene {}: a volume load on the clamped bar is not supported",
+            s.scene
+        ));
+    }
+    let n = g.dofs.n_free();
+    let mesh = g.mesh.mesh();
+    let d = mesh.dim();
+    // The load's components per unit mass: along the slope (e_1) and into the plane (e_d).
+    let (sin, cos) = s.incline.to_radians().sin_cos();
+    // A flat plane keeps f = −gravity e_d bit for bit (no −0.0 slope component either).
+    let f_t = if s.incline == 0.0 {
+        0.0
+    } else {
+        s.gravity * sin
+    };
+    let f_d = fall * cos;
+    let mut ed = vec![0.0; n];
+    for &r in &g.vertical {
+        ed[r] = 1.0;
+    }
+    let mut m_ed = vec![0.0; n];
+    m.matvec_into(&ed, &mut m_ed);
+    let vertical_mass: f64 = g.vertical.iter().map(|&r| m_ed[r]).sum();
+    // The body force on every dof, clamped ones included: its vertical sum is f_d·∫ρ (Σφ = 1).
+    let mut f = [0.0; 3];
+    f[0] = f_t;
+    f[d - 1] = f_d;
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let body = assemble_load(mesh, &all, s.density, f, &|_| 1.0);
+    // |f_d| ≥ gravity·cos 89.99…° > 0: the planner keeps |α| < 90°.
+    let body_mass = body.iter().skip(d - 1).step_by(d).sum::<f64>() / f_d;
+    // M e_1 for the inertial load's slope component (only on an incline).
+    let m_e1 = (f_t != 0.0).then(|| {
+        let mut e1 = vec![0.0; n];
+        for &r in &g.tangential {
+            e1[r] = 1.0;
+        }
+        let mut out = vec![0.0; n];
+        m.matvec_into(&e1, &mut out);
+        out
+    });
+    let force: Vec<f64> = match s.load {
+        LoadModel::Body => g.dofs.free.iter().map(|&gd| body[gd]).collect(),
+        LoadModel::Inertial => match &m_e1 {
+            None => m_ed.iter().map(|x| f_d * x).collect(),
+            Some(m_e1) => m_ed
+                .iter()
+                .zip(m_e1)
+                .map(|(x, y)| f_d * x + f_t * y)
+                .collect(),
+        },
+    };
+    // The rigid acceleration f on every free dof.
+    let mut rigid: Vec<f64> = ed.iter().map(|e| f_d * e).collect();
+    if f_t != 0.0 {
+        for &r in &g.tangential {
+            rigid[r] = f_t;
+        }
+    }
+    let keeps_row_sums = matches!(cfg.mass, MassVariant::Consistent | MassVariant::Lumped);
+    let a0 = if s.load == LoadModel::Inertial || keeps_row_sums {
+        rigid
+    } else {
+        // (M + I_massless) a = F with F = 0 on the massless rows: M's massless rows and
+        // columns are zero (module header of the mass variants), so a_f = M_ff⁻¹ F_f, a_c = 0.
+        let mut shifted = m.clone();
+        let diag = m.diagonal();
+        let mut rhs = force.clone();
+        for (j, &dj) in diag.iter().enumerate() {
+            if dj == 0.0 {
+                let k = shifted
+                    .pattern
+                    .position(j, j)
+                    .expect("the pattern holds the diagonal");
+                shifted.values[k] = 1.0;
+                rhs[j] = 0.0;
+            }
+        }
+        let inv = jacobi(&shifted).map_err(|e| format!("initial acceleration: {e}"))?;
+        let mut a = rigid;
+        let mut work = CgWork::new(n);
+        pcg_into(
+            &shifted,
+            &inv,
+            &rhs,
+            &mut a,
+            CgOptions::new(1e-14),
+            &mut work,
+        )
+        .map_err(|e| format!("initial acceleration M a⁰ = F: {e}"))?;
+        a
+    };
+    let v_t = s.v0_tangential;
+    let mut energy_scale = body_mass * fall.abs() * s.gap;
+    if v_t != 0.0 {
+        energy_scale += 0.5 * body_mass * v_t * v_t;
+    }
+    if energy_scale == 0.0 {
+        let heights = (0..mesh.num_nodes()).map(|a| mesh.coord(a)[d - 1]);
+        let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
+            (lo.min(z), hi.max(z))
+        });
+        energy_scale = body_mass * fall.abs() * (hi - lo);
+    }
+    Ok(Some(GravityLoad {
+        force,
+        a0,
+        m_ed,
+        vertical_mass,
+        energy_scale,
+    }))
+}

@@ -1,0 +1,140 @@
+//! The mass variants of SPEC §2.2 on the FE meshes: the consistent and lumped matrices and the
+//! redistributions that move the contact layer's mass inward (massless contact dofs).
+
+use super::geometry::{FeMesh, Geometry};
+use crate::scene::FeSetup;
+use crate::space::MassVariant;
+use crate::space::fe::{DofMap, ElementOp, Mesh, SymMatrix, assemble, fe_pattern};
+
+/// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
+/// layer (mod2) and the weight of layer 1 (mod3).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Redistribution {
+    pub(super) mod2: f64,
+    pub(super) mod3: f64,
+}
+
+impl Redistribution {
+    /// Layers of equal mass m/L (the bars' box: uniform elements, as many per layer):
+    /// mod2 = L/(L−1), mod3 = 2 — the 1D weights of 000 §3.
+    pub(super) fn equal_layers(layers: usize) -> Redistribution {
+        Redistribution {
+            mod2: layers as f64 / (layers as f64 - 1.0),
+            mod3: 2.0,
+        }
+    }
+
+    /// From the measured masses: total m, layer 0 m₀, layer 1 m₁ (the disc/ball, whose layers
+    /// differ): mod2 = m/(m − m₀), mod3 = 1 + m₀/m₁, so the total mass is conserved.
+    pub(super) fn measured(total: f64, m0: f64, m1: f64) -> Redistribution {
+        Redistribution {
+            mod2: total / (total - m0),
+            mod3: 1.0 + m0 / m1,
+        }
+    }
+}
+
+/// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (SPEC §2.2).
+pub(super) fn layer_weight(mass: &MassVariant, layer: usize, r: Redistribution) -> f64 {
+    match (mass, layer) {
+        (
+            MassVariant::Mod1 | MassVariant::Mod2 | MassVariant::Mod3 | MassVariant::Weights(_),
+            0,
+        ) => 0.0,
+        (MassVariant::Mod2, _) => r.mod2,
+        (MassVariant::Mod3, 1) => r.mod3,
+        (MassVariant::Weights(w), k) => w[(k - 1).min(w.len() - 1)],
+        _ => 1.0,
+    }
+}
+
+/// 1ᵀM1 over one component of the mass assembled with the element weights `weight` on the full
+/// dof set (clamped nodes included), leaving out the entries `zeroed(i, j)` (dofs).
+pub(super) fn component_total(
+    mesh: &dyn Mesh,
+    rho: f64,
+    weight: &dyn Fn(usize) -> f64,
+    zeroed: &dyn Fn(usize, usize) -> bool,
+) -> f64 {
+    let d = mesh.dim();
+    let all = DofMap::all(mesh.num_nodes() * d);
+    let full_pattern = fe_pattern(mesh, &all);
+    let full = assemble(mesh, &all, &full_pattern, ElementOp::Mass { rho }, weight);
+    let mut total = 0.0;
+    for j in (0..full_pattern.n).filter(|j| j % d == 0) {
+        for k in full_pattern.col_ptr[j]..full_pattern.col_ptr[j + 1] {
+            if !zeroed(full_pattern.row_idx[k], j) {
+                total += full.values[k];
+            }
+        }
+    }
+    total
+}
+
+/// The run's mass matrix and 1ᵀM1 (per component: the total mass it represents).
+pub(super) fn mass_matrix(
+    g: &Geometry,
+    s: &FeSetup,
+    mass: &MassVariant,
+) -> Result<(SymMatrix, f64), String> {
+    let layers = g.mesh.num_layers();
+    if layers < 2 && mass.massless_contact() {
+        return Err(format!(
+            "mass = {} needs at least two element layers",
+            mass.name()
+        ));
+    }
+    let fm = &g.mesh;
+    let mesh = fm.mesh();
+    let never = |_: usize, _: usize| false;
+    let redistribution = match fm {
+        FeMesh::Ball(_) | FeMesh::Gmsh { .. }
+            if matches!(mass, MassVariant::Mod2 | MassVariant::Mod3) =>
+        {
+            let layer_mass = |l: usize| {
+                let w = |e: usize| f64::from(u8::from(fm.element_layer(e) == l));
+                component_total(mesh, s.density, &w, &never)
+            };
+            let total = component_total(mesh, s.density, &|_| 1.0, &never);
+            Redistribution::measured(total, layer_mass(0), layer_mass(1))
+        }
+        _ => Redistribution::equal_layers(layers),
+    };
+    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), redistribution);
+    let rho = ElementOp::Mass { rho: s.density };
+    let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
+    match mass {
+        MassVariant::Lumped => {
+            let sums = m.row_sums();
+            // Row-sum lumping of P2 simplices gives the vertices no mass (triangles: their rows
+            // of the P2 mass matrix sum to 0) or a negative one (tetrahedra): the step then
+            // has massless or anti-inertial dofs and blows up at the contact (the Hertz
+            // half-disc, docs/methods.md). Refused rather than run.
+            if let Some((i, x)) = sums.iter().enumerate().find(|(_, x)| **x <= 0.0) {
+                return Err(format!(
+                    "mass = lumped: row-sum lumping gives free dof {i} the mass {x:.3e} ≤ 0 (the vertices of P2 triangles and tetrahedra); use consistent or a modified mass, or degree-1 elements"
+                ));
+            }
+            m = SymMatrix::diagonal_from(&g.pattern, &sums);
+        }
+        MassVariant::ZeroContact => {
+            let p = &g.pattern;
+            for j in 0..p.n {
+                for k in p.col_ptr[j]..p.col_ptr[j + 1] {
+                    if g.on_contact_node[j] || g.on_contact_node[p.row_idx[k]] {
+                        m.values[k] = 0.0;
+                    }
+                }
+            }
+        }
+        _ => {}
+    }
+    // 1ᵀM1 over one component, clamped nodes included: assembled on the full dof set.
+    let d = mesh.dim();
+    let bottom_node = |dof: usize| g.contact_node[dof / d];
+    let zeroed = |i: usize, j: usize| {
+        matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j))
+    };
+    let total = component_total(mesh, s.density, &weight, &zeroed);
+    Ok((m, total))
+}

@@ -1,0 +1,214 @@
+//! Generalized-α/HHT (SPEC §3.2): the equation at t^{n+1−α} with the history κ_m aⁿ, κ_f Kuⁿ,
+//! κ_f fⁿ, Newmark's updates; one step with the nodal multiplier (LCP or Coulomb/Tresca), one
+//! with Nitsche/penalty (the engine's semismooth Newton, ± friction).
+
+use super::correction::{add_columns, add_point_columns, add_rows, add_theta_term};
+use super::run::MethodRun;
+use crate::run::Stop;
+use crate::run::fe::config::{LCP_MAX_ITER, LCP_TOL};
+use crate::run::fe::nitsche::{newton, newton_friction};
+use crate::time::GeneralizedAlphaParams;
+
+impl MethodRun<'_> {
+    /// Generalized-α/HHT with Nitsche/penalty: K_Θ in A, the history of the contact force from the
+    /// previous step's Newton, f_c^{n+1} by the engine's (frictional) Newton with coefficient c.
+    /// The step's total normal force.
+    pub(super) fn alpha_nitsche_step(
+        &mut self,
+        step: usize,
+        ga: GeneralizedAlphaParams,
+    ) -> Result<f64, Stop<String>> {
+        let (tau, n) = (self.tau, self.u.len());
+        let c = self.c.expect("implicit methods have a step matrix");
+        let t2 = tau * tau;
+        let MethodRun {
+            geo,
+            fac,
+            work,
+            u,
+            v,
+            a,
+            mu,
+            mv,
+            ma,
+            ku,
+            sd,
+            y,
+            pred,
+            q,
+            lambda,
+            lambda_prev,
+            newton_work,
+            nit_fric,
+            newton_max,
+            iterations,
+            force_vec,
+            ..
+        } = self;
+        let g = &**geo;
+        let force_vec: &[f64] = force_vec;
+        let f = fac.as_deref().expect("implicit methods have a factor");
+        let nit = fac.as_ref().and_then(|f| f.nitsche.as_ref());
+        let work = work.as_mut().expect("implicit methods have solve scratch");
+        // Nitsche/penalty: K_Θ is in A, the contact force f_c(u) =
+        // Σ_q φ_q(p_q·u) C_q, f_cⁿ = f_c(uⁿ) (φⁿ kept from the last step's
+        // Newton, which solved φ at uⁿ), f_c^{n+1} by the engine's Newton.
+        let ops = nit.expect("checked");
+        let (km, kf) = ga.history_coefficients(tau);
+        let kp = t2 * (0.5 - ga.beta);
+        let bt2 = ga.beta * t2;
+        for i in 0..n {
+            pred[i] = u[i] + tau * v[i] + kp * a[i];
+            y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+        }
+        add_theta_term(ops, &u, kf, y);
+        add_point_columns(ops, &lambda_prev, kf, y);
+        sd.copy_from_slice(&y);
+        f.chol.solve_in_place(y, work);
+        work.check()
+            .map_err(|e| Stop::Solver(step, e.to_string()))?;
+        let it = if let Some(st) = nit_fric.as_mut() {
+            // Friction (nitsche.rs header, coefficient c): x0 = P y +
+            // k u_tⁿ (the slip from uⁿ), λ the previous step's forces
+            // (the warm start), kept for f̄_t.
+            st.start_step(ops, &y, &u, q);
+            newton_friction(
+                ops,
+                st.law,
+                &f.h,
+                c,
+                &q,
+                lambda,
+                &mut st.slides,
+                newton_work,
+            )
+        } else {
+            for (k, qk) in q.iter_mut().enumerate() {
+                *qk = ops.apply(&ops.p, k, &y);
+            }
+            newton(ops, &f.h, c, &q, &ops.gap, lambda, newton_work)
+        }
+        .map_err(|e| Stop::Solver(step, e))?;
+        *newton_max = (*newton_max).max(it);
+        *iterations += it as i64;
+        add_columns(&f.z, &lambda, c, y);
+        add_point_columns(ops, &lambda, c, sd);
+        lambda_prev.copy_from_slice(&lambda);
+        // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
+        std::mem::swap(u, y);
+        g.k.matvec_into(&u, ku);
+        for i in 0..n {
+            sd[i] -= c * ku[i];
+        }
+        add_theta_term(ops, &u, c, sd);
+        let g1 = 1.0 - ga.gamma;
+        for i in 0..n {
+            let an = (u[i] - pred[i]) / bt2;
+            let mpred = mu[i] + tau * mv[i] + kp * ma[i];
+            let man = (sd[i] - mpred) / bt2;
+            v[i] += tau * (g1 * a[i] + ga.gamma * an);
+            mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+            a[i] = an;
+            ma[i] = man;
+            mu[i] = sd[i];
+        }
+        // The normal forces (d per point with friction).
+        Ok(lambda.iter().step_by(ops.per_point()).sum::<f64>())
+    }
+
+    /// Generalized-α/HHT with the nodal multiplier: the history κ_f Bᵀλⁿ (and the previous tangential
+    /// forces), the LCP or the frictional problem on By + g. The step's total contact force.
+    pub(super) fn alpha_mixed_step(
+        &mut self,
+        step: usize,
+        ga: GeneralizedAlphaParams,
+    ) -> Result<f64, Stop<String>> {
+        let (tau, n) = (self.tau, self.u.len());
+        let c = self.c.expect("implicit methods have a step matrix");
+        let t2 = tau * tau;
+        let MethodRun {
+            geo,
+            fac,
+            work,
+            u,
+            v,
+            a,
+            mu,
+            mv,
+            ma,
+            ku,
+            sd,
+            y,
+            pred,
+            q,
+            lambda,
+            lambda_prev,
+            lcp,
+            fric,
+            newton_max,
+            iterations,
+            gaps,
+            force_vec,
+            ..
+        } = self;
+        let g = &**geo;
+        let gaps: &[f64] = gaps;
+        let force_vec: &[f64] = force_vec;
+        let f = fac.as_deref().expect("implicit methods have a factor");
+        let work = work.as_mut().expect("implicit methods have solve scratch");
+        let (km, kf) = ga.history_coefficients(tau);
+        let kp = t2 * (0.5 - ga.beta);
+        let bt2 = ga.beta * t2;
+        for i in 0..n {
+            pred[i] = u[i] + tau * v[i] + kp * a[i];
+            y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+        }
+        add_rows(&g.contact, &lambda_prev, kf, y);
+        if let Some(fr) = fric.as_ref() {
+            fr.add_previous_tangential(kf, y);
+        }
+        sd.copy_from_slice(&y);
+        f.chol.solve_in_place(y, work);
+        work.check()
+            .map_err(|e| Stop::Solver(step, e.to_string()))?;
+        let it = if let Some(fr) = fric.as_mut() {
+            // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
+            fr.set_free(&y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
+            let it = fr
+                .solve(c, false, y, sd, lambda)
+                .map_err(|e| Stop::Solver(step, e))?;
+            fr.take_forces(1.0);
+            it
+        } else {
+            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(gaps) {
+                *qi = y[ci] + gi;
+            }
+            let it = lcp
+                .solve(&q, lambda, LCP_MAX_ITER, LCP_TOL)
+                .map_err(|e| Stop::Solver(step, e.to_string()))?;
+            add_columns(&f.z, &lambda, c, y);
+            add_rows(&g.contact, &lambda, c, sd);
+            it
+        };
+        *newton_max = (*newton_max).max(it);
+        *iterations += it as i64;
+        lambda_prev.copy_from_slice(&lambda);
+        // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
+        // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
+        std::mem::swap(u, y);
+        g.k.matvec_into(&u, ku);
+        let g1 = 1.0 - ga.gamma;
+        for i in 0..n {
+            let an = (u[i] - pred[i]) / bt2;
+            let mpred = mu[i] + tau * mv[i] + kp * ma[i];
+            let mun = sd[i] - c * ku[i];
+            let man = (mun - mpred) / bt2;
+            v[i] += tau * (g1 * a[i] + ga.gamma * an);
+            mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+            a[i] = an;
+            ma[i] = man;
+            mu[i] = mun;
+        }
+        Ok(lambda.iter().sum::<f64>())
+    }
+}
