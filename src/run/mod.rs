@@ -18,6 +18,7 @@ pub mod oscillator;
 pub mod record;
 pub mod reference;
 mod spec;
+mod stepping;
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
