@@ -38,8 +38,9 @@
 
 use std::time::Instant;
 
-use super::observe::{Divergence, ExactValues, Observer, SampledTimer, StepValues};
-use super::{Metrics, Outcome, RunOptions, Series, Status, Stop};
+use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::stepping::{Clock, LoopEnd, failed, finished, time_loop};
+use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::friction;
 use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{BarExact, BarParams};
@@ -137,7 +138,7 @@ fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
 
 /// The contact node of a tangential chain (the layer's S-wave chain, SPEC §1.7): held by the
 /// friction law instead of the obstacle. Before each step the layer's driver
-/// ([`super::layer1d`]) sets the bound b of the step (from the normal chain's force of the same
+/// (the layer1d engine) sets the bound b of the step (from the normal chain's force of the same
 /// step) and the slip's reference value: the step's scalar s is then u₀^{n+1} (position-level
 /// schemes, s_ref = u₀ⁿ) or v₀^{n+1} + e v₀ⁿ (Moreau–Jean, s_ref = e v₀ⁿ), and the slip is
 /// s − s_ref. `kappa` is the penalty's tangential stiffness (f_t = proj_[−b,b](−κ·slip)).
@@ -596,43 +597,9 @@ impl Engine {
     #[inline(never)]
     fn step_comparison(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
         let tau = self.tau;
-        let m = self.sp.m;
-        let sp = &self.sp;
         let s_n = self.p.dot(&st.u) + self.p0;
         let phi = match self.scheme {
-            _ if self.kinematic => {
-                // v^{n+½} = vⁿ + τ/2 aⁿ, u^{n+1} = uⁿ + τ v^{n+½}, the contact node put back on
-                // the obstacle by an impulse on v^{n+½}; a^{n+1} = M⁻¹(−K u^{n+1}).
-                for i in 0..m {
-                    st.v[i] += 0.5 * tau * st.a[i];
-                    st.u[i] += tau * st.v[i];
-                }
-                let (u0, dv, lambda) = match &self.tangential {
-                    None => {
-                        crate::time::kinematic_impulse(st.u[0], -sp.bar.gap, sp.mass.diag[0], tau)
-                    }
-                    // Kinematic friction: the tangential impulse that stops the node's slip
-                    // increment, limited by the bound (μ_f times the normal impulse's force).
-                    Some(t) => {
-                        let m0 = sp.mass.diag[0];
-                        let s_ref = t.s_ref.get();
-                        let (f_t, slip, _) = friction::solve_tangential(
-                            st.u[0] - s_ref,
-                            tau * tau / m0,
-                            t.bound.get(),
-                        );
-                        (s_ref + slip, tau * f_t / m0, f_t)
-                    }
-                };
-                st.u[0] = u0;
-                st.v[0] += dv;
-                self.acceleration_into(&st.u, 0.0, &mut st.a);
-                for i in 0..m {
-                    st.v[i] += 0.5 * tau * st.a[i];
-                }
-                // λ ≥ 0 pushes the node up: φ = −λ with the force φ q, q = −e₀.
-                -lambda
-            }
+            _ if self.kinematic => self.kinematic_step(st),
             Scheme::Kane => {
                 // A massless node keeps SPEC §3.2's formula as written: its row of S Δu is
                 // (τ²/4)(K Δu)₀ = −(τ²/2)(K uⁿ)₀ + (τ²/2)φq₀, i.e. (K u^{n+½})₀ = φq₀ — quasi-static
@@ -645,115 +612,190 @@ impl Engine {
                 self.finish_increment(st, wk, tau);
                 phi
             }
-            Scheme::DiscreteGradient => {
-                self.increment_rhs(st, wk);
-                self.a_lu.solve_in_place(&mut wk.b);
-                std::mem::swap(&mut wk.b, &mut wk.y);
-                let s_free = self.p.dot(&wk.y) + s_n;
-                let sol = gradient::solve(self.potential_stiffness(), s_n, s_free, self.w)?;
-                self.extra_iterations
-                    .set(self.extra_iterations.get() + sol.iterations.max(1) as i64 - 1);
-                // The force −D p enters as φ q̃ with q = p (penalty; Nitsche with Θ = 1).
-                let phi = -sol.d;
-                if phi != 0.0 {
-                    for (y, z) in wk.y.iter_mut().zip(&self.z) {
-                        *y += phi * z;
-                    }
-                }
-                self.finish_increment(st, wk, tau);
-                phi
-            }
-            Scheme::ContactStabilizedNewmark => {
-                // Predictor: the M-projection of uⁿ + τvⁿ onto the admissible set.
-                for i in 0..m {
-                    wk.pred[i] = st.u[i] + tau * st.v[i];
-                }
-                let s_free = self.p.dot(&wk.pred) + self.p0;
-                // The admissible set constrains the normal rows only: a tangential chain's
-                // predictor is the free flight.
-                let pred = match self.tangential {
-                    None => contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?,
-                    Some(_) => contact::ContactSolution {
-                        s: s_free,
-                        phi: 0.0,
-                    },
-                };
-                self.extra_iterations.set(self.extra_iterations.get() + 1);
-                if pred.phi != 0.0 {
-                    for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
-                        *x += pred.phi * z;
-                    }
-                }
-                // kane from u^pred: S Δ = −τ²/4 K(uⁿ + u^pred) + τ²/2 φ q, Δ = u^{n+1} − u^pred.
-                for i in 0..m {
-                    wk.y[i] = st.u[i] + wk.pred[i];
-                }
-                self.klin.mul_into(&wk.y, &mut wk.b);
-                let c = 0.25 * tau * tau;
-                for b in wk.b.iter_mut() {
-                    *b *= -c;
-                }
-                let s_pred = self.p.dot(&wk.pred) + self.p0;
-                let (_, phi) = self.solve_step(wk, &ContactLaw::Complementarity, s_pred)?;
-                for i in 0..m {
-                    st.v[i] += 2.0 * wk.y[i] / tau;
-                    st.u[i] = wk.pred[i] + wk.y[i];
-                }
-                phi
-            }
-            Scheme::GeneralizedAlpha(ga @ GeneralizedAlphaParams { beta, gamma, .. }) => {
-                // ũ = uⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (u^{n+1} − ũ)/(βτ²); the equation at
-                // t^{n+1−α} times βτ²/(1−α_m):
-                // (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f φⁿ q + c φ^{n+1} q.
-                let bt2 = beta * tau * tau;
-                let kp = tau * tau * (0.5 - beta);
-                let (km, kf) = ga.history_coefficients(tau);
-                gen_alpha_rhs_into(
-                    &sp.mass,
-                    &self.klin,
-                    st,
-                    (tau, kp, km, kf),
-                    (&mut wk.pred, &mut wk.y, &mut wk.b),
-                );
-                wk.b[0] += kf * st.phi_prev * sp.q.0[0];
-                wk.b[1] += kf * st.phi_prev * sp.q.0[1];
-                let (_, phi) = self.solve_step(wk, &self.state_law(), self.p0)?;
-                let ib = 1.0 / bt2;
-                for i in 0..m {
-                    let an = (wk.y[i] - wk.pred[i]) * ib;
-                    st.v[i] += tau * ((1.0 - gamma) * st.a[i] + gamma * an);
-                    st.a[i] = an;
-                }
-                std::mem::swap(&mut st.u, &mut wk.y);
-                phi
-            }
-            Scheme::MoreauJean(MoreauJeanParams { theta, restitution }) => {
-                // (M + θ²τ²K)Δv = −τK(uⁿ + θτvⁿ) + Bᵀp; the contact row is active when its
-                // predicted gap (Buⁿ + g) + ½τ Bvⁿ closes, and then 0 ≤ p ⊥ Bv^{n+1} + e Bvⁿ ≥ 0.
-                for i in 0..m {
-                    wk.y[i] = st.u[i] + theta * tau * st.v[i];
-                }
-                self.klin.mul_into(&wk.y, &mut wk.b);
-                for b in wk.b.iter_mut() {
-                    *b *= -tau;
-                }
-                let vn = self.p.dot(&st.v);
-                let law = if s_n + 0.5 * tau * vn <= 0.0 {
-                    ContactLaw::Complementarity
-                } else {
-                    ContactLaw::PositivePart { k: 0.0 }
-                };
-                let (_, phi) = self.solve_step(wk, &law, (1.0 + restitution) * vn)?;
-                for i in 0..m {
-                    st.u[i] += tau * (st.v[i] + theta * wk.y[i]);
-                    st.v[i] += wk.y[i];
-                }
-                phi
-            }
+            Scheme::DiscreteGradient => self.discrete_gradient_step(st, wk, s_n)?,
+            Scheme::ContactStabilizedNewmark => self.stabilized_step(st, wk)?,
+            Scheme::GeneralizedAlpha(ga) => self.gen_alpha_step(st, wk, ga)?,
+            Scheme::MoreauJean(mj) => self.moreau_jean_step(st, wk, s_n, mj)?,
             _ => unreachable!("not a SPEC §3.2 method"),
         };
         st.s_prev = self.p.dot(&st.u) + self.p0;
         st.phi_prev = phi;
+        Ok(phi)
+    }
+
+    /// Central difference with `mixed` and a diagonal mass: the contact node put back on the
+    /// obstacle (or held by friction) by an impulse on the half-step velocity; returns φ.
+    fn kinematic_step(&self, st: &mut State) -> f64 {
+        let tau = self.tau;
+        let m = self.sp.m;
+        let sp = &self.sp;
+        // v^{n+½} = vⁿ + τ/2 aⁿ, u^{n+1} = uⁿ + τ v^{n+½}, the contact node put back on
+        // the obstacle by an impulse on v^{n+½}; a^{n+1} = M⁻¹(−K u^{n+1}).
+        for i in 0..m {
+            st.v[i] += 0.5 * tau * st.a[i];
+            st.u[i] += tau * st.v[i];
+        }
+        let (u0, dv, lambda) = match &self.tangential {
+            None => crate::time::kinematic_impulse(st.u[0], -sp.bar.gap, sp.mass.diag[0], tau),
+            // Kinematic friction: the tangential impulse that stops the node's slip
+            // increment, limited by the bound (μ_f times the normal impulse's force).
+            Some(t) => {
+                let m0 = sp.mass.diag[0];
+                let s_ref = t.s_ref.get();
+                let (f_t, slip, _) =
+                    friction::solve_tangential(st.u[0] - s_ref, tau * tau / m0, t.bound.get());
+                (s_ref + slip, tau * f_t / m0, f_t)
+            }
+        };
+        st.u[0] = u0;
+        st.v[0] += dv;
+        self.acceleration_into(&st.u, 0.0, &mut st.a);
+        for i in 0..m {
+            st.v[i] += 0.5 * tau * st.a[i];
+        }
+        // λ ≥ 0 pushes the node up: φ = −λ with the force φ q, q = −e₀.
+        -lambda
+    }
+
+    /// The discrete gradient's step: kane's increment with φ = −D(sⁿ, s^{n+1}), the difference
+    /// quotient of the contact potential (a Newton iteration); returns φ.
+    fn discrete_gradient_step(
+        &self,
+        st: &mut State,
+        wk: &mut Work,
+        s_n: f64,
+    ) -> Result<f64, ContactSolveError> {
+        let tau = self.tau;
+        self.increment_rhs(st, wk);
+        self.a_lu.solve_in_place(&mut wk.b);
+        std::mem::swap(&mut wk.b, &mut wk.y);
+        let s_free = self.p.dot(&wk.y) + s_n;
+        let sol = gradient::solve(self.potential_stiffness(), s_n, s_free, self.w)?;
+        self.extra_iterations
+            .set(self.extra_iterations.get() + sol.iterations.max(1) as i64 - 1);
+        // The force −D p enters as φ q̃ with q = p (penalty; Nitsche with Θ = 1).
+        let phi = -sol.d;
+        if phi != 0.0 {
+            for (y, z) in wk.y.iter_mut().zip(&self.z) {
+                *y += phi * z;
+            }
+        }
+        self.finish_increment(st, wk, tau);
+        Ok(phi)
+    }
+
+    /// Contact-stabilized Newmark's step: the M-projection of the free flight, then kane from
+    /// the projected predictor; returns φ.
+    fn stabilized_step(&self, st: &mut State, wk: &mut Work) -> Result<f64, ContactSolveError> {
+        let tau = self.tau;
+        let m = self.sp.m;
+        // Predictor: the M-projection of uⁿ + τvⁿ onto the admissible set.
+        for i in 0..m {
+            wk.pred[i] = st.u[i] + tau * st.v[i];
+        }
+        let s_free = self.p.dot(&wk.pred) + self.p0;
+        // The admissible set constrains the normal rows only: a tangential chain's
+        // predictor is the free flight.
+        let pred = match self.tangential {
+            None => contact::solve(&ContactLaw::Complementarity, s_free, self.wm)?,
+            Some(_) => contact::ContactSolution {
+                s: s_free,
+                phi: 0.0,
+            },
+        };
+        self.extra_iterations.set(self.extra_iterations.get() + 1);
+        if pred.phi != 0.0 {
+            for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
+                *x += pred.phi * z;
+            }
+        }
+        // kane from u^pred: S Δ = −τ²/4 K(uⁿ + u^pred) + τ²/2 φ q, Δ = u^{n+1} − u^pred.
+        for i in 0..m {
+            wk.y[i] = st.u[i] + wk.pred[i];
+        }
+        self.klin.mul_into(&wk.y, &mut wk.b);
+        let c = 0.25 * tau * tau;
+        for b in wk.b.iter_mut() {
+            *b *= -c;
+        }
+        let s_pred = self.p.dot(&wk.pred) + self.p0;
+        let (_, phi) = self.solve_step(wk, &ContactLaw::Complementarity, s_pred)?;
+        for i in 0..m {
+            st.v[i] += 2.0 * wk.y[i] / tau;
+            st.u[i] = wk.pred[i] + wk.y[i];
+        }
+        Ok(phi)
+    }
+
+    /// Generalized-α's (and HHT's) step at t^{n+1−α}, carrying the previous contact force;
+    /// returns φ^{n+1}.
+    fn gen_alpha_step(
+        &self,
+        st: &mut State,
+        wk: &mut Work,
+        ga: GeneralizedAlphaParams,
+    ) -> Result<f64, ContactSolveError> {
+        let GeneralizedAlphaParams { beta, gamma, .. } = ga;
+        let tau = self.tau;
+        let m = self.sp.m;
+        let sp = &self.sp;
+        // ũ = uⁿ + τvⁿ + τ²(½ − β)aⁿ, a^{n+1} = (u^{n+1} − ũ)/(βτ²); the equation at
+        // t^{n+1−α} times βτ²/(1−α_m):
+        // (M + cK)u^{n+1} = M(ũ − κ_m aⁿ) − κ_f K uⁿ + κ_f φⁿ q + c φ^{n+1} q.
+        let bt2 = beta * tau * tau;
+        let kp = tau * tau * (0.5 - beta);
+        let (km, kf) = ga.history_coefficients(tau);
+        gen_alpha_rhs_into(
+            &sp.mass,
+            &self.klin,
+            st,
+            (tau, kp, km, kf),
+            (&mut wk.pred, &mut wk.y, &mut wk.b),
+        );
+        wk.b[0] += kf * st.phi_prev * sp.q.0[0];
+        wk.b[1] += kf * st.phi_prev * sp.q.0[1];
+        let (_, phi) = self.solve_step(wk, &self.state_law(), self.p0)?;
+        let ib = 1.0 / bt2;
+        for i in 0..m {
+            let an = (wk.y[i] - wk.pred[i]) * ib;
+            st.v[i] += tau * ((1.0 - gamma) * st.a[i] + gamma * an);
+            st.a[i] = an;
+        }
+        std::mem::swap(&mut st.u, &mut wk.y);
+        Ok(phi)
+    }
+
+    /// Moreau–Jean's step on Δv, the contact row active when the predicted gap closes;
+    /// returns the impulse p^{n+1}.
+    fn moreau_jean_step(
+        &self,
+        st: &mut State,
+        wk: &mut Work,
+        s_n: f64,
+        MoreauJeanParams { theta, restitution }: MoreauJeanParams,
+    ) -> Result<f64, ContactSolveError> {
+        let tau = self.tau;
+        let m = self.sp.m;
+        // (M + θ²τ²K)Δv = −τK(uⁿ + θτvⁿ) + Bᵀp; the contact row is active when its
+        // predicted gap (Buⁿ + g) + ½τ Bvⁿ closes, and then 0 ≤ p ⊥ Bv^{n+1} + e Bvⁿ ≥ 0.
+        for i in 0..m {
+            wk.y[i] = st.u[i] + theta * tau * st.v[i];
+        }
+        self.klin.mul_into(&wk.y, &mut wk.b);
+        for b in wk.b.iter_mut() {
+            *b *= -tau;
+        }
+        let vn = self.p.dot(&st.v);
+        let law = if s_n + 0.5 * tau * vn <= 0.0 {
+            ContactLaw::Complementarity
+        } else {
+            ContactLaw::PositivePart { k: 0.0 }
+        };
+        let (_, phi) = self.solve_step(wk, &law, (1.0 + restitution) * vn)?;
+        for i in 0..m {
+            st.u[i] += tau * (st.v[i] + theta * wk.y[i]);
+            st.v[i] += wk.y[i];
+        }
         Ok(phi)
     }
 
@@ -907,44 +949,22 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         length_scale: Some(cfg.bar.length),
         ..Metrics::default()
     };
-    let fail = |status, msg: String, metrics: Metrics| Outcome {
-        status,
-        message: Some(msg),
-        metrics,
-        series: Series::default(),
-        reference: None,
-    };
     let sp = match Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method) {
         Ok(sp) => sp,
-        Err(e) => return fail(Status::Invalid, e.to_string(), metrics),
+        Err(e) => return failed(Status::Invalid, e.to_string(), metrics),
     };
     metrics.mass_total = Some(sp.mass_total);
     if let Some((status, msg)) = opts.setup_stop(start, "the operators") {
-        return fail(status, msg, metrics);
+        return failed(status, msg, metrics);
     }
     let tau = cfg.dt;
-    let (eng, starter) = match cfg.scheme {
-        Scheme::PaoliSchatzman(ps) => {
-            let nm = Scheme::Newmark(NewmarkParams {
-                beta: ps.beta,
-                gamma: 0.5,
-            });
-            match (
-                Engine::new(sp.clone(), cfg.scheme, tau),
-                Engine::new(sp.clone(), nm, tau),
-            ) {
-                (Ok(a), Ok(b)) => (a, Some(b)),
-                (Err(e), _) | (_, Err(e)) => return fail(Status::SolverFailed, e, metrics),
-            }
-        }
-        _ => match Engine::new(sp.clone(), cfg.scheme, tau) {
-            Ok(e) => (e, None),
-            Err(e) => return fail(Status::SolverFailed, e, metrics),
-        },
+    let (eng, starter) = match engines(&sp, cfg.scheme, tau) {
+        Ok(x) => x,
+        Err(e) => return failed(Status::SolverFailed, e, metrics),
     };
     metrics.factorizations = eng.factorizations + starter.as_ref().map_or(0, |s| s.factorizations);
     if let Some((status, msg)) = opts.setup_stop(start, "the factorisation") {
-        return fail(status, msg, metrics);
+        return failed(status, msg, metrics);
     }
     let m = sp.m;
     let mut wk = Work {
@@ -965,93 +985,128 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         Ok(x) => x,
         Err(e) => {
             metrics.solver_failures = 1;
-            return fail(
+            return failed(
                 Status::SolverFailed,
                 format!("initial state (t = 0): {e}"),
                 metrics,
             );
         }
     };
-    let interrupted = |n: usize| opts.step_stop::<ContactSolveError>(n, CLOCK_EVERY, start);
-    let mut done = 0usize;
-    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
-    let loop_start = Instant::now();
-    let mut observe_timer = SampledTimer::default();
-    let stop = (|| -> Result<(), Stop<ContactSolveError>> {
-        rec.record(0, &st.u, &st.v, sigma0)
-            .map_err(Stop::Diverged)?;
-        match &starter {
-            None => {
-                for n in 1..=cfg.steps {
-                    let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(n, e))?;
-                    metrics.iterations += 1;
-                    let sigma = eng.sigma(&st.u, phi);
-                    observe_timer
-                        .time(n, || rec.record(n, &st.u, &st.v, sigma))
-                        .map_err(Stop::Diverged)?;
-                    done = n;
-                    interrupted(n)?;
-                }
+    let steps = cfg.steps;
+    let end = time_loop(
+        opts,
+        start,
+        (CLOCK_EVERY, tau, steps),
+        &mut metrics,
+        |clock, metrics| {
+            rec.record(0, &st.u, &st.v, sigma0)
+                .map_err(Stop::Diverged)?;
+            let mut run = LoopParts {
+                st: &mut st,
+                wk: &mut wk,
+                rec: &mut rec,
+                clock,
+                metrics,
+            };
+            match &starter {
+                None => run.one_step(&eng, steps),
+                Some(first) => run.paoli_schatzman(&eng, first, steps),
             }
-            Some(first) => {
-                // U¹ from Newmark(β, ½); then U^{n+1} from (U^n, U^{n−1}) and v^n centred.
-                let mut prev = st.u.clone();
-                first
-                    .step(&mut st, &mut wk)
-                    .map_err(|e| Stop::Solver(1, e))?;
-                metrics.iterations += 1;
-                let mut vn = vec![0.0; m];
-                let Scheme::PaoliSchatzman(ps) = cfg.scheme else {
-                    unreachable!()
-                };
-                let e = ps.restitution;
-                for n in 1..=cfg.steps {
-                    // b = M(2Uⁿ − Uⁿ⁻¹) − τ²K((1−2β)Uⁿ + βUⁿ⁻¹)
-                    for i in 0..m {
-                        wk.pred[i] = 2.0 * st.u[i] - prev[i];
-                        vn[i] = (1.0 - 2.0 * ps.beta) * st.u[i] + ps.beta * prev[i];
-                    }
-                    eng.sp.mass.mul_into(&wk.pred, &mut wk.b);
-                    eng.klin.mul_into(&vn, &mut wk.y);
-                    for i in 0..m {
-                        wk.b[i] -= tau * tau * wk.y[i];
-                    }
-                    if eng.sp.massless_contact {
-                        wk.b[0] = 0.0;
-                    }
-                    let p0 = e * prev[0] / (1.0 + e) + eng.sp.bar.gap;
-                    let (_, lambda) = eng
-                        .solve_step(&mut wk, &ContactLaw::Complementarity, p0)
-                        .map_err(|err| Stop::Solver(n, err))?;
-                    metrics.iterations += 1;
-                    // wk.y = U^{n+1}; v^n = (U^{n+1} − U^{n−1}) / 2τ
-                    for i in 0..m {
-                        vn[i] = (wk.y[i] - prev[i]) / (2.0 * tau);
-                    }
-                    observe_timer
-                        .time(n, || rec.record(n, &st.u, &vn, lambda))
-                        .map_err(Stop::Diverged)?;
-                    done = n;
-                    std::mem::swap(&mut prev, &mut st.u);
-                    std::mem::swap(&mut st.u, &mut wk.y);
-                    interrupted(n)?;
-                }
+        },
+    );
+    metrics.iterations += eng.extra_iterations.get();
+    rec.obs.finish(&mut metrics, end.status == Status::Ok);
+    metrics.exit_velocity = rec.exit_velocity;
+    finished(end.status, end.message, metrics, &mut rec.obs)
+}
+
+/// The run's engine and, for Paoli–Schatzman, the Newmark(β, ½) engine of its first step.
+fn engines(sp: &Bar1dSpace, scheme: Scheme, tau: f64) -> Result<(Engine, Option<Engine>), String> {
+    match scheme {
+        Scheme::PaoliSchatzman(ps) => {
+            let nm = Scheme::Newmark(NewmarkParams {
+                beta: ps.beta,
+                gamma: 0.5,
+            });
+            match (
+                Engine::new(sp.clone(), scheme, tau),
+                Engine::new(sp.clone(), nm, tau),
+            ) {
+                (Ok(a), Ok(b)) => Ok((a, Some(b))),
+                (Err(e), _) | (_, Err(e)) => Err(e),
             }
         }
+        _ => Engine::new(sp.clone(), scheme, tau).map(|e| (e, None)),
+    }
+}
+
+/// What the time loop steps and observes, once the initial state is recorded.
+struct LoopParts<'l, 'r, 'c, 'o> {
+    st: &'l mut State,
+    wk: &'l mut Work,
+    rec: &'l mut Recorder<'r>,
+    clock: &'l mut Clock<'c>,
+    metrics: &'o mut Metrics,
+}
+
+impl LoopParts<'_, '_, '_, '_> {
+    /// Steps 1…`steps` of a one-step scheme.
+    fn one_step(&mut self, eng: &Engine, steps: usize) -> LoopEnd {
+        let (st, rec) = (&mut *self.st, &mut *self.rec);
+        for n in 1..=steps {
+            let phi = eng.step(st, self.wk).map_err(|e| Stop::Solver(n, e))?;
+            self.metrics.iterations += 1;
+            let sigma = eng.sigma(&st.u, phi);
+            self.clock
+                .observe(n, || rec.record(n, &st.u, &st.v, sigma))?;
+            self.clock.completed(n)?;
+        }
         Ok(())
-    })();
-    metrics.steps = done as i64;
-    metrics.iterations += eng.extra_iterations.get();
-    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
-    metrics.observe_time_s = observe_timer.estimate_s();
-    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
-    rec.obs.finish(&mut metrics, status == Status::Ok);
-    metrics.exit_velocity = rec.exit_velocity;
-    Outcome {
-        status,
-        message,
-        metrics,
-        series: std::mem::take(&mut rec.obs.series),
-        reference: None,
+    }
+
+    /// Paoli–Schatzman's two-step loop: U¹ from Newmark(β, ½) (`first`); then U^{n+1} from
+    /// (U^n, U^{n−1}) and v^n centred, step n recorded once U^{n+1} is known.
+    fn paoli_schatzman(&mut self, eng: &Engine, first: &Engine, steps: usize) -> LoopEnd {
+        let (st, wk, rec) = (&mut *self.st, &mut *self.wk, &mut *self.rec);
+        let m = eng.sp.m;
+        let tau = eng.tau;
+        let mut prev = st.u.clone();
+        first.step(st, wk).map_err(|e| Stop::Solver(1, e))?;
+        self.metrics.iterations += 1;
+        let mut vn = vec![0.0; m];
+        let Scheme::PaoliSchatzman(ps) = eng.scheme else {
+            unreachable!()
+        };
+        let e = ps.restitution;
+        for n in 1..=steps {
+            // b = M(2Uⁿ − Uⁿ⁻¹) − τ²K((1−2β)Uⁿ + βUⁿ⁻¹)
+            for i in 0..m {
+                wk.pred[i] = 2.0 * st.u[i] - prev[i];
+                vn[i] = (1.0 - 2.0 * ps.beta) * st.u[i] + ps.beta * prev[i];
+            }
+            eng.sp.mass.mul_into(&wk.pred, &mut wk.b);
+            eng.klin.mul_into(&vn, &mut wk.y);
+            for i in 0..m {
+                wk.b[i] -= tau * tau * wk.y[i];
+            }
+            if eng.sp.massless_contact {
+                wk.b[0] = 0.0;
+            }
+            let p0 = e * prev[0] / (1.0 + e) + eng.sp.bar.gap;
+            let (_, lambda) = eng
+                .solve_step(wk, &ContactLaw::Complementarity, p0)
+                .map_err(|err| Stop::Solver(n, err))?;
+            self.metrics.iterations += 1;
+            // wk.y = U^{n+1}; v^n = (U^{n+1} − U^{n−1}) / 2τ
+            for i in 0..m {
+                vn[i] = (wk.y[i] - prev[i]) / (2.0 * tau);
+            }
+            self.clock
+                .observe(n, || rec.record(n, &st.u, &vn, lambda))?;
+            std::mem::swap(&mut prev, &mut st.u);
+            std::mem::swap(&mut st.u, &mut wk.y);
+            self.clock.completed(n)?;
+        }
+        Ok(())
     }
 }

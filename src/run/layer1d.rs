@@ -25,9 +25,11 @@
 use std::time::Instant;
 
 use super::bar1d::{self, Bar1dConfig, Engine, State, Tangential, Work};
-use super::observe::{ExactValues, Observer, SampledTimer, StepValues};
-use super::{Metrics, Outcome, RunOptions, Series, Status, Stop};
+use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::stepping::{failed, finished, time_loop};
+use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::ContactSolveError;
+use crate::contact::friction::FrictionLaw;
 use crate::scene::{BarParams, LayerExact, LayerParams};
 use crate::space::{Bar1dSpace, ContactInit, ContactMethod, MassVariant};
 use crate::time::{NewmarkParams, Scheme};
@@ -226,16 +228,81 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
         length_scale: Some(cfg.layer.height),
         ..Metrics::default()
     };
-    let mut stats = FrictionStats::default();
-    let fail = |status, msg: String, metrics: Metrics| Outcome {
-        status,
-        message: Some(msg),
-        metrics,
-        series: Series::default(),
-        reference: None,
-    };
     let law = cfg.layer.friction;
     let tau = cfg.dt;
+    let (mut normal, sigma0, mut tang) = match chains(cfg) {
+        Ok(c) => c,
+        Err(e) => {
+            return (
+                failed(Status::SolverFailed, e, metrics),
+                FrictionStats::default(),
+            );
+        }
+    };
+    metrics.mass_total = normal.eng.space().mass_total.into();
+    metrics.factorizations = 4;
+    if let Some((status, msg)) = opts.setup_stop(start, "the operators") {
+        return (failed(status, msg, metrics), FrictionStats::default());
+    }
+    let view = View {
+        exact: cfg.layer.exact(),
+        tau,
+        h: normal.eng.space().h,
+        gap: cfg.layer.gap,
+    };
+    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
+    let e0 = normal.energy() + tang.energy();
+    let scale = e0;
+    obs = obs.with_energy_scale(scale);
+    let mut acc = Account::new(cfg, &view, e0);
+    let end = time_loop(
+        opts,
+        start,
+        (CLOCK_EVERY, tau, cfg.steps),
+        &mut metrics,
+        |clock, metrics| {
+            obs.set_friction(0.0, tang.st.v[0], 0.0);
+            view.record(&mut obs, 0, &normal, &tang, sigma0)
+                .map_err(Stop::Diverged)?;
+            for n in 1..=cfg.steps {
+                let (sigma_n, sigma_t) = acc.step(n, &mut normal, &mut tang, &view)?;
+                metrics.iterations += 1;
+                obs.set_friction(sigma_t, tang.st.v[0], acc.work);
+                clock.observe(n, || view.record(&mut obs, n, &normal, &tang, sigma_n))?;
+                let balance = normal.energy() + tang.energy() + acc.work;
+                acc.max_inc = acc.max_inc.max((balance - acc.balance_prev) / scale);
+                acc.balance_prev = balance;
+                clock.completed(n)?;
+            }
+            Ok(())
+        },
+    );
+    metrics.iterations += normal.eng.extra_iterations() + tang.eng.extra_iterations();
+    obs.finish(&mut metrics, end.status == Status::Ok);
+    metrics.energy_scale = Some(scale);
+    let stats = acc.stats(end.done, &normal, &tang, &view);
+    metrics.exit_velocity = Some(stats.normal_velocity_final);
+    metrics.tangential_velocity_final = Some(stats.tangential_velocity_final);
+    metrics.normal_velocity_final = Some(stats.normal_velocity_final);
+    if end.status == Status::Ok {
+        metrics.err_sigma_t_l2 = stats.err_sigma_t_l2;
+        metrics.err_vt_final = stats.err_vt_final;
+    }
+    // The friction columns belong to a friction law (null for `none`, SPEC §5).
+    if !law.is_none() {
+        metrics.friction_work = Some(stats.friction_work);
+        metrics.energy_balance_drift = Some(stats.energy_balance_drift);
+        metrics.energy_balance_max_increase = Some(stats.energy_balance_max_increase);
+        metrics.stick_steps = Some(stats.stick_steps);
+        metrics.slip_steps = Some(stats.slip_steps);
+        metrics.friction_ratio_max = stats.friction_ratio_max;
+    }
+    (finished(end.status, end.message, metrics, &mut obs), stats)
+}
+
+/// The two chains (the normal one with its σ_C⁰): the tangential chain's contact node held by
+/// the friction law, with the penalty's tangential stiffness κ = (λ + 2μ)γ0/h.
+fn chains(cfg: &Layer1dConfig) -> Result<(Chain, f64, Chain), String> {
     let kappa = match cfg.method {
         ContactMethod::Penalty { gamma0 } => {
             Some(cfg.layer.p_modulus() * gamma0 * cfg.elements as f64 / cfg.layer.height)
@@ -243,41 +310,39 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
         _ => None,
     };
     let normal_cfg = cfg.normal_chain();
-    let (mut normal, sigma0) = match Chain::new(&normal_cfg, None) {
-        Ok(c) => c,
-        Err(e) => return (fail(Status::SolverFailed, e, metrics), stats),
-    };
+    let (normal, sigma0) = Chain::new(&normal_cfg, None)?;
     let tangential_cfg = cfg.tangential_chain();
     let hook = Tangential {
         kappa,
         ..Tangential::default()
     };
-    let (mut tang, _) = match Chain::new(&tangential_cfg, Some(hook)) {
-        Ok(c) => c,
-        Err(e) => return (fail(Status::SolverFailed, e, metrics), stats),
-    };
-    metrics.mass_total = normal.eng.space().mass_total.into();
-    metrics.factorizations = 4;
-    if let Some((status, msg)) = opts.setup_stop(start, "the operators") {
-        return (fail(status, msg, metrics), stats);
-    }
-    let exact: Option<LayerExact> = cfg.layer.exact();
-    let h = normal.eng.space().h;
-    let moreau = matches!(cfg.scheme, Scheme::MoreauJean(_));
-    let restitution = match cfg.scheme {
-        Scheme::MoreauJean(p) => p.restitution,
-        _ => 0.0,
-    };
-    let weight = work_weight(cfg);
-    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
-    let e0 = normal.energy() + tang.energy();
-    let scale = e0;
-    obs = obs.with_energy_scale(scale);
-    let observe = |obs: &mut Observer, step: usize, n: &Chain, t: &Chain, sigma: f64| {
-        let time = step as f64 * tau;
+    let (tang, _) = Chain::new(&tangential_cfg, Some(hook))?;
+    Ok((normal, sigma0, tang))
+}
+
+/// What the observation of a step needs besides the chains: the exact solution, τ, h, g.
+struct View {
+    exact: Option<LayerExact>,
+    tau: f64,
+    h: f64,
+    gap: f64,
+}
+
+impl View {
+    /// Observe step `step`: the normal chain's contact node and σ_C, the energy of both
+    /// chains, the errors of the 2-vector field.
+    fn record(
+        &self,
+        obs: &mut Observer,
+        step: usize,
+        n: &Chain,
+        t: &Chain,
+        sigma: f64,
+    ) -> Result<(), Divergence> {
+        let time = step as f64 * self.tau;
         let energy = n.energy() + t.energy();
-        let ex = exact.map(|ex| {
-            let (l2_sq, h1_semi_sq) = ex.error_sq(&n.st.u, &t.st.u, h, time);
+        let ex = self.exact.map(|ex| {
+            let (l2_sq, h1_semi_sq) = ex.error_sq(&n.st.u, &t.st.u, self.h, time);
             ExactValues {
                 u_contact: ex.w(0.0, time),
                 sigma_contact: ex.base_sigma_n(time),
@@ -301,140 +366,149 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
                 energy_elastic: None,
                 energy_gravity: None,
                 u_lowest: None,
-                penetration: Some((-n.st.u[0] - cfg.layer.gap).max(0.0)),
+                penetration: Some((-n.st.u[0] - self.gap).max(0.0)),
             },
             ex,
         )
-    };
-    // The tangential force of the state (a force, impulses over τ) and W_f.
-    let mut f_t_prev = 0.0;
-    let mut work = 0.0;
-    let mut balance_prev = e0;
-    let mut max_inc = f64::NEG_INFINITY;
-    let mut min_tw = f64::INFINITY;
-    let (mut sum_st, mut ratio_max) = (0.0, None::<f64>);
-    if let Some(ex) = &exact {
-        // The layer starts with no tangential force: σ_t,h⁰ = 0.
-        let d = ex.base_sigma_t(0.0);
-        sum_st += d * d;
     }
-    let interrupted = |n: usize| opts.step_stop::<ContactSolveError>(n, CLOCK_EVERY, start);
-    let mut done = 0usize;
-    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
-    let loop_start = Instant::now();
-    let mut observe_timer = SampledTimer::default();
-    let stop = (|| -> Result<(), Stop<ContactSolveError>> {
-        obs.set_friction(0.0, tang.st.v[0], 0.0);
-        observe(&mut obs, 0, &normal, &tang, sigma0).map_err(Stop::Diverged)?;
-        for n in 1..=cfg.steps {
-            let phi_n = normal
-                .eng
-                .step(&mut normal.st, &mut normal.wk)
-                .map_err(|e| Stop::Solver(n, e))?;
-            // The normal force on the body (φ q with q = −e₀: f_n = −φ), an impulse for
-            // Moreau–Jean; the bound in the same unit (Tresca's s·τ for an impulse).
-            let f_n = -phi_n;
-            let in_contact = f_n > 0.0;
-            let b = if in_contact {
-                law.bound(f_n, if moreau { tau } else { 1.0 })
-            } else {
-                0.0
-            };
-            let hook = tang.eng.tangential.as_ref().expect("the tangential chain");
-            hook.bound.set(b);
-            let u_prev = tang.st.u[0];
-            hook.s_ref.set(if moreau {
-                restitution * tang.st.v[0]
-            } else {
-                u_prev
-            });
-            let phi_t = tang
-                .eng
-                .step(&mut tang.st, &mut tang.wk)
-                .map_err(|e| Stop::Solver(n, e))?;
-            metrics.iterations += 1;
-            let (f_t, f_n_force) = if moreau {
-                (-phi_t / tau, f_n / tau)
-            } else {
-                (-phi_t, f_n)
-            };
-            let du = tang.st.u[0] - u_prev;
-            let fbar = (1.0 - weight) * f_t_prev + weight * f_t;
-            work -= fbar * du;
-            f_t_prev = f_t;
-            min_tw = min_tw.min(-f_t * du / scale);
-            if in_contact {
-                if du.abs() <= 1e-12 * h {
-                    stats.stick_steps += 1;
-                } else {
-                    stats.slip_steps += 1;
-                }
-                let r = f_t.abs() / f_n_force;
-                ratio_max = Some(ratio_max.map_or(r, |x: f64| x.max(r)));
-            }
-            let sigma_n = normal.eng.sigma(&normal.st.u, phi_n);
-            let sigma_t = tang.eng.sigma(&tang.st.u, phi_t);
-            let time = n as f64 * tau;
-            if let Some(ex) = &exact {
-                let d = sigma_t - ex.base_sigma_t(time);
-                sum_st += d * d;
-            }
-            obs.set_friction(sigma_t, tang.st.v[0], work);
-            observe_timer
-                .time(n, || observe(&mut obs, n, &normal, &tang, sigma_n))
-                .map_err(Stop::Diverged)?;
-            let balance = normal.energy() + tang.energy() + work;
-            max_inc = max_inc.max((balance - balance_prev) / scale);
-            balance_prev = balance;
-            done = n;
-            interrupted(n)?;
+}
+
+/// The frictional accounts of the loop: the tangential force of the state (a force, impulses
+/// over τ), W_f, E + W_f and its largest rise, stick and slip, |f_t|/f_n, the σ_t error sum.
+struct Account {
+    law: FrictionLaw,
+    moreau: bool,
+    restitution: f64,
+    weight: f64,
+    scale: f64,
+    e0: f64,
+    f_t_prev: f64,
+    work: f64,
+    balance_prev: f64,
+    max_inc: f64,
+    min_tw: f64,
+    sum_st: f64,
+    ratio_max: Option<f64>,
+    stick_steps: i64,
+    slip_steps: i64,
+}
+
+impl Account {
+    fn new(cfg: &Layer1dConfig, view: &View, e0: f64) -> Account {
+        let mut sum_st = 0.0;
+        if let Some(ex) = &view.exact {
+            // The layer starts with no tangential force: σ_t,h⁰ = 0.
+            let d = ex.base_sigma_t(0.0);
+            sum_st += d * d;
         }
-        Ok(())
-    })();
-    metrics.steps = done as i64;
-    metrics.iterations += normal.eng.extra_iterations() + tang.eng.extra_iterations();
-    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
-    metrics.observe_time_s = observe_timer.estimate_s();
-    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
-    obs.finish(&mut metrics, status == Status::Ok);
-    metrics.energy_scale = Some(scale);
-    let t_end = done as f64 * tau;
-    stats.friction_work = work / scale;
-    stats.energy_balance_drift = (balance_prev - e0) / scale;
-    stats.energy_balance_max_increase = if done > 0 { max_inc } else { 0.0 };
-    stats.friction_ratio_max = ratio_max;
-    stats.tangential_velocity_final = tang.eng.space().mean_velocity(&tang.st.v);
-    stats.normal_velocity_final = normal.eng.space().mean_velocity(&normal.st.v);
-    stats.tangential_work_min = if done > 0 { min_tw } else { 0.0 };
-    if let Some(ex) = &exact {
-        stats.err_sigma_t_l2 = Some((tau * sum_st).sqrt());
-        stats.err_vt_final =
-            Some((stats.tangential_velocity_final - ex.mean_tangential_velocity(t_end)).abs());
+        Account {
+            law: cfg.layer.friction,
+            moreau: matches!(cfg.scheme, Scheme::MoreauJean(_)),
+            restitution: match cfg.scheme {
+                Scheme::MoreauJean(p) => p.restitution,
+                _ => 0.0,
+            },
+            weight: work_weight(cfg),
+            scale: e0,
+            e0,
+            f_t_prev: 0.0,
+            work: 0.0,
+            balance_prev: e0,
+            max_inc: f64::NEG_INFINITY,
+            min_tw: f64::INFINITY,
+            sum_st,
+            ratio_max: None,
+            stick_steps: 0,
+            slip_steps: 0,
+        }
     }
-    metrics.exit_velocity = Some(stats.normal_velocity_final);
-    metrics.tangential_velocity_final = Some(stats.tangential_velocity_final);
-    metrics.normal_velocity_final = Some(stats.normal_velocity_final);
-    if status == Status::Ok {
-        metrics.err_sigma_t_l2 = stats.err_sigma_t_l2;
-        metrics.err_vt_final = stats.err_vt_final;
+
+    /// Step `n`: the normal chain, then the tangential chain under the bound of the normal
+    /// force of the same step, and the step's friction accounts. Returns (σ_n, σ_t).
+    fn step(
+        &mut self,
+        n: usize,
+        normal: &mut Chain,
+        tang: &mut Chain,
+        view: &View,
+    ) -> Result<(f64, f64), Stop<ContactSolveError>> {
+        let (tau, h) = (view.tau, view.h);
+        let phi_n = normal
+            .eng
+            .step(&mut normal.st, &mut normal.wk)
+            .map_err(|e| Stop::Solver(n, e))?;
+        // The normal force on the body (φ q with q = −e₀: f_n = −φ), an impulse for
+        // Moreau–Jean; the bound in the same unit (Tresca's s·τ for an impulse).
+        let f_n = -phi_n;
+        let in_contact = f_n > 0.0;
+        let b = if in_contact {
+            self.law.bound(f_n, if self.moreau { tau } else { 1.0 })
+        } else {
+            0.0
+        };
+        let hook = tang.eng.tangential.as_ref().expect("the tangential chain");
+        hook.bound.set(b);
+        let u_prev = tang.st.u[0];
+        hook.s_ref.set(if self.moreau {
+            self.restitution * tang.st.v[0]
+        } else {
+            u_prev
+        });
+        let phi_t = tang
+            .eng
+            .step(&mut tang.st, &mut tang.wk)
+            .map_err(|e| Stop::Solver(n, e))?;
+        let (f_t, f_n_force) = if self.moreau {
+            (-phi_t / tau, f_n / tau)
+        } else {
+            (-phi_t, f_n)
+        };
+        let du = tang.st.u[0] - u_prev;
+        let fbar = (1.0 - self.weight) * self.f_t_prev + self.weight * f_t;
+        self.work -= fbar * du;
+        self.f_t_prev = f_t;
+        self.min_tw = self.min_tw.min(-f_t * du / self.scale);
+        if in_contact {
+            if du.abs() <= 1e-12 * h {
+                self.stick_steps += 1;
+            } else {
+                self.slip_steps += 1;
+            }
+            let r = f_t.abs() / f_n_force;
+            self.ratio_max = Some(self.ratio_max.map_or(r, |x: f64| x.max(r)));
+        }
+        let sigma_n = normal.eng.sigma(&normal.st.u, phi_n);
+        let sigma_t = tang.eng.sigma(&tang.st.u, phi_t);
+        let time = n as f64 * tau;
+        if let Some(ex) = &view.exact {
+            let d = sigma_t - ex.base_sigma_t(time);
+            self.sum_st += d * d;
+        }
+        Ok((sigma_n, sigma_t))
     }
-    // The friction columns belong to a friction law (null for `none`, SPEC §5).
-    if !law.is_none() {
-        metrics.friction_work = Some(stats.friction_work);
-        metrics.energy_balance_drift = Some(stats.energy_balance_drift);
-        metrics.energy_balance_max_increase = Some(stats.energy_balance_max_increase);
-        metrics.stick_steps = Some(stats.stick_steps);
-        metrics.slip_steps = Some(stats.slip_steps);
-        metrics.friction_ratio_max = stats.friction_ratio_max;
+
+    /// The run's friction measurements after `done` steps.
+    fn stats(&self, done: usize, normal: &Chain, tang: &Chain, view: &View) -> FrictionStats {
+        let tau = view.tau;
+        let scale = self.scale;
+        let t_end = done as f64 * tau;
+        let mut stats = FrictionStats {
+            stick_steps: self.stick_steps,
+            slip_steps: self.slip_steps,
+            ..FrictionStats::default()
+        };
+        stats.friction_work = self.work / scale;
+        stats.energy_balance_drift = (self.balance_prev - self.e0) / scale;
+        stats.energy_balance_max_increase = if done > 0 { self.max_inc } else { 0.0 };
+        stats.friction_ratio_max = self.ratio_max;
+        stats.tangential_velocity_final = tang.eng.space().mean_velocity(&tang.st.v);
+        stats.normal_velocity_final = normal.eng.space().mean_velocity(&normal.st.v);
+        stats.tangential_work_min = if done > 0 { self.min_tw } else { 0.0 };
+        if let Some(ex) = &view.exact {
+            stats.err_sigma_t_l2 = Some((tau * self.sum_st).sqrt());
+            stats.err_vt_final =
+                Some((stats.tangential_velocity_final - ex.mean_tangential_velocity(t_end)).abs());
+        }
+        stats
     }
-    (
-        Outcome {
-            status,
-            message,
-            metrics,
-            series: std::mem::take(&mut obs.series),
-            reference: None,
-        },
-        stats,
-    )
 }

@@ -20,6 +20,7 @@ mod outcome;
 pub mod record;
 pub mod reference;
 mod spec;
+mod stepping;
 
 pub use config::RunConfig;
 pub use dispatch::{lockstep_key, simulate, simulate_group, simulate_with};

@@ -50,12 +50,15 @@
 use std::time::Instant;
 
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
+use super::stepping::{Clock, LoopEnd, finished, time_loop};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::friction::{PointState, solve_tangential};
 use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{DryFrictionExact, OscillatorExact, OscillatorParams};
 use crate::space::ContactMethod;
-use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
+use crate::time::{
+    GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, PaoliSchatzmanParams, Scheme,
+};
 
 /// A validated oscillator run.
 #[derive(Debug, Clone, PartialEq)]
@@ -566,6 +569,85 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         Exact::Free(p.exact(t_final))
     };
     let eng = Osc::new(cfg, cfg.scheme);
+    let (st, phi0, ft0) = initial_state(cfg, &eng);
+    let x0 = st.x;
+    let mut run = OscRun {
+        cfg,
+        eng: &eng,
+        st,
+        dry,
+        // E + W_f after the last step and its largest one-step rise (SPEC §2.5's balance).
+        acc: DryAccount {
+            work: 0.0,
+            balance: eng.energy(x0, p.v0),
+            balance_rise: f64::NEG_INFINITY,
+            watch: StopWatch {
+                tol: 1e-12 * x0.abs().max(p.gap),
+                last_move: None,
+                last_step: 0,
+            },
+        },
+        rec: Recorder {
+            eng: &eng,
+            obs: Observer::new(tau, opts.series_every, cfg.steps),
+            err: Errors {
+                exact: &exact,
+                cursor: 0,
+                sum_v: 0.0,
+                was_active: phi0 != 0.0,
+                starts: Vec::with_capacity(cfg.steps + 1),
+            },
+        },
+    };
+    let end = time_loop(
+        opts,
+        start,
+        (CLOCK_EVERY, tau, cfg.steps),
+        &mut metrics,
+        |clock, metrics| match cfg.scheme {
+            Scheme::PaoliSchatzman(ps) => run.paoli_schatzman(ps, phi0, clock, metrics),
+            _ => {
+                let friction = dry.then_some((ft0, 0.0));
+                run.rec
+                    .record(0, run.st.x, run.st.v, phi0, phi0 != 0.0, friction)
+                    .map_err(Stop::Diverged)?;
+                run.one_step(clock, metrics)
+            }
+        },
+    );
+    let complete = end.status == Status::Ok;
+    run.rec.obs.finish(&mut metrics, complete);
+    // The bar's H1 and pressure columns have no meaning for a point mass.
+    metrics.err_u_l2h1 = None;
+    metrics.err_sigma_l2 = None;
+    metrics.err_sigma_mid_l2 = None;
+    if complete && dry {
+        run.acc.columns(&mut metrics, &eng, x0, tau, &exact);
+    }
+    if complete {
+        metrics.err_v_l2 = Some((tau * run.rec.err.sum_v).sqrt());
+        metrics.err_impact_time = (!exact.impacts().is_empty()).then(|| {
+            exact
+                .impacts()
+                .iter()
+                .map(|ti| {
+                    run.rec
+                        .err
+                        .starts
+                        .iter()
+                        .map(|s| (s - ti).abs())
+                        .fold(t_final, f64::min)
+                })
+                .fold(0.0, f64::max)
+        });
+    }
+    finished(end.status, end.message, metrics, &mut run.rec.obs)
+}
+
+/// The initial state (x⁰ perturbed for ensembles), its contact force φ⁰ and friction f_t⁰.
+fn initial_state(cfg: &OscillatorConfig, eng: &Osc) -> (State, f64, f64) {
+    let p = cfg.params;
+    let dry = p.friction > 0.0;
     let mut x0 = p.x0;
     if let Some((delta, seed)) = cfg.perturbation {
         let mut rng = fastrand::Rng::with_seed(seed);
@@ -573,7 +655,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
     }
     let phi0 = eng.state_force(x0);
     let ft0 = eng.initial_friction(x0, p.v0, phi0);
-    let mut st = State {
+    let st = State {
         x: x0,
         v: p.v0,
         // The equation at t⁰, the friction included where there is one.
@@ -586,32 +668,84 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         phi_prev: phi0,
         ft_prev: ft0,
     };
-    // Dry friction's columns: the work W_f = −Σ f̄_t (x^{n+1} − xⁿ) and the stop (SPEC §1.5).
-    let mut work = 0.0;
-    // E + W_f after the last step and its largest one-step rise (SPEC §2.5's balance).
-    let mut balance = eng.energy(x0, p.v0);
-    let mut balance_rise = f64::NEG_INFINITY;
-    let mut watch = StopWatch {
-        tol: 1e-12 * x0.abs().max(p.gap),
-        last_move: None,
-        last_step: 0,
-    };
-    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
-    let mut err = Errors {
-        exact: &exact,
-        cursor: 0,
-        sum_v: 0.0,
-        was_active: phi0 != 0.0,
-        starts: Vec::with_capacity(cfg.steps + 1),
-    };
-    let mut record = |n: usize,
-                      x: f64,
-                      v: f64,
-                      phi: f64,
-                      active: bool,
-                      friction: Option<(f64, f64)>|
-     -> Result<(), Divergence> {
-        let t = n as f64 * tau;
+    (st, phi0, ft0)
+}
+
+/// Dry friction's accounts (SPEC §1.5): the work W_f = −Σ f̄_t (x^{n+1} − xⁿ), E + W_f after
+/// the last step and its largest one-step rise, and the stop.
+struct DryAccount {
+    work: f64,
+    balance: f64,
+    balance_rise: f64,
+    watch: StopWatch,
+}
+
+impl DryAccount {
+    /// Step `n` moved the mass from `x_old` to `st.x` under the friction forces `ft_old`, `ft`:
+    /// returns what the friction series shows (f_t, W_f so far).
+    fn step(
+        &mut self,
+        eng: &Osc,
+        n: usize,
+        st: &State,
+        x_old: f64,
+        ft: f64,
+        ft_old: f64,
+    ) -> (f64, f64) {
+        let dx = st.x - x_old;
+        let w = eng.work_weight;
+        self.work -= (w * ft + (1.0 - w) * ft_old) * dx;
+        self.watch.observe(n, dx);
+        // E + W_f: what the normal contact (and the scheme) did in the step.
+        let b = eng.energy(st.x, st.v) + self.work;
+        self.balance_rise = self.balance_rise.max(b - self.balance);
+        self.balance = b;
+        (ft, self.work)
+    }
+
+    /// The frictional columns of a complete run started at `x0`.
+    fn columns(&self, metrics: &mut Metrics, eng: &Osc, x0: f64, tau: f64, exact: &Exact) {
+        let p = eng.p;
+        let done = metrics.steps;
+        let scale = p.energy(x0, p.v0).abs().max(f64::MIN_POSITIVE);
+        metrics.friction_work = Some(self.work / scale);
+        // The frictional summaries judge E + W_f (SPEC §2.5), as on the layer and the FE
+        // scenes: its drift from E⁰ and its largest one-step rise, over the same scale.
+        metrics.energy_balance_drift = Some((self.balance - eng.energy(x0, p.v0)) / scale);
+        metrics.energy_balance_max_increase = Some(if done > 0 {
+            self.balance_rise / scale
+        } else {
+            0.0
+        });
+        metrics.stop_time = self.watch.stop_time(tau);
+        if let Exact::Dry(e) = exact {
+            metrics.stop_time_exact = e.stop().map(|(t, _)| t);
+        }
+    }
+}
+
+/// Records a step: the observer and the error sums against the exact solution.
+struct Recorder<'a> {
+    eng: &'a Osc,
+    obs: Observer,
+    err: Errors<'a>,
+}
+
+impl Recorder<'_> {
+    /// Observe step `n` (x, v, the reported force φ, whether the contact is active, and with
+    /// dry friction the friction series: f_t as it entered the step, W_f so far).
+    fn record(
+        &mut self,
+        n: usize,
+        x: f64,
+        v: f64,
+        phi: f64,
+        active: bool,
+        friction: Option<(f64, f64)>,
+    ) -> Result<(), Divergence> {
+        let (eng, obs, err) = (self.eng, &mut self.obs, &mut self.err);
+        let p = eng.p;
+        let t = n as f64 * eng.tau;
         // With dry friction, the friction series: f_t as it entered the step, the mass's
         // velocity (its slip), W_f so far.
         if let Some((ft, w)) = friction {
@@ -656,116 +790,85 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
                 h1_semi_sq: 0.0,
             }),
         )
-    };
-    let interrupted = |n: usize| opts.step_stop::<ContactSolveError>(n, CLOCK_EVERY, start);
-    metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
-    let loop_start = Instant::now();
-    let mut done = 0usize;
-    let stop = (|| -> Result<(), Stop<ContactSolveError>> {
-        match cfg.scheme {
-            Scheme::PaoliSchatzman(ps) => {
-                // x¹ from Newmark(β, ½); then x^{n+1} from (x^n, x^{n−1}), v^n centred: step n
-                // is recorded once x^{n+1} is known, with the multiplier λ^n of its equation.
-                let starter = Osc::new(
-                    cfg,
-                    Scheme::Newmark(NewmarkParams {
-                        beta: ps.beta,
-                        gamma: 0.5,
-                    }),
-                );
-                record(0, st.x, st.v, phi0, phi0 != 0.0, None).map_err(Stop::Diverged)?;
-                let mut prev = st.x;
-                starter.step(&mut st).map_err(|e| Stop::Solver(1, e))?;
-                metrics.iterations += 1;
-                let (e, beta) = (ps.restitution, ps.beta);
-                let (k, m) = (p.stiffness, p.mass);
-                for n in 1..=cfg.steps {
-                    let b = m * (2.0 * st.x - prev)
-                        - tau * tau * k * ((1.0 - 2.0 * beta) * st.x + beta * prev)
-                        + eng.k.c * p.force;
-                    let p0 = e * prev / (1.0 + e) + p.gap;
-                    let (next, _, lambda) = eng
-                        .solve(b, &ContactLaw::Complementarity, p0)
-                        .map_err(|err| Stop::Solver(n, err))?;
-                    metrics.iterations += 1;
-                    let v = (next - prev) / (2.0 * tau);
-                    record(n, st.x, v, lambda, lambda != 0.0, None).map_err(Stop::Diverged)?;
-                    done = n;
-                    prev = st.x;
-                    st.x = next;
-                    interrupted(n)?;
-                }
-            }
-            _ => {
-                record(0, st.x, st.v, phi0, phi0 != 0.0, dry.then_some((ft0, 0.0)))
-                    .map_err(Stop::Diverged)?;
-                for n in 1..=cfg.steps {
-                    let (x_old, ft_old) = (st.x, st.ft_prev);
-                    let (phi, ft, active) = eng.step(&mut st).map_err(|e| Stop::Solver(n, e))?;
-                    metrics.iterations += 1;
-                    let friction = if dry {
-                        let dx = st.x - x_old;
-                        let w = eng.work_weight;
-                        work -= (w * ft + (1.0 - w) * ft_old) * dx;
-                        watch.observe(n, dx);
-                        // E + W_f: what the normal contact (and the scheme) did in the step.
-                        let b = eng.energy(st.x, st.v) + work;
-                        balance_rise = balance_rise.max(b - balance);
-                        balance = b;
-                        Some((ft, work))
-                    } else {
-                        None
-                    };
-                    record(n, st.x, st.v, phi, active, friction).map_err(Stop::Diverged)?;
-                    done = n;
-                    interrupted(n)?;
-                }
-            }
+    }
+}
+
+/// A run in its time loop: the engine, the state, the recorder and the friction accounts.
+struct OscRun<'a> {
+    cfg: &'a OscillatorConfig,
+    eng: &'a Osc,
+    st: State,
+    dry: bool,
+    acc: DryAccount,
+    rec: Recorder<'a>,
+}
+
+impl OscRun<'_> {
+    /// Steps 1…N of a one-step scheme (step 0 recorded).
+    fn one_step(&mut self, clock: &mut Clock, metrics: &mut Metrics) -> LoopEnd {
+        let eng = self.eng;
+        for n in 1..=self.cfg.steps {
+            let (x_old, ft_old) = (self.st.x, self.st.ft_prev);
+            let (phi, ft, active) = eng.step(&mut self.st).map_err(|e| Stop::Solver(n, e))?;
+            metrics.iterations += 1;
+            let friction = if self.dry {
+                Some(self.acc.step(eng, n, &self.st, x_old, ft, ft_old))
+            } else {
+                None
+            };
+            let st = self.st;
+            self.rec
+                .record(n, st.x, st.v, phi, active, friction)
+                .map_err(Stop::Diverged)?;
+            clock.completed(n)?;
         }
         Ok(())
-    })();
-    metrics.steps = done as i64;
-    metrics.stepping_time_s = Some(loop_start.elapsed().as_secs_f64());
-    let (status, message) = Stop::status(stop, tau, cfg.steps, start, &mut metrics);
-    let complete = status == Status::Ok;
-    obs.finish(&mut metrics, complete);
-    // The bar's H1 and pressure columns have no meaning for a point mass.
-    metrics.err_u_l2h1 = None;
-    metrics.err_sigma_l2 = None;
-    metrics.err_sigma_mid_l2 = None;
-    if complete && dry {
-        let scale = p.energy(x0, p.v0).abs().max(f64::MIN_POSITIVE);
-        metrics.friction_work = Some(work / scale);
-        // The frictional summaries judge E + W_f (SPEC §2.5), as on the layer and the FE
-        // scenes: its drift from E⁰ and its largest one-step rise, over the same scale.
-        metrics.energy_balance_drift = Some((balance - eng.energy(x0, p.v0)) / scale);
-        metrics.energy_balance_max_increase =
-            Some(if done > 0 { balance_rise / scale } else { 0.0 });
-        metrics.stop_time = watch.stop_time(tau);
-        if let Exact::Dry(e) = &exact {
-            metrics.stop_time_exact = e.stop().map(|(t, _)| t);
+    }
+
+    /// Paoli–Schatzman: x¹ from Newmark(β, ½); then x^{n+1} from (x^n, x^{n−1}), v^n centred:
+    /// step n is recorded once x^{n+1} is known, with the multiplier λ^n of its equation.
+    fn paoli_schatzman(
+        &mut self,
+        ps: PaoliSchatzmanParams,
+        phi0: f64,
+        clock: &mut Clock,
+        metrics: &mut Metrics,
+    ) -> LoopEnd {
+        let (cfg, eng) = (self.cfg, self.eng);
+        let (p, tau) = (cfg.params, cfg.dt);
+        let st = &mut self.st;
+        let starter = Osc::new(
+            cfg,
+            Scheme::Newmark(NewmarkParams {
+                beta: ps.beta,
+                gamma: 0.5,
+            }),
+        );
+        self.rec
+            .record(0, st.x, st.v, phi0, phi0 != 0.0, None)
+            .map_err(Stop::Diverged)?;
+        let mut prev = st.x;
+        starter.step(st).map_err(|e| Stop::Solver(1, e))?;
+        metrics.iterations += 1;
+        let (e, beta) = (ps.restitution, ps.beta);
+        let (k, m) = (p.stiffness, p.mass);
+        for n in 1..=cfg.steps {
+            let b = m * (2.0 * st.x - prev)
+                - tau * tau * k * ((1.0 - 2.0 * beta) * st.x + beta * prev)
+                + eng.k.c * p.force;
+            let p0 = e * prev / (1.0 + e) + p.gap;
+            let (next, _, lambda) = eng
+                .solve(b, &ContactLaw::Complementarity, p0)
+                .map_err(|err| Stop::Solver(n, err))?;
+            metrics.iterations += 1;
+            let v = (next - prev) / (2.0 * tau);
+            self.rec
+                .record(n, st.x, v, lambda, lambda != 0.0, None)
+                .map_err(Stop::Diverged)?;
+            prev = st.x;
+            st.x = next;
+            clock.completed(n)?;
         }
-    }
-    if complete {
-        metrics.err_v_l2 = Some((tau * err.sum_v).sqrt());
-        metrics.err_impact_time = (!exact.impacts().is_empty()).then(|| {
-            exact
-                .impacts()
-                .iter()
-                .map(|ti| {
-                    err.starts
-                        .iter()
-                        .map(|s| (s - ti).abs())
-                        .fold(t_final, f64::min)
-                })
-                .fold(0.0, f64::max)
-        });
-    }
-    Outcome {
-        status,
-        message,
-        metrics,
-        series: std::mem::take(&mut obs.series),
-        reference: None,
+        Ok(())
     }
 }

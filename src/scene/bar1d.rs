@@ -72,6 +72,34 @@ impl Bar1dScene {
     }
 }
 
+/// The uniform P1 mesh of size `h` on a 1D body of extent `(key, symbol, value)` (the bar's
+/// length L, the layer's height H): extent/h elements, a whole number and at least 2, or why
+/// not. Shared by the 1D scenes, whose meshes are all this one.
+pub(super) fn uniform_mesh(
+    (key, symbol, extent): (&str, &str, f64),
+    h: f64,
+) -> Result<MeshChoice, String> {
+    let ratio = extent / h;
+    let m = ratio.round();
+    if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
+        return Err(format!(
+            "h = {h} does not divide {key} = {extent} into at least 2 elements ({symbol}/h = {ratio}); use `elements` or an h with {symbol}/h a whole number"
+        ));
+    }
+    Ok(MeshChoice {
+        elements: m as usize,
+        h: extent / m,
+    })
+}
+
+/// The uniform mesh of `elements` elements on a 1D body of extent `extent`.
+pub(super) fn uniform_elements(extent: f64, elements: usize) -> MeshChoice {
+    MeshChoice {
+        elements,
+        h: extent / elements as f64,
+    }
+}
+
 impl Scene for Bar1dScene {
     fn contact_init_matters(&self) -> bool {
         true
@@ -90,24 +118,10 @@ impl Scene for Bar1dScene {
         Self::bar(physics).wave_speed()
     }
     fn mesh_from_h(&self, physics: &Physics, h: f64) -> Result<MeshChoice, String> {
-        let length = physics.get("length");
-        let ratio = length / h;
-        let m = ratio.round();
-        if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
-            return Err(format!(
-                "h = {h} does not divide length = {length} into at least 2 elements (L/h = {ratio}); use `elements` or an h with L/h a whole number"
-            ));
-        }
-        Ok(MeshChoice {
-            elements: m as usize,
-            h: length / m,
-        })
+        uniform_mesh(("length", "L", physics.get("length")), h)
     }
     fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String> {
-        Ok(MeshChoice {
-            elements,
-            h: physics.get("length") / elements as f64,
-        })
+        Ok(uniform_elements(physics.get("length"), elements))
     }
     fn supports(
         &self,

@@ -97,24 +97,13 @@ impl Scene for Layer1dScene {
         Self::layer(physics).c_p()
     }
     fn mesh_from_h(&self, physics: &Physics, h: f64) -> Result<MeshChoice, String> {
-        let height = physics.get("height");
-        let ratio = height / h;
-        let m = ratio.round();
-        if (ratio - m).abs() > 1e-9 * m.max(1.0) || m < 2.0 {
-            return Err(format!(
-                "h = {h} does not divide height = {height} into at least 2 elements (H/h = {ratio}); use `elements` or an h with H/h a whole number"
-            ));
-        }
-        Ok(MeshChoice {
-            elements: m as usize,
-            h: height / m,
-        })
+        super::bar1d::uniform_mesh(("height", "H", physics.get("height")), h)
     }
     fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String> {
-        Ok(MeshChoice {
+        Ok(super::bar1d::uniform_elements(
+            physics.get("height"),
             elements,
-            h: physics.get("height") / elements as f64,
-        })
+        ))
     }
     /// `mixed` and `penalty` with every 1D mass variant; the one-step schemes whose frictional
     /// version the literature defines (SPEC §2.5). Paoli–Schatzman, the hybrid schemes and
