@@ -114,7 +114,7 @@ def synth_series(method: dict, h: float, dt: float, steps: int, rng, with_exact:
         v_contact=np.gradient(u, dt), sigma_contact=sigma, energy=energy,
     )
     if kind == "dissipate":
-        # A frictional run's W_f^n (SPEC §2.5): here friction takes 90 % of what is lost, so
+        # A frictional run's W_f^n (contract §2.5): here friction takes 90 % of what is lost, so
         # E + W_f falls by a tenth of the loss (plot_energy_impacts.py --balance draws it).
         out["friction_work"] = 0.9 * (e0 - energy)
     if method["params"]["space"] == "nitsche":

@@ -8,7 +8,7 @@ T = 12) and the l2(τ;H1) error on the h = τ ladder with its least-squares rate
     python3 analysis/method_table.py out/003-fig2 out/003-fig3 out/003-fig9 out/003-figs4-8 \
         --ladder out/003-fig10
 
-Paper statements are quoted from 003 §4.1.2 and SPEC §6; nothing here is tuned to them.
+Paper statements are quoted from 003 §4.1.2 and contract §6; nothing here is tuned to them.
 """
 import argparse
 import math
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import polars as pl
 
-# What the papers say, keyed by the engine's label (003 §4.1.2a–e, SPEC §6).
+# What the papers say, keyed by the engine's label (003 §4.1.2a–e, contract §6).
 PAPER = {
     "nitsche(Θ=1, γ0=1e-6) · consistent · backward-euler": "≈ 20 % of E0 left (strongly damped)",
     "nitsche(Θ=1, γ0=1e-6) · consistent · newmark-dissipative": "≈ 40 % of E0 left",
@@ -27,12 +27,12 @@ PAPER = {
     "nitsche(Θ=1, γ0=1e-6) · consistent · hybrid": "≈ −1 %; converges (slowly) in H1",
     "mixed · zero-contact · crank-nicolson": "1–2 % dissipation; converges in H1",
     "nitsche(Θ=1, γ0=1e-6) · zero-contact · crank-nicolson": "1–2 % dissipation",
-    # contact_init = interpolant (SPEC §2.2): the start 003's Fig 9 appears to use
+    # contact_init = interpolant (contract §2.2): the start 003's Fig 9 appears to use
     "mixed · zero-contact (interpolant start) · crank-nicolson": "1–2 % dissipation (reproduced by this start)",
     "nitsche(Θ=1, γ0=1e-6) · zero-contact (interpolant start) · crank-nicolson": "1–2 % dissipation (reproduced by this start)",
     "mixed · mod3 · crank-nicolson": "best of the redistributions (000)",
     "nitsche(Θ=1, γ0=1e-1) · consistent · crank-nicolson": "+2 to 4 %",
-    "nitsche(Θ=-1, γ0=1e-1) · consistent · crank-nicolson": "≈ +30 % (not reproduced, SPEC §6)",
+    "nitsche(Θ=-1, γ0=1e-1) · consistent · crank-nicolson": "≈ +30 % (not reproduced, contract §6)",
     "nitsche(Θ=0, γ0=1e-1) · consistent · crank-nicolson": "+2 to 4 %",
     "nitsche(Θ=1, γ0=1e0) · consistent · crank-nicolson": "unphysical, E^h very large",
     "nitsche(Θ=1, γ0=3e0) · consistent · crank-nicolson": "Newton fails (γ0 > 1)",

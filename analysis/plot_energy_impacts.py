@@ -7,7 +7,7 @@
 One figure per results folder DIR (e.g. out/003_fig11 from
 sweeps/003_fig11_disc.toml): the discrete energy E^h of every run divided by
 its `energy_scale` (disc2d/sphere3d: m|f|·gap, the kinetic energy of a rigid
-body reaching the plane; E⁰ = 0 there, SPEC §1.3), against time t, one curve
+body reaching the plane; E⁰ = 0 there, contract §1.3), against time t, one curve
 per run, named as the paper names the methods (mixed + CN, Nitsche + CN,
 Nitsche-Hybrid, modified mass + CN; other runs by their label). The runs table
 is joined to the series on run_id for the labels and the scale.
@@ -17,13 +17,13 @@ to hundreds of energy scales) and a zoom on the runs that stay within one
 energy scale of E⁰, where the few-percent behaviour of the others shows.
 Nitsche runs also get their augmented energy E_Θ (energy_theta), dashed in the
 run's colour: during the contact E^h departs from E_Θ by the Nitsche terms,
-E^h − E_Θ = (Θ/2)(‖γ^½ σ_n‖² − ‖γ^−½ [P_γ]_+‖²) over Γ_C (SPEC §2.3), and
+E^h − E_Θ = (Θ/2)(‖γ^½ σ_n‖² − ‖γ^−½ [P_γ]_+‖²) over Γ_C (contract §2.3), and
 comes back after the release (--no-theta leaves E_Θ out). Curves drawn
 earlier are drawn wider, so one that coincides with a later one (Nitsche + CN
 under Nitsche-Hybrid during the contact) still shows as its outline. The first contact time of the runs (the
 earliest) is marked by a dotted vertical line.
 
-With --balance, frictional runs (series column friction_work, W_f^n, SPEC
+With --balance, frictional runs (series column friction_work, W_f^n, contract
 §2.5) also get E^h + W_f, dash-dotted in the run's colour: the energy plus the
 work friction took, which changes only by the normal contact's work (kane and
 moreau-jean θ = ½ never raise it). Runs without friction_work are drawn as

@@ -73,7 +73,7 @@ def exact_energy(row: dict) -> float | None:
 
 def zero_start_scale(row: dict, e: np.ndarray) -> float | None:
     """The run's `energy_scale` when its initial energy is zero (disc2d/sphere3d: E⁰ = 0
-    under gravity, SPEC §1.3), else None. Dividing by the first non-zero value would divide
+    under gravity, contract §1.3), else None. Dividing by the first non-zero value would divide
     by the rounding of the first steps (~1e-17) there."""
     scale = row.get("energy_scale")
     if scale is None or not np.isfinite(scale) or scale <= 0 or e.size == 0 or not np.isfinite(e[0]):

@@ -1,4 +1,4 @@
-"""Read a results folder with every reader SPEC §8 promises, as a user would (issue 23).
+"""Read a results folder with every reader contract §8 promises, as a user would (issue 23).
 
     python3 analysis/readers_check.py check DIR --runs N
         one read with each reader; exits 1 unless every reader sees exactly N runs, each once

@@ -28,7 +28,7 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cp "$out/summary/convergence.tex" "$work/"
-# The paper's figures are SPEC §6's (003 §4.1.2e, Fig 10): l2(τ;H1) at h = τ = 1/4 … 1/256.
+# The paper's figures are contract §6's (003 §4.1.2e, Fig 10): l2(τ;H1) at h = τ = 1/4 … 1/256.
 cat >"$work/render.tex" <<'EOF'
 \documentclass[10pt]{article}
 \usepackage[paperwidth=17cm,paperheight=80cm,margin=6mm]{geometry}
@@ -40,7 +40,7 @@ cat >"$work/render.tex" <<'EOF'
 \begin{document}
 \begin{table}[htbp]
   \centering\small
-  \caption{Paper 003, section 4.1.2e, Fig 10, as printed (SPEC section 6): $u$ in $l^2(\tau;H^1)$ on
+  \caption{Paper 003, section 4.1.2e, Fig 10, as printed (contract section 6): $u$ in $l^2(\tau;H^1)$ on
     the ladder $h = \tau$ ($\nu = 1$). The tables below are \texttt{contact-sweep summarize}'s
     \texttt{convergence.tex} for \texttt{sweeps/003\_fig10\_ladder.toml}, unchanged.}
   \begin{tabular}{lrrrr}

@@ -1,4 +1,4 @@
-//! Benchmarks of the 1D engine, reusing the bar of SPEC §1.1.
+//! Benchmarks of the 1D engine, reusing the bar of contract §1.1.
 //!
 //! - `step/…`: one run per scheme at m = 1000, ν = 1, one period (3000 steps): the cost of the
 //!   O(m) step (tridiagonal solve + exact scalar contact solve + exact error integration).
@@ -12,7 +12,7 @@
 //!   in alternation, 9 rounds, medians; the table is printed (`per-step ÷ Thomas`).
 //!
 //! - `scheme-ratio`: for m = 10³, 10⁴, 10⁵, the cost of a run (errors included, series off) of
-//!   each method of SPEC §3.2 against Crank–Nicolson on the same mesh and step (mixed +
+//!   each method of contract §3.2 against Crank–Nicolson on the same mesh and step (mixed +
 //!   consistent mass; the discrete gradient with the penalty, central difference with the
 //!   lumped mass at ν = 0.9), timed in alternation, 5 rounds, medians; target ≤ 1.3×.
 //!
@@ -336,7 +336,7 @@ fn lanes_ratio(c: &mut Criterion) {
     }
 }
 
-/// Per-step cost of each SPEC §3.2 method against Crank–Nicolson, m = 10³ … 10⁵ (module header).
+/// Per-step cost of each contract §3.2 method against Crank–Nicolson, m = 10³ … 10⁵ (module header).
 fn scheme_ratio(c: &mut Criterion) {
     use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams};
     if !wanted("scheme-ratio") {
@@ -379,7 +379,7 @@ fn scheme_ratio(c: &mut Criterion) {
         ),
     ];
     println!(
-        "\nscheme-ratio: a run of each SPEC §3.2 method against Crank–Nicolson (ns per node-step)"
+        "\nscheme-ratio: a run of each contract §3.2 method against Crank–Nicolson (ns per node-step)"
     );
     println!(
         "{:>8} {:>28} {:>10} {:>10} {:>8}",

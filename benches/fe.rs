@@ -1,4 +1,4 @@
-//! Benchmarks of the finite-element engine (SPEC §1.2, §4), reusing the bars of `scene::bar`.
+//! Benchmarks of the finite-element engine (contract §1.2, §4), reusing the bars of `scene::bar`.
 //!
 //! - `bar3d-20k/…`: the 3D bar at h = 0.0125 (9 × 9 × 81 nodes, 19 440 free dofs), mod3 mass,
 //!   Crank–Nicolson with τ = h/2: the numeric factorisation of A = M + τ²/4 K, one solve with it
@@ -19,7 +19,7 @@
 //!   paper's T = 40 by `sweeps/003_fig11_disc.toml` / `003_fig12_sphere.toml`
 //!   (`stepping_time_s / steps` of the runs table).
 //!
-//! - `bar2d-methods/…` (issue 20, done-when 4): one step of each SPEC §3.2 method against
+//! - `bar2d-methods/…` (issue 20, done-when 4): one step of each contract §3.2 method against
 //!   Crank–Nicolson on bar2d at h = 0.00625 (17 × 161 nodes, 5 440 dofs, 17 contact dofs),
 //!   consistent mass, τ = h/2, T = 1 (free flight, the impact at t = 0.4 and the contact
 //!   phase): the engine's stepping time per step over the run, factor cached (as in a sweep),
@@ -132,7 +132,7 @@ fn bench_bar(c: &mut Criterion, name: &str, dim: usize, h: f64) {
 }
 
 /// The disc (dim 2) or ball (dim 3) of 003 §4.2 at degree 2 and nominal size h, as the engine
-/// builds it for a run (SPEC §1.3: R = 20, λ = μ = 20, ρ = 1, centre R + 5 above the plane).
+/// builds it for a run (contract §1.3: R = 20, λ = μ = 20, ρ = 1, centre R + 5 above the plane).
 fn ball_operators(dim: usize, h: f64) -> (BallMesh, DofMap, SymMatrix, SymMatrix) {
     let (radius, lame) = (20.0, 20.0);
     let mut centre = [0.0; 3];

@@ -1,4 +1,4 @@
-//! The frictional layer (SPEC §1.7, issue 32): what friction costs a step.
+//! The frictional layer (contract §1.7, issue 32): what friction costs a step.
 //!
 //! `friction-ratio`: for each method that defines friction, a run of the layer with Coulomb
 //! friction (slip regime: V_t = 1, μ_f = 0.1) against the same run with `friction = "none"`

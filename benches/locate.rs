@@ -1,4 +1,4 @@
-//! Point location for references on meshes that are not nested (issue 22, SPEC §1.6,
+//! Point location for references on meshes that are not nested (issue 22, contract §1.6,
 //! done-when 5: "locating 10⁵ coarse nodes in a 10⁶-node reference mesh takes less than 1 s"),
 //! on the two kinds of bodies a sweep meets:
 //!

@@ -1,5 +1,5 @@
 //! Reading and assembling a Gmsh mesh against one factorisation of its step matrix (issue 22,
-//! done-when 5, SPEC §1.6): a mesh scene's set-up (read, validate, assemble) must cost less
+//! done-when 5, contract §1.6): a mesh scene's set-up (read, validate, assemble) must cost less
 //! than the factorisation every run of a sweep makes anyway, or the file format would be the
 //! bottleneck of a sweep over meshes.
 //!

@@ -15,13 +15,13 @@
 //!   `space::cg` (Jacobi-preconditioned conjugate gradient, `solver = "cg"`) and
 //!   `space::step_solver` (the per-step solve, dispatching to either).
 //! - [`time`] — the time schemes as data with named presets, the methods of the comparison
-//!   literature (SPEC §3.2: kane, contact-stabilized Newmark, generalized-α/HHT, Moreau–Jean,
+//!   literature (contract §3.2: kane, contact-stabilized Newmark, generalized-α/HHT, Moreau–Jean,
 //!   discrete gradient, kinematic central difference) among them.
 //! - [`contact`] — the condensed contact solve: one scalar piecewise-linear equation per step,
 //!   solved exactly by branch enumeration (1D); a small dense LCP on the contact dofs solved
 //!   exactly by an active-set method (2D/3D); the discrete gradient's scalar equation by a
 //!   safeguarded semismooth Newton iteration ([`contact::gradient`]).
-//! - [`model`] — the data that crosses layers: SPEC §7's parameter keys and values, the
+//! - [`model`] — the data that crosses layers: contract §7's parameter keys and values, the
 //!   column choice of the summary tables.
 //! - [`run`] — one run: setup (factorisations once, shared between runs with the same matrix),
 //!   the allocation-free time loop of the tridiagonal, the sparse and the one-dof engine,

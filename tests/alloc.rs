@@ -119,7 +119,7 @@ fn assert_loop_allocates_nothing_with(text: &str, t_final: f64, min_switches: i6
 }
 
 /// Every 1D scheme family with every contact treatment it runs with (and the massless
-/// quasi-static contact node, whose rows take their own path), the methods of SPEC §3.2
+/// quasi-static contact node, whose rows take their own path), the methods of contract §3.2
 /// included (kane, contact-stabilized Newmark's two solves, generalized-α/hht, Moreau–Jean, the
 /// discrete gradient's Newton iteration, kinematic central difference with the lumped mass).
 #[test]
@@ -203,7 +203,7 @@ fn fe_time_loops_allocate_nothing() {
     }
 }
 
-/// Friction on the FE scenes (SPEC §2.5, issue 33): mixed + Crank–Nicolson and backward Euler
+/// Friction on the FE scenes (contract §2.5, issue 33): mixed + Crank–Nicolson and backward Euler
 /// with Coulomb and Tresca on bar2d and bar3d (3D: the disc's linearised projection) — the
 /// frictional contact solve (semismooth Newton, its dense LU) and the friction tally, nothing
 /// allocated.
@@ -256,7 +256,7 @@ fn disc2d_time_loops_allocate_nothing() {
     assert_loop_allocates_nothing_with(&fe_sweep("alloc-disc", "disc2d", DISC, &methods), 15.0, 1);
 }
 
-/// The FE engine's SPEC §3.2 methods (run::fe's methods module) on bar2d: kane with the
+/// The FE engine's contract §3.2 methods (run::fe's methods module) on bar2d: kane with the
 /// consistent and a massless contact mass, contact-stabilized Newmark's two LCPs (M⁻¹Bᵀ built
 /// at setup), generalized-α/hht, Moreau–Jean's masked LCP, kinematic central difference.
 #[test]
@@ -314,7 +314,7 @@ fn disc2d_comparison_methods_allocate_nothing() {
     );
 }
 
-/// The oscillator (SPEC §1.5): every scheme family it runs, with both contact treatments —
+/// The oscillator (contract §1.5): every scheme family it runs, with both contact treatments —
 /// the exact solution is built at setup and the contact starts go to a buffer sized there.
 #[test]
 fn oscillator_time_loops_allocate_nothing() {
@@ -363,7 +363,7 @@ scheme = "contact-stabilized-newmark"
     );
 }
 
-/// The frictional layer (SPEC §1.7, issue 32): every method that defines friction, stick and
+/// The frictional layer (contract §1.7, issue 32): every method that defines friction, stick and
 /// slip, Coulomb and Tresca — two chains and the friction law's local solve per step,
 /// nothing allocated.
 #[test]
@@ -398,9 +398,9 @@ method = [
     );
 }
 
-/// The dry-friction oscillator (SPEC §1.5, `friction_force`): the relay of every scheme that
+/// The dry-friction oscillator (contract §1.5, `friction_force`): the relay of every scheme that
 /// takes it, with impacts (the obstacle in reach: the relay combined with the contact) and with
-/// a stop (SPEC's setting, the mass at rest after t ≈ 22.4) — the exact solution's segments
+/// a stop (the contract's setting, the mass at rest after t ≈ 22.4) — the exact solution's segments
 /// are built at setup, the stop watch and the work are scalars.
 #[test]
 fn dry_friction_oscillator_time_loops_allocate_nothing() {

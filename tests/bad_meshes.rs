@@ -294,7 +294,7 @@ fn clockwise_surface_is_reoriented_not_refused() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Sweeps of the `mesh2d`/`mesh3d` scenes (SPEC §1.6) with a bad mesh or bad mesh keys: refused
+// Sweeps of the `mesh2d`/`mesh3d` scenes (contract §1.6) with a bad mesh or bad mesh keys: refused
 // by `plan` and by `run` with exit status 2, the message naming the sweep file, the key and the
 // reason (and the mesh file where it is at fault), no panic, nothing run (no output folder).
 
@@ -342,7 +342,7 @@ const SWEEP_CASES: &[(&str, &str, &[&str])] = &[
             "hybrid with nitsche or penalty",
         ],
     ),
-    // `obstacle` and `gap` are two names of one plane (SPEC §1.6): both given is refused,
+    // `obstacle` and `gap` are two names of one plane (contract §1.6): both given is refused,
     // naming both keys.
     (
         "[fixed]\ndt = 0.1\nmesh = \"body.msh\"\ngap = 0.1\nobstacle = -0.1\n",
@@ -359,7 +359,7 @@ const SWEEP_CASES: &[(&str, &str, &[&str])] = &[
             "inside the obstacle",
         ],
     ),
-    // A reference on another mesh file is located node by node (SPEC §1.6), but it must be
+    // A reference on another mesh file is located node by node (contract §1.6), but it must be
     // at least as fine as the run's: this one's largest cell is larger (a node moved up).
     (
         "reference = { dt = 0.05, mesh = \"fine.msh\" }\n[fixed]\ndt = 0.1\nmesh = \"body.msh\"\n",

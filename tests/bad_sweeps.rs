@@ -246,7 +246,7 @@ const CASES: &[(&str, &str, &str)] = &[
         "summary",
         "expected a table",
     ),
-    // Friction (SPEC §2.5): bounds, a law without its parameter, a bound without a law, and
+    // Friction (contract §2.5): bounds, a law without its parameter, a bound without a law, and
     // the scenes and methods that cannot take one.
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nfriction = \"coulomb\"\nfriction_coefficient = -0.1\n",
@@ -301,12 +301,12 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nscheme = \"discrete-gradient\"\nspace = \"penalty\"\nfriction = \"tresca\"\ntresca_threshold = 0.1\n",
         "fixed.scheme",
-        "discrete-gradient has no frictional version in the literature (SPEC §2.5)",
+        "discrete-gradient has no frictional version in the literature (contract §2.5)",
     ),
     (
         "name = \"x\"\nscene = \"bar1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nscheme = \"paoli-schatzman\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
         "fixed.scheme",
-        "paoli-schatzman has no frictional version in the literature (SPEC §2.5)",
+        "paoli-schatzman has no frictional version in the literature (contract §2.5)",
     ),
     (
         "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nfriction_coefficient = 0.3\n",
@@ -316,14 +316,14 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nspace = \"penalty\"\npenalty_gamma0 = 10.0\nscheme = \"discrete-gradient\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
         "fixed.scheme",
-        "scheme = discrete-gradient has no frictional version in the literature (SPEC §2.5)",
+        "scheme = discrete-gradient has no frictional version in the literature (contract §2.5)",
     ),
     (
         "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nfriction = \"tresca\"\ntresca_threshold = inf\n",
         "fixed.tresca_threshold",
         "must be a finite number",
     ),
-    // The oscillator's dry friction (SPEC §1.5): F ≥ 0 and finite, the oscillator's key only,
+    // The oscillator's dry friction (contract §1.5): F ≥ 0 and finite, the oscillator's key only,
     // and only with a scheme that has a frictional step.
     (
         "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nfriction_force = -1.0\n",
@@ -350,7 +350,7 @@ const CASES: &[(&str, &str, &str)] = &[
         "fixed.friction_force",
         "paoli-schatzman has no frictional version in the literature",
     ),
-    // SPEC §1.8: the tilt of the plane under a mesh body (|α| < 90°: at 90° the weight no
+    // contract §1.8: the tilt of the plane under a mesh body (|α| < 90°: at 90° the weight no
     // longer presses the body on it), the initial tangential velocity (finite), and each key
     // only on the scenes that take it (velocity_tangential: layer1d, disc2d, sphere3d, mesh2d,
     // mesh3d; incline: mesh2d, mesh3d). The range checks come before the mesh file is read.

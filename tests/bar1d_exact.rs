@@ -1,4 +1,4 @@
-//! The closed form of the bar (SPEC §1.1) and the exactness of the error norms.
+//! The closed form of the bar (contract §1.1) and the exactness of the error norms.
 
 mod common;
 
@@ -210,7 +210,7 @@ fn non_default_bar_scales_exactly_onto_the_default() {
         fine < 0.06 && rate > 0.5,
         "relative contact errors {coarse} → {fine} (rate {rate})"
     );
-    // …and so the scaled errors shrink at the default's rate: ≈ 0.7–0.9 in L2 (SPEC §6).
+    // …and so the scaled errors shrink at the default's rate: ≈ 0.7–0.9 in L2 (contract §6).
     let r = (rates[0].1 / rates[2].1).ln() / (rates[0].0 / rates[2].0).ln();
     assert!((0.6..1.1).contains(&r), "L2 rate {r}");
 }

@@ -1,4 +1,4 @@
-//! The 2D and 3D bars dropped on an obstacle (SPEC §1.2, §6; paper 000 Table 1, paper 002).
+//! The 2D and 3D bars dropped on an obstacle (contract §1.2, §6; paper 000 Table 1, paper 002).
 //!
 //! The target figures come from a GetFEM implementation of the same discretisation (Q1,
 //! exact element integration, nodal contact on every bottom node, the same mass layers), so
@@ -28,7 +28,7 @@ fn close(x: f64, target: f64, rel: f64, what: &str) {
     );
 }
 
-/// SPEC §6: L∞(0,T;L2) at h = 0.05, τ = h/2 with CN against the mod3 + CN reference at h/32,
+/// contract §6: L∞(0,T;L2) at h = 0.05, τ = h/2 with CN against the mod3 + CN reference at h/32,
 /// τ/32 (82 k dofs, 2560 steps): consistent 9.18e-3, mod1 3.70e-3, mod2 3.69e-3, mod3 1.50e-3.
 /// Printed to three digits, so 1 % (the tolerance) also covers the rounding.
 #[test]
@@ -58,7 +58,7 @@ mass = ["consistent", "mod1", "mod2", "mod3"]
     }
 }
 
-/// SPEC §6 / 002 Figs 1–3: CN with the consistent mass gains energy and chatters — E(T)/E⁰ =
+/// contract §6 / 002 Figs 1–3: CN with the consistent mass gains energy and chatters — E(T)/E⁰ =
 /// 2.75 at h = 0.05, 3.48 at h/2, 4.58 at h/4 (printed to three digits: ±0.5 % covers the
 /// rounding) with a contact force switching on and off ≥ 10 times, more under refinement —
 /// while the modified masses keep E(T)/E⁰ within 1e-3 of 1 with one clean contact interval
@@ -125,8 +125,8 @@ scheme = ["crank-nicolson", "backward-euler"]
     }
 }
 
-/// SPEC §6, 3D at h = 0.05 (τ = h/2), against a mod3 + CN reference at h/4, τ/4 (the setting
-/// whose figures SPEC quotes): mod3 7.7e-4 < mod2 1.47e-3 < mod1 1.56e-3 in L∞(0,T;L2),
+/// contract §6, 3D at h = 0.05 (τ = h/2), against a mod3 + CN reference at h/4, τ/4 (the setting
+/// whose figures the contract quotes): mod3 7.7e-4 < mod2 1.47e-3 < mod1 1.56e-3 in L∞(0,T;L2),
 /// consistent + CN E(T)/E⁰ = 2.65. Two or three printed digits: 1 % tolerance.
 #[test]
 fn bar3d_orders_the_masses_like_2d() {
@@ -159,7 +159,7 @@ mass = ["consistent", "mod1", "mod2", "mod3"]
     assert_eq!((r.contact_dofs, r.dofs), (Some(9), 540));
 }
 
-/// The layer weights are one mechanism (SPEC §2.2): `weights = [2, 1]` is mod3 and
+/// The layer weights are one mechanism (contract §2.2): `weights = [2, 1]` is mod3 and
 /// `weights = [n_d/(n_d−1)]` is mod2, to the last bit of the error norms (same matrices,
 /// same operations). Lumped and zero-contact run too, with the total mass they represent:
 /// lumping keeps ρ·|Ω| = 0.1; zero-contact drops the bottom nodes' rows and columns, i.e. the

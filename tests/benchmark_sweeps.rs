@@ -93,7 +93,7 @@ fn bad_benchmark_input_names_file_key_and_reason() {
     let e =
         refused("name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nright_end = \"free\"\n");
     assert!(e.contains("right_end"), "{e}");
-    // SPEC §3.2's applicability on the oscillator: kane, CSN and Moreau–Jean are multiplier
+    // contract §3.2's applicability on the oscillator: kane, CSN and Moreau–Jean are multiplier
     // (impulse) methods, the discrete gradient is the penalty potential's.
     let e = refused(
         "name = \"o\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nspace = \"penalty\"\npenalty_gamma0 = 1.0\nscheme = \"kane\"\n",
@@ -131,10 +131,10 @@ fn benchmark_sweep_files_plan() {
         let sf = SweepFile::parse(&path, &text).unwrap_or_else(|e| panic!("{e}"));
         sweep::expand(&sf).unwrap_or_else(|e| panic!("{e}"))
     };
-    // 7 levels × 3 Courant numbers × 23 methods (16 of SPEC §2–§3, 7 of §3.2).
+    // 7 levels × 3 Courant numbers × 23 methods (16 of contract §2–§3, 7 of §3.2).
     assert_eq!(load("flying_bar.toml").runs.len(), 7 * 3 * 23);
     assert_eq!(load("siconos_impacting_bar.toml").runs.len(), 12);
-    // 7 steps × 3 laws × 15 methods (8 of SPEC §3, 7 of §3.2).
+    // 7 steps × 3 laws × 15 methods (8 of contract §3, 7 of §3.2).
     assert_eq!(load("oscillator.toml").runs.len(), 7 * 3 * 15);
 }
 

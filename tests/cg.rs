@@ -90,7 +90,7 @@ fn assert_cg_matches_direct(text: &str, rel: f64) -> RunRecord {
     cg
 }
 
-/// SPEC §1.2's 3D bar at h = 0.0125 (19 440 dofs, 81 contact columns), mod3 + CN, τ = h/2,
+/// contract §1.2's 3D bar at h = 0.0125 (19 440 dofs, 81 contact columns), mod3 + CN, τ = h/2,
 /// against a direct reference with τ/2 on the same mesh.
 #[test]
 fn bar3d_cg_gives_the_direct_errors() {

@@ -1,4 +1,4 @@
-//! Curved degree-2 cells are integrated exactly on their own geometry (SPEC §1.6, issue 34):
+//! Curved degree-2 cells are integrated exactly on their own geometry (contract §1.6, issue 34):
 //! every element mass matrix of a curved P2 triangle, P2 tetrahedron, Q2 quadrilateral and Q2
 //! hexahedron (and a distorted Q1 hexahedron) equals the one a much higher-order rule gives —
 //! degree 14+ in 2D, 10+ in 3D — to 1e-13 relative, and so does the load ∫ρ f·φ.

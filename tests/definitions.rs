@@ -1,4 +1,4 @@
-//! Issue 34's definition changes and the run ids: the body load of SPEC §1.3 (key `load`) and
+//! Issue 34's definition changes and the run ids: the body load of contract §1.3 (key `load`) and
 //! exact quadrature on curved cells moved the numbers of every run with gravity and of every
 //! run on cells that can be curved, so those runs have new ids — and a folder that holds their
 //! old rows is never resumed into (two answers to one question in its tables). Runs no change
@@ -30,7 +30,7 @@ fn refused(text: &str) -> String {
     }
 }
 
-/// The id a run had before issue 34: the documented rule (SPEC §8, `sweep::plan`'s header) on
+/// The id a run had before issue 34: the documented rule (contract §8, `sweep::plan`'s header) on
 /// its canonical parameters alone.
 fn id_before(scene: SceneKind, canonical: &[(Key, String)]) -> String {
     let map: BTreeMap<Key, String> = canonical.iter().cloned().collect();

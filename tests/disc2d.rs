@@ -1,4 +1,4 @@
-//! The disc and the ball falling under gravity (SPEC §1.3, 003 §4.2; issue 8 "done when" 1):
+//! The disc and the ball falling under gravity (contract §1.3, 003 §4.2; issue 8 "done when" 1):
 //! before the first contact the centre of mass follows −½|f|t², exactly for every Newmark
 //! scheme (constant acceleration is integrated exactly: (1−2β)a + 2βa = a) and off by
 //! (θ − ½)|f|τt for the θ-scheme; the first contact happens at t = √(2·5/0.1) = 10.
@@ -222,7 +222,7 @@ fn ball_nitsche_hybrid_and_modified_mass_keep_the_energy_mixed_gains() {
 /// unstable and the corollary's hypothesis (a well-posed step) fails. What the scheme
 /// guarantees is E_Θ^{n+1} ≤ E_Θ^n in exact arithmetic; the rounding of E_Θ (sums of ~10⁴
 /// terms of size ≤ energy_scale) is ~1e-13: bound 1e-12 of energy_scale, as the issue asks.
-/// The same for the penalty (SPEC §2.4) with E^h, which then includes the penalty potential.
+/// The same for the penalty (contract §2.4) with E^h, which then includes the penalty potential.
 #[test]
 fn hybrid_never_increases_the_augmented_energy() {
     let mut rng = fastrand::Rng::with_seed(8);
@@ -355,7 +355,7 @@ degree = [1, 2, 1, 2]
     }
 }
 
-/// Penalty (SPEC §2.4) on the disc in the paper's setting (Q2, h = 4, τ = 0.1, T = 40), with
+/// Penalty (contract §2.4) on the disc in the paper's setting (Q2, h = 4, τ = 0.1, T = 40), with
 /// κ = E·20/h_K — the stiffness 1/γ_h of Nitsche's γ0 = 1e-3 (E = 50) — under Crank–Nicolson
 /// and the hybrid scheme. E^h includes the penalty potential ½∫κ[u_n − g]_+².
 #[test]
@@ -411,10 +411,10 @@ scheme = ["crank-nicolson", "hybrid"]
     assert!(cn.energy_max_increase.unwrap() > 1e-6);
 }
 
-/// The mass variants of SPEC §2.2 on the disc and the ball (scene module header): `mod2` and
+/// The mass variants of contract §2.2 on the disc and the ball (scene module header): `mod2` and
 /// `mod3` conserve the total mass (their weights come from the measured layer masses), `mod1`
 /// and `weights = [1]` (the same matrix) remove layer 0's, `zero-contact` the Γ_C nodes' rows.
-/// `energy_scale` is m·|f|·gap with m = ∫ρ the body's mass for every variant and load (SPEC
+/// `energy_scale` is m·|f|·gap with m = ∫ρ the body's mass for every variant and load (contract
 /// §1.3). Free fall until the contact at t ≈ 10, Crank–Nicolson, both loads (issue 34):
 /// - `load = "inertial"` (F = M_run f e_d): the rigid fall solves every variant, so the centre
 ///   of mass follows −½|f|t² to round-off;
@@ -535,7 +535,7 @@ fn ball_mass_variants_conserve_mass_and_fall_freely() {
     check_mass_variants("sphere3d", 8.0, "2");
 }
 
-/// The energy parts and the lowest point in free fall (SPEC §1.3), Crank–Nicolson, both
+/// The energy parts and the lowest point in free fall (contract §1.3), Crank–Nicolson, both
 /// degrees, up to t = 9.9 (before the contact). With u⁰ = v⁰ = 0 and the load F = M f e_d the
 /// rigid fall u^n = ½ f t_n² e_d (f = −0.1) solves every Newmark step exactly (K kills
 /// translations, a = f is constant), so with m = e_dᵀ M e_d = `mass_total`:
@@ -653,7 +653,7 @@ method = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nits
 /// 30 runs, ≈ 1 s on two threads — diverging runs stop early). The map of docs/methods.md "The disc's
 /// γ0 × Θ map": Θ = 1 loses the positivity of the step matrix M + τ²/4·K_Θ between γ0 = 1e-3
 /// and 1e-2 (K_Θ = K − Θ Σ w γ s sᵀ; the inverse trace constant of Q2 at h = 4 puts the limit
-/// near 3e-3, SPEC §6), which the factorisation reports before the first step; γ0 = 1e-4 is
+/// near 3e-3, contract §6), which the factorisation reports before the first step; γ0 = 1e-4 is
 /// close to the ill-posed mixed method, so Crank–Nicolson chatters and gains tens of energy
 /// scales, while the hybrid scheme stays within 1 %; large γ0 with Θ ∈ {0, −1} lets the
 /// consistency term dominate and the energy passes 1e6 energy scales after the impact.
@@ -885,8 +885,8 @@ dt = [0.1, 0.05]
     );
 }
 
-/// Issue 20: `sweeps/comparison_disc.toml` — SPEC §3.2's methods on the 003 §4.2 disc beside
-/// the seeds' — with the properties SPEC §3.2 states, per step and relative to the energy
+/// Issue 20: `sweeps/comparison_disc.toml` — contract §3.2's methods on the 003 §4.2 disc beside
+/// the seeds' — with the properties contract §3.2 states, per step and relative to the energy
 /// scale m·g·gap (docs/methods.md "The same methods on the disc" prints these runs):
 /// kane, contact-stabilized Newmark and Moreau–Jean (θ = ½) never raise E^h by more than
 /// 1e-12 (measured ≤ 5.0e-14); the discrete gradient with the penalty conserves E^h + Φ and
@@ -947,11 +947,11 @@ fn comparison_disc_methods_have_their_properties() {
     }
 }
 
-/// Regression (issue 22 × 20): the SPEC §3.2 methods' time loop read a reference on another
+/// Regression (issue 22 × 20): the contract §3.2 methods' time loop read a reference on another
 /// mesh as if it were on the run's own (`data.u[base + i]`, the nested path), so their errors
 /// against a finer disc were read at the wrong reference dofs. Through the first impact
 /// (contact from t = √(2·gap/g) = 10; T = 12) generalized-α with ρ∞ = 1 is Crank–Nicolson to
-/// round-off (SPEC §3.2, `tests/fe_methods.rs`), so both loops must report the same errors
+/// round-off (contract §3.2, `tests/fe_methods.rs`), so both loops must report the same errors
 /// against one non-nested reference (h = 4: (n_t, n_r) = (8, 3), in the reference's (16, 5))
 /// — to 1e-8 relative, far above the schemes' round-off difference and far below the O(1)
 /// change of reading the wrong dofs. (The free fall alone would not do: both meshes carry the

@@ -1,8 +1,8 @@
-//! The dry-friction oscillator (SPEC §1.5, Siconos' FrictionOscillator). Its exact solution on
-//! its own: SPEC's setting (turning points, stop time and position), the energy lost at each
+//! The dry-friction oscillator (contract §1.5, Siconos' FrictionOscillator). Its exact solution on
+//! its own: the contract's setting (turning points, stop time and position), the energy lost at each
 //! half oscillation, the equation of motion between events, impacts with friction, and F = 0
 //! equal to the frictionless closed form. Then the engine (`friction_force`): Moreau–Jean's
-//! relay stops where SPEC §6 says, at first order in τ; the key keeps the frictionless ids.
+//! relay stops where contract §6 says, at first order in τ; the key keeps the frictionless ids.
 
 use std::path::Path;
 
@@ -190,8 +190,8 @@ fn stop_of(o: &Outcome, dt: f64) -> (f64, f64, f64) {
     )
 }
 
-/// SPEC §6's Coulomb oscillator: Moreau–Jean θ = ½ at τ = 1e-2 stops at t = 22.44 (to the
-/// step) and x = 0.682044 (SPEC's printed digits: half a unit of the last, 5e-7). Beyond them,
+/// contract §6's Coulomb oscillator: Moreau–Jean θ = ½ at τ = 1e-2 stops at t = 22.44 (to the
+/// step) and x = 0.682044 (the contract's printed digits: half a unit of the last, 5e-7). Beyond them,
 /// an independent 12-line Python transcription of the same relay step (v^{n+1} = 0 where
 /// |A v_free| ≤ τF, else v_free ∓ τF/A; A = 1 + θ²τ²) gives x = 0.6820441351951919, which
 /// the engine matches to 2.2e-13 — three thousand steps of round-off: asserted to 1e-9. The
@@ -322,7 +322,7 @@ fn friction_force_keeps_the_frictionless_ids() {
     );
 }
 
-/// `sweeps/friction_oscillator.toml` plans the SPEC setting: Moreau–Jean and CN over the
+/// `sweeps/friction_oscillator.toml` plans the contract setting: Moreau–Jean and CN over the
 /// τ ladder, F = 1, the obstacle out of reach.
 #[test]
 fn the_friction_oscillator_sweep_plans() {
@@ -337,7 +337,7 @@ fn the_friction_oscillator_sweep_plans() {
     }
 }
 
-/// The relay combined with the contact (the obstacle in reach, SPEC §1.5's defaults: gap ½,
+/// The relay combined with the contact (the obstacle in reach, contract §1.5's defaults: gap ½,
 /// x0 = 0, v0 = −1; F = 0.05): Moreau–Jean θ = ½ with e = 1 makes the normal impulse do no
 /// work (v^{n+1} = −vⁿ where it acts), so every step's energy change is the relay's,
 /// p_t(vⁿ + v^{n+1})/2 = −ΔW_f: E^n + W_f^n = E⁰ at every step, to the round-off of 1000 steps

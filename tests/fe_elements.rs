@@ -465,7 +465,7 @@ fn q1_stiffness_hand_values() {
 /// One Crank–Nicolson run of M ü + K u = 0 (ρ = 1, λ = 1/4, μ = 1/2) from u⁰ = I_h u_exact(0),
 /// v⁰ = 0, over `steps` steps of size `tau`; `exact(x, t)` the modal solution.
 struct CnResult {
-    /// max_n ‖u^n − I_h u(t_n)‖_M (L∞(0,T; L2) at the nodes, SPEC §1.2's norm).
+    /// max_n ‖u^n − I_h u(t_n)‖_M (L∞(0,T; L2) at the nodes, contract §1.2's norm).
     err_linf: f64,
     /// ‖u^N − I_h u(T)‖_M.
     err_final: f64,

@@ -1,4 +1,4 @@
-//! SPEC §3.2's methods on the finite-element scenes (issue 20, "done when" 2): property tests
+//! contract §3.2's methods on the finite-element scenes (issue 20, "done when" 2): property tests
 //! over seeded random h, τ and parameters in both FE dimensions.
 //!
 //! - `kane`, `contact-stabilized-newmark` and `moreau-jean` (θ = ½) never increase E^h by more
@@ -77,7 +77,7 @@ fn bar_draws(seed: u64, hs: &[f64], count: usize) -> Vec<(f64, f64, f64)> {
 
 /// E^h never increases by more than 1e-12·energy_scale per step: round-off of energies of
 /// size energy_scale summed over ~100 dofs is ~1e-15 of it (measured ≤ 5.2e-15), so 1e-12 is
-/// the SPEC's bound with room, while a scheme that does work on the system (CN with the
+/// the contract's bound with room, while a scheme that does work on the system (CN with the
 /// consistent mass gains 175 % over the run at h = 0.05) fails it by orders of magnitude.
 ///
 /// Moreau–Jean's impulse does the work ½p(1 − e)·Bvⁿ per step (θ = ½): zero for e = 1, ≤ 0
@@ -175,7 +175,7 @@ method = [
                 "{scene} h = {h} dt = {dt:.5} {mass}: steps 0..={end} (impact at {first}): max rel. differences u {:.2e}, E {:.2e}, force {:.2e}",
                 worst[0], worst[1], worst[2]
             );
-            // SPEC §3.2: equal to 1e-9 (relative to each quantity's scale) through the first
+            // contract §3.2: equal to 1e-9 (relative to each quantity's scale) through the first
             // impact; the two right-hand sides differ by round-off only (module header of
             // run::fe's methods: same matrix, same contact problem).
             for (w, what) in worst.iter().zip(["u_contact", "energy", "force"]) {
@@ -202,7 +202,7 @@ fn bar3d_generalized_alpha_rho_one_is_crank_nicolson() {
 /// seeded τ, γ0 on the disc or the ball under gravity (gap 0.05: the impact at t ≈ 1, then it
 /// stays in contact, bouncing). The conservation is exact in exact arithmetic; round-off of
 /// energies of size energy_scale and the Newton's residual at the round-off of its terms
-/// leave ~1e-14 (measured below), so 1e-12·energy_scale per step is SPEC's bound with room.
+/// leave ~1e-14 (measured below), so 1e-12·energy_scale per step is the contract's bound with room.
 fn gradient_conserves(scene: &str, seed: u64) {
     let mut rng = fastrand::Rng::with_seed(seed);
     for _ in 0..2 {
@@ -257,7 +257,7 @@ fn sphere3d_discrete_gradient_conserves_the_energy() {
 
 /// Kinematic contact (central difference, mixed, lumped) puts a penetrating dof exactly on
 /// the obstacle, so the penetration max(−u_d − g)_+ is 0 to the rounding of u = −g
-/// (≤ 1e-14·length scale, SPEC's bound; measured exactly 0). Every run of the new methods
+/// (≤ 1e-14·length scale, the contract's bound; measured exactly 0). Every run of the new methods
 /// reports `pressure_oscillation` (≥ 1 by construction: TV ≥ 2·max) and `max_penetration`.
 #[test]
 fn kinematic_contact_never_penetrates() {
@@ -341,7 +341,7 @@ scheme = "central-difference"
     }
 }
 
-/// Every new method's FE run fills `pressure_oscillation` (SPEC §3.2: computed online from the
+/// Every new method's FE run fills `pressure_oscillation` (contract §3.2: computed online from the
 /// total contact force, the observer's contact phases) and `max_penetration`; Moreau–Jean
 /// penetrates by O(τ) where the position-level methods hold the constraint to the LCP's
 /// round-off (≤ 1e-12 of the gap's scale, the LCP tolerance).
@@ -386,7 +386,7 @@ method = [
     }
 }
 
-/// Where the methods apply on the FE scenes (SPEC §3.2): the planner leaves out what needs
+/// Where the methods apply on the FE scenes (contract §3.2): the planner leaves out what needs
 /// inertia on a massless contact dof with its reason, and the discrete gradient with mixed (no
 /// contact potential) on the bars too.
 #[test]
@@ -428,7 +428,7 @@ fn fe_applicability_is_planned_with_reasons() {
 /// penalty too (f_cⁿ = f_c(uⁿ): the ½–½ average of the contact forces is CN's force at t^{n+1}
 /// once the equation held at tⁿ), on the disc and the ball through the first impact. Both
 /// solve the same Newton to 1e-12 relative, so their states differ by that much at most at
-/// each step: 1e-9 is SPEC's bound with three digits of room.
+/// each step: 1e-9 is the contract's bound with three digits of room.
 fn alpha_equals_cn_nitsche(scene: &str, seed: u64) {
     let mut rng = fastrand::Rng::with_seed(seed);
     let dt = 0.05 + 0.1 * rng.f64();
@@ -457,7 +457,7 @@ method = [
 
 /// Runs in pairs (Crank–Nicolson, then generalized-α with ρ∞ = 1 on the same method): each
 /// pair equal through the first impact to 1e-9 of each quantity's scale
-/// ([`alpha_cn_differences`]; SPEC §3.2's bound, with three digits of room over the Newton's
+/// ([`alpha_cn_differences`]; contract §3.2's bound, with three digits of room over the Newton's
 /// 1e-12 relative tolerance both runs solve to).
 fn alpha_pairs_agree(place: &str, runs: &[(String, Outcome)]) {
     for pair in runs.chunks(2) {

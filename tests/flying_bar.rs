@@ -1,4 +1,4 @@
-//! The flying bar (SPEC §1.4): its closed form on its own, the exactness of its error norms,
+//! The flying bar (contract §1.4): its closed form on its own, the exactness of its error norms,
 //! Siconos' steel bar run from its sweep file in SI units, and convergence in h = cτ.
 //!
 //! Every tolerance is relative to the bar's own scales (length L, time L/c, speed V, pressure
@@ -16,7 +16,7 @@ const CN: Scheme = Scheme::Newmark(NewmarkParams {
     gamma: 0.5,
 });
 
-/// Siconos' ImpactingBar (SPEC §1.4).
+/// Siconos' ImpactingBar (contract §1.4).
 fn siconos() -> BarParams {
     BarParams {
         length: 1.0,
@@ -97,7 +97,7 @@ fn exact_solution_fronts_contact_momentum_energy() {
         let t_after = t_c + 1.3 * dur;
         assert!((ex.u(0.7 * l, t_after) - (-g + v * 0.3 * dur)).abs() <= 1e-12 * g);
         assert_eq!(ex.contact_stress(t_after), 0.0);
-        // Steps landing on either end of the contact take σ = 0 (SPEC §1.4).
+        // Steps landing on either end of the contact take σ = 0 (contract §1.4).
         assert_eq!(ex.contact_stress(t_c), 0.0);
         assert_eq!(ex.contact_stress(t_c + dur), 0.0);
         // Momentum −ρLV before, +ρLV after, and energy ½ρLV² at every time (midpoint rule on
@@ -209,7 +209,7 @@ fn error_norms_are_integrated_exactly_at_the_fronts() {
     }
 }
 
-/// Other combinations of the new keys have no closed form (SPEC §1.4): errors null.
+/// Other combinations of the new keys have no closed form (contract §1.4): errors null.
 #[test]
 fn no_closed_form_means_null_errors() {
     let clamped_moving = BarParams {
@@ -237,7 +237,7 @@ fn no_closed_form_means_null_errors() {
     }
 }
 
-/// Siconos' ImpactingBar run from its sweep file, in SI units (SPEC §1.4; done-when 3 of
+/// Siconos' ImpactingBar run from its sweep file, in SI units (contract §1.4; done-when 3 of
 /// issue 21): mod3 + CN starts its contact at t_c = 5.0e-4 s, holds it for 2L/c = 3.854e-4 s
 /// and the bar leaves with −v0, each to the step or the percent.
 #[test]
@@ -250,7 +250,7 @@ fn siconos_impacting_bar_from_its_sweep_file() {
     assert_eq!(records.len(), 12);
     let p = siconos();
     let (t_c, dur) = p.exact().unwrap().contact_interval().unwrap();
-    // The figures SPEC §1.4 states, from the SI parameters alone.
+    // The figures contract §1.4 states, from the SI parameters alone.
     assert!((t_c - 5.0e-4).abs() < 1e-15);
     assert!((dur - 3.854e-4).abs() < 0.0005e-4, "2L/c = {dur}");
     for r in &records {
@@ -297,7 +297,7 @@ fn siconos_impacting_bar_from_its_sweep_file() {
     assert!((r.energy_initial.unwrap() - 39.0).abs() < 1e-12 * 39.0);
 }
 
-/// The contact pressure of mod3 + CN on the Siconos bar against ρcV (SPEC §1.4).
+/// The contact pressure of mod3 + CN on the Siconos bar against ρcV (contract §1.4).
 #[test]
 fn siconos_contact_pressure_is_rho_c_v() {
     let p = siconos();
@@ -367,7 +367,7 @@ fn fitted_rate(points: &[(f64, f64)]) -> f64 {
 /// Convergence in h = cτ (issue 21, done-when 4). The exact solution's strain jumps across the
 /// fronts (u ∈ H^{3/2−ε}): the best P1 approximation converges as h^{3/2} in L2 and h^{1/2} in
 /// H1, and the discrete fronts' phase error (dispersion) lowers that further — measured L2
-/// rates 0.5–0.7 and H1 rates 0.25–0.31, the clamped bar's picture (SPEC §6: ≈ 0.7–0.9 in L2,
+/// rates 0.5–0.7 and H1 rates 0.25–0.31, the clamped bar's picture (contract §6: ≈ 0.7–0.9 in L2,
 /// ≈ 0.3 in H1). The windows are ±0.1 about the measured fitted rates (the consecutive rates
 /// of the ladder vary by ±0.05), so a change of method behaviour shows.
 #[test]
@@ -442,7 +442,7 @@ fn flying_bar_convergence_rates() {
     }
     // Mixed + consistent mass + CN at ν = 1 (and Nitsche, penalty alike): the H1 error grows
     // as h falls (rates ≈ −0.25) and E(T)/E⁰ ≈ 26 — the ill-posed semi-discretisation of
-    // SPEC §2.1, as on the clamped bar (003 Fig 10).
+    // contract §2.1, as on the clamped bar (003 Fig 10).
     let pts = flying_ladder(1.0, MassVariant::Consistent, mixed, CN);
     let h1 = fitted_rate(&pts.iter().map(|p| (p.0, p.2)).collect::<Vec<_>>());
     assert!(h1 < 0.0, "mixed + CN: H1 rate {h1}");
@@ -452,7 +452,7 @@ fn flying_bar_convergence_rates() {
     );
 }
 
-/// The SPEC §3.2 methods on the same ladder (ν = 1; issue 21, done-when 4). In 1D the fronts'
+/// The contract §3.2 methods on the same ladder (ν = 1; issue 21, done-when 4). In 1D the fronts'
 /// regularity, not the time scheme, limits every method: measured fitted L2 / H1 rates kane
 /// 0.63 / 0.30 (consistent mass), 0.64 / 0.30 (mod3), contact-stabilized Newmark 0.73 / 0.32,
 /// Moreau–Jean (θ = ½) e = 0 0.88 / 0.33 and e = 1 0.81 / 0.29, generalized-α ρ∞ = ½ 0.70 /

@@ -6,13 +6,13 @@
 //!
 //! The disc (R = 20, Q2, λ = μ = 20, ρ = 1, gravity 0.1, gap 5) starts with the velocity
 //! 0.5 e_1 and reaches the plane at t = 10 with the normal velocity 1; μ_f = 0.2. The columns
-//! (SPEC §5): E(T) + W_f − E⁰ (`energy_balance_drift`) and its largest one-step rise over
+//! (contract §5): E(T) + W_f − E⁰ (`energy_balance_drift`) and its largest one-step rise over
 //! `energy_scale`, W_f(T) (`friction_work`), max |Σf_t|/Σf_n (`friction_ratio_max`; Nitsche's
 //! sums over its quadrature points in contact, `run::fe_nitsche`), the mean velocities
 //! v̄_1(T) and v̄_d(T) (1ᵀMv/1ᵀM1 along e_1, e_d), `max_penetration`, stick/slip node-steps and contact phases. Besides
 //! the printed figures, the properties that hold whatever the digits:
 //! - |Σf_t| ≤ μ_f Σf_n at every contact step, for every method;
-//! - kane and moreau-jean (θ = ½) never raise E + W_f (SPEC §2.5);
+//! - kane and moreau-jean (θ = ½) never raise E + W_f (contract §2.5);
 //! - the plane's tangential impulse is at most μ_f times its normal one: with 1ᵀK = 0 (nothing
 //!   clamped) and the body load −m g e_d, the momentum equations summed over the nodes give
 //!   m(V − v̄_1(T)) = ∫Σf_t ≤ μ_f ∫Σf_n = μ_f m (v̄_d(T) + gT) (v̄_d(0) = 0), the integrals
@@ -298,9 +298,9 @@ fn coarse_level_energy_and_friction_table() {
         let rise = m.energy_balance_max_increase.unwrap();
         match row.rise {
             Some(p) => assert_printed(&what("energy_balance_max_increase"), rise, p),
-            // kane and moreau-jean θ = ½ never raise E + W_f (SPEC §2.5; the bound is
+            // kane and moreau-jean θ = ½ never raise E + W_f (contract §2.5; the bound is
             // 1e-12 energy scales per step); contact-stabilized Newmark does not either here
-            // (measured, not a theorem of SPEC's: as without friction on the disc, docs/methods.md
+            // (measured, not a theorem of the contract's: as without friction on the disc, docs/methods.md
             // "The same methods on the disc"). Measured 7.1e-15, 7.3e-15 and 1.3e-14: the
             // rounding of energies ~1e2 over ~500 dofs, relative to the scale 785.
             None => assert!(rise <= 1e-12, "{}: E + W_f rose by {rise:.3e}", what("")),

@@ -1,5 +1,5 @@
 //! Friction on the finite-element scenes with `space = "mixed"` and the Newmark/θ schemes
-//! (SPEC §1.8, §2.5; issue 33): the condensed Coulomb/Tresca problem of
+//! (contract §1.8, §2.5; issue 33): the condensed Coulomb/Tresca problem of
 //! [`contact_sweep::contact::coulomb`] in the sparse engine.
 //!
 //! - μ_f = 0 and s = 0 give the frictionless rows bit for bit (every numeric column but the
@@ -60,7 +60,7 @@ fn differing(a: &RunRecord, b: &RunRecord) -> Vec<String> {
     out
 }
 
-/// SPEC §2.5: μ_f = 0 and s = 0 are the frictionless problem, numbers bit for bit.
+/// contract §2.5: μ_f = 0 and s = 0 are the frictionless problem, numbers bit for bit.
 #[test]
 fn zero_friction_is_frictionless_bit_for_bit() {
     let laws = r#"
@@ -176,14 +176,14 @@ friction = [
     }
 }
 
-/// Each step's own tangential work −Σ f_t^{n+1}·Δu_t ≥ 0 (SPEC §2.5), for every scheme of the
+/// Each step's own tangential work −Σ f_t^{n+1}·Δu_t ≥ 0 (contract §2.5), for every scheme of the
 /// stepper, every mass, both laws, bar2d and the disc; the tally's minimum is over
 /// energy_scale and may be negative by round-off only: a stick node's Δu_t is a difference
 /// of nearly equal displacements, ~1e-16·|u| (measured ≥ −4e-18). Where f̄ = f^{n+1}
 /// (backward Euler, newmark-dissipative) W_f is the sum of those terms: it never decreases in
 /// the series. Crank–Nicolson's f̄ averages two steps and W_f has no sign there: on the
 /// chattering consistent-mass bar it ends negative (measured −1.0e-2 with μ_f = 0.3), which
-/// is what SPEC §2.5 leaves open.
+/// is what contract §2.5 leaves open.
 #[test]
 fn the_tangential_work_of_each_step_is_non_negative() {
     let runs = outcomes(

@@ -1,4 +1,4 @@
-//! Friction in SPEC §3.2's methods with the nodal multiplier (issue 33, "done when" 2):
+//! Friction in contract §3.2's methods with the nodal multiplier (issue 33, "done when" 2):
 //! property tests over seeded random (h, τ, μ_f) on bar2d, bar3d, disc2d and sphere3d.
 //!
 //! - `kane` and `moreau-jean` (θ = ½) never raise E^h + W_f by more than 1e-12 energy scales in
@@ -62,7 +62,7 @@ fn check_common(place: &str, label: &str, o: &Outcome, mu: Option<f64>) -> (f64,
         m.contact_phases.unwrap() >= 1,
         "{place} {label}: the body must hit the obstacle"
     );
-    // Every position-level method's step does the tangential work −Σf_t^{n+1}·Δu_t ≥ 0 (SPEC
+    // Every position-level method's step does the tangential work −Σf_t^{n+1}·Δu_t ≥ 0 (contract
     // §2.5: the law's own sign, per node); a stuck node's Δu_t is the solver's residual, whose
     // work is ~1e-12 of a force times 1e-12 of a displacement: nothing at 1e-15 scales.
     // (Moreau–Jean's slip is v_t^{n+1}, not Δu_t/τ: no sign.)
@@ -140,7 +140,7 @@ law = [
 }
 
 /// μ_f = 0 and s = 0 are the frictionless problem: every method's rows equal `friction =
-/// "none"`'s bit for bit (SPEC §2.5) — energies, contact force, displacement and velocity at
+/// "none"`'s bit for bit (contract §2.5) — energies, contact force, displacement and velocity at
 /// every step, and the run's energy columns; the run ids differ. Seeded h, τ on bar2d (the
 /// kinematic run below its CFL step, 0.89 h at h = 0.05).
 #[test]
@@ -216,7 +216,7 @@ fn frictional_sweep(scene: &str, fixed: &str, law: &str, methods: &str) -> Vec<(
 }
 
 /// `kane` and `moreau-jean` (θ = ½) never raise E + W_f by more than 1e-12 energy scales in a
-/// step (SPEC §2.5, module header of run::fe's methods: kane's step changes it by
+/// step (contract §2.5, module header of run::fe's methods: kane's step changes it by
 /// −λ·(Buⁿ + g) ≤ 0, Moreau–Jean's by ½(1 − e)p_n·Bvⁿ). Moreau–Jean with e = 1 conserves
 /// E + W_f: its step change is ½p_n·(Bv^{n+1} + Bvⁿ), zero up to the solver's residual.
 ///
@@ -357,7 +357,7 @@ fn sphere3d_energy_plus_friction_work_never_rises() {
 
 /// The disc thrown along e_1 (v⁰ = (V, 0) on every node; set on the planned run, the sweep key
 /// being the mesh scenes'): while every contact node slides forward, f_t = −μ_f f_n at each of
-/// them, and the free body's momentum P = 1ᵀMv per direction obeys SPEC §1.8's balance
+/// them, and the free body's momentum P = 1ᵀMv per direction obeys contract §1.8's balance
 /// P_1 + μ_f P_d − (ΣF_1 + μ_f ΣF_d)·t = const (1ᵀK = 0 for the unclamped disc; every
 /// method's momentum equation is linear in the forces of its time levels). With the body load
 /// ΣF = −g·m e_d and 1ᵀM1 = m per direction (consistent and lumped masses), in mean velocities:

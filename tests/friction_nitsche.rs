@@ -1,5 +1,5 @@
 //! Coulomb and Tresca friction with `space = "nitsche"` and `space = "penalty"` on the FE
-//! scenes (issue 33; SPEC §1.8, §2.5): GetFEM's full-vector Nitsche form with friction.
+//! scenes (issue 33; contract §1.8, §2.5): GetFEM's full-vector Nitsche form with friction.
 //!
 //! - μ_f = 0 / s = 0 give `none`'s numbers bit for bit with the penalty and Nitsche at Θ = 0;
 //!   at Θ = 1 the full-vector frictionless form differs slightly (5.5e-4 energy scales
@@ -26,7 +26,7 @@ fn root() -> PathBuf {
 }
 
 /// Every run of the sweep `text` (as the file `path`) with its series, the initial tangential
-/// velocity set on the run's setup (the disc thrown obliquely, SPEC §1.8), in the context `ctx`.
+/// velocity set on the run's setup (the disc thrown obliquely, contract §1.8), in the context `ctx`.
 fn outcomes_with(path: &Path, text: &str, vt: f64, ctx: &RunContext) -> Vec<(String, Outcome)> {
     let thrown = |cfg: &mut RunConfig| {
         if let RunConfig::Fe(fe) = cfg {
@@ -135,7 +135,7 @@ fn getfem_run(t_final: f64, vt: f64, mu: f64) -> Getfem {
 /// the smallest |Δu_t| in the phase is 4.4e-5, far from the threshold on both sides) — Nitsche's
 /// stick is regularised (f_t = σ_t − Δu_t/(γτ) inside the cone) and decided at the Gauss points:
 /// there, of the point-steps in contact, 74 stick (|p_t| ≤ μ_f f_n) and 249 slip in both runs,
-/// exactly (SPEC §5's `stick_steps`/`slip_steps` against GetFEM's count).
+/// exactly (contract §5's `stick_steps`/`slip_steps` against GetFEM's count).
 #[test]
 fn nitsche_coulomb_equals_getfem_on_the_thrown_p2_disc() {
     let (t_final, vt, mu) = (13.0, 0.5, 0.3);
@@ -280,7 +280,7 @@ fn compare_nodal_slip(label: &str, o: &Outcome, gf: &Getfem, first: usize, end: 
         .flat_map(|k| nodes.clone().map(move |j| du_g(k, j).abs()))
         .fold(0.0f64, f64::max);
     let mut err = 0.0f64;
-    // Stick at a node: |Δu_t| ≤ 1e-12·h (SPEC §5's criterion). The counts are compared per step
+    // Stick at a node: |Δu_t| ≤ 1e-12·h (contract §5's criterion). The counts are compared per step
     // over the node-steps where both sides are a factor 1e3 or more from the threshold (a
     // difference of 1e-8 of the largest slip could move a node across it otherwise).
     let thr = 1e-12 * mesh.h;
@@ -329,7 +329,7 @@ fn compare_nodal_slip(label: &str, o: &Outcome, gf: &Getfem, first: usize, end: 
     );
 }
 
-/// SPEC §2.5: μ_f = 0 (and s = 0) give the frictionless run's numbers bit for bit with the
+/// contract §2.5: μ_f = 0 (and s = 0) give the frictionless run's numbers bit for bit with the
 /// penalty and with Nitsche at Θ = 0 (the frictionless engine solves them: `fe::frictional`);
 /// with Θ ≠ 0 the frictional form at μ_f = 0 is the full-vector frictionless Nitsche (σ_t = 0
 /// imposed weakly with its Θ term), which differs from `none`'s (σ_t = 0 natural) by a small
@@ -386,10 +386,10 @@ fn zero_friction_is_frictionless_except_the_full_vector_theta_term() {
     }
 }
 
-/// Friction does work on the bars (SPEC §1.8, §2.5): bar2d dropped with v⁰ = −½ e_d spreads
+/// Friction does work on the bars (contract §1.8, §2.5): bar2d dropped with v⁰ = −½ e_d spreads
 /// laterally on impact (Poisson), so Γ_C's points slide outwards against the friction. With
 /// backward Euler (θ = 1, so f̄ = f^{n+1}) W_f's increments are the per-step tangential work
-/// −Σ f_t^{n+1}·Δu_t, which SPEC §2.5 says is ≥ 0 for position-level methods: pointwise for
+/// −Σ f_t^{n+1}·Δu_t, which contract §2.5 says is ≥ 0 for position-level methods: pointwise for
 /// the penalty (f_t = proj(−κΔu_t)), summed over Γ_C for Nitsche. Checked per step to a
 /// round-off allowance of 1e-12 of the run's final W_f, and W_f > 0 at the end.
 #[test]
@@ -452,7 +452,7 @@ const ALPHA_SPACES: [&str; 3] = [
     r#"space = "penalty", penalty_gamma0 = 100.0"#,
 ];
 
-/// SPEC §2.5 with generalized-α/HHT (issue 33): μ_f = 0 and s = 0 give the frictionless rows
+/// contract §2.5 with generalized-α/HHT (issue 33): μ_f = 0 and s = 0 give the frictionless rows
 /// bit for bit with the penalty and with Nitsche at Θ = 0 (the frictionless engine solves them,
 /// `fe::frictional`), on the disc thrown obliquely through its first impact.
 #[test]
@@ -538,7 +538,7 @@ fn rho_one_equals_crank_nicolson(label: &str, runs: &[(String, Outcome)], tol: f
             cn.metrics.stick_steps,
             al.metrics.stick_steps
         );
-        // CN's W_f can be negative (f̄ = ½(fⁿ + f^{n+1}), SPEC §2.5), not zero: friction acts.
+        // CN's W_f can be negative (f̄ = ½(fⁿ + f^{n+1}), contract §2.5), not zero: friction acts.
         assert!(wf != 0.0, "{lc}: friction works");
         for (what, d) in [("energy", e), ("f_n", f), ("f_t", ft), ("W_f", w)] {
             assert!(d <= tol, "{label} {la}: {what} differs from CN by {d:.3e}");
@@ -621,7 +621,7 @@ fn generalized_alpha_rho_one_is_crank_nicolson_on_the_thrown_disc() {
 /// The penalty's and backward Euler's minima are 0 exactly (measured).
 const OWN_WORK_ALLOWANCE: f64 = 1e-6;
 
-/// SPEC §2.5 with generalized-α/HHT and Nitsche/penalty (issue 33): on bar2d dropped with
+/// contract §2.5 with generalized-α/HHT and Nitsche/penalty (issue 33): on bar2d dropped with
 /// v⁰ = −½ e_d (Γ_C slides outwards on impact, [`friction_does_nonnegative_work_on_the_bars`])
 /// each step's own tangential work −Σ f_t^{n+1}·Δu_t is ≥ 0 (the law's sign; for Nitsche
 /// summed over Γ_C), to [`OWN_WORK_ALLOWANCE`], |f_t| ≤ μ_f f_n, and the

@@ -1,7 +1,7 @@
 //! The engine against GetFEM on the same Gmsh file (issue 34): the 003 disc as P2 triangles
 //! (`sweeps/meshes/disc_p2.msh`, curved boundary cells), `mesh2d` with gravity 0.1, gap 5,
 //! λ = μ = 20, mixed contact + Crank–Nicolson, τ = 0.1, T = 40, five masses — against
-//! `tests/getfem/disc_mixed.py`, which assembles K, M (the layer weights of SPEC §2.2) and the
+//! `tests/getfem/disc_mixed.py`, which assembles K, M (the layer weights of contract §2.2) and the
 //! body force with GetFEM 5.4 (Debian's python3-getfem, installed by `tests/install_getfem.sh`)
 //! on the same file and steps the same scheme in numpy, sharing no code with the engine; and
 //! Nitsche's contact (Θ = 1, γ0 = 1e-3, consistent mass, 003 §4.2's setting) with the Nitsche
@@ -21,8 +21,8 @@
 //!   contact phase) and for Nitsche (its Newton solves to a residual of 1e-10 against a
 //!   right-hand side of ~10³: u to ~1e-10, the energy to ~1e-10 of its scale), and through the
 //!   first contact phase for the consistent mass with mixed contact, whose
-//!   Crank–Nicolson is chaotic afterwards (SPEC §2.1: ill-posed in practice, 1e-14 moves it).
-//! - `energy_scale` = ρ|Ω_h|·|f|·gap with GetFEM's body mass, whatever the variant (SPEC §1.3).
+//!   Crank–Nicolson is chaotic afterwards (contract §2.1: ill-posed in practice, 1e-14 moves it).
+//! - `energy_scale` = ρ|Ω_h|·|f|·gap with GetFEM's body mass, whatever the variant (contract §1.3).
 //!
 //! Before issue 34 the engine missed by far more: its load followed the modified mass (mod1's
 //! body 16.5 % lighter than the paper's, the first contact force 460 → 402) and its degree-4

@@ -1,7 +1,7 @@
 //! The Hertz half-disc example (issue 22: `sweeps/hertz_halfdisc.toml` on the Gmsh mesh
 //! `sweeps/meshes/hertz_halfdisc.msh`, P2 triangles, R = 1, nothing clamped).
 //!
-//! - the sweep file plans as committed: the seeds' methods and SPEC §3.2's (17 runs) on one
+//! - the sweep file plans as committed: the seeds' methods and contract §3.2's (17 runs) on one
 //!   mesh whose `h` and cell count come from the file;
 //! - a short version of it (T = 2: the impact at t = 0.2 and most of the contact, which lasts
 //!   until t ≈ 2.7) runs in well under a second in release and shows what docs/methods.md reports:
@@ -146,7 +146,7 @@ fn short_impact_energies() {
     let msg = lumped.message.as_deref().unwrap_or_default();
     assert!(msg.contains("row-sum lumping"), "{msg}");
 
-    // SPEC §3.2's properties on this P2 mesh (per step, in units of E⁰ = energy_scale; the
+    // contract §3.2's properties on this P2 mesh (per step, in units of E⁰ = energy_scale; the
     // bound is round-off of energies of size E⁰ over 3 208 dofs, ~1e-14 of it, as in
     // tests/fe_methods.rs — measured over T = 6: ≤ 2.8e-13 for kane, CSN and the penalty's
     // hybrid, 4.1e-13 for Nitsche-Hybrid's E_Θ).

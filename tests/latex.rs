@@ -216,7 +216,7 @@ fn fig10_ladder_tables_compile_and_print_the_papers_digits() {
     assert_eq!(tex.matches("\\begin{table}[htbp]").count(), 5);
     assert_eq!(tex.matches("\\begin{longtable}").count(), 0);
     assert!(tex.contains("\\textit{path 1}: $\\nu = 1$ fixed, $h$ refined"));
-    // SPEC §6 (003 Fig 10), l2(τ;H1) at h = 1/4 … 1/256, as the paper prints them. The
+    // contract §6 (003 Fig 10), l2(τ;H1) at h = 1/4 … 1/256, as the paper prints them. The
     // table prints four significant digits too; they agree within one unit of the last printed
     // digit, the tolerance of tests/paper_figures.rs: two of the paper's figures are double
     // roundings (2.37249 → 2.3725 → 2.373, 0.542748 → 0.54275 → 0.5428) where the table

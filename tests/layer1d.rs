@@ -1,5 +1,5 @@
-//! The frictional layer (SPEC §1.7) run by the methods: SPEC §6's friction table to its
-//! printed digits, the energy properties of SPEC §2.5 over seeded random h, τ, V_t, μ_f, the
+//! The frictional layer (contract §1.7) run by the methods: contract §6's friction table to its
+//! printed digits, the energy properties of contract §2.5 over seeded random h, τ, V_t, μ_f, the
 //! frictionless limits bit for bit, and the layer through the planner.
 
 use contact_sweep::contact::friction::FrictionLaw;
@@ -38,10 +38,10 @@ const MJ1: Scheme = Scheme::MoreauJean(MoreauJeanParams {
     restitution: 1.0,
 });
 
-/// A row of SPEC §6's friction table: (V_t, μ_f, mass, scheme, [(value, tolerance); 5]).
+/// A row of contract §6's friction table: (V_t, μ_f, mass, scheme, [(value, tolerance); 5]).
 type Row = (f64, f64, MassVariant, Scheme, [(f64, f64); 5]);
 
-/// SPEC §6: defaults, 80 elements, c_p τ/h = ½ (τ = 1/320), T = 2.5, Coulomb. Each value must
+/// contract §6: defaults, 80 elements, c_p τ/h = ½ (τ = 1/320), T = 2.5, Coulomb. Each value must
 /// round to the printed digits: the tolerance is half a unit of the last printed digit.
 #[test]
 fn spec_friction_table() {
@@ -134,7 +134,7 @@ fn spec_friction_table() {
     assert!(bad.is_empty(), "{bad:#?}\n{report}");
 }
 
-/// SPEC §6: `mixed` + consistent mass + CN is ill-posed in practice on the layer too: test
+/// contract §6: `mixed` + consistent mass + CN is ill-posed in practice on the layer too: test
 /// only that it gains energy.
 #[test]
 fn consistent_mass_crank_nicolson_gains_energy() {
@@ -163,7 +163,7 @@ impl Rng {
     }
 }
 
-/// SPEC §2.5 over seeded random h, τ, V_t, μ_f (both regimes, both signs of V_t): `kane` and
+/// contract §2.5 over seeded random h, τ, V_t, μ_f (both regimes, both signs of V_t): `kane` and
 /// `moreau-jean` (θ = ½) never raise E + W_f by more than 1e-12·E⁰ in a step, Moreau–Jean with
 /// e = 1 conserves it (its normal impulse does no work, W_f is the tangential impulse's work
 /// exactly): |drift| ≤ 1e-12·E⁰ per step over the run; each step's tangential work
@@ -241,7 +241,7 @@ fn zero_friction_is_frictionless_bit_for_bit() {
             (ContactMethod::Mixed, MassVariant::Consistent),
             (ContactMethod::Penalty { gamma0: 10.0 }, MassVariant::Lumped),
         ] {
-            // kane, contact-stabilized-newmark and moreau-jean are `mixed` only (SPEC §3.2).
+            // kane, contact-stabilized-newmark and moreau-jean are `mixed` only (contract §3.2).
             if method != ContactMethod::Mixed
                 && scheme.is_comparison()
                 && !matches!(scheme, Scheme::GeneralizedAlpha(_))
@@ -424,18 +424,18 @@ fn friction_layer_sweep_matches_the_methods_table() {
 /// the convergence tables, and the report's energy-balance and slip-velocity figures.
 ///
 /// The expected classes, with δ = h/H (ν = ½ < 1, H = 1: 0.05 … 0.0125) — measured, and why:
-/// - slip (V_t = 1, μ_f = 0.1): the base does W_f ≈ 0.16 E⁰ (SPEC §6), far above δ, so E falls
+/// - slip (V_t = 1, μ_f = 0.1): the base does W_f ≈ 0.16 E⁰ (contract §6), far above δ, so E falls
 ///   by more than δ; zero-contact + CN (E + W_f rises ≤ 2e-4 E⁰), kane and Moreau–Jean e = 0
 ///   (E + W_f falls ≤ 9.5e-3 E⁰ at h = 1/20, halving with h: below δ at every level) and e = 1
 ///   (E + W_f conserved to round-off) are "dissipative with friction accounted";
 /// - stick (V_t = μ_f = 0.3): no exact work; zero-contact + CN, kane and Moreau–Jean e = 0 keep
 ///   E within δ (|drift| ≤ 1.8e-2 at h = 1/20, 4.4e-3 at 1/80) — conserving. Moreau–Jean e = 1
-///   chatters at the base (SPEC §6: W_f = 0.035 E⁰ where the exact solution has none), E + W_f
+///   chatters at the base (contract §6: W_f = 0.035 E⁰ where the exact solution has none), E + W_f
 ///   is conserved to round-off, so the lost 3.5 % exceeds δ from h = 1/40 on: "dissipative with
 ///   friction accounted" — the class says the energy went into (spurious) friction, not into
 ///   the scheme;
 /// - consistent mass + CN (ill-posed: E + W_f gains 2–10 E⁰) and HHT α = 0.1 (one step raises
-///   E + W_f by up to 0.25 E⁰, SPEC §6 table) are growing in both regimes.
+///   E + W_f by up to 0.25 E⁰, contract §6 table) are growing in both regimes.
 #[test]
 fn summaries_judge_frictional_runs_by_energy_plus_friction_work() {
     use polars::prelude::*;
@@ -523,7 +523,7 @@ method = [
     }
 
     // The energy table: every run judged by E^h + W_f, its drift the runs' balance column;
-    // Moreau–Jean e = 1 conserves the balance to round-off (SPEC §2.5: 1e-12 E⁰ per step).
+    // Moreau–Jean e = 1 conserves the balance to round-off (contract §2.5: 1e-12 E⁰ per step).
     let en = read("energy.parquet");
     assert!(
         strs(&en, "energy_functional")

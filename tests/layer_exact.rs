@@ -1,4 +1,4 @@
-//! The frictional layer's exact solution (SPEC §1.7) on its own, before any method is measured
+//! The frictional layer's exact solution (contract §1.7) on its own, before any method is measured
 //! against it: the bulk wave equations (characteristic invariants, the displacement's
 //! derivatives), the free top, the initial state, Signorini and the friction law at the base
 //! (stick and slip, Coulomb and Tresca), the energy identity E + W_f = E⁰, the mean tangential
@@ -76,7 +76,7 @@ fn cases() -> Vec<(&'static str, LayerExact)> {
     ]
 }
 
-/// SPEC §6's friction rows state the exact values: slip (V_t = 1, μ_f = 0.1): σ_t* = 0.2,
+/// contract §6's friction rows state the exact values: slip (V_t = 1, μ_f = 0.1): σ_t* = 0.2,
 /// v_slip = 0.8, v̄_t⁺ = 0.8, E(T)/E⁰ = 0.84; stick (V_t = μ_f = 0.3): σ_t* = 0.3, v̄_t⁺ = 0,
 /// E(T)/E⁰ = 1. The values are short binary-inexact decimals: a few ulps.
 #[test]
@@ -93,7 +93,7 @@ fn the_default_slip_and_stick_values() {
     assert!((k.sigma_t_star() - 0.3).abs() < 1e-15);
     assert!(k.mean_tangential_velocity_after().abs() < 1e-15);
     assert_eq!(k.friction_work(2.5), 0.0);
-    // Coulomb's v̄_t⁺ = V_t − min(2V_t c_s/c_p, 2μ_f V_n) (SPEC §1.7) on the odd material.
+    // Coulomb's v̄_t⁺ = V_t − min(2V_t c_s/c_p, 2μ_f V_n) (contract §1.7) on the odd material.
     for e in [
         odd(0.4, FrictionLaw::Coulomb { coefficient: 0.25 }),
         odd(0.4, FrictionLaw::Coulomb { coefficient: 0.9 }),

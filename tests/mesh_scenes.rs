@@ -1,4 +1,4 @@
-//! The `mesh2d`/`mesh3d` scenes (SPEC §1.6, issue 22): the user's body from a Gmsh file.
+//! The `mesh2d`/`mesh3d` scenes (contract §1.6, issue 22): the user's body from a Gmsh file.
 //!
 //! - issue 22 "done when" 2: the 002 bar meshed by Gmsh as transfinite quadrilaterals
 //!   (sweeps/meshes/bar2d_quad.msh: the nodes and Q1 elements of bar2d's box at h = 0.05, in
@@ -125,7 +125,7 @@ scheme = ["crank-nicolson", "backward-euler"]
     assert!(worst.0 < 1e-10, "{worst:?}");
 }
 
-/// SPEC §3.2's methods on the mesh scenes (issue 22: "every contact method and scheme that
+/// contract §3.2's methods on the mesh scenes (issue 22: "every contact method and scheme that
 /// applies"): the Gmsh copy of the 002 bar gives bar2d's rows for Nitsche (Θ = 1 hybrid,
 /// Θ = −1 CN) and the penalty (backward Euler) — the same face quadrature points from the other
 /// path (`gmsh_contact_faces`: faces matched to their cells, heights above the lowest contact
@@ -180,7 +180,7 @@ method = [
 /// (`sweeps/meshes/bar3d_hex.msh`, 2 × 2 × 20 hexahedra extruded in layers, bottom = `contact`)
 /// gives bar3d's rows for Nitsche (Θ = 1 hybrid, Θ = −1 CN), the penalty (backward Euler,
 /// hybrid), the discrete gradient with both, the mixed method's seeds (CN with the consistent
-/// mass and mod3) and SPEC §3.2's mixed methods, against one mod3 + CN reference (τ/4). Same
+/// mass and mod3) and contract §3.2's mixed methods, against one mod3 + CN reference (τ/4). Same
 /// bound and reason as in 2D; 3D factors are supernodal, which rounds differently again.
 /// Measured: at most 4.8e-12 (HHT's pressure_oscillation).
 #[test]
@@ -347,7 +347,7 @@ fn a_mesh_run_above_the_memory_budget_is_refused_towards_a_coarser_file() {
     assert_eq!(expand_with(&sweep, &ok).unwrap().runs.len(), 1);
 }
 
-/// References on another mesh (SPEC §1.6, issue 22 done-when 3's second half on the mesh
+/// References on another mesh (contract §1.6, issue 22 done-when 3's second half on the mesh
 /// scenes): the Gmsh bar `bar2d_quad.msh` (h = 0.05) measured against a finer mesh *file*
 /// (`bar2d_quad_n4.msh`, h = 0.025: a mesh2d reference, located node by node) and against a
 /// `bar2d` reference (`reference = { scene = "bar2d", … }`: the box stored whole, located)
@@ -523,13 +523,13 @@ fn triangles_converge_to_the_bar2d_reference() {
         );
         assert!((1.0..1.6).contains(&ratio), "{mass}: {ratio}");
     }
-    // The consistent mass with CN is ill-posed (SPEC §2.1): no convergence in L2 (measured
+    // The consistent mass with CN is ill-posed (contract §2.1): no convergence in L2 (measured
     // slope −0.01; bar2d's 0.25), energy growing (E(T)/E⁰ 1.98 → 4.93).
     let s = slope("consistent", |r| r.err_u_l2l2);
     assert!(s < 0.3, "consistent: L2 slope {s}");
 }
 
-/// SPEC §1.6's `obstacle`: the absolute plane x_d = obstacle is the gap under another name
+/// contract §1.6's `obstacle`: the absolute plane x_d = obstacle is the gap under another name
 /// (gap = lowest contact node's x_d − obstacle), so the run it gives is the `gap` run — the same
 /// id, the same configuration — and a list of obstacles is an axis like any key. The Gmsh bar's
 /// bottom is at y = 0 (to ~1e-17), so obstacle = −g is gap = g; the default gap 0.2 is the

@@ -212,7 +212,7 @@ fn interpolant_start_persists_where_the_node_row_holds_at_the_midpoint() {
 
 /// Issue 20: the method-class table of `sweeps/comparison_bar1d.toml` is computed from the runs
 /// (summary/methods.md) and the README prints that table, row for row. The classes themselves
-/// follow from the methods' properties (SPEC §3.2), asserted here with the reason for each.
+/// follow from the methods' properties (contract §3.2), asserted here with the reason for each.
 #[test]
 fn comparison_bar1d_method_classes_are_the_readmes() {
     let tmp = tempfile::tempdir().unwrap();
@@ -237,7 +237,7 @@ fn comparison_bar1d_method_classes_are_the_readmes() {
             .unwrap_or_else(|| panic!("no row {label} in\n{table}"));
         line.split('|').map(|c| c.trim().to_string()).collect()
     };
-    // Kane's step never increases E^h (SPEC §3.2) and puts the node on the obstacle exactly.
+    // Kane's step never increases E^h (contract §3.2) and puts the node on the obstacle exactly.
     let kane = row("mixed · consistent · kane");
     assert_eq!(
         (kane[2].as_str(), kane[4].as_str()),
@@ -250,7 +250,7 @@ fn comparison_bar1d_method_classes_are_the_readmes() {
     // The discrete gradient conserves E^h + Φ: never growing, a penalty penetrates.
     let dg = row("penalty(γ0=1e2) · consistent · discrete-gradient");
     assert_eq!((dg[2].as_str(), dg[4].as_str()), ("conserving", "O(τ)"));
-    // Crank–Nicolson with the consistent mass gains energy at impacts (000 §3, SPEC §6).
+    // Crank–Nicolson with the consistent mass gains energy at impacts (000 §3, contract §6).
     assert_eq!(row("mixed · consistent · crank-nicolson")[2], "growing");
     // The report draws the same table.
     let r = cli(tmp.path(), &["report", "cmp"]);

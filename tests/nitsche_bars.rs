@@ -1,5 +1,5 @@
 //! Nitsche and the penalty on the bars and the Gmsh meshes (issue 20 "every contact method on
-//! every scene", issue 22 "boundary faces of Γ_C with their quadrature"; SPEC §1.2, §2.3, §2.4,
+//! every scene", issue 22 "boundary faces of Γ_C with their quadrature"; contract §1.2, §2.3, §2.4,
 //! §3.2):
 //!
 //! - the face quadrature of Γ_C ([`face_contact_points`]) integrates the contact area exactly
@@ -147,7 +147,7 @@ fn increase_and_change(x: &[f64], scale: f64) -> (f64, f64) {
 /// Both hold in exact arithmetic; the rounding of energies of size energy_scale (= E⁰) summed
 /// over 84 dofs, and the Newton's residual at the round-off of its terms, leave ~1e-14
 /// (measured: hybrid's largest rise of E_Θ 1.8e-14, the discrete gradient's largest change
-/// 1.3e-14): 1e-12·energy_scale per step is SPEC's bound with room, while CN with Nitsche,
+/// 1.3e-14): 1e-12·energy_scale per step is the contract's bound with room, while CN with Nitsche,
 /// which does work during contact (003 §4.2), moves E_Θ by 2.3e-2 … 0.85 of it in one step
 /// (the counter-check asserts > 1e-8). γ0 ∈ [1e-3, 1e-2] keeps K_Θ coercive on this mesh.
 #[test]
@@ -198,7 +198,7 @@ method = [
 /// The papers' question "mass redistribution against Nitsche on the same 2D bar": bar2d at
 /// h = 0.05, τ = 0.0125, T = 2, mixed with mod3 and Nitsche (Θ = 1, γ0 = 1e-3) with the
 /// energy-conserving hybrid scheme and Crank–Nicolson, all against one reference: mixed mod3
-/// Crank–Nicolson on the nested mesh h = 0.025 with τ = 0.003125 (SPEC §1.2). Measured:
+/// Crank–Nicolson on the nested mesh h = 0.025 with τ = 0.003125 (contract §1.2). Measured:
 ///   mixed mod3 CN      err_u_l2l2 1.040e-3, err_u_l2h1 3.052e-2, energy drift  5.7e-4;
 ///   Nitsche hybrid     err_u_l2l2 1.436e-3, err_u_l2h1 3.650e-2, energy drift −1.9e-2;
 ///   Nitsche CN         err_u_l2l2 8.059e-3, err_u_l2h1 1.509e-1, energy drift  1.25.

@@ -1,4 +1,4 @@
-//! The impact oscillator (SPEC §1.5): its exact solution on its own (impact times by hand,
+//! The impact oscillator (contract §1.5): its exact solution on its own (impact times by hand,
 //! energy, Zeno accumulation), and what the schemes do against it.
 
 use contact_sweep::run::oscillator::OscillatorConfig;
@@ -148,7 +148,7 @@ fn fitted(points: &[(f64, f64)]) -> f64 {
     contact_sweep::summary::convergence::lsq_slope(&x, &e).expect("a ladder of distinct sizes")
 }
 
-/// The velocity-level scheme with the exact law converges at first order (SPEC §1.5; issue 21
+/// The velocity-level scheme with the exact law converges at first order (contract §1.5; issue 21
 /// done-when 4). Paoli–Schatzman with e = e_x, τ = 0.02 … 0.00125 over T = 10 (seven impacts
 /// for e_x = 1): the position is first order (measured fitted rates 1.05 for e_x = 1, 0.94 for
 /// e_x = ½, 1.24 for e_x = 0), and so are the impact times (1.04, 0.87): an impact is located
@@ -194,7 +194,7 @@ fn paoli_schatzman_with_the_exact_law_converges_at_first_order() {
     );
 }
 
-/// The position-level methods do not converge to the e_x = 1 solution (SPEC §1.5, reported
+/// The position-level methods do not converge to the e_x = 1 solution (contract §1.5, reported
 /// rather than hidden): a point mass has no impact law in them. With the multiplier on
 /// x^{n+1} the mass is stopped on the obstacle, and its velocity after the impact step is
 /// whatever the scheme's update makes of that stop — with Newmark, v^{n+1} depends on how far
@@ -299,7 +299,7 @@ fn rates(l: &[(f64, f64, f64, f64)]) -> (f64, f64, f64) {
 }
 
 /// Moreau–Jean (θ = ½) with e = e_x converges at first order in position and impact time
-/// (SPEC §1.5; Acary 2016): measured fitted rates on the ladder τ = 0.02 … 0.00125, T = 10:
+/// (contract §1.5; Acary 2016): measured fitted rates on the ladder τ = 0.02 … 0.00125, T = 10:
 /// e_x = 1: position 0.95, impact time 0.96 (velocity 0.37: the O(1) jump on O(1) steps, as
 /// Paoli–Schatzman); e_x = ½: 0.88, 0.91 (0.36). The errors are not monotone in τ (the
 /// penetration, ≤ ½τ|v⁻| by the predicted-gap activation, depends on where the impact falls in
@@ -341,7 +341,7 @@ fn moreau_jean_with_the_exact_law_converges_at_first_order() {
     assert!(l[4].1 < 0.05, "e = 0: {:?}", l[4]);
 }
 
-/// kane and contact-stabilized Newmark do not converge to the e_x = 1 solution (SPEC §1.5:
+/// kane and contact-stabilized Newmark do not converge to the e_x = 1 solution (contract §1.5:
 /// position-level, no impact law for a point mass). Measured on the ladder:
 /// - kane: errors 1.2 – 2.2 against e_x = 1 (rate 0.06) and 0.39 – 1.7 against e_x = 0 (rate
 ///   0.04): the stop at x^{n+1} = −g leaves v^{n+1} = 2Δx/τ − vⁿ, a rebound that depends on
@@ -405,7 +405,7 @@ fn kane_and_contact_stabilized_newmark_do_not_converge_to_e_1() {
     }
 }
 
-/// Energy on the oscillator (SPEC §3.2): kane and contact-stabilized Newmark never increase
+/// Energy on the oscillator (contract §3.2): kane and contact-stabilized Newmark never increase
 /// E^h (largest step increase measured 6.7e-16 on E⁰ = ½: round-off; 1e-14·E⁰ allows the
 /// rounding of the O(1) terms); Moreau–Jean with θ = ½ and e = 1 conserves it through the
 /// impacts (|E^n − E⁰| ≤ 1e-12·E⁰ over 8000 steps, round-off accumulated; e = 0 loses it at
@@ -454,7 +454,7 @@ fn energy_properties_of_the_comparison_methods() {
         // 8000 steps of round-off on terms up to κ[s]₊² ~ 1e4·τ²: measured 2.1e-12·E⁰.
         assert!(drift <= 1e-11 * e0, "DG, τ = {dt}: drift {drift}");
         // Through the first impact (t = π/6) and two steps after it: later both are chaotic
-        // (SPEC §3.2; CN's aⁿ carries the stop's O(1/τ²) acceleration, the difference grows
+        // (contract §3.2; CN's aⁿ carries the stop's O(1/τ²) acceleration, the difference grows
         // to 1e-9 by t = 1).
         let ga = run(
             p,

@@ -1,6 +1,6 @@
-//! The acceptance figures of SPEC §6 for the 1D bar, each a test of the engine.
+//! The acceptance figures of contract §6 for the 1D bar, each a test of the engine.
 //!
-//! Deterministic figures are asserted to the digits SPEC §6 prints ([`common::assert_printed`]:
+//! Deterministic figures are asserted to the digits contract §6 prints ([`common::assert_printed`]:
 //! two independent implementations agree to 1e-11, so the printed rounding is the tolerance).
 //! The ill-posed cases (mixed or Nitsche with Crank–Nicolson at ν = 1.5) are asserted as
 //! behaviour — energy grows — never as digits: round-off moves them anywhere in 1.07–3.9.
@@ -95,7 +95,7 @@ fn fig2_fig3_table_of_spec_6() {
 fn crank_nicolson_with_consistent_mass_is_ill_posed_energy_grows() {
     for method in [ContactMethod::Mixed, nitsche(1.0, 1e-6)] {
         let o = ok(fig(method, MassVariant::Consistent, CN));
-        // Behaviour only (SPEC §6): growth by more than 5 % and at least one increasing step.
+        // Behaviour only (contract §6): growth by more than 5 % and at least one increasing step.
         assert!(
             energy_ratio(&o) > 1.05,
             "{method:?}: E(T)/E0 = {}",
@@ -127,7 +127,7 @@ fn gamma0_tenth_theta_variants() {
 fn gamma0_one_symmetric_is_unphysical_but_augmented_energy_holds() {
     for scheme in [CN, Scheme::Hybrid] {
         let o = ok(fig(nitsche(1.0, 1.0), MassVariant::Consistent, scheme));
-        // E^h peaks about 231·E0 in each contact phase (SPEC §6): max |E − E0|/E0 ≈ 230.
+        // E^h peaks about 231·E0 in each contact phase (contract §6): max |E − E0|/E0 ≈ 230.
         let peak = 1.0 + o.metrics.energy_max_dev.unwrap();
         assert!(
             (200.0..260.0).contains(&peak),
@@ -145,7 +145,7 @@ fn gamma0_one_symmetric_is_unphysical_but_augmented_energy_holds() {
     for theta in [0.0, -1.0] {
         let o = ok(fig(nitsche(theta, 1.0), MassVariant::Consistent, CN));
         let r = energy_ratio(&o);
-        // SPEC §6: +2.6 … 2.8 %.
+        // contract §6: +2.6 … 2.8 %.
         assert!((1.026..=1.028).contains(&r), "Θ={theta}: E(T)/E0 = {r}");
     }
 }
@@ -156,7 +156,7 @@ fn gamma0_three_symmetric_diverges_before_any_contact() {
     assert_eq!(o.status, Status::Diverged);
     let msg = o.message.unwrap();
     assert!(msg.contains("exceeded 1e6"), "{msg}");
-    // The first impact is at t = 1 (SPEC §1.1): A_Θγ is indefinite, growth starts at once.
+    // The first impact is at t = 1 (contract §1.1): A_Θγ is indefinite, growth starts at once.
     assert!(
         (o.metrics.steps as f64) * 0.015 < 1.0,
         "diverged at step {}",
@@ -202,7 +202,7 @@ fn zero_contact_mass_removes_oscillations() {
 
 #[test]
 fn zero_contact_cn_energy_depends_on_the_start_of_the_contact_node() {
-    // SPEC §6 (003 §4.1.2d, Fig 9): E(T)/E0 = 0.99511 with the quasi-static start, 0.97845 with
+    // contract §6 (003 §4.1.2d, Fig 9): E(T)/E0 = 0.99511 with the quasi-static start, 0.97845 with
     // the interpolant start (E0 = 1/8) — the paper's "1–2 %" is the latter. Both figures come
     // from the independent numpy implementation, so the printed rounding is the tolerance. The
     // Nitsche variant (Θ = 1, γ0 = 1e-6) is the mixed method up to O(γ0) = 1e-6 relative in the
@@ -382,7 +382,7 @@ fn fig10_ladder_h_equals_tau() {
                 scheme,
                 0,
             ));
-            // One unit in the last place: SPEC's 2.373 for mixed+CN at h = 1/4 is the double
+            // One unit in the last place: the contract's 2.373 for mixed+CN at h = 1/4 is the double
             // rounding of 2.37249 (→ 2.3725 → 2.373); every other figure matches to ±½ unit.
             assert_printed_within(
                 &format!("{what} h=1/{m}"),
@@ -427,7 +427,10 @@ fn fig10_ladder_h_equals_tau() {
 fn assert_significant(what: &str, x: f64, printed: &str) {
     let target: f64 = printed.parse().unwrap();
     if target == 0.0 {
-        assert!(x.abs() <= 1e-15, "{what}: computed {x:e}, SPEC §6 prints 0");
+        assert!(
+            x.abs() <= 1e-15,
+            "{what}: computed {x:e}, contract §6 prints 0"
+        );
         return;
     }
     let (mantissa, exp) = match printed.split_once('e') {
@@ -438,11 +441,11 @@ fn assert_significant(what: &str, x: f64, printed: &str) {
     let half_unit = 0.5 * 10f64.powi(exp - decimals);
     assert!(
         (x - target).abs() <= half_unit * (1.0 + 1e-9),
-        "{what}: computed {x:.6e}, SPEC §6 prints {printed} (tolerance ±{half_unit:e})"
+        "{what}: computed {x:.6e}, contract §6 prints {printed} (tolerance ±{half_unit:e})"
     );
 }
 
-/// SPEC §6 "Methods of §3.2 on the default bar, h = 0.01, τ = 0.015, T = 12" (mixed + consistent
+/// contract §6 "Methods of §3.2 on the default bar, h = 0.01, τ = 0.015, T = 12" (mixed + consistent
 /// mass unless stated): E(T)/E⁰, l2(τ;L2), l2(τ;H1), max_penetration, pressure_oscillation for
 /// every row, to the printed digits (an independent numpy implementation; round-off moves none
 /// of them by more than 1e-9, so the printed rounding is the tolerance).
@@ -521,9 +524,9 @@ fn methods_of_spec_3_2_table() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// SPEC §6's last row, `central-difference` + `lumped` (kinematic contact), τ = 0.009: printed
+/// contract §6's last row, `central-difference` + `lumped` (kinematic contact), τ = 0.009: printed
 /// E(T)/E⁰ 0.98785, l2(τ;L2) 0.01049, l2(τ;H1) 0.2384, max_penetration 0, pressure_oscillation
-/// 3.87. This engine — and an independent 40-line numpy transcription of SPEC §3.2's formulas
+/// 3.87. This engine — and an independent 40-line numpy transcription of contract §3.2's formulas
 /// (v^{n+½} = vⁿ + τ/2 aⁿ, u^{n+1} = uⁿ + τv^{n+½}, the node put on the obstacle by Δv on
 /// v^{n+½}, a^{n+1} = M⁻¹(−Ku^{n+1}), v^{n+1} = v^{n+½} + τ/2 a^{n+1}) — both give
 /// E(T)/E⁰ = 0.990591 (and l2(τ;L2) 0.01107, l2(τ;H1) 0.2459, pressure_oscillation 4.10); the

@@ -1,4 +1,4 @@
-//! The planner (SPEC §7): product, zip, bundles, exclude, applicability collapse, courant,
+//! The planner (contract §7): product, zip, bundles, exclude, applicability collapse, courant,
 //! and run ids that are stable and canonical.
 
 use std::path::Path;
@@ -206,7 +206,7 @@ fn contact_init_applies_to_a_massless_contact_node_only() {
         "{}",
         p.runs[2].label
     );
-    // Frozen ids (SPEC §7): explicit `consistent` is the default and enters no id, so runs
+    // Frozen ids (contract §7): explicit `consistent` is the default and enters no id, so runs
     // written before the key existed keep theirs — the 003 CN run with the consistent mass
     // and with mod3 (see run_ids_are_canonical_and_stable).
     assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
@@ -242,7 +242,7 @@ fn ensembles_expand_into_distinct_members() {
 
 #[test]
 fn an_axis_overrides_a_fixed_value() {
-    // SPEC §7's own example sets h and dt in [fixed] and again in [zip]: [fixed] is a baseline.
+    // contract §7's own example sets h and dt in [fixed] and again in [zip]: [fixed] is a baseline.
     let p = plan(&format!(
         "{HEAD}[fixed]\nh = 0.01\ndt = 0.015\nmass = \"mod3\"\n[grid]\nmass = [\"mod1\", \"mod2\"]\n[zip]\nh = [0.25, 0.125]\ndt = [0.25, 0.125]\n"
     ));
@@ -311,7 +311,7 @@ fn bar2d_runs_share_one_reference_stored_on_the_coarsest_common_lattice() {
             .iter()
             .all(|x| x.reference.as_deref() == Some(r.spec.run_id.as_str()))
     );
-    // Defaults of bar2d (SPEC §1.2) fill the columns; elements counts the height (1/h).
+    // Defaults of bar2d (contract §1.2) fill the columns; elements counts the height (1/h).
     assert_eq!(num(&p, 0, Key::T), 2.0);
     assert_eq!(num(&p, 0, Key::Gap), 0.2);
     assert_eq!(num(&p, 0, Key::LameMu), 0.5);
@@ -401,7 +401,7 @@ fn bar2d_refuses_what_it_cannot_model_with_the_key_and_reason() {
     );
 }
 
-/// SPEC §3.2's keys (`rho_inf`, `hht_alpha`, and `theta_scheme`/`restitution` now also read by
+/// contract §3.2's keys (`rho_inf`, `hht_alpha`, and `theta_scheme`/`restitution` now also read by
 /// moreau-jean) do not apply to the existing schemes: crossing the 003 CN run with them
 /// collapses to that run, with its frozen id; the new schemes drop what does not apply to them.
 #[test]
@@ -436,7 +436,7 @@ fn comparison_method_keys_collapse_and_keep_existing_ids() {
     assert_eq!(p.runs[5].params[&Key::Restitution].as_f64(), Some(0.0));
 }
 
-/// Where the methods of SPEC §3.2 do not apply, the planner leaves the run out with its reason.
+/// Where the methods of contract §3.2 do not apply, the planner leaves the run out with its reason.
 #[test]
 fn comparison_methods_are_left_out_where_they_do_not_apply() {
     let p = plan(&format!(
@@ -464,7 +464,7 @@ fn comparison_methods_are_left_out_where_they_do_not_apply() {
     assert_eq!(labels, ["mixed · lumped · central-difference"]);
 }
 
-/// `sweeps/comparison_bar1d.toml` plans every method of SPEC §3.2 applicable to the bar on the
+/// `sweeps/comparison_bar1d.toml` plans every method of contract §3.2 applicable to the bar on the
 /// h = τ ladder and at ν = 1.5: 14 methods × 6 levels, nothing collapsed or left out, and its
 /// CN run at the 003 setting is the frozen run of `run_ids_are_canonical_and_stable`.
 #[test]
@@ -480,7 +480,7 @@ fn comparison_sweep_plans_every_method_on_its_ladder() {
     assert!(ids(&p).contains(&"35050bcfa8862a8f".to_string()));
 }
 
-/// SPEC §2.5: `friction = "none"` is today's engine. Given explicitly (as `--set` puts it on
+/// contract §2.5: `friction = "none"` is today's engine. Given explicitly (as `--set` puts it on
 /// top of a file), it keeps every run id of every 1D and 2D sweep file — the key's default
 /// never enters the canonical text — and the 003 CN run keeps its frozen id.
 #[test]
@@ -522,7 +522,7 @@ fn friction_none_keeps_every_run_id() {
     assert_eq!(p.runs[0].run_id, "35050bcfa8862a8f");
 }
 
-/// SPEC §1.8's keys at their defaults keep every run id: `velocity_tangential = 0` on every
+/// contract §1.8's keys at their defaults keep every run id: `velocity_tangential = 0` on every
 /// disc2d/sphere3d/mesh2d/mesh3d sweep file and `incline = 0` on the mesh files, set on top of
 /// the file as `--set` does (a physics key at its default never enters the canonical text), and
 /// the 003 disc's CN run keeps the id main gives it. Files that already set a key are skipped
@@ -574,7 +574,7 @@ fn velocity_tangential_and_incline_at_zero_keep_every_run_id() {
     assert_ne!(moving.runs[0].run_id, "831b1028f988a386");
 }
 
-/// The friction keys on the layer (SPEC §2.5, §7): a bound applies to its own law only, so
+/// The friction keys on the layer (contract §2.5, §7): a bound applies to its own law only, so
 /// across a `friction` axis the frictionless runs (and Tresca's runs crossed with Coulomb's
 /// coefficients) collapse, with the reason; `none` never enters an id, each bound does.
 #[test]

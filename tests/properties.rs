@@ -8,7 +8,7 @@
 //!
 //! Tolerance 1e-12 of the initial energy: the proofs give ≤ 0 exactly; what remains is the
 //! round-off of an energy difference of O(1) quantities accumulated over ≤ 1e5 steps (worst seen
-//! over 200 draws: 5e-13, SPEC §6).
+//! over 200 draws: 5e-13, contract §6).
 
 mod common;
 
@@ -186,7 +186,7 @@ fn hybrid_schemes_stay_stable_over_a_hundred_impacts_at_large_courant_numbers() 
     }
 }
 
-// ---- Methods of the comparison literature (SPEC §3.2) ----
+// ---- Methods of the comparison literature (contract §3.2) ----
 
 /// kane (trapezoidal rule, contact force fully implicit): the force λ^{n+1} does the work
 /// λ·(u₀^{n+1} − u₀ⁿ) ≤ 0 (it acts only with u₀^{n+1} = −g ≤ u₀ⁿ), so E^h never increases —
@@ -220,7 +220,7 @@ fn contact_stabilized_newmark_energy_never_increases() {
 /// (B v^{n+1} = −e B vⁿ where p > 0). With e = 1 that is zero whatever the row does: E^h never
 /// increases (round-off, as above). With e < 1 it is ≤ 0 on a row that approaches (B vⁿ ≤ 0)
 /// but positive on an active row that separates (B vⁿ > 0, its predicted gap still closed after
-/// a bounce): SPEC §3.2's "never increases" holds for e = 1 only. Measured over 40 draws
+/// a bounce): contract §3.2's "never increases" holds for e = 1 only. Measured over 40 draws
 /// (h ∈ [1/400, 1/4], τ ∈ [h/10, 10h]): e = ½ rose in every draw, by up to 4.7e-2·E⁰; e = 0 in 2
 /// draws (ν ≈ 10, by 1.5e-4·E⁰). Asserted: e = 1 at round-off on every draw; e = 0 at round-off
 /// for ν ≤ 2 (no separating active row there).
@@ -315,7 +315,7 @@ fn discrete_gradient_conserves_its_energy_every_step() {
         );
         // The run did meet the obstacle (else conservation would be the trivial linear case).
         assert!(o.metrics.contact_switches >= 1, "{method:?}: no contact");
-        // Newton iterations are counted: at least one per step, at most 100 (SPEC §4).
+        // Newton iterations are counted: at least one per step, at most 100 (contract §4).
         let (it, steps) = (o.metrics.iterations, o.metrics.steps);
         assert!(
             it >= steps && it <= 100 * steps,
@@ -333,9 +333,9 @@ fn discrete_gradient_conserves_its_energy_every_step() {
 ///   the round-off stays round-off — u(0, t) and E^h agree to 1e-9 through T = 2, the end of
 ///   the first impact. (A stiff penalty chatters like the mixed method and amplifies round-off
 ///   the same way: κh/E = 1126 at m = 139, τ = 4.4e-3 — 1e-10 at t = 1.12, 2e-5 at 1.77.)
-/// - mixed + consistent mass (ill-posed, SPEC §2.1): they agree to round-off until the first
+/// - mixed + consistent mass (ill-posed, contract §2.1): they agree to round-off until the first
 ///   contact (measured ≤ 3e-11 after ≤ 2e4 steps; asserted 1e-9), after which the chattering contact amplifies
-///   the round-off exponentially, not "to round-off through the impact" as SPEC §3.2 says:
+///   the round-off exponentially, not "to round-off through the impact" as contract §3.2 says:
 ///   measured at m = 139, τ = 4.4e-3: 4e-11 at t = 1.04, 1e-9 at 1.17, 2e-6 at 1.52, 4e-2 at
 ///   1.89 — both runs chatter (σ_C switching on and off) and the chatter's phase drifts.
 #[test]

@@ -1,4 +1,4 @@
-//! The analysis contract (SPEC §8) with the readers users install today (issue 23): polars,
+//! The analysis contract (contract §8) with the readers users install today (issue 23): polars,
 //! pandas, pyarrow and DuckDB, each at its newest release (`analysis/requirements.txt` has no
 //! upper pins; this test installs it), read a results folder
 //! (a) again and again while a sweep writes it — current polars expands `runs/*.parquet` to

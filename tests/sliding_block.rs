@@ -1,4 +1,4 @@
-//! The sliding block (SPEC §1.8, issue 33 "done when" 1): a Gmsh block with nothing clamped
+//! The sliding block (contract §1.8, issue 33 "done when" 1): a Gmsh block with nothing clamped
 //! (`sweeps/meshes/block2d.msh`, 8 × 4 Q1 quadrilaterals of [0,1]×[0,0.5];
 //! `sweeps/meshes/block3d.msh`, 4 × 2 × 2 Q1 hexahedra of [0,1]×[0,0.5]²) resting on the plane
 //! (gap 0) under gravity g, thrown along it at V e_1, on a flat plane and on one tilted by α.
@@ -170,7 +170,7 @@ fn trace_with(
     let mut t_half = Vec::new();
     let mut p_half = Vec::new();
     let mut all_forward = Vec::new();
-    // Moreau–Jean's slip is the velocity v_t^{n+1} (SPEC §2.5), not the increment: a node may
+    // Moreau–Jean's slip is the velocity v_t^{n+1} (contract §2.5), not the increment: a node may
     // stick at the velocity level (v_t^{n+1} = 0) while (u^{n+1} − u^n)/τ = (v^n + v^{n+1})/2
     // is still positive. Its contact velocities from the displacements, v^{k+1} = 2(u^{k+1} −
     // u^k)/τ − v^k (θ = ½), from v⁰ = V.
@@ -289,7 +289,7 @@ fn frictionless_block_keeps_its_tangential_momentum() {
 /// −Fᵀu = m·g·cos α·z (z the centre of mass's vertical displacement, the along-slope part
 /// aside on the incline), and ½vᵀMv ≥ P_1²/(2m), so m·g·cos α·z ≤ E^n − E⁰ +
 /// (P_1^0² − P_1^n²)/(2m) — flat: z ≤ max_n (E^n − E⁰)/(m g) (the consistent mass's CN gains up
-/// to 1e-2 of the energy scale here: SPEC §2.1's spurious growth, which lifts the 3D block
+/// to 1e-2 of the energy scale here: contract §2.1's spurious growth, which lifts the 3D block
 /// 3e-3 off the plane at times). The nodes never go below the plane (max_penetration at
 /// round-off).
 #[test]
@@ -356,7 +356,7 @@ fn frictionless_block_rests_on_the_plane() {
 /// translates at V: the plain mean of u_1 over the nodes is V·t, the lateral Poisson spreading
 /// under the weight being antisymmetric. Tolerance 1e-8·V·T: the asymmetry is round-off, which
 /// the contact's chatter amplifies where Γ_C keeps mass (CN with a mass on the contact rows
-/// gains up to 1e-1 of the energy scale here, SPEC §2.1): measured 3e-10 (3D lumped), ≤ 2e-11
+/// gains up to 1e-1 of the energy scale here, contract §2.1): measured 3e-10 (3D lumped), ≤ 2e-11
 /// with the massless variants.
 #[test]
 fn frictionless_block_slides_with_every_mass_variant() {
@@ -448,13 +448,13 @@ fn sliding_block_keeps_the_frictional_invariant_until_it_sticks() {
 }
 
 /// Issue 33 "done when" 1 in 3D: the invariant to 1e-10·mV for the five methods, flat and on
-/// the incline, where SPEC §1.8's premise holds — every contact point slides along +e_1. With
+/// the incline, where contract §1.8's premise holds — every contact point slides along +e_1. With
 /// Lamé λ = 0 (ν = 0) the weight and the e_1–e_d friction strain the box in no lateral way, and
 /// on the structured Q1 box the solution independent of x_2 with u_2 = 0 solves the discrete
 /// equations (every e_2 equation's terms carry ∂/∂x_2 of u_1, u_d or u_2 itself), so the
 /// lateral momentum P_2 stays at round-off and the disc law gives f_t = −μ_f f_n e_1 at each
 /// node. The box starts 1e-3 above the plane: resting at gap 0, Moreau–Jean's index set
-/// (predicted gap (Buⁿ + g) + ½τBvⁿ ≤ 0, SPEC §3.2) decides nodes whose gap is 0 to round-off by
+/// (predicted gap (Buⁿ + g) + ½τBvⁿ ≤ 0, contract §3.2) decides nodes whose gap is 0 to round-off by
 /// the sign of that round-off, which breaks the box's mirror symmetry at the second step
 /// (lateral displacements of 1e-5 per step, P_2 ~ 1e-9 … 4e-5·mV after, measured): a property of
 /// the method's sharp index set, not of the friction. Landing at √(2g·1e-3) = 0.014, every node
@@ -503,7 +503,7 @@ fn sliding_block_stops_near_the_rigid_time() {
                 // Measured (stop_time / rigid): kane 1.043, 1.084 (5°) in 2D, 1.041, 1.072 in
                 // 3D; Moreau–Jean 1.028 (2D), 1.031, 1.082 (3D), none by 1.2·t_rigid at 5° in
                 // 2D. The CN-based runs (mixed, Nitsche, penalty with the consistent mass) gain
-                // energy at the contact (SPEC §2.1's spurious oscillations: the block hops)
+                // energy at the contact (contract §2.1's spurious oscillations: the block hops)
                 // and stop late or not by 1.2·t_rigid: printed, not asserted. Asserted: kane
                 // and Moreau–Jean stop within 5 % on the flat plane, kane within 10 % at 5°
                 // (the net deceleration g(μ_f cos α − sin α) is 2 % of g there, so the elastic

@@ -135,7 +135,7 @@ fn a_bad_sweep_never_reaches_the_queue() {
     assert!(!tmp.path().join("o").exists());
 }
 
-/// SPEC §1.2 on a cluster: a reference job computes the sweep's reference run once; the array
+/// contract §1.2 on a cluster: a reference job computes the sweep's reference run once; the array
 /// tasks depend on it (afterok) and read the stored solution instead of computing it again.
 #[test]
 fn a_reference_job_runs_before_the_array_and_every_task_reuses_it() {

@@ -87,7 +87,7 @@ fn ensemble_flags_the_ill_posed_cn_methods_of_003_fig3_and_not_the_stable_ones()
         assert_eq!(members[i], 8, "{}", labels[i]);
         let s = spread[i].unwrap();
         if labels[i].contains("consistent · crank-nicolson") {
-            // SPEC §6: round-off moves E(T)/E⁰ anywhere in ≈ 1.07–3.9; eight members spread it
+            // contract §6: round-off moves E(T)/E⁰ anywhere in ≈ 1.07–3.9; eight members spread it
             // by far more than 10 % of the median (measured 0.78 and 0.70).
             assert!(sensitive[i], "{} must be sensitive", labels[i]);
             assert!(s > 0.3, "{}: spread of E(T)/E⁰ {s}", labels[i]);
@@ -316,7 +316,7 @@ fn gamma0_search_for_theta_one_brackets_the_spec_threshold() {
     let found = boundaries(&dir);
     assert_eq!(found.len(), 2, "{found:?}");
     for (method, state, holding, failing, _) in &found {
-        // SPEC §6: γ0 = 1 runs to the end, γ0 ≥ 3 blows up — the threshold lies in [1, 3]; the
+        // contract §6: γ0 = 1 runs to the end, γ0 ≥ 3 blows up — the threshold lies in [1, 3]; the
         // search puts it at γ0 = 1 to its tolerance (1e-3): every γ0 above 1 fails.
         assert_eq!(state, "found", "{method}");
         assert!(
@@ -383,7 +383,7 @@ fn spec_6_nitsche_behaviours_hold_through_the_theta_gamma0_stability_map() {
             .map(|(_, v)| v.clone())
             .unwrap_or_else(|| panic!("no cell {s} Θ={th} γ0={g}"))
     };
-    // The first impact is at t = 1 (SPEC §1.1).
+    // The first impact is at t = 1 (contract §1.1).
     for s in ["crank-nicolson", "hybrid"] {
         for g in [3.0, 10.0, 100.0, 1e4] {
             // Θ = 1, γ0 ≥ 3: A_Θγ indefinite, blows up before any contact.
@@ -402,7 +402,7 @@ fn spec_6_nitsche_behaviours_hold_through_the_theta_gamma0_stability_map() {
         }
     }
     // Nitsche-Hybrid, Θ = −1: every γ0 ≥ 3 diverges; for γ0 = 3 and 10 after the first impact
-    // as SPEC §6 says. (Measured, not in SPEC: for γ0 = 100 and 1e4 the hybrid blows up before
+    // as contract §6 says. (Measured, not in the contract: for γ0 = 100 and 1e4 the hybrid blows up before
     // the first impact, at t = 0.42 and 0.03.)
     for g in [3.0, 10.0, 100.0, 1e4] {
         let (st, t) = get("hybrid", -1.0, g);
@@ -414,9 +414,9 @@ fn spec_6_nitsche_behaviours_hold_through_the_theta_gamma0_stability_map() {
             );
         }
     }
-    // Θ = −1 with CN stays finite (SPEC: E(T)/E⁰ 4.97 at γ0 = 10, 6.02 at 100).
+    // Θ = −1 with CN stays finite (the contract: E(T)/E⁰ 4.97 at γ0 = 10, 6.02 at 100).
     assert_ne!(get("crank-nicolson", -1.0, 100.0).0, "diverged");
-    // Θ = 1, γ0 = 1 is unphysical: E^h strays by more than 100 E⁰ (SPEC: peaks ≈ 231 E⁰)
+    // Θ = 1, γ0 = 1 is unphysical: E^h strays by more than 100 E⁰ (the contract: peaks ≈ 231 E⁰)
     // while the run ends ok.
     let runs = contact_sweep::sink::read_runs(&dir).unwrap();
     let unphys = runs
@@ -443,7 +443,7 @@ fn hard_cases_every_run_ends_with_a_status_and_a_message() {
     use contact_sweep::sweep::{Key, SweepFile, expand};
     // The file plans, and its plan reaches every edge the issue names: ν 0.1 … 100, γ0
     // 1e-10 … 1e4 (Nitsche and penalty), Θ ∈ {−1, 0, 1}, T = 300 (100 impacts), h = 1/4096,
-    // every scheme of SPEC §3 — without the full product (h = 1/4096 only with T = 1.5).
+    // every scheme of contract §3 — without the full product (h = 1/4096 only with T = 1.5).
     let path = repo().join("sweeps/hard_cases.toml");
     let text = std::fs::read_to_string(&path).unwrap();
     let plan = expand(&SweepFile::parse(&path, &text).unwrap()).unwrap();

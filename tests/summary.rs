@@ -69,7 +69,7 @@ fn run(
     }
 }
 
-/// The runs table of the current version (SPEC §8 columns that the summary reads, plus the
+/// The runs table of the current version (contract §8 columns that the summary reads, plus the
 /// ones it must tolerate). c0 = 1 (young = density = 1), so courant = dt/h.
 fn runs_frame(rows: &[R]) -> DataFrame {
     let n = rows.len();

@@ -2,7 +2,7 @@
 //! ν = 1, h = 1/4 … 1/4096) → Parquet → `summarize` → `summary/convergence.parquet`, and the
 //! paper's conclusion read off the summary table.
 //!
-//! SPEC §6: mixed+CN and Nitsche+CN do not converge in l2(τ;H1); Nitsche-Hybrid and the
+//! contract §6: mixed+CN and Nitsche+CN do not converge in l2(τ;H1); Nitsche-Hybrid and the
 //! modified masses do, with rates ≈ 0.3 in l2(τ;H1) and ≈ 0.7–0.9 in l2(τ;L2). The LSQ slope
 //! over six levels includes the pre-asymptotic coarse ones, hence bands of ±0.1 around those
 //! figures.

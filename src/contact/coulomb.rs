@@ -1,4 +1,4 @@
-//! The condensed frictional contact problem of m contact nodes (SPEC §2.5, §4): Coulomb's or
+//! The condensed frictional contact problem of m contact nodes (contract §2.5, §4): Coulomb's or
 //! Tresca's law on a dense, symmetric positive semi-definite W.
 //!
 //! Each node i carries d forces on the body, node-major f_i = (f_n, f_t) with f_t ∈ ℝ^{d−1}
@@ -34,7 +34,7 @@
 //! system, or a 3D one without a slipping node, depends only on the node states (and μ_f), so
 //! its LU is kept and reused while the states repeat — from one time step to the next during a
 //! steady contact phase a step then costs two triangular solves. Convergence: the natural
-//! residual ‖Φ‖_∞ below `tol` relative to the problem's force scale max(|f|, r|q|) (SPEC §4:
+//! residual ‖Φ‖_∞ below `tol` relative to the problem's force scale max(|f|, r|q|) (contract §4:
 //! 1e-12); not converged within `max_iter` steps is an error ([`FrictionalContactError`]), which
 //! an engine reports as a `solver-failed` run. Warm-started from the caller's forces (the
 //! previous step's): a phase whose states do not change costs one Newton step.

@@ -1,4 +1,4 @@
-//! Friction laws as data (SPEC §2.5) and the exact local solve of one contact point.
+//! Friction laws as data (contract §2.5) and the exact local solve of one contact point.
 //!
 //! A contact point carries a normal force f_n ≥ 0 (on the body, away from the obstacle) and a
 //! tangential force f_t with |f_t| ≤ b, f_t = −b·ṡ/|ṡ| where the slip ṡ ≠ 0 (stick: ṡ = 0). The
@@ -14,7 +14,7 @@
 //!   slip = slip_free + w_tn f_n + w_tt f_t,
 //!
 //! with w_nn, w_tt > 0 (pushing the body away opens the gap, pulling it along moves it along).
-//! This is the 1D local problem of SPEC §2.5/§4, and it is solved *exactly* by case analysis,
+//! This is the 1D local problem of contract §2.5/§4, and it is solved *exactly* by case analysis,
 //! as the frictionless scalar problem is solved by branch enumeration ([`super::solve`]):
 //!
 //! - open (take-off): f_n = f_t = 0, admissible iff gap_free ≥ 0;
@@ -61,7 +61,7 @@ impl FrictionKind {
     }
 }
 
-/// A friction law with its parameter (SPEC §2.5).
+/// A friction law with its parameter (contract §2.5).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum FrictionLaw {
     /// Frictionless: f_t = 0 (today's engine).
@@ -191,7 +191,7 @@ pub fn solve_tangential(slip_free: f64, w: f64, b: f64) -> (f64, f64, PointState
     }
 }
 
-/// The penalised tangential problem (SPEC §2.5, `penalty`): slip = slip_free + w f_t with
+/// The penalised tangential problem (contract §2.5, `penalty`): slip = slip_free + w f_t with
 /// f_t = proj_[−b, b](−κ·slip) — an elastic spring of stiffness κ on the slip, capped at the
 /// bound. Monotone in f_t, so exactly one of its two branches holds: the spring branch
 /// f_t = −κ slip_free/(1 + κw) when it lies within the bound (reported as stick), the capped

@@ -1,4 +1,4 @@
-//! The discrete gradient of a scalar contact potential (SPEC §3.2 `discrete-gradient`;
+//! The discrete gradient of a scalar contact potential (contract §3.2 `discrete-gradient`;
 //! Gonzalez 1996, Armero–Petőcz 1998, Hauret–Le Tallec 2006).
 //!
 //! The contact potential of one contact point is Φ(s) = k/2 [s]₊² in its argument s (penalty:
@@ -61,7 +61,7 @@ pub struct GradientSolution {
     pub iterations: usize,
 }
 
-/// Most Newton iterations (SPEC §4).
+/// Most Newton iterations (contract §4).
 pub const MAX_ITERATIONS: usize = 100;
 
 /// Solve s = s_free − w D(a, s) for the potential k/2 [s]₊² (k ≥ 0, w > 0).

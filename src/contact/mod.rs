@@ -1,4 +1,4 @@
-//! The condensed contact solve (SPEC §4).
+//! The condensed contact solve (contract §4).
 //!
 //! Every implicit step has the form A x = b + φ q̃ with A constant (factored once per run) and
 //! the nonlinearity acting through one scalar s = pᵀx + p₀. With z = A⁻¹q̃ precomputed and
@@ -17,7 +17,7 @@
 //! scheme's contact force is a difference quotient, not a piecewise-linear law: [`gradient`]
 //! solves its scalar equation by a safeguarded semismooth Newton iteration.
 //!
-//! Friction (SPEC §2.5) is a law of its own, [`friction`]: the law as data (none, Tresca,
+//! Friction (contract §2.5) is a law of its own, [`friction`]: the law as data (none, Tresca,
 //! Coulomb) and the exact case analysis of one point's normal and tangential rows, which every
 //! stepper calls with its condensed rows — the same local solve for every scheme. Several
 //! coupled frictional nodes (the FE scenes' Γ_C) are [`coulomb`]'s: semismooth Newton on the

@@ -1,4 +1,4 @@
-//! Reference runs (SPEC §1.2, §7 `reference = {…}`): each distinct reference of a plan is
+//! Reference runs (contract §1.2, §7 `reference = {…}`): each distinct reference of a plan is
 //! computed once per output folder and stored in `DIR/references/<run_id>.ref`, then reused on
 //! resume, by every shard, and by every run measured against it.
 //!

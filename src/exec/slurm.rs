@@ -10,7 +10,7 @@
 //!   [`super::shard`]); a task that is requeued or rerun resumes, skipping the run_ids already
 //!   committed;
 //! - `summarize.sh`: `summarize DIR`, to run after the array (`--dependency=afterok`);
-//! - `references.sh`, when the sweep has reference runs (SPEC §1.2): `run --references-only`,
+//! - `references.sh`, when the sweep has reference runs (contract §1.2): `run --references-only`,
 //!   one job computing each reference once; the array depends on it (`afterok`), so no task
 //!   computes a reference and every task reads the stored ones.
 //!

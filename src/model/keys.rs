@@ -1,4 +1,4 @@
-//! The parameter keys of SPEC §7: their types, value ranges and the methods they apply to.
+//! The parameter keys of contract §7: their types, value ranges and the methods they apply to.
 
 use std::fmt;
 
@@ -33,51 +33,51 @@ pub enum Key {
     ContactInit,
     /// Polynomial degree of the elements (disc2d/sphere3d: 1 or 2).
     Degree,
-    /// bar1d's right end (SPEC §1.4): `clamped` (default) or `free`.
+    /// bar1d's right end (contract §1.4): `clamped` (default) or `free`.
     RightEnd,
     /// Uniform initial velocity (bar1d, oscillator; negative towards the obstacle).
     Velocity,
-    /// Oscillator (SPEC §1.5): mass m, spring stiffness k, constant force f, Newton's
+    /// Oscillator (contract §1.5): mass m, spring stiffness k, constant force f, Newton's
     /// restitution coefficient e_x of the exact solution.
     PointMass,
     Stiffness,
     Force,
     ImpactLaw,
-    /// Generalized-α spectral radius at infinity ρ∞ (SPEC §3.2).
+    /// Generalized-α spectral radius at infinity ρ∞ (contract §3.2).
     RhoInf,
-    /// HHT α (SPEC §3.2, preset `hht` of generalized-α).
+    /// HHT α (contract §3.2, preset `hht` of generalized-α).
     HhtAlpha,
     /// The step solves of the 2D/3D scenes: `direct` (sparse Cholesky, default) or `cg`
-    /// (Jacobi-preconditioned conjugate gradient, SPEC §4).
+    /// (Jacobi-preconditioned conjugate gradient, contract §4).
     Solver,
     /// CG's relative residual tolerance (default 1e-12; `solver = "cg"` only).
     CgTol,
-    /// The Gmsh mesh file of `mesh2d`/`mesh3d` (SPEC §1.6), relative to the sweep file; its
+    /// The Gmsh mesh file of `mesh2d`/`mesh3d` (contract §1.6), relative to the sweep file; its
     /// canonical text (the run id's) is the file's content hash, not its path.
     Mesh,
-    /// The rigid plane x_d = `obstacle` of `mesh2d`/`mesh3d` (SPEC §1.6), exclusive with `gap`:
+    /// The rigid plane x_d = `obstacle` of `mesh2d`/`mesh3d` (contract §1.6), exclusive with `gap`:
     /// the planner turns it into the run's gap (lowest Γ_C node − obstacle), so it never enters
     /// a run id (the same plane given by `gap` is the same run).
     Obstacle,
-    /// How gravity enters the FE scenes (SPEC §1.3): `body` (default, F = ∫ρ f·φ whatever the
+    /// How gravity enters the FE scenes (contract §1.3): `body` (default, F = ∫ρ f·φ whatever the
     /// mass variant) or `inertial` (F = M_run f e_d, the load following the modified inertia).
     Load,
-    /// The friction law at the contact points (SPEC §2.5): `none` (default: today's engine,
+    /// The friction law at the contact points (contract §2.5): `none` (default: today's engine,
     /// every id unchanged), `tresca` or `coulomb`.
     Friction,
     /// Coulomb's coefficient μ_f ≥ 0 (`friction = "coulomb"` only).
     FrictionCoefficient,
     /// Tresca's threshold s ≥ 0, a traction (`friction = "tresca"` only).
     TrescaThreshold,
-    /// The layer's height H (SPEC §1.7).
+    /// The layer's height H (contract §1.7).
     Height,
-    /// The initial tangential velocity: layer1d's V_t (SPEC §1.7); the e_1 velocity of every
-    /// node not clamped on disc2d, sphere3d, mesh2d and mesh3d (SPEC §1.8).
+    /// The initial tangential velocity: layer1d's V_t (contract §1.7); the e_1 velocity of every
+    /// node not clamped on disc2d, sphere3d, mesh2d and mesh3d (contract §1.8).
     VelocityTangential,
-    /// Dry (Coulomb) friction on the oscillator's mass, F ≥ 0 (SPEC §1.5; default 0, so the
+    /// Dry (Coulomb) friction on the oscillator's mass, F ≥ 0 (contract §1.5; default 0, so the
     /// frictionless runs keep their ids).
     FrictionForce,
-    /// The plane's tilt α in degrees (mesh2d/mesh3d, SPEC §1.8): the volume load becomes
+    /// The plane's tilt α in degrees (mesh2d/mesh3d, contract §1.8): the volume load becomes
     /// ρ·gravity·(sin α e_1 − cos α e_d). Default 0, so every existing run keeps its id.
     Incline,
 }
@@ -397,7 +397,7 @@ impl Key {
             Key::Load => match s {
                 "body" | "inertial" => Ok(()),
                 _ => Err(format!(
-                    "unknown load `{s}` (expected body — the body force ∫ρ f·φ, SPEC §1.3 — or inertial — M_run f e_d, the weight following the run's modified mass)"
+                    "unknown load `{s}` (expected body — the body force ∫ρ f·φ, contract §1.3 — or inertial — M_run f e_d, the weight following the run's modified mass)"
                 )),
             },
             Key::Solver => {
@@ -488,7 +488,7 @@ impl Key {
                     ))
                 }
             }
-            // A zero amplitude is the flying bar's unstrained start (SPEC §1.4).
+            // A zero amplitude is the flying bar's unstrained start (contract §1.4).
             Key::Gap | Key::Amplitude => {
                 finite(x)?;
                 if x >= 0.0 {
@@ -545,7 +545,7 @@ fn within(x: f64, lo: f64, hi: f64) -> Result<(), String> {
     }
 }
 
-/// Scheme names and aliases accepted in sweep files (SPEC §3).
+/// Scheme names and aliases accepted in sweep files (contract §3).
 pub const SCHEME_NAMES: [&str; 14] = [
     "newmark",
     "crank-nicolson",

@@ -1,5 +1,5 @@
 //! The data that crosses layers, below every layer that exchanges it (run and up): what a sweep's parameters are
-//! ([`keys::Key`], [`keys::Value`]: SPEC §7's keys, their types and ranges) and what the
+//! ([`keys::Key`], [`keys::Value`]: contract §7's keys, their types and ranges) and what the
 //! convergence tables are asked to print ([`summary_options::SummaryOptions`]).
 //!
 //! Why a layer of its own: the planner (`sweep`) parses these, a run (`run`) writes them into its

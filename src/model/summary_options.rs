@@ -9,7 +9,7 @@
 //! again, and `summarize --errors` overrides it. The Parquet and CSV tables always hold every
 //! column: the choice only decides what the text tables show.
 
-/// Every error column the tables can show (SPEC §5's error norms of a run's row), in output
+/// Every error column the tables can show (contract §5's error norms of a run's row), in output
 /// order.
 pub const ERROR_COLUMNS: &[&str] = &[
     "err_u_l2l2",
@@ -23,7 +23,7 @@ pub const ERROR_COLUMNS: &[&str] = &[
     "err_vt_final",
 ];
 
-/// The tangential errors of a frictional scene (SPEC §5: the layer's σ_t in L2 over both
+/// The tangential errors of a frictional scene (contract §5: the layer's σ_t in L2 over both
 /// components, the mean tangential velocity at T). Null for every frictionless scene, so a
 /// folder has them only when its scene computes them: the text tables then show them after
 /// the chosen columns unless `--errors` or `[summary]` chose otherwise — a frictional rate

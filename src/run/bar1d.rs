@@ -1,4 +1,4 @@
-//! The 1D engine: every contact treatment × mass variant × time scheme on the bar (SPEC §2–§4).
+//! The 1D engine: every contact treatment × mass variant × time scheme on the bar (contract §2–§4).
 //!
 //! Setup (once per run): assemble M, K, K_lin (tridiagonal), form A = M + c K_lin, factor it,
 //! and precompute z = A⁻¹q̃ and w = pᵀz — the contact condensed onto the contact node. A step is
@@ -8,7 +8,7 @@
 //!
 //! A contact node without inertia (zero mass row) is quasi-static: its row of the step system
 //! is c·(K_lin u)₀ = c_f φ q₀ — the equation of the node at the scheme's evaluation time — and
-//! at t = 0 its value is given by the same equation (SPEC §2.2). With the explicit Newmark
+//! at t = 0 its value is given by the same equation (contract §2.2). With the explicit Newmark
 //! (c = 0) that row is replaced by K_lin row 0 itself.
 //!
 //! `contact_init = interpolant` ([`ContactInit`]) starts that node at the interpolant u0(0)
@@ -26,7 +26,7 @@
 //! its quadratic part (kept in K*, node 0 clamped at −g) and −(E/2h)[u₁+g]₊², whose force
 //! (E/h)[u₁+g]₊ e₁ is switched between midpoint and Crank–Nicolson on the sign of u₁^n + g.
 //!
-//! The methods of SPEC §3.2 ([`Engine::step_comparison`]) use the same constant matrix and the
+//! The methods of contract §3.2 ([`Engine::step_comparison`]) use the same constant matrix and the
 //! same condensation: `kane`, `discrete-gradient` step the increment Δu with S = M + τ²/4 K
 //! (one scalar solve; the discrete gradient's is a Newton iteration on the contact point's
 //! difference quotient, [`crate::contact::gradient`]); `contact-stabilized-newmark` adds the
@@ -89,7 +89,7 @@ impl Bar1dConfig {
         }
     }
 
-    /// The same run with the massless contact node started by `init` (SPEC §2.2).
+    /// The same run with the massless contact node started by `init` (contract §2.2).
     pub fn with_contact_init(mut self, init: ContactInit) -> Self {
         self.contact_init = init;
         self
@@ -136,7 +136,7 @@ fn max_frequency_sq(sp: &Bar1dSpace) -> f64 {
     free.max(active.max_generalized_eigenvalue(&sp.mass))
 }
 
-/// The contact node of a tangential chain (the layer's S-wave chain, SPEC §1.7): held by the
+/// The contact node of a tangential chain (the layer's S-wave chain, contract §1.7): held by the
 /// friction law instead of the obstacle. Before each step the layer's driver
 /// (the layer1d engine) sets the bound b of the step (from the normal chain's force of the same
 /// step) and the slip's reference value: the step's scalar s is then u₀^{n+1} (position-level
@@ -312,7 +312,7 @@ impl Engine {
         }
         if scheme.needs_contact_mass() && sp.massless_contact {
             return Err(format!(
-                "{} needs inertia on the contact node (SPEC §3.2)",
+                "{} needs inertia on the contact node (contract §3.2)",
                 scheme.family()
             ));
         }
@@ -422,7 +422,7 @@ impl Engine {
     /// Contact pressure to report for a state whose step returned `phi`.
     pub(super) fn sigma(&self, u: &[f64], phi: f64) -> f64 {
         if let Scheme::MoreauJean(_) = self.scheme {
-            // φ is the impulse p^{n+1} of the step: the force is p/τ (SPEC §3.2).
+            // φ is the impulse p^{n+1} of the step: the force is p/τ (contract §3.2).
             return phi / self.tau;
         }
         if self.sp.method == ContactMethod::Mixed && !self.reduced {
@@ -502,7 +502,7 @@ impl Engine {
                 }
             }
             Scheme::PaoliSchatzman(_) => unreachable!("two-step scheme"),
-            _ => unreachable!("SPEC §3.2 methods step in step_comparison"),
+            _ => unreachable!("contract §3.2 methods step in step_comparison"),
         }
         if sp.massless_contact {
             // Massless row: only the contact force (and, for the hybrid, its own history).
@@ -589,7 +589,7 @@ impl Engine {
         }
     }
 
-    /// One step of a method of SPEC §3.2 (or kinematic central difference); returns φ.
+    /// One step of a method of contract §3.2 (or kinematic central difference); returns φ.
     ///
     /// Never inlined into [`Self::step`]: inlined, it made the Newmark/θ/hybrid path of `step`
     /// 4× as costly (its loops lost their vectorised form; CN on the 400-run overhead sweep went
@@ -601,7 +601,7 @@ impl Engine {
         let phi = match self.scheme {
             _ if self.kinematic => self.kinematic_step(st),
             Scheme::Kane => {
-                // A massless node keeps SPEC §3.2's formula as written: its row of S Δu is
+                // A massless node keeps contract §3.2's formula as written: its row of S Δu is
                 // (τ²/4)(K Δu)₀ = −(τ²/2)(K uⁿ)₀ + (τ²/2)φq₀, i.e. (K u^{n+½})₀ = φq₀ — quasi-static
                 // at the midpoint, where the trapezoidal rule evaluates K u. Then the step's
                 // energy change is φq₀·Δu₀ ≤ 0 for every mass; the row at t^{n+1} instead
@@ -616,7 +616,7 @@ impl Engine {
             Scheme::ContactStabilizedNewmark => self.stabilized_step(st, wk)?,
             Scheme::GeneralizedAlpha(ga) => self.gen_alpha_step(st, wk, ga)?,
             Scheme::MoreauJean(mj) => self.moreau_jean_step(st, wk, s_n, mj)?,
-            _ => unreachable!("not a SPEC §3.2 method"),
+            _ => unreachable!("not a contract §3.2 method"),
         };
         st.s_prev = self.p.dot(&st.u) + self.p0;
         st.phi_prev = phi;
@@ -814,7 +814,7 @@ impl Engine {
 }
 
 /// Build the initial state: interpolated u⁰ (perturbed for ensembles), v⁰ the bar's uniform
-/// initial velocity (0 but for the flying bar, SPEC §1.4), a massless
+/// initial velocity (0 but for the flying bar, contract §1.4), a massless
 /// node at its quasi-static value (or left at the interpolant, `contact_init = interpolant`),
 /// a⁰ from the equation at t = 0 on the free nodes. Returns the state and σ_C⁰.
 pub(super) fn initial_state(
@@ -924,13 +924,13 @@ impl Recorder<'_> {
                 sigma_mid,
                 energy,
                 energy_theta,
-                // Not stored in 1D: SPEC §5 lists no energy parts for the bar, and two more
+                // Not stored in 1D: contract §5 lists no energy parts for the bar, and two more
                 // float columns would add ≈ 60 % to the series' bytes and writer time (issue 12).
                 energy_kinetic: None,
                 energy_elastic: None,
                 energy_gravity: None,
                 u_lowest: None,
-                // u_n = −u₀ at the contact node, non-penetration u₀ ≥ −g (SPEC §1.1).
+                // u_n = −u₀ at the contact node, non-penetration u₀ ≥ −g (contract §1.1).
                 penetration: Some((-u[0] - self.sp.bar.gap).max(0.0)),
             },
             exact,

@@ -72,7 +72,7 @@ impl RunConfig {
         }
     }
 
-    /// The friction law at the contact (SPEC §2.5). Only the layer has a tangential direction
+    /// The friction law at the contact (contract §2.5). Only the layer has a tangential direction
     /// today; the planner refuses a law ≠ none on every other scene before a config is built,
     /// so for them the law is none and nothing changes.
     pub fn with_friction(mut self, law: crate::contact::friction::FrictionLaw) -> RunConfig {
@@ -84,7 +84,7 @@ impl RunConfig {
         self
     }
 
-    /// The initial value of a massless contact node (SPEC §2.2). The FE scenes start from
+    /// The initial value of a massless contact node (contract §2.2). The FE scenes start from
     /// rest and unloaded, where the interpolant of u⁰ = 0 is already the quasi-static value:
     /// both starts are the same state there.
     pub fn with_contact_init(mut self, init: ContactInit) -> RunConfig {

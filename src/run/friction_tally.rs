@@ -1,5 +1,5 @@
-//! The friction observables of a finite-element run (SPEC §1.8, §2.5, §5), one tally for every
-//! FE engine with friction (the mixed Newmark/θ stepper, SPEC §3.2's methods, Nitsche).
+//! The friction observables of a finite-element run (contract §1.8, §2.5, §5), one tally for every
+//! FE engine with friction (the mixed Newmark/θ stepper, contract §3.2's methods, Nitsche).
 //!
 //! Per step n → n+1 the engine hands over the contact forces f^{n+1} of its contact points
 //! (node-major [f_n, f_t…], d per point, on the body: f_n ≥ 0 along e_d, f_t along e_1 (, e_2))
@@ -24,7 +24,7 @@
 //! [`MeanVelocity`] gives the body's mean velocity per axis, v̄_k = 1_kᵀMv/1_kᵀM1_k with 1_k the
 //! indicator of axis k's dofs (the momentum along e_k over the mass along it), from the M v the
 //! engines carry: the stop time's e_1 component and the final `tangential_velocity_final`
-//! (v̄_1 in 2D, √(v̄_1² + v̄_2²) in 3D) and `normal_velocity_final` (v̄_d) of SPEC §5.
+//! (v̄_1 in 2D, √(v̄_1² + v̄_2²) in 3D) and `normal_velocity_final` (v̄_d) of contract §5.
 
 use super::observe::Metrics;
 use crate::space::fe::SymMatrix;
@@ -73,7 +73,7 @@ impl MeanVelocity {
         }
     }
 
-    /// The tangential value of SPEC §5 from [v̄_1, v̄_2, v̄_d]: v̄_1 in 2D, the norm
+    /// The tangential value of contract §5 from [v̄_1, v̄_2, v̄_d]: v̄_1 in 2D, the norm
     /// √(v̄_1² + v̄_2²) in 3D.
     pub fn tangential(&self, means: &[f64; 3]) -> f64 {
         if self.axes[1].is_empty() {
@@ -237,7 +237,7 @@ impl FrictionTally {
         self.tangential_work_min
     }
 
-    /// The friction columns (SPEC §5) into `metrics`: energies over `energy_scale`, and the
+    /// The friction columns (contract §5) into `metrics`: energies over `energy_scale`, and the
     /// body's final mean tangential (3D: the norm of both) and normal velocities.
     pub fn finish(
         &self,

@@ -20,13 +20,13 @@
 //! 400-run 1D sweep) only to find these phases; a run knows them for the cost of a comparison
 //! per step, and they travel with the run's row, committed atomically with it.
 //!
-//! # Pressure oscillation (SPEC §3.2)
+//! # Pressure oscillation (contract §3.2)
 //! Per contact interval, TV/(2·max|σ_C|) with TV the total variation of σ_C over the
 //! interval's steps, the rise from zero before its first step and the fall to zero after its
 //! last included: 1 for a pressure that rises once and falls once (any monotone rise and fall),
 //! 1 + (the chatter's variation)/(2·peak) otherwise. The run's `pressure_oscillation` is the
 //! largest over its intervals (None without contact). The intervals here are the maximal runs
-//! of consecutive steps with σ_C < 0 — *not* the phases above, whose one-step gaps merge: SPEC
+//! of consecutive steps with σ_C < 0 — *not* the phases above, whose one-step gaps merge: contract
 //! §6's figures are those of unmerged intervals (Moreau–Jean with e = 1 applies its impulses
 //! every other step through an impact, each one an interval of one step: 1.00; merged, the
 //! same run would read 30). Accumulated at every step: a decimated series would miss it.

@@ -1,4 +1,4 @@
-//! The frictional layer's engine (SPEC §1.7): two P1 chains on the same nodes, stepped by the
+//! The frictional layer's engine (contract §1.7): two P1 chains on the same nodes, stepped by the
 //! 1D engine's schemes, coupled only through the friction law at node 0.
 //!
 //! The normal chain is the flying bar of §1.4 (modulus λ + 2μ, gap g, velocity −V_n) and its
@@ -9,7 +9,7 @@
 //! decoupled in the bulk and their condensed contact rows are diagonal (w_nt = w_tn = 0), so a
 //! step is the normal step, then the tangential step whose scalar problem is the law's exact
 //! case analysis ([`crate::contact::friction`]) — the same local solve for every scheme. What
-//! the slip is belongs to the scheme (SPEC §2.5): the increment u₀^{n+1} − u₀ⁿ for the
+//! the slip is belongs to the scheme (contract §2.5): the increment u₀^{n+1} − u₀ⁿ for the
 //! position-level schemes (Newmark, θ, `kane`, generalized-α/HHT,
 //! `contact-stabilized-newmark`, GetFEM's choice, b from f_n^{n+1}), v₀^{n+1} with impulses for
 //! `moreau-jean` (De Saxcé's take-off / stick / slide; the bound μ_f p_n, Tresca's s·τ), the
@@ -130,7 +130,7 @@ impl Layer1dConfig {
     }
 }
 
-/// What a frictional run measured besides the bar's metrics (SPEC §5's friction columns, and
+/// What a frictional run measured besides the bar's metrics (contract §5's friction columns, and
 /// the step-wise extremes the property tests look at).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FrictionStats {
@@ -149,7 +149,7 @@ pub struct FrictionStats {
     pub tangential_velocity_final: f64,
     pub normal_velocity_final: f64,
     /// min over the steps of the tangential work −f_t^{n+1}·Δu_t,0, over energy_scale (≥ 0
-    /// for the position-level methods, SPEC §2.5).
+    /// for the position-level methods, contract §2.5).
     pub tangential_work_min: f64,
     /// l2(τ) error of σ_t at the base, and |v̄_t(T) − exact|.
     pub err_sigma_t_l2: Option<f64>,
@@ -157,7 +157,7 @@ pub struct FrictionStats {
 }
 
 /// How the tangential force enters the scheme's momentum equation over a step: f̄ = (1 − c)fⁿ
-/// + c f^{n+1} (SPEC §2.5's W_f).
+/// + c f^{n+1} (contract §2.5's W_f).
 fn work_weight(cfg: &Layer1dConfig) -> f64 {
     match cfg.scheme {
         Scheme::Newmark(NewmarkParams { gamma, .. }) if !is_kinematic(cfg) => gamma,
@@ -170,7 +170,7 @@ fn work_weight(cfg: &Layer1dConfig) -> f64 {
 }
 
 /// Central difference with `mixed` and the lumped mass: kinematic contact and friction, an
-/// impulse on the half-step velocity (SPEC §3.2); with the penalty it is a Newmark scheme.
+/// impulse on the half-step velocity (contract §3.2); with the penalty it is a Newmark scheme.
 fn is_kinematic(cfg: &Layer1dConfig) -> bool {
     cfg.scheme == Scheme::Newmark(NewmarkParams::central_difference())
         && cfg.method == ContactMethod::Mixed
@@ -288,7 +288,7 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
         metrics.err_sigma_t_l2 = stats.err_sigma_t_l2;
         metrics.err_vt_final = stats.err_vt_final;
     }
-    // The friction columns belong to a friction law (null for `none`, SPEC §5).
+    // The friction columns belong to a friction law (null for `none`, contract §5).
     if !law.is_none() {
         metrics.friction_work = Some(stats.friction_work);
         metrics.energy_balance_drift = Some(stats.energy_balance_drift);

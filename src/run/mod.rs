@@ -3,7 +3,7 @@
 //!
 //! The run never panics on numerical trouble: a step whose contact equation has no or several
 //! solutions ends the run `solver-failed`; a non-finite value or an energy above 1e6·E⁰ ends it
-//! `diverged` (SPEC §5); a run past its time budget ends `timeout`. What was observed up to that
+//! `diverged` (contract §5); a run past its time budget ends `timeout`. What was observed up to that
 //! point is kept.
 
 pub mod bar1d;

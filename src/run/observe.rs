@@ -1,5 +1,5 @@
 //! Observables of a run: energies, contact quantities and error norms against the exact
-//! solution, accumulated step by step without storing the trajectory (SPEC §5).
+//! solution, accumulated step by step without storing the trajectory (contract §5).
 //!
 //! Sums and maxima run over n = 0 … N, both ends included (003 §4.1.2e):
 //! err_u_l2l2 = (τ Σ‖e^n‖²_L2)^½, err_u_l2h1 = (τ Σ‖e^n‖²_H1)^½ with the full H1 norm,
@@ -11,7 +11,7 @@
 //! Nitsche-Hybrid's σ_C^n alternates between 0 and ≈ 3× the exact value while σ_C(u^{n−½})
 //! stays near it.
 
-/// Scalar results of a run (SPEC §5). Energies are relative to E⁰, the energy of the initial
+/// Scalar results of a run (contract §5). Energies are relative to E⁰, the energy of the initial
 /// (consistent) discrete state.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Metrics {
@@ -75,19 +75,19 @@ pub struct Metrics {
     pub impacts: Option<Vec<super::impacts::Phase>>,
     /// E_Θ⁰ (Nitsche): the unit of the impacts' E_Θ losses.
     pub energy_theta_initial: Option<f64>,
-    /// max over the observed steps of the step's penetration (u_n − g)_+ (SPEC §1.3), where
+    /// max over the observed steps of the step's penetration (u_n − g)_+ (contract §1.3), where
     /// the engine reports one ([`StepValues::penetration`]).
     pub max_penetration: Option<f64>,
-    /// l2(τ) error of the velocity (oscillator, SPEC §1.5).
+    /// l2(τ) error of the velocity (oscillator, contract §1.5).
     pub err_v_l2: Option<f64>,
     /// Largest distance from an exact impact time to the nearest discrete contact start
-    /// (oscillator, SPEC §1.5).
+    /// (oscillator, contract §1.5).
     pub err_impact_time: Option<f64>,
     /// The bar's mean velocity 1ᵀMv/1ᵀM1 at the last step (bar1d with a free end).
     pub exit_velocity: Option<f64>,
-    /// max over the contact phases of TV(σ_C)/(2·max|σ_C|) (SPEC §3.2), from the phases.
+    /// max over the contact phases of TV(σ_C)/(2·max|σ_C|) (contract §3.2), from the phases.
     pub pressure_oscillation: Option<f64>,
-    /// Friction (SPEC §5; null without a friction law): W_f(T), E^N + W_f^N − E⁰ and the
+    /// Friction (contract §5; null without a friction law): W_f(T), E^N + W_f^N − E⁰ and the
     /// largest one-step rise of E + W_f, all over energy_scale; contact node-steps in stick
     /// and in slip; max |f_t|/f_n over the contact steps.
     pub friction_work: Option<f64>,
@@ -95,22 +95,22 @@ pub struct Metrics {
     pub energy_balance_max_increase: Option<f64>,
     pub stick_steps: Option<i64>,
     pub slip_steps: Option<i64>,
-    /// max over the contact steps of |Σf_t|/Σf_n (SPEC §5).
+    /// max over the contact steps of |Σf_t|/Σf_n (contract §5).
     pub friction_ratio_max: Option<f64>,
     /// Mean tangential and normal velocities 1ᵀMv/1ᵀM1 at T (scenes with a tangential
     /// direction; FE: e_1 in 2D, the tangential norm in 3D, and e_d).
     pub tangential_velocity_final: Option<f64>,
     pub normal_velocity_final: Option<f64>,
-    /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, SPEC §1.7).
+    /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, contract §1.7).
     pub err_sigma_t_l2: Option<f64>,
     pub err_vt_final: Option<f64>,
-    /// Dry friction on the oscillator (SPEC §1.5): the time after which the mass never moves
+    /// Dry friction on the oscillator (contract §1.5): the time after which the mass never moves
     /// again (null while it moves at T), and the exact rest time (null if after T).
     pub stop_time: Option<f64>,
     pub stop_time_exact: Option<f64>,
     /// min over the steps of the step's own tangential work −Σ f_t^{n+1}·Δu_t over
     /// energy_scale (FE scenes with friction, [`super::friction_tally`]; ≥ 0 for the
-    /// position-level methods, SPEC §2.5). Not a column of the runs table: for the tests.
+    /// position-level methods, contract §2.5). Not a column of the runs table: for the tests.
     pub tangential_work_min: Option<f64>,
 }
 
@@ -152,7 +152,7 @@ impl SampledTimer {
     }
 }
 
-/// One row of the time series (SPEC §5).
+/// One row of the time series (contract §5).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeriesRow {
     pub step: i64,
@@ -168,7 +168,7 @@ pub struct SeriesRow {
     pub energy_elastic: Option<f64>,
     pub energy_gravity: Option<f64>,
     pub u_lowest: Option<f64>,
-    /// Friction (SPEC §5): the base's σ_t (1D; 2D/3D the total tangential force), the contact
+    /// Friction (contract §5): the base's σ_t (1D; 2D/3D the total tangential force), the contact
     /// node's slip velocity (2D/3D: the Γ_C mean of v_1), W_f.
     pub sigma_t_contact: Option<f64>,
     pub v_t_contact: Option<f64>,
@@ -338,14 +338,14 @@ pub struct StepValues {
     pub sigma_mid: Option<f64>,
     pub energy: f64,
     pub energy_theta: Option<f64>,
-    /// The parts of E^h, where the engine has them: ½vᵀMv, ½uᵀKu, −Fᵀu (SPEC §1.3).
+    /// The parts of E^h, where the engine has them: ½vᵀMv, ½uᵀKu, −Fᵀu (contract §1.3).
     pub energy_kinetic: Option<f64>,
     pub energy_elastic: Option<f64>,
     pub energy_gravity: Option<f64>,
     /// Vertical displacement u_d of the lowest point of the reference configuration
     /// (disc/ball).
     pub u_lowest: Option<f64>,
-    /// max over the contact points the engine checks of (u_n − g)_+ at this step (SPEC §1.3);
+    /// max over the contact points the engine checks of (u_n − g)_+ at this step (contract §1.3);
     /// the run's `max_penetration` is its maximum over the steps.
     pub penetration: Option<f64>,
 }
@@ -394,7 +394,7 @@ pub struct Observer {
     sum_energy: f64,
     max_contact: f64,
     observed: usize,
-    /// The scene's energy scale when it is not E⁰ (disc/sphere: E⁰ = 0, SPEC §1.3).
+    /// The scene's energy scale when it is not E⁰ (disc/sphere: E⁰ = 0, contract §1.3).
     scale: Option<f64>,
     first_contact: Option<f64>,
     phases: i64,
@@ -407,7 +407,7 @@ pub struct Observer {
     pub series: Series,
 }
 
-/// Energy bound above which a run is `diverged` (SPEC §5).
+/// Energy bound above which a run is `diverged` (contract §5).
 pub const DIVERGENCE_FACTOR: f64 = 1e6;
 
 impl Observer {
@@ -449,7 +449,7 @@ impl Observer {
     }
 
     /// Measure relative energies (drift, deviations, increases, divergence) in `scale`
-    /// instead of E⁰ (SPEC §1.3: m·|f|·gap for the disc and the sphere, whose E⁰ is 0).
+    /// instead of E⁰ (contract §1.3: m·|f|·gap for the disc and the sphere, whose E⁰ is 0).
     pub fn with_energy_scale(mut self, scale: f64) -> Self {
         self.scale = Some(scale);
         self

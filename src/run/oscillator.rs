@@ -1,10 +1,10 @@
-//! The oscillator's engine (SPEC §1.5): one mass m, one spring k, a constant force f and an
-//! obstacle x ≥ −g, integrated by the schemes of SPEC §3 that apply to one constrained dof.
+//! The oscillator's engine (contract §1.5): one mass m, one spring k, a constant force f and an
+//! obstacle x ≥ −g, integrated by the schemes of contract §3 that apply to one constrained dof.
 //!
-//! The conventions are the 1D bar's at its contact node (SPEC §2.1, §2.4), so the same contact
+//! The conventions are the 1D bar's at its contact node (contract §2.1, §2.4), so the same contact
 //! solve serves: the contact force enters as φ·q with q = −1 (pushing the mass up for φ < 0);
 //! `mixed`: s = x + g, 0 ≤ s ⊥ φ ≤ 0 (φ the multiplier); `penalty`: s = −x − g,
-//! φ = −κ[s]₊ with κ = `penalty_gamma0`·k (SPEC §1.5). A step is the scalar version of the 1D
+//! φ = −κ[s]₊ with κ = `penalty_gamma0`·k (contract §1.5). A step is the scalar version of the 1D
 //! engine's: A x = b + c·f + c_f φ q with A = m + c k, then the exact branch solve of
 //! s = s_free + w φ(s) ([`crate::contact::solve`]).
 //!
@@ -14,7 +14,7 @@
 //! - Paoli–Schatzman(β, e): two-step, A = m + βτ²k, contact on (x^{n+1} + e x^{n−1})/(1+e) + g,
 //!   x¹ from Newmark(β, ½), v^n = (x^{n+1} − x^{n−1})/(2τ) (as the bar).
 //!
-//! The methods of SPEC §3.2 with B = 1, M = m, K = k (the scalar versions of the 1D engine's
+//! The methods of contract §3.2 with B = 1, M = m, K = k (the scalar versions of the 1D engine's
 //! steps, [`crate::run::bar1d`]):
 //! - `kane` (`mixed`): S Δx = τ m vⁿ − τ²/2 k xⁿ + τ²/2 f + τ²/2 φ q, S = m + τ²/4 k,
 //!   complementarity on xⁿ + Δx + g, v^{n+1} = 2Δx/τ − vⁿ; the force does φq·Δx ≤ 0 of work
@@ -22,7 +22,7 @@
 //! - `contact-stabilized-newmark` (`mixed`): the M-projection of xⁿ + τvⁿ onto x ≥ −g is, for
 //!   one dof, the clamp x^pred = max(xⁿ + τvⁿ, −g); then kane from x^pred,
 //!   S Δ = −τ²/4 k (xⁿ + x^pred) + τ²/2 f + τ²/2 φ q, v^{n+1} = vⁿ + (2/τ)Δ. A step whose
-//!   predictor is clamped is in contact (SPEC §1.5); its reported force is the kane step's φ;
+//!   predictor is clamped is in contact (contract §1.5); its reported force is the kane step's φ;
 //! - `generalized-alpha`/`hht`: (m + ck)x^{n+1} = m(x̃ − κ_m aⁿ) − κ_f k xⁿ + κ_f φⁿ q +
 //!   c φ^{n+1} q + c f/(1−α_f), c = (1−α_f)βτ²/(1−α_m), κ_{m,f} = α_{m,f}βτ²/(1−α_m),
 //!   x̃ = xⁿ + τvⁿ + τ²(½ − β)aⁿ; `mixed` (multiplier) or `penalty` (φ(x^{n+1}));
@@ -38,7 +38,7 @@
 //! (`scene::oscillator`); a velocity-level scheme reports its impulse / τ as φ, and a scheme
 //! whose contact is decided by a predictor returns `true` for `active` when it is constrained
 //! — `err_impact_time` counts a contact start where a step is active after one that was not
-//! (SPEC §1.5). The observables, the exact solution and the error columns need nothing more.
+//! (contract §1.5). The observables, the exact solution and the error columns need nothing more.
 //!
 //! Errors against the exact solution (event by event, [`OscillatorExact`]): err_u_l2l2 =
 //! (τΣ|x^n − x(t^n)|²)^½, err_u_linfl2 = max|x^n − x(t^n)|, err_v_l2 = (τΣ|v^n − v(t^n)|²)^½,
@@ -164,13 +164,13 @@ struct Osc {
     /// z = c_f q / A and w = p_x z: the contact condensed (q = −1).
     z: f64,
     w: f64,
-    /// Dry friction (SPEC §1.5): the relay's bound on the force as it enters the step (F, or
+    /// Dry friction (contract §1.5): the relay's bound on the force as it enters the step (F, or
     /// the impulse τF for Moreau–Jean), 0 without friction; the step's slip is
     /// (x − slip_ref)·slip_scale of the solved unknown x (module header).
     bound: f64,
     slip_scale: f64,
     /// Weight of f_t^{n+1} in the force that does the step's work, f̄ = ω f^{n+1} + (1 − ω) fⁿ
-    /// (SPEC §2.5: γ for Newmark, θ for the θ-scheme, 1 − α_f for generalized-α, 1 else).
+    /// (contract §2.5: γ for Newmark, θ for the θ-scheme, 1 − α_f for generalized-α, 1 else).
     work_weight: f64,
 }
 
@@ -251,7 +251,7 @@ impl Osc {
         }
     }
 
-    /// The step's solve with dry friction (SPEC §1.5): A x = b + c_f(φq + f_t), the contact
+    /// The step's solve with dry friction (contract §1.5): A x = b + c_f(φq + f_t), the contact
     /// law on p_x x + p0 and the relay f_t ∈ −bound·Sign(slip), slip = (x − x_ref)·scale,
     /// both on the one dof. Returns (x, s, φ, f_t). The problem is the minimum of a strictly
     /// convex function of x (the quadratic, the relay's bound·|slip|, the contact's
@@ -419,7 +419,7 @@ impl Osc {
                 st.s_prev = s;
                 st.x = pred + dx;
                 st.ft_prev = ft;
-                // SPEC §1.5: a step whose predictor is constrained is in contact.
+                // contract §1.5: a step whose predictor is constrained is in contact.
                 return Ok((phi, ft, constrained || phi != 0.0));
             }
             Scheme::GeneralizedAlpha(ga @ GeneralizedAlphaParams { beta, gamma, .. }) => {
@@ -459,7 +459,7 @@ impl Osc {
                 st.v += dv;
                 st.a = dv / tau;
                 st.s_prev = x + self.p.gap;
-                // Reported forces: the impulses over the step (SPEC §3.2).
+                // Reported forces: the impulses over the step (contract §3.2).
                 (impulse / tau, pt / tau, x)
             }
             Scheme::DiscreteGradient => {
@@ -512,7 +512,7 @@ impl Exact {
     }
 }
 
-/// When the mass stops for good (SPEC §1.5 `stop_time`): the time of the last step that moved
+/// When the mass stops for good (contract §1.5 `stop_time`): the time of the last step that moved
 /// it by more than `tol` — after it the mass never moves again. `None` while it still moves
 /// at the last step.
 struct StopWatch {
@@ -576,7 +576,7 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
         eng: &eng,
         st,
         dry,
-        // E + W_f after the last step and its largest one-step rise (SPEC §2.5's balance).
+        // E + W_f after the last step and its largest one-step rise (contract §2.5's balance).
         acc: DryAccount {
             work: 0.0,
             balance: eng.energy(x0, p.v0),
@@ -671,7 +671,7 @@ fn initial_state(cfg: &OscillatorConfig, eng: &Osc) -> (State, f64, f64) {
     (st, phi0, ft0)
 }
 
-/// Dry friction's accounts (SPEC §1.5): the work W_f = −Σ f̄_t (x^{n+1} − xⁿ), E + W_f after
+/// Dry friction's accounts (contract §1.5): the work W_f = −Σ f̄_t (x^{n+1} − xⁿ), E + W_f after
 /// the last step and its largest one-step rise, and the stop.
 struct DryAccount {
     work: f64,
@@ -709,7 +709,7 @@ impl DryAccount {
         let done = metrics.steps;
         let scale = p.energy(x0, p.v0).abs().max(f64::MIN_POSITIVE);
         metrics.friction_work = Some(self.work / scale);
-        // The frictional summaries judge E + W_f (SPEC §2.5), as on the layer and the FE
+        // The frictional summaries judge E + W_f (contract §2.5), as on the layer and the FE
         // scenes: its drift from E⁰ and its largest one-step rise, over the same scale.
         metrics.energy_balance_drift = Some((self.balance - eng.energy(x0, p.v0)) / scale);
         metrics.energy_balance_max_increase = Some(if done > 0 {

@@ -90,7 +90,7 @@ macro_rules! schema {
     ($(#[$meta:meta])* $name:ident, $consts:ident { $($field:ident : $ty:ty => $unit:literal, $doc:literal;)* }) => {
         $(#[$meta])*
         #[derive(Debug, Clone, PartialEq)]
-        #[allow(non_snake_case)] // `T` is the column name of SPEC §7
+        #[allow(non_snake_case)] // `T` is the column name of contract §7
         pub struct $name {
             $(#[doc = $doc] pub $field: $ty,)*
         }
@@ -114,7 +114,7 @@ macro_rules! schema {
 
 schema! {
     /// One row of `DIR/runs`: the full parameter set of a run (null where a parameter does not
-    /// apply to its method) and what it measured (SPEC §5, §8).
+    /// apply to its method) and what it measured (contract §5, §8).
     RunRecord, COLUMNS {
         run_id: String => "", "stable hash of the run's canonical parameters (same run, same id, everywhere)";
         sweep: String => "", "name of the sweep that produced the row";
@@ -128,7 +128,7 @@ schema! {
         dt: f64 => "s", "time step τ (derived from courant when the sweep gave courant)";
         courant: f64 => "", "Courant number ν = c0 τ / h";
         space: String => "", "contact treatment: mixed | nitsche | penalty";
-        mass: String => "", "mass variant (SPEC §2.2)";
+        mass: String => "", "mass variant (contract §2.2)";
         mass_weights: Option<String> => "", "user element weights w1,w2,… (mass = weights)";
         contact_init: Option<String> => "", "start of a massless contact node: consistent (its quasi-static value) or interpolant (u0(0)); null when the contact node has mass";
         scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid | kane | contact-stabilized-newmark | generalized-alpha | hht | moreau-jean | discrete-gradient";
@@ -140,8 +140,8 @@ schema! {
         newmark_gamma: Option<f64> => "", "Newmark γ";
         theta_scheme: Option<f64> => "", "θ of the θ-scheme";
         restitution: Option<f64> => "", "Paoli–Schatzman restitution e";
-        rho_inf: Option<f64> => "", "generalized-α spectral radius at infinity ρ∞ (SPEC §3.2)";
-        hht_alpha: Option<f64> => "", "HHT α (scheme = hht, SPEC §3.2)";
+        rho_inf: Option<f64> => "", "generalized-α spectral radius at infinity ρ∞ (contract §3.2)";
+        hht_alpha: Option<f64> => "", "HHT α (scheme = hht, contract §3.2)";
         length: Option<f64> => "m", "bar length L";
         young: Option<f64> => "Pa", "Young modulus E";
         density: Option<f64> => "kg/m", "density ρ";
@@ -202,29 +202,29 @@ schema! {
         free_fall_error: Option<f64> => "m", "largest deviation of the centre of mass's vertical displacement from the free fall −½ g t² (g = gravity) over the steps before the first contact (scenes with gravity)";
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed), semismooth Newton iterations (mixed with friction: the Alart–Curnier Newton; Nitsche, penalty) (2D/3D)";
         max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
-        right_end: Option<String> => "", "bar1d's end x = L: clamped (SPEC §1.1) or free (the flying bar, SPEC §1.4)";
+        right_end: Option<String> => "", "bar1d's end x = L: clamped (contract §1.1) or free (the flying bar, contract §1.4)";
         velocity: Option<f64> => "m/s", "uniform initial velocity v0 (bar1d, oscillator; negative towards the obstacle)";
-        point_mass: Option<f64> => "kg", "oscillator mass m (SPEC §1.5)";
+        point_mass: Option<f64> => "kg", "oscillator mass m (contract §1.5)";
         stiffness: Option<f64> => "N/m", "oscillator spring stiffness k";
         force: Option<f64> => "N", "oscillator constant force f (negative towards the obstacle)";
         impact_law: Option<f64> => "", "oscillator: Newton's restitution e_x of the exact solution the run is measured against";
         err_v_l2: Option<f64> => "m·s^-½", "oscillator: (τ Σ_n |v^n − v(t^n)|²)^½ (velocities jump at impacts: the l2(τ) norm is the meaningful one)";
         err_impact_time: Option<f64> => "s", "oscillator: max over the exact impacts in [0, T] of the distance to the nearest discrete contact start";
         exit_velocity: Option<f64> => "m/s", "bar1d with a free end: the bar's mean velocity 1ᵀMv/1ᵀM1 at T (the flying bar leaves with −v0)";
-        pressure_oscillation: Option<f64> => "", "max over the contact phases (impact_*) of TV/(2·max|σ_C|), TV the total variation of σ_C (1D) or of the total contact force (2D/3D) over the phase's steps, rise from and fall to zero included: 1 for a pressure that rises once and falls once, larger when it chatters (SPEC §3.2); null without contact";
-        solver: Option<String> => "", "step solves of the 2D/3D scenes (SPEC §4): direct (sparse Cholesky) | cg (Jacobi-preconditioned conjugate gradient); null for bar1d and the oscillator";
+        pressure_oscillation: Option<f64> => "", "max over the contact phases (impact_*) of TV/(2·max|σ_C|), TV the total variation of σ_C (1D) or of the total contact force (2D/3D) over the phase's steps, rise from and fall to zero included: 1 for a pressure that rises once and falls once, larger when it chatters (contract §3.2); null without contact";
+        solver: Option<String> => "", "step solves of the 2D/3D scenes (contract §4): direct (sparse Cholesky) | cg (Jacobi-preconditioned conjugate gradient); null for bar1d and the oscillator";
         cg_tol: Option<f64> => "", "CG's relative residual tolerance, ‖r‖ ≤ cg_tol·‖b‖ in the D⁻¹ norm, D = diag(A) (solver = cg)";
         solver_iterations: Option<i64> => "", "CG iterations of the step solves of the time loop, summed over the steps (solver = cg; null for direct)";
         solver_iterations_max_step: Option<i64> => "", "most CG iterations of one step's solve (solver = cg)";
-        load: Option<String> => "", "how gravity enters (SPEC §1.3): body (F = ∫ρ f·φ whatever the mass variant, the papers' model) or inertial (F = M_run f e_d, the weight following the modified mass); null without gravity";
+        load: Option<String> => "", "how gravity enters (contract §1.3): body (F = ∫ρ f·φ whatever the mass variant, the papers' model) or inertial (F = M_run f e_d, the weight following the modified mass); null without gravity";
         lockstep: Option<i64> => "", "members of the lockstep group the run was stepped in (runs sharing the step matrix make one multi-column solve per step; its numbers equal the run alone bit for bit, and its timings are the group's divided among the members); null: stepped alone";
-        friction: Option<String> => "", "friction law at the contact (SPEC §2.5): none | tresca | coulomb (null on scenes without a tangential direction)";
+        friction: Option<String> => "", "friction law at the contact (contract §2.5): none | tresca | coulomb (null on scenes without a tangential direction)";
         friction_coefficient: Option<f64> => "", "Coulomb's μ_f (friction = coulomb)";
         tresca_threshold: Option<f64> => "Pa", "Tresca's threshold s, a traction (friction = tresca)";
         height: Option<f64> => "m", "layer1d: the layer's height H";
-        velocity_tangential: Option<f64> => "m/s", "initial tangential velocity: layer1d's V_t (SPEC §1.7); disc2d, sphere3d, mesh2d, mesh3d: the e_1 velocity of every node not clamped (SPEC §1.8; the disc thrown obliquely, the sliding block)";
-        incline: Option<f64> => "°", "mesh2d, mesh3d: the plane's tilt α in degrees, the volume load ρ·gravity·(sin α e_1 − cos α e_d) (SPEC §1.8)";
-        friction_work: Option<f64> => "", "friction: W_f(T)/energy_scale, the work the friction force took from the body (SPEC §5; null without friction)";
+        velocity_tangential: Option<f64> => "m/s", "initial tangential velocity: layer1d's V_t (contract §1.7); disc2d, sphere3d, mesh2d, mesh3d: the e_1 velocity of every node not clamped (contract §1.8; the disc thrown obliquely, the sliding block)";
+        incline: Option<f64> => "°", "mesh2d, mesh3d: the plane's tilt α in degrees, the volume load ρ·gravity·(sin α e_1 − cos α e_d) (contract §1.8)";
+        friction_work: Option<f64> => "", "friction: W_f(T)/energy_scale, the work the friction force took from the body (contract §5; null without friction)";
         energy_balance_drift: Option<f64> => "", "friction: (E^N + W_f^N − E⁰)/energy_scale — the normal contact's work over the run";
         energy_balance_max_increase: Option<f64> => "", "friction: max_n of the one-step rise of E + W_f, over energy_scale (≤ 0 up to round-off for kane and moreau-jean θ = ½)";
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
@@ -234,8 +234,8 @@ schema! {
         normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
         err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
-        friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (SPEC §1.5; 0: frictionless)";
-        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (SPEC §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
+        friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (contract §1.5; 0: frictionless)";
+        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
@@ -316,7 +316,7 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "sigma_t_contact",
         "Option<f64>",
         "Pa",
-        "friction (SPEC §2.5): the base's tangential stress σ_t (layer1d; the force the scheme applied at t^n, impulses over τ); null without a tangential direction",
+        "friction (contract §2.5): the base's tangential stress σ_t (layer1d; the force the scheme applied at t^n, impulses over τ); null without a tangential direction",
     ),
     (
         "v_t_contact",
@@ -328,7 +328,7 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "friction_work",
         "Option<f64>",
         "J",
-        "friction: the frictional work W_f^n = −Σ f̄_t·Δu_t so far (SPEC §2.5); energy + friction_work − its initial value is the normal contact's work",
+        "friction: the frictional work W_f^n = −Σ f̄_t·Δu_t so far (contract §2.5); energy + friction_work − its initial value is the normal contact's work",
     ),
 ];
 

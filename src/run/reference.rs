@@ -1,10 +1,10 @@
-//! Reference solutions of scenes without a closed form (SPEC §1.2): a run of the same scene on a
+//! Reference solutions of scenes without a closed form (contract §1.2): a run of the same scene on a
 //! nested finer mesh and step records its solution on the lattice its consumers need — every
 //! `space_stride`-th node along each axis, every `time_stride`-th step — and each coarse run
 //! reads its own nodes and times from it (nested meshes: every coarse node is a reference node,
 //! every coarse time a reference time, so I_h u_ref is a plain lookup).
 //!
-//! Meshes that are not nested (the disc and ball's mapped meshes of two sizes, mesh files, SPEC
+//! Meshes that are not nested (the disc and ball's mapped meshes of two sizes, mesh files, contract
 //! §1.6) store every node (`space_stride` 1; a mesh file's clamped nodes as zeros) and the mesh
 //! itself ([`ReferenceData::mesh`]): a coarse run locates its nodes in it and evaluates the
 //! reference's finite-element function there ([`crate::space::fe::locate`]). The bars' box

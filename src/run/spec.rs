@@ -1,5 +1,5 @@
 //! A run's parameters as the planner resolved them: its id, its label, every parameter column
-//! (SPEC §7's keys with defaults filled), the engine configuration and where its errors are
+//! (contract §7's keys with defaults filled), the engine configuration and where its errors are
 //! measured against.
 //!
 //! Why here and not with the planner: a run builds its row from these ([`super::RunRecord`]),
@@ -27,7 +27,7 @@ pub struct RunSpec {
     /// Ensemble member (sample index, relative perturbation).
     pub sample: Option<(usize, f64)>,
     pub scene: SceneKind,
-    /// The run_id of the reference run its errors are measured against (SPEC §1.2, §7).
+    /// The run_id of the reference run its errors are measured against (contract §1.2, §7).
     pub reference: Option<String>,
     /// The `[search]` this run is a probe of ([`crate::sweep::plan::search_tag`]); None for grid runs.
     pub search: Option<String>,

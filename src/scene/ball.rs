@@ -1,5 +1,5 @@
 //! Impacts of a disc (2D, plane strain) and a ball (3D) under gravity on a rigid plane
-//! (SPEC §1.3, paper 003 §4.2): `disc2d` and `sphere3d`.
+//! (contract §1.3, paper 003 §4.2): `disc2d` and `sphere3d`.
 //!
 //! Diameter 40 (R = 20), λ = μ = 20, ρ = 1, volume load f = −0.1 e_d per unit mass, the lowest
 //! point 5 above the plane x_d = 0 (centre at height R + 5), at rest and unloaded at t = 0,
@@ -9,7 +9,7 @@
 //! 2D, h ≈ 8 in 3D). `elements` is the number n_t of elements along a quarter of the boundary
 //! circle (even); h and n_t are linked by n_t = 2·round(πR/(4h)).
 //!
-//! `velocity_tangential` (default 0; SPEC §1.8) gives every node the initial velocity V_t e_1:
+//! `velocity_tangential` (default 0; contract §1.8) gives every node the initial velocity V_t e_1:
 //! the disc thrown obliquely, for friction.
 //!
 //! Energies are measured in `energy_scale` = m·|f|·gap, the kinetic energy of the body
@@ -17,7 +17,7 @@
 //! run yet: the runs report energies and contact observables, not errors.
 //!
 //! Implemented so far (issue 8, in stages): `mixed`, `nitsche` and `penalty` (κ = E·γ0/h_K)
-//! contact with every mass variant of SPEC §2.2 but the 1D-only two (`singular-dynamic`,
+//! contact with every mass variant of contract §2.2 but the 1D-only two (`singular-dynamic`,
 //! `node-neighbour`), the Newmark / θ schemes, and the hybrid scheme with `nitsche` or
 //! `penalty` (000 §5's reduced hybrid of `mixed` with a massless contact is 1D only).
 //!
@@ -37,7 +37,7 @@ use super::{
 };
 use crate::space::fe::BallMesh;
 
-/// Radius of the disc and the ball (diameter 40, SPEC §1.3).
+/// Radius of the disc and the ball (diameter 40, contract §1.3).
 pub const RADIUS: f64 = 20.0;
 
 /// The scenes `disc2d` (dim 2) and `sphere3d` (dim 3).
@@ -71,13 +71,13 @@ const BALL_PHYSICS: [PhysicsKey; 8] = [
         name: "degree",
         default: 2.0,
     },
-    // A choice key: the index into `Key::Load.choices()`, 0 = body (SPEC §1.3).
+    // A choice key: the index into `Key::Load.choices()`, 0 = body (contract §1.3).
     PhysicsKey {
         name: "load",
         default: 0.0,
     },
-    // The disc thrown obliquely (SPEC §1.8): the initial e_1 velocity of every node (nothing
-    // is clamped). Default 0: the runs of SPEC §1.3 keep their ids.
+    // The disc thrown obliquely (contract §1.8): the initial e_1 velocity of every node (nothing
+    // is clamped). Default 0: the runs of contract §1.3 keep their ids.
     PhysicsKey {
         name: "velocity_tangential",
         default: 0.0,

@@ -1,4 +1,4 @@
-//! The elastic bar dropped on an obstacle, 2D (plane strain) and 3D (SPEC §1.2; papers 000
+//! The elastic bar dropped on an obstacle, 2D (plane strain) and 3D (contract §1.2; papers 000
 //! Table 1 and 002).
 //!
 //! Ω = [0, 0.1] × [0, 1] or [0, 0.1]² × [0, 1], the last axis vertical; ρ = 1, λ = 0.25,
@@ -6,7 +6,7 @@
 //! traction-free, the bottom face x_d = 0 is Γ_C, facing a rigid plane at distance g = 0.2:
 //! u_d ≥ −g. Undeformed at t = 0 with v⁰ = −½ e_d on every node not on the clamped face; T = 2.
 //! There is no closed form: errors are measured against a reference run of the same scene on a
-//! nested finer mesh and step (SPEC §1.2, the sweep file's `reference = {…}`).
+//! nested finer mesh and step (contract §1.2, the sweep file's `reference = {…}`).
 //!
 //! `elements` counts the elements across the height (n_d = 1/h); the width 0.1 must hold a whole
 //! number of elements too, so h ∈ {0.1, 0.05, 0.025, …, 0.1/k}.
@@ -61,7 +61,7 @@ impl FeGeometry {
     }
 }
 
-/// How a volume load (gravity) enters the FE scenes (SPEC §1.3, key `load`).
+/// How a volume load (gravity) enters the FE scenes (contract §1.3, key `load`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LoadModel {
     /// The body force F = ∫ρ f·φ, whatever the mass variant: the papers' model (GetFEM
@@ -87,9 +87,9 @@ impl LoadModel {
 impl FeSetup {
     /// Lines added to the run id of a run whose numbers a definition change moved (issue 34),
     /// so a resumed folder never holds the numbers of two definitions under one id:
-    /// - the load of SPEC §1.3 (F = ∫ρ f·φ, `energy_scale` with the body's mass): every run
+    /// - the load of contract §1.3 (F = ∫ρ f·φ, `energy_scale` with the body's mass): every run
     ///   with gravity;
-    /// - exact quadrature on curved cells (SPEC §1.6): every run whose cells can be curved or
+    /// - exact quadrature on curved cells (contract §1.6): every run whose cells can be curved or
     ///   distorted — degree-2 cells and hexahedra of the mapped ball and of mesh files (the
     ///   bars' boxes are affine: their matrices did not change).
     pub fn id_revision(&self) -> String {
@@ -133,14 +133,14 @@ pub struct FeSetup {
     pub gap: f64,
     /// Volume load per unit mass towards the obstacle (−gravity e_d).
     pub gravity: f64,
-    /// How that load enters the equations (SPEC §1.3, key `load`).
+    /// How that load enters the equations (contract §1.3, key `load`).
     pub load: LoadModel,
     /// Initial vertical velocity of every node not on a clamped face.
     pub v0: f64,
-    /// Initial e_1 velocity of every node not on a clamped face (SPEC §1.8
+    /// Initial e_1 velocity of every node not on a clamped face (contract §1.8
     /// `velocity_tangential`: the disc thrown obliquely, the sliding block; 0 on the bars).
     pub v0_tangential: f64,
-    /// The plane's tilt α in degrees (SPEC §1.8 `incline`, mesh scenes): the volume load is
+    /// The plane's tilt α in degrees (contract §1.8 `incline`, mesh scenes): the volume load is
     /// ρ·gravity·(sin α e_1 − cos α e_d); 0 elsewhere.
     pub incline: f64,
 }

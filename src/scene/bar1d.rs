@@ -4,13 +4,13 @@
 //! u(x, 0) = a (1 − x/L), u_t(x, 0) = 0.
 //!
 //! For g = 0 the solution is u(x, t) = 2a · U(x/L, c0 t/L) with U the reference solution for
-//! L = E = ρ = 1, a = ½ (SPEC §1.1): period 3, contact during s mod 3 ∈ [1, 2]. U is piecewise
+//! L = E = ρ = 1, a = ½ (contract §1.1): period 3, contact during s mod 3 ∈ [1, 2]. U is piecewise
 //! affine in (ξ, s); its kinks at a given time lie at ξ = f and ξ = 1 − f (f = s mod 1). Error
 //! norms are therefore integrated *exactly*: every element is split at those kinks and the
 //! difference between the P1 field and the exact field is affine on each piece.
 //!
 //! With `right_end = "free"`, no initial strain and a uniform velocity −V towards the obstacle
-//! (SPEC §1.4, the flying bar of Doyen–Ern–Piperno 2011 and Siconos' ImpactingBar) the solution
+//! (contract §1.4, the flying bar of Doyen–Ern–Piperno 2011 and Siconos' ImpactingBar) the solution
 //! is d'Alembert's: with c = √(E/ρ), t_c = g/V and s = t − t_c,
 //! u(x, t) = −g − V·min(x/c, s, 2L/c − s) for every t (before the impact the minimum is s, the
 //! rigid flight −Vt; after it 2L/c − s, the rigid rebound). The compression front x = c s
@@ -22,7 +22,7 @@
 
 use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 
-/// The scene `bar1d` (SPEC §1.1): physics keys, mesh from h, closed form for a zero gap.
+/// The scene `bar1d` (contract §1.1): physics keys, mesh from h, closed form for a zero gap.
 #[derive(Debug, Clone, Copy)]
 pub struct Bar1dScene;
 
@@ -47,7 +47,7 @@ const BAR1D_PHYSICS: [PhysicsKey; 7] = [
         name: "gap",
         default: 0.0,
     },
-    // A choice key: the index into `Key::RightEnd.choices()`, 0 = clamped (SPEC §1.1's bar).
+    // A choice key: the index into `Key::RightEnd.choices()`, 0 = clamped (contract §1.1's bar).
     PhysicsKey {
         name: "right_end",
         default: 0.0,
@@ -147,8 +147,8 @@ impl Scene for Bar1dScene {
 pub use crate::space::bar1d::BarParams;
 
 impl BarParams {
-    /// The closed form: the clamped bar released at rest with a zero gap (SPEC §1.1), or the
-    /// flying bar — free end, no initial strain, moving towards the obstacle (SPEC §1.4).
+    /// The closed form: the clamped bar released at rest with a zero gap (contract §1.1), or the
+    /// flying bar — free end, no initial strain, moving towards the obstacle (contract §1.4).
     /// Other combinations have none.
     pub fn exact(&self) -> Option<BarExact> {
         let clamped = !self.free_end && self.gap == 0.0 && self.velocity == 0.0;
@@ -165,7 +165,7 @@ struct RefValue {
     u_s: f64,
 }
 
-/// Reference solution U(ξ, s) for L = E = ρ = 1, a = ½ (table of SPEC §1.1).
+/// Reference solution U(ξ, s) for L = E = ρ = 1, a = ½ (table of contract §1.1).
 fn reference(xi: f64, s: f64) -> RefValue {
     let (phase, f) = phase_of(s);
     reference_at(xi, phase, f)
@@ -223,7 +223,7 @@ impl BarExact {
         reference(x / self.p.length, self.scaled_time(t))
     }
 
-    /// Whether this is the flying bar (SPEC §1.4) rather than the clamped one.
+    /// Whether this is the flying bar (contract §1.4) rather than the clamped one.
     pub fn is_flying(&self) -> bool {
         self.p.free_end
     }
@@ -275,7 +275,7 @@ impl BarExact {
         3.0 * self.p.length / self.p.wave_speed()
     }
 
-    /// The flying bar's first contact t_c = g/V and the contact's duration 2L/c (SPEC §1.4).
+    /// The flying bar's first contact t_c = g/V and the contact's duration 2L/c (contract §1.4).
     pub fn contact_interval(&self) -> Option<(f64, f64)> {
         self.is_flying().then(|| {
             (
@@ -360,7 +360,7 @@ impl BarExact {
 
 /// ∫(u_h − u)² and ∫(u_h' − u')² over `elements` P1 elements of size h with nodal values
 /// `node(i)`, i = 0 … elements, against a continuous field `exact` that is affine between the
-/// kinks, sorted ascending (only those inside an element matter; the layer of SPEC §1.7 has up
+/// kinks, sorted ascending (only those inside an element matter; the layer of contract §1.7 has up
 /// to four per component). On each affine piece the error is affine, so its values at the piece
 /// ends determine both integrals: ∫ e² over a piece of length d is d (e_a² + e_a e_b + e_b²)/3,
 /// ∫ e'² is (e_b − e_a)²/d.

@@ -1,4 +1,4 @@
-//! The frictional layer of SPEC §1.7 and its exact solution — the frictional twin of the
+//! The frictional layer of contract §1.7 and its exact solution — the frictional twin of the
 //! flying bar (§1.4).
 //!
 //! A layer 0 < z < H of an elastic solid (ρ, λ, μ) in plane strain, every field a function of
@@ -31,7 +31,7 @@
 use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 use crate::contact::friction::FrictionLaw;
 
-/// The scene `layer1d` (SPEC §1.7).
+/// The scene `layer1d` (contract §1.7).
 #[derive(Debug, Clone, Copy)]
 pub struct Layer1dScene;
 
@@ -106,7 +106,7 @@ impl Scene for Layer1dScene {
         ))
     }
     /// `mixed` and `penalty` with every 1D mass variant; the one-step schemes whose frictional
-    /// version the literature defines (SPEC §2.5). Paoli–Schatzman, the hybrid schemes and
+    /// version the literature defines (contract §2.5). Paoli–Schatzman, the hybrid schemes and
     /// the discrete gradient have none, and the layer exists for friction.
     fn supports(
         &self,
@@ -126,7 +126,7 @@ impl Scene for Layer1dScene {
             return Err((
                 "scheme",
                 format!(
-                    "scheme = {scheme} has no frictional version in the literature (SPEC §2.5), and layer1d is the frictional benchmark: it runs the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean and central-difference"
+                    "scheme = {scheme} has no frictional version in the literature (contract §2.5), and layer1d is the frictional benchmark: it runs the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean and central-difference"
                 ),
             ));
         }
@@ -146,7 +146,7 @@ impl Scene for Layer1dScene {
     }
 }
 
-/// The layer's physics (SPEC §1.7 keys) and its friction law.
+/// The layer's physics (contract §1.7 keys) and its friction law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LayerParams {
     /// H (`height`).
@@ -168,7 +168,7 @@ pub struct LayerParams {
 }
 
 impl Default for LayerParams {
-    /// SPEC §1.7's defaults: H = ρ = μ = 1, λ = 2 (c_p = 2, c_s = 1), g = 0.1, V_n = 1,
+    /// contract §1.7's defaults: H = ρ = μ = 1, λ = 2 (c_p = 2, c_s = 1), g = 0.1, V_n = 1,
     /// V_t = 0.3, frictionless.
     fn default() -> Self {
         LayerParams {

@@ -1,4 +1,4 @@
-//! The user's own body from a Gmsh mesh file (SPEC §1.6, issue 22): `mesh2d` (plane strain) and
+//! The user's own body from a Gmsh mesh file (contract §1.6, issue 22): `mesh2d` (plane strain) and
 //! `mesh3d`.
 //!
 //! Why a scene of its own: every other scene knows its geometry; here the geometry, `h` and the
@@ -10,12 +10,12 @@
 //!
 //! Physics: physical group `clamped` (optional) has u = 0, `contact` is Γ_C, every other boundary
 //! is traction-free. The rigid plane is x_d = (lowest x_d of Γ_C) − `gap`, normal −e_d, gap
-//! function g(x) = x_d − obstacle (SPEC §1.3's conventions): the engine's contact rows are the
+//! function g(x) = x_d − obstacle (contract §1.3's conventions): the engine's contact rows are the
 //! vertical dofs of the Γ_C nodes (`mixed`), each with its own initial gap. The plane may be
 //! given by its height instead, `obstacle` (exclusive with `gap`): the planner turns it into
 //! the gap it names, so both spellings of one plane are one run with one id. Loads: `gravity`
 //! (per unit mass, towards the obstacle, default 0) and the initial velocity `velocity` e_d on
-//! every node not clamped (default 0; negative moves towards the obstacle). SPEC §1.8 adds
+//! every node not clamped (default 0; negative moves towards the obstacle). contract §1.8 adds
 //! `velocity_tangential` (the initial e_1 velocity of every node not clamped) and `incline`
 //! (α in degrees, |α| < 90: the plane tilted by α, the volume load ρ·gravity·(sin α e_1 −
 //! cos α e_d), so the body slides down +e_1), both default 0. Material defaults
@@ -23,14 +23,14 @@
 //! meshed by Gmsh with `velocity = -0.5` is `bar2d`.
 //!
 //! `h` is the mesh's largest element diameter (reported, it orders refinement paths) and
-//! `elements` its number of cells. Methods: `mixed` contact with every mass variant of SPEC §2.2
+//! `elements` its number of cells. Methods: `mixed` contact with every mass variant of contract §2.2
 //! but the 1D-only two (layers by topology: layer 0 = the cells with a node on Γ_C, layer k + 1
 //! their neighbours by shared nodes), `nitsche` and `penalty` on the `contact` group's faces,
-//! and the schemes of every finite-element scene ([`super::fe_supports`]: Newmark, θ, SPEC
+//! and the schemes of every finite-element scene ([`super::fe_supports`]: Newmark, θ, contract
 //! §3.2's methods, hybrid with Nitsche or the penalty) — the engines act on the assembled
 //! operators and the Γ_C rows or quadrature points, whatever the mesh.
 //!
-//! Errors are measured against a reference run at least as fine (SPEC §1.6): on the same file
+//! Errors are measured against a reference run at least as fine (contract §1.6): on the same file
 //! with a finer step, on another (finer) mesh file of the same body, or — `reference = { scene
 //! = "bar2d", h = …, dt = … }` — on the built-in scene the file meshes, with the same physics
 //! (the planner checks it). The reference stores its whole mesh (a mesh file's clamped nodes
@@ -76,15 +76,15 @@ const MESH_PHYSICS: [PhysicsKey; 9] = [
         name: "velocity",
         default: 0.0,
     },
-    // A choice key: the index into `Key::Load.choices()`, 0 = body (SPEC §1.3); it applies
+    // A choice key: the index into `Key::Load.choices()`, 0 = body (contract §1.3); it applies
     // only with gravity (the planner drops it otherwise).
     PhysicsKey {
         name: "load",
         default: 0.0,
     },
-    // SPEC §1.8: the initial e_1 velocity of every node not clamped (the sliding block) and
+    // contract §1.8: the initial e_1 velocity of every node not clamped (the sliding block) and
     // the plane's tilt α in degrees (the volume load ρ·gravity·(sin α e_1 − cos α e_d)). Both
-    // default to 0, so the runs of SPEC §1.6 keep their ids.
+    // default to 0, so the runs of contract §1.6 keep their ids.
     PhysicsKey {
         name: "velocity_tangential",
         default: 0.0,

@@ -1,4 +1,4 @@
-//! Scenes: a physical problem with its geometry, material, loads and initial state (SPEC §1).
+//! Scenes: a physical problem with its geometry, material, loads and initial state (contract §1).
 //!
 //! A scene is *data* behind the [`Scene`] trait: it declares its physics keys with their
 //! defaults, its default final time, which contact methods / masses / schemes it supports, how a
@@ -26,7 +26,7 @@ pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
 
-/// A physics parameter of a scene: its key name (SPEC §7) and default value.
+/// A physics parameter of a scene: its key name (contract §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PhysicsKey {
     pub name: &'static str,
@@ -63,7 +63,7 @@ impl Physics {
 pub enum ErrorSource {
     /// A closed-form solution (bar1d: clamped with zero gap, or the flying bar; the oscillator).
     Exact,
-    /// A reference run of the same scene on a finer nested mesh and step (SPEC §1.2).
+    /// A reference run of the same scene on a finer nested mesh and step (contract §1.2).
     ReferenceRun,
 }
 
@@ -84,9 +84,9 @@ pub enum SceneSetup {
     Bar1d { bar: BarParams, elements: usize },
     /// A finite-element scene (sparse engine).
     Fe(FeSetup),
-    /// The impact oscillator: one mass, one spring, one obstacle (SPEC §1.5).
+    /// The impact oscillator: one mass, one spring, one obstacle (contract §1.5).
     Oscillator(OscillatorParams),
-    /// The frictional layer: two P1 chains on the same nodes (SPEC §1.7).
+    /// The frictional layer: two P1 chains on the same nodes (contract §1.7).
     Layer1d { layer: LayerParams, elements: usize },
 }
 
@@ -135,7 +135,7 @@ pub trait Scene: Send + Sync {
     -> Result<(), (&'static str, String)>;
     /// Whether the start of a massless contact node (`contact_init`) changes anything: only
     /// where the quasi-static contact value differs from the interpolant of u0 (the 1D bar,
-    /// SPEC §1.1). The FE scenes start at rest or in free flight, where both starts coincide,
+    /// contract §1.1). The FE scenes start at rest or in free flight, where both starts coincide,
     /// so the key is inapplicable there and a sweep over it makes no duplicate runs.
     fn contact_init_matters(&self) -> bool {
         false
@@ -150,20 +150,20 @@ pub trait Scene: Send + Sync {
     }
     /// The dimension of a finite-element body in 2D/3D (the bars, the disc/ball, the mesh
     /// files), None for the others: a mesh file's run may take its reference from another
-    /// scene of the same dimension (SPEC §1.6, `reference = { scene = … }`).
+    /// scene of the same dimension (contract §1.6, `reference = { scene = … }`).
     fn fe_dim(&self) -> Option<usize> {
         None
     }
-    /// Whether the scene takes a friction law (SPEC §2.5, `friction` ≠ `none`); `Err` says
+    /// Whether the scene takes a friction law (contract §2.5, `friction` ≠ `none`); `Err` says
     /// why not. A friction law needs a tangential direction at the contact: the 1D bar has
     /// none (its one displacement is normal to the obstacle); the finite-element scenes have
-    /// one at every Γ_C point (e_1 in 2D, e_1 and e_2 in 3D, SPEC §1.8).
+    /// one at every Γ_C point (e_1 in 2D, e_1 and e_2 in 3D, contract §1.8).
     fn supports_friction(&self) -> Result<(), String> {
         if self.fe_dim().is_some() {
             return Ok(());
         }
         Err(format!(
-            "scene {} has no tangential direction at its contact (its one displacement is normal to the obstacle): friction needs layer1d (SPEC §1.7)",
+            "scene {} has no tangential direction at its contact (its one displacement is normal to the obstacle): friction needs layer1d (contract §1.7)",
             self.name()
         ))
     }
@@ -178,7 +178,7 @@ pub trait Scene: Send + Sync {
     }
     /// The description the engines run.
     fn setup(&self, physics: &Physics, mesh: MeshChoice) -> SceneSetup;
-    /// Whether the body comes from a mesh file (the `mesh` key, SPEC §1.6) rather than from
+    /// Whether the body comes from a mesh file (the `mesh` key, contract §1.6) rather than from
     /// `h` or `elements`.
     fn takes_mesh_file(&self) -> bool {
         false
@@ -200,9 +200,9 @@ pub trait Scene: Send + Sync {
 }
 
 /// What every finite-element scene takes — the bars, the disc/ball and the mesh files alike
-/// (SPEC §1.2: every contact method on every scene): `mixed`, `nitsche`, `penalty`; every mass
-/// variant of SPEC §2.2 but the 1D-only two; the newmark and θ families (central difference's
-/// kinematic contact needs `lumped`, the planner checks it), SPEC §3.2's methods
+/// (contract §1.2: every contact method on every scene): `mixed`, `nitsche`, `penalty`; every mass
+/// variant of contract §2.2 but the 1D-only two; the newmark and θ families (central difference's
+/// kinematic contact needs `lumped`, the planner checks it), contract §3.2's methods
 /// ([`crate::run::fe`]'s methods module, on any mesh: they act on the assembled M, K and the
 /// Γ_C rows or quadrature points; the planner checks their contact methods and masses), and
 /// hybrid with a contact potential (Nitsche or the penalty on Γ_C's quadrature points).
@@ -222,7 +222,7 @@ pub(crate) fn fe_supports(
         return Err((
             "mass",
             format!(
-                "mass = {mass} is defined for the 1D bar only (SPEC §2.2); scene {scene} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact"
+                "mass = {mass} is defined for the 1D bar only (contract §2.2); scene {scene} takes consistent, lumped, mod1, mod2, mod3, weights and zero-contact"
             ),
         ));
     }
@@ -242,33 +242,33 @@ pub(crate) fn fe_supports(
         return Err((
             "scheme",
             format!(
-                "scheme = {scheme} is not available for scene {scene} with space = {space} (newmark and theta schemes, the SPEC §3.2 methods kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean, discrete-gradient; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)"
+                "scheme = {scheme} is not available for scene {scene} with space = {space} (newmark and theta schemes, the contract §3.2 methods kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean, discrete-gradient; hybrid with nitsche or penalty — the reduced hybrid of mixed with a massless contact (000 §5) is 1D only)"
             ),
         ));
     }
     Ok(())
 }
 
-/// The scenes the engine can run (the registry; SPEC §1).
+/// The scenes the engine can run (the registry; contract §1).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum SceneKind {
-    /// The 1D impacting bar with its closed form (SPEC §1.1).
+    /// The 1D impacting bar with its closed form (contract §1.1).
     Bar1d,
-    /// The 2D plane-strain bar dropped on an obstacle (SPEC §1.2).
+    /// The 2D plane-strain bar dropped on an obstacle (contract §1.2).
     Bar2d,
-    /// The 3D bar dropped on an obstacle (SPEC §1.2).
+    /// The 3D bar dropped on an obstacle (contract §1.2).
     Bar3d,
-    /// The disc falling under gravity on a rigid plane (SPEC §1.3).
+    /// The disc falling under gravity on a rigid plane (contract §1.3).
     Disc2d,
-    /// The ball falling under gravity on a rigid plane (SPEC §1.3).
+    /// The ball falling under gravity on a rigid plane (contract §1.3).
     Sphere3d,
-    /// One mass, one spring, one obstacle (SPEC §1.5).
+    /// One mass, one spring, one obstacle (contract §1.5).
     Oscillator,
-    /// The user's own 2D body, a Gmsh mesh (SPEC §1.6).
+    /// The user's own 2D body, a Gmsh mesh (contract §1.6).
     Mesh2d,
-    /// The user's own 3D body, a Gmsh mesh (SPEC §1.6).
+    /// The user's own 3D body, a Gmsh mesh (contract §1.6).
     Mesh3d,
-    /// The frictional layer with its exact solution (SPEC §1.7).
+    /// The frictional layer with its exact solution (contract §1.7).
     Layer1d,
 }
 
@@ -283,7 +283,7 @@ static MESH3D: MeshScene = MeshScene { dim: 3 };
 static LAYER1D: Layer1dScene = Layer1dScene;
 
 impl SceneKind {
-    /// Every scene name of SPEC §1, with whether this build implements it.
+    /// Every scene name of contract §1, with whether this build implements it.
     pub const NAMES: [(&'static str, Option<SceneKind>); 9] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),

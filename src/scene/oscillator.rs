@@ -1,4 +1,4 @@
-//! The impact oscillator (SPEC §1.5; Code_Aster V5.01.102/108, Siconos' BouncingBall, Acary
+//! The impact oscillator (contract §1.5; Code_Aster V5.01.102/108, Siconos' BouncingBall, Acary
 //! 2016): one mass on one spring under a constant force, above a rigid obstacle.
 //!
 //! m ẍ + k x = f, x ≥ −g, Newton's impact law ẋ(t⁺) = −e_x ẋ(t⁻) at each contact. It is the
@@ -13,7 +13,7 @@
 //! below (finitely many impacts per unit time). With the net force at the obstacle pushing into
 //! it (f + k g < 0) and e_x < 1 the rebound speeds fall geometrically and the flight times with
 //! them (Zeno): the flights are summed until the rebound speed falls below 1e-14 of the
-//! motion's speed scale (SPEC says 1e-14·|v0|; with v0 = 0 the scale is ω·R of the first
+//! motion's speed scale (the contract says 1e-14·|v0|; with v0 = 0 the scale is ω·R of the first
 //! segment instead), and the mass then rests on the obstacle for good (the force still pushes
 //! into it). A rebound that slow with the net force pulling away is a grazing orbit: the mass
 //! touches the obstacle at zero speed once per period, which is no impact.
@@ -24,7 +24,7 @@
 use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
 use crate::time::Scheme;
 
-/// The scene `oscillator` (SPEC §1.5).
+/// The scene `oscillator` (contract §1.5).
 #[derive(Debug, Clone, Copy)]
 pub struct OscillatorScene;
 
@@ -57,7 +57,7 @@ const OSCILLATOR_PHYSICS: [PhysicsKey; 8] = [
         name: "impact_law",
         default: 1.0,
     },
-    // Dry friction on the mass (SPEC §1.5): 0 is the frictionless oscillator, and being the
+    // Dry friction on the mass (contract §1.5): 0 is the frictionless oscillator, and being the
     // default it enters no run id.
     PhysicsKey {
         name: "friction_force",
@@ -108,16 +108,16 @@ impl Scene for OscillatorScene {
         })
     }
     /// The mass meets the obstacle along its one dof: a friction law at the contact has no
-    /// direction to act in. Dry friction on the mass is SPEC §1.5's physics key
+    /// direction to act in. Dry friction on the mass is contract §1.5's physics key
     /// `friction_force`, not the friction axis.
     fn supports_friction(&self) -> Result<(), String> {
-        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is SPEC §1.5's `friction_force` key, not a friction law at the contact".into())
+        Err("the oscillator's one dof is normal to the obstacle: dry friction on the mass is contract §1.5's `friction_force` key, not a friction law at the contact".into())
     }
 
-    /// Dry friction enters a step as a relay on the step's slip (SPEC §1.5): the increment
+    /// Dry friction enters a step as a relay on the step's slip (contract §1.5): the increment
     /// (x^{n+1} − xⁿ)/τ of an implicit position-level step, Moreau–Jean's v^{n+1}. An explicit
     /// step's increment does not depend on the step's own force, so the relay has nothing to
-    /// solve; and the schemes SPEC §2.5 gives no frictional version (Paoli–Schatzman's two-step
+    /// solve; and the schemes contract §2.5 gives no frictional version (Paoli–Schatzman's two-step
     /// contact argument, the hybrid and discrete-gradient energy splittings) are not invented
     /// here.
     fn supports_physics(
@@ -130,13 +130,13 @@ impl Scene for OscillatorScene {
         }
         let why = match scheme {
             Scheme::PaoliSchatzman(_) => {
-                "paoli-schatzman has no frictional version in the literature (SPEC §2.5)"
+                "paoli-schatzman has no frictional version in the literature (contract §2.5)"
             }
             Scheme::Hybrid => {
-                "the hybrid scheme has no frictional version in the literature (SPEC §2.5)"
+                "the hybrid scheme has no frictional version in the literature (contract §2.5)"
             }
             Scheme::DiscreteGradient => {
-                "discrete-gradient has no frictional version in the literature (SPEC §2.5)"
+                "discrete-gradient has no frictional version in the literature (contract §2.5)"
             }
             s if s.is_explicit() => {
                 "an explicit step's increment does not depend on the step's friction force: the relay on (x^{n+1} − xⁿ)/τ is undetermined"
@@ -162,7 +162,7 @@ impl Scene for OscillatorScene {
             return Err((
                 "space",
                 format!(
-                    "space = {space} does not apply to the oscillator (SPEC §1.5: a multiplier on the one dof, `mixed`, or `penalty`)"
+                    "space = {space} does not apply to the oscillator (contract §1.5: a multiplier on the one dof, `mixed`, or `penalty`)"
                 ),
             ));
         }
@@ -170,7 +170,7 @@ impl Scene for OscillatorScene {
             return Err((
                 "mass",
                 format!(
-                    "mass = {mass} does not apply to the oscillator: its one dof is the mass (SPEC §1.5: mass variants do not apply)"
+                    "mass = {mass} does not apply to the oscillator: its one dof is the mass (contract §1.5: mass variants do not apply)"
                 ),
             ));
         }
@@ -194,7 +194,7 @@ impl Scene for OscillatorScene {
                 format!("scheme = {scheme} is not implemented for the oscillator yet"),
             ));
         }
-        // SPEC §3.2: kane, contact-stabilized Newmark and Moreau–Jean are multiplier (impulse)
+        // contract §3.2: kane, contact-stabilized Newmark and Moreau–Jean are multiplier (impulse)
         // methods, `mixed` only; the discrete gradient is the penalty potential's.
         if matches!(
             scheme,
@@ -203,13 +203,13 @@ impl Scene for OscillatorScene {
         {
             return Err((
                 "scheme",
-                format!("scheme = {scheme} applies to space = mixed only (SPEC §3.2)"),
+                format!("scheme = {scheme} applies to space = mixed only (contract §3.2)"),
             ));
         }
         if scheme == "discrete-gradient" && space != "penalty" {
             return Err((
                 "scheme",
-                "scheme = discrete-gradient applies to the oscillator with space = penalty only (SPEC §3.2)".into(),
+                "scheme = discrete-gradient applies to the oscillator with space = penalty only (contract §3.2)".into(),
             ));
         }
         if scheme == "hybrid" && space != "penalty" {
@@ -228,7 +228,7 @@ impl Scene for OscillatorScene {
     }
 }
 
-/// Physical parameters of the oscillator (SPEC §1.5 defaults: m = k = 1, f = 0, g = ½,
+/// Physical parameters of the oscillator (contract §1.5 defaults: m = k = 1, f = 0, g = ½,
 /// x0 = 0, v0 = −1, e_x = 1).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OscillatorParams {
@@ -281,7 +281,7 @@ impl OscillatorParams {
     }
 }
 
-/// The oscillator with dry (Coulomb) friction on the mass (SPEC §1.5, Siconos'
+/// The oscillator with dry (Coulomb) friction on the mass (contract §1.5, Siconos'
 /// FrictionOscillator): m ẍ + k x = f − F·sign(ẋ) while it moves, at rest where |k x − f| ≤ F.
 ///
 /// Exact, piece by piece: while the mass moves in the direction s = ±1 the friction is the

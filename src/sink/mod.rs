@@ -1,4 +1,4 @@
-//! Crash-safe Parquet output (SPEC §8).
+//! Crash-safe Parquet output (contract §8).
 //!
 //! Layout of DIR:
 //! - `runs/part-*.parquet` — rows of [`RunRecord`], one file per batch;
@@ -82,7 +82,7 @@ pub enum SinkError {
         expected: String,
     },
     #[error(
-        "{path}: holds {count} row(s) of this sweep's runs computed before a change of definition moved their numbers (the body load of SPEC §1.3 and exact quadrature on curved cells, issue 34; e.g. run {example}, now {now}); resuming would put both numbers in one folder's tables — run into a new --out"
+        "{path}: holds {count} row(s) of this sweep's runs computed before a change of definition moved their numbers (the body load of contract §1.3 and exact quadrature on curved cells, issue 34; e.g. run {example}, now {now}); resuming would put both numbers in one folder's tables — run into a new --out"
     )]
     Superseded {
         path: PathBuf,

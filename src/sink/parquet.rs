@@ -1,6 +1,6 @@
 //! The Parquet encoding of the sink's parts (runs and series), on the arrow-rs crates.
 //!
-//! What a part stores is what the readers of SPEC §8 (polars, pandas/pyarrow, DuckDB) need to
+//! What a part stores is what the readers of contract §8 (polars, pandas/pyarrow, DuckDB) need to
 //! read it fast and what a simulation's numbers compress to; each column gets the encoding
 //! that suits its values, not one writer-wide default:
 //! - Float64: BYTE_STREAM_SPLIT. The eight bytes of a double are stored as eight streams (all

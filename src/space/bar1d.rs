@@ -1,14 +1,14 @@
 //! P1 discretisation of the bar (0, L): nodes x_i = i h, i = 0 … m, node m clamped and
-//! eliminated (m unknowns) or, with a free right end (SPEC §1.4), kept (m + 1 unknowns, a
+//! eliminated (m unknowns) or, with a free right end (contract §1.4), kept (m + 1 unknowns, a
 //! natural boundary condition: nothing else changes); node 0 the contact node. All operators
 //! are tridiagonal.
 //!
-//! Mass variants (SPEC §2.2): element k (nodes k, k+1) carries ρ h/6 [2 1; 1 2] times a weight
+//! Mass variants (contract §2.2): element k (nodes k, k+1) carries ρ h/6 [2 1; 1 2] times a weight
 //! w_k (element-weight family of 000 §3), or is lumped, or has the contact row modified.
 //! `mass_total` = 1ᵀ M 1 over all m+1 nodes (the clamped node included), i.e. the total mass
 //! the matrix represents: ρL for consistent, lumped, mod2, mod3; ρ(L − h) for mod1.
 //!
-//! Contact (SPEC §2.1, §2.3, §2.4), with s = pᵀu + p₀ the argument of the nonlinearity and the
+//! Contact (contract §2.1, §2.3, §2.4), with s = pᵀu + p₀ the argument of the nonlinearity and the
 //! force F_c = φ · q entering the right-hand side:
 //! - mixed: s = u₀ + g, q = −e₀, φ = λ ≤ 0 (complementarity);
 //! - Nitsche: s = P_γ(u) − g = −u₀ − γ₀E(u₁ − u₀) − g, q = ∂P_Θγ/∂v = (−1 + Θγ₀E, −Θγ₀E),
@@ -19,7 +19,7 @@
 
 use super::{ContactMethod, MassVariant, Tridiag};
 
-/// Physical parameters of the bar (SPEC §1.1 defaults: L = E = ρ = 1, a = ½, g = 0, clamped
+/// Physical parameters of the bar (contract §1.1 defaults: L = E = ρ = 1, a = ½, g = 0, clamped
 /// at x = L, at rest).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BarParams {
@@ -28,7 +28,7 @@ pub struct BarParams {
     pub density: f64,
     pub amplitude: f64,
     pub gap: f64,
-    /// The end x = L is traction-free (SPEC §1.4) instead of clamped.
+    /// The end x = L is traction-free (contract §1.4) instead of clamped.
     pub free_end: bool,
     /// Uniform initial velocity v0 (negative towards the obstacle).
     pub velocity: f64,
@@ -278,7 +278,7 @@ impl Bar1dSpace {
     }
 
     /// Mechanical energy E^h = ½vᵀMv + ½uᵀKu, plus the penalty potential κ/2 [s]₊² for the
-    /// penalty method (SPEC §2.4), and the augmented Nitsche energy E_Θ (SPEC §2.3) if any.
+    /// penalty method (contract §2.4), and the augmented Nitsche energy E_Θ (contract §2.3) if any.
     pub fn energies(&self, u: &[f64], v: &[f64]) -> (f64, Option<f64>) {
         let eh = 0.5 * self.mass.quad(v) + self.strain_energy(u);
         let s = self.p.dot(u) + self.p0;

@@ -1,5 +1,5 @@
 //! Jacobi-preconditioned conjugate gradient for the step matrices of the 2D/3D scenes
-//! (`solver = "cg"`, SPEC §4): A = M + cτ²K (and the Nitsche variant M + cτ²(K − Θ·γ-term)),
+//! (`solver = "cg"`, contract §4): A = M + cτ²K (and the Nitsche variant M + cτ²(K − Θ·γ-term)),
 //! solved without a factor — the memory of a run is the matrices and a few vectors, never the
 //! fill of a Cholesky factor (nnz(L) ≈ 12.5·n^{4/3} in 3D: 4 GiB at n = 3·10⁵).
 //!

@@ -1,5 +1,5 @@
 //! Sparse Cholesky factorisation P A Pᵀ = L Lᵀ of the symmetric positive definite step matrices of
-//! the 2D/3D scenes (M + βτ²K, M + τ²/4 K, …; SPEC §4), by faer.
+//! the 2D/3D scenes (M + βτ²K, M + τ²/4 K, …; contract §4), by faer.
 //!
 //! Two stages, because their lifetimes differ:
 //! - [`SymbolicCholesky`]: the fill-reducing ordering (AMD) and the symbolic factor (elimination

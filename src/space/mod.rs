@@ -1,5 +1,5 @@
 //! Space discretisation: how the body is meshed, which mass matrix it carries and how contact
-//! enters the semi-discrete system M ü + K u + f_c(u) = F (SPEC §2).
+//! enters the semi-discrete system M ü + K u + f_c(u) = F (contract §2).
 //!
 //! The contact treatments are data: [`ContactMethod`] names the method and its parameters; the
 //! scene-specific module turns it into the linear operators (K_Θ for Nitsche) and the contact
@@ -17,7 +17,7 @@ pub mod tridiag;
 pub use bar1d::Bar1dSpace;
 pub use tridiag::{Tridiag, TridiagLu};
 
-/// How the Signorini condition is imposed (SPEC §2.1, §2.3, §2.4).
+/// How the Signorini condition is imposed (contract §2.1, §2.3, §2.4).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactMethod {
     /// Nodal Lagrange multiplier: 0 ≤ u₀ + g ⊥ λ ≤ 0.
@@ -38,7 +38,7 @@ impl ContactMethod {
     }
 }
 
-/// The mass matrix variants of SPEC §2.2.
+/// The mass matrix variants of contract §2.2.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MassVariant {
     Consistent,
@@ -108,7 +108,7 @@ impl MassVariant {
     }
 }
 
-/// Initial value of a contact node without inertia (SPEC §2.2, `contact_init`). Only runs whose
+/// Initial value of a contact node without inertia (contract §2.2, `contact_init`). Only runs whose
 /// mass variant has a zero contact row use it; a contact node with mass starts at the
 /// interpolant, its equation having an acceleration to absorb the difference.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

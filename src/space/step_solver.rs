@@ -1,4 +1,4 @@
-//! The per-step linear solve of the 2D/3D engines, direct or iterative (`solver` key, SPEC §4):
+//! The per-step linear solve of the 2D/3D engines, direct or iterative (`solver` key, contract §4):
 //! one type with the calls the time loops make (`work()`, `work_for(k)`, `solve_in_place`,
 //! `solve_many_in_place`), dispatching to the sparse Cholesky factor ([`super::linalg`]) or to
 //! Jacobi-preconditioned conjugate gradient on the step matrix itself ([`super::cg`]).

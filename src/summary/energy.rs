@@ -24,18 +24,18 @@
 //! 1100 %, far above δ at every h. For the schemes with a proven non-increasing functional —
 //! the hybrid with Nitsche Θ = 1 and E_Θ (003 Cor 3.8), the 000 §5 hybrid (mixed, massless
 //! contact node) and E^h (Lemma 5.1), backward Euler with Nitsche Θ = 1 and E_Θ (003 Cor 3.2),
-//! and the methods of SPEC §3.2 with a proof (kane with inertia on the contact node,
+//! and the methods of contract §3.2 with a proof (kane with inertia on the contact node,
 //! contact-stabilized Newmark, Moreau–Jean with θ = ½ and e = 1, the discrete gradient)
 //! — a single step that raises F by more than [`ENERGY_TOL`]·F⁰ is growth as well: the proof
-//! forbids it, and rounding stays below 1e-12 (SPEC §6).
+//! forbids it, and rounding stays below 1e-12 (contract §6).
 //!
 //! # Frictional runs
 //! With `friction` ≠ `none` the energy alone says nothing about the scheme: E falls by the
-//! frictional work W_f ≥ 0 whatever the method (0.16 E⁰ on the layer's slip regime, SPEC §6),
+//! frictional work W_f ≥ 0 whatever the method (0.16 E⁰ on the layer's slip regime, contract §6),
 //! so every frictional run would read `dissipative`. Such runs are judged by the balance
-//! F + W_f instead (SPEC §5's `energy_balance_drift`, `energy_balance_max_increase`; F is the
+//! F + W_f instead (contract §5's `energy_balance_drift`, `energy_balance_max_increase`; F is the
 //! `energy` column, which holds the penalty potential for penalty): growing if it rises by
-//! more than δ (or, for the methods SPEC §2.5 proves never raise E + W_f — `kane` with inertia
+//! more than δ (or, for the methods contract §2.5 proves never raise E + W_f — `kane` with inertia
 //! on the contact node, `moreau-jean` with θ = ½ and e = 1 — one step by more than
 //! [`ENERGY_TOL`]), dissipative if it falls by more than δ (energy lost besides the friction's
 //! work: the scheme's own dissipation), and otherwise [`FRICTION_ACCOUNTED`] when E itself
@@ -52,7 +52,7 @@ use super::runs::{Run, Runs};
 use super::table::{self, Table, TextTable, text_columns};
 
 /// A one-step increase of a provably non-increasing functional above this fraction of its
-/// initial value is growth. SPEC §6: the schemes that provably do not gain energy stay below
+/// initial value is growth. contract §6: the schemes that provably do not gain energy stay below
 /// 1e-12·E⁰ (worst seen 5e-13), so 1e-10 leaves two decades for rounding.
 pub const ENERGY_TOL: f64 = 1e-10;
 
@@ -72,7 +72,7 @@ pub const CLASSES: [&str; 5] = [
 /// The run has a friction law (`friction` ≠ `none`) and its row the energy balance.
 pub(crate) fn frictional(runs: &Runs, r: &Run) -> bool {
     let law = runs.param_str(r, "friction").is_some_and(|f| f != "none");
-    // The oscillator's dry friction is its `friction_force` (SPEC §1.5), not a `friction` law.
+    // The oscillator's dry friction is its `friction_force` (contract §1.5), not a `friction` law.
     let dry = runs.param_f64(r, "friction_force").is_some_and(|f| f > 0.0);
     (law || dry) && r.energy_balance_drift.is_some()
 }
@@ -104,7 +104,7 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
     let theta_scheme = runs.param_f64(r, "theta_scheme");
     let friction = frictional(runs, r);
     let (functional, drift, max_increase) = match space {
-        // The `energy` column already holds the penalty potential (SPEC §5).
+        // The `energy` column already holds the penalty potential (contract §5).
         "penalty" if friction => (
             "E^h + penalty + W_f",
             r.energy_balance_drift,
@@ -122,7 +122,7 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
         _ => ("E^h", r.energy_drift, r.energy_max_increase),
     };
     let nitsche_theta_one = space == "nitsche" && theta == Some(1.0) && functional == "E_Θ";
-    // SPEC §3.2: kane (contact node with inertia), contact-stabilized Newmark, Moreau–Jean with
+    // contract §3.2: kane (contact node with inertia), contact-stabilized Newmark, Moreau–Jean with
     // θ = ½ and e = 1 (the impulses do no work; e < 1 may gain on a separating active row, see
     // tests/properties.rs) never increase E^h; the discrete gradient conserves its functional.
     let with_inertia = matches!(runs.param_str(r, "mass"), Some("consistent" | "lumped"));
@@ -132,7 +132,7 @@ pub(crate) fn classify(runs: &Runs, r: &Run) -> EnergyClass {
             && theta_scheme == Some(0.5)
             && runs.param_f64(r, "restitution") == Some(1.0))
         || (scheme == "discrete-gradient" && (space == "penalty" || nitsche_theta_one));
-    // With friction only what SPEC §2.5 states of E + W_f: kane with inertia and Moreau–Jean
+    // With friction only what contract §2.5 states of E + W_f: kane with inertia and Moreau–Jean
     // (θ = ½; e = 1 as without friction, e < 1 may gain on a separating row) never raise it.
     // The other proofs are of the frictionless functional and say nothing of the balance.
     let monotone = if friction {
@@ -385,7 +385,7 @@ struct RunPhases {
 /// exists. Both paths read the same per-step values (the observer's E^n, E_Θ^n, t^n, copied
 /// unchanged into the row's lists or the series), so a complete series gives the same table.
 fn phases_of(r: &Run, series: &Result<HashMap<String, Series>, String>) -> Option<RunPhases> {
-    // E⁰: the run's initial energy (SPEC §5); E(t⁰) from the data when the row lacks it or
+    // E⁰: the run's initial energy (contract §5); E(t⁰) from the data when the row lacks it or
     // it is 0 (a disc's E⁰ = 0: the losses are then not finite, as before).
     let e0_row = r.energy_initial.filter(|e| e.is_finite() && *e != 0.0);
     if let Some(online) = &r.impacts {
@@ -831,7 +831,7 @@ fn markdown(
         let _ = writeln!(
             md,
             "Frictional runs (friction ≠ none) are judged by the balance F + W_f (W_f the \
-             frictional work, SPEC §5's energy_balance_drift and energy_balance_max_increase; \
+             frictional work, contract §5's energy_balance_drift and energy_balance_max_increase; \
              functional \"… + W_f\"), since E alone falls by W_f whatever the scheme: growing if \
              it rises by more than δ (or one step by more than {ENERGY_TOL:e}·E⁰ for kane with \
              inertia and Moreau–Jean θ = ½, e = 1), dissipative if it falls by more than δ, \

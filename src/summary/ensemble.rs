@@ -5,10 +5,10 @@
 //!
 //! # Why a spread means something
 //! A well-posed discrete problem is Lipschitz in its data: perturbing u⁰ by ε moves every
-//! output by at most L·ε, and for the schemes SPEC §6 calls stable the measured moves under
+//! output by at most L·ε, and for the schemes contract §6 calls stable the measured moves under
 //! ε = 1e-14 stay below 1e-9 relative (L ≲ 1e5 over a whole run). An ill-posed one — mixed or
 //! Nitsche (γ0 → 0) with the consistent mass and Crank–Nicolson at ν = 1.5 — chooses between
-//! contact branches that round-off decides, and E(T)/E⁰ lands anywhere in ≈ 1.07–3.9 (SPEC §6).
+//! contact branches that round-off decides, and E(T)/E⁰ lands anywhere in ≈ 1.07–3.9 (contract §6).
 //!
 //! # The flag
 //! For a column x over the ok members, the relative spread is

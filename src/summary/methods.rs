@@ -7,7 +7,7 @@
 //!   group's ok runs (growing beats dissipative beats conserving: one growing run is enough to
 //!   show the method can gain energy);
 //! - pressure: `smooth` if the largest `pressure_oscillation` of the group's runs is at most
-//!   [`SMOOTH_PRESSURE`] (a pressure rising once and falling once reads 1; the methods of SPEC
+//!   [`SMOOTH_PRESSURE`] (a pressure rising once and falling once reads 1; the methods of contract
 //!   §3.2 without step-to-step alternation read about 3 at ν = 1.5, kane's alternation 11.3),
 //!   `oscillating` above, `no contact` without a contact phase;
 //! - penetration: `none` if the largest `max_penetration` is at most [`NO_PENETRATION`] of the

@@ -1,5 +1,5 @@
 //! Summaries of a results folder: `contact-sweep summarize DIR` turns `DIR/runs` into the
-//! tables of a paper under `DIR/summary/` (SPEC §8, issue 4). The impacts come from the runs'
+//! tables of a paper under `DIR/summary/` (contract §8, issue 4). The impacts come from the runs'
 //! own contact-phase lists; `DIR/series` is read only for rows of older versions without them.
 //!
 //! # Groups and refinement paths

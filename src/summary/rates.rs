@@ -5,14 +5,14 @@
 //! levels.
 
 /// Pair rates spread over more than this: the errors are not yet in the asymptotic regime.
-/// A clean power law gives spread 0; the converging ladders of SPEC §6 (h = 1/4 … 1/256, ratio
+/// A clean power law gives spread 0; the converging ladders of contract §6 (h = 1/4 … 1/256, ratio
 /// 4, l2(τ;H1)) wobble by 0.11 (Nitsche-Hybrid: 0.21, 0.28, 0.32), 0.04 (mod3 + CN) and 0.16
 /// (zero-contact + CN), while the non-converging mixed + CN ladder (2.373, 1.470, 3.166,
 /// 4.610) spreads by 0.9.
 pub const PRE_ASYMPTOTIC_SPREAD: f64 = 0.3;
 /// LSQ slope over the finest (up to) three usable levels below this: stagnating (includes
 /// negative slopes, i.e. errors growing under refinement). The slowest genuine convergence the
-/// papers report is ≈ 0.3 (SPEC §6), three times this.
+/// papers report is ≈ 0.3 (contract §6), three times this.
 pub const STAGNATION_SLOPE: f64 = 0.1;
 /// Finest usable error at most this times the coarsest usable error: round-off floor. No
 /// discretisation ladder reduces an error by twelve orders of magnitude (order 2 from h = 1/4

@@ -14,7 +14,7 @@ use polars::prelude::*;
 
 use super::columns::{Kind, columns};
 
-/// Parameter columns (SPEC §7, §8) that identify a method group, in output order. The
+/// Parameter columns (contract §7, §8) that identify a method group, in output order. The
 /// refinement axes ([`REFINEMENT`]) and the derived `label` are not among them: `label` is a
 /// function of these parameters and is carried, not grouped by. `sweep` is not a parameter:
 /// the same method run by two sweeps into one folder (`--resume`) is one group.
@@ -63,7 +63,7 @@ pub(crate) const REFINEMENT: &[(&str, Kind)] = &columns![
     h: F64, elements: I64, dt: F64, courant: F64,
 ];
 
-/// The error columns of SPEC §5, in output order.
+/// The error columns of contract §5, in output order.
 pub(crate) const ERRORS: &[&str] = crate::model::ERROR_COLUMNS;
 
 /// Measured columns read besides parameters and errors.
@@ -162,7 +162,7 @@ pub(crate) struct Run {
     pub pressure_oscillation: Option<f64>,
     /// Runs columns `friction_work` (W_f(T)), `energy_balance_drift` ((E + W_f)(T) − E⁰) and
     /// `energy_balance_max_increase` (largest one-step rise of E + W_f), all over
-    /// `energy_scale`; None for frictionless runs and older folders (SPEC §5).
+    /// `energy_scale`; None for frictionless runs and older folders (contract §5).
     pub friction_work: Option<f64>,
     pub energy_balance_drift: Option<f64>,
     pub energy_balance_max_increase: Option<f64>,
@@ -904,7 +904,7 @@ impl RunColumns {
             })
     }
 
-    /// Row `i`'s h: h is always filled by this version (SPEC §8); an older row with only
+    /// Row `i`'s h: h is always filled by this version (contract §8); an older row with only
     /// `elements` gets h = length / elements.
     fn h_of(&self, i: usize, params_i: &[Cell]) -> Option<f64> {
         finite(self.h[i]).filter(|x| *x > 0.0).or_else(|| {

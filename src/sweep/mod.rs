@@ -1,4 +1,4 @@
-//! Sweep files (SPEC §7): parse, validate and expand into runs.
+//! Sweep files (contract §7): parse, validate and expand into runs.
 //!
 //! A sweep file names a scene and a parameter space: `[fixed]` values, a cartesian `[grid]`
 //! (items may be bundles — inline tables setting several parameters at once), equal-length
@@ -10,7 +10,7 @@
 //! order, meaningless combinations dropped, parameters that do not apply to a run's method
 //! removed and the resulting duplicates merged, each run keyed by a stable [`plan::RunSpec::run_id`].
 
-/// SPEC §7's keys live one layer down ([`crate::model::keys`]): a run's row names them too.
+/// contract §7's keys live one layer down ([`crate::model::keys`]): a run's row names them too.
 pub use crate::model::keys;
 pub mod overrides;
 pub mod plan;
@@ -174,7 +174,7 @@ pub struct Search {
     pub log: bool,
 }
 
-/// Columns an `error-below` criterion may name besides the error norms of SPEC §5
+/// Columns an `error-below` criterion may name besides the error norms of contract §5
 /// ([`crate::model::ERROR_COLUMNS`]): the contact force's error and the energy drift.
 pub const SEARCH_EXTRA_COLUMNS: [&str; 2] = ["err_force_l2", "energy_drift"];
 
@@ -204,11 +204,11 @@ pub struct SweepFile {
     pub series_every: usize,
     /// `[fixed]` values that an axis overrides (reported by the plan).
     pub overridden: Vec<String>,
-    /// `reference = {…}`: the parameters that turn each run into its reference run (SPEC §7;
+    /// `reference = {…}`: the parameters that turn each run into its reference run (contract §7;
     /// scenes without a closed form).
     pub reference: Option<Vec<Entry>>,
     /// `reference = { scene = "bar2d", … }`: the reference is a run of another scene (a mesh
-    /// file's body measured against the built-in scene it meshes, SPEC §1.6); None: the
+    /// file's body measured against the built-in scene it meshes, contract §1.6); None: the
     /// sweep's own scene.
     pub reference_scene: Option<SceneKind>,
     /// `[search]`: a boundary to find by bisection for every method of the grid.
@@ -480,7 +480,7 @@ impl Checker {
 }
 
 /// The scene named by `reference = { scene = NAME, … }` in a sweep of scene `own`: the same
-/// scene, or — for a body from a mesh file (SPEC §1.6) — a finite-element scene of the same
+/// scene, or — for a body from a mesh file (contract §1.6) — a finite-element scene of the same
 /// dimension whose errors come from a reference run (the built-in bar or disc/ball the file
 /// meshes): the run's nodes are located in the reference's mesh. Other pairs have no common
 /// body to compare.
@@ -489,7 +489,7 @@ fn reference_scene_of(own: SceneKind, name: &str) -> Result<SceneKind, String> {
         Some((_, Some(kind))) => *kind,
         Some((_, None)) => {
             return Err(format!(
-                "scene `{name}` is specified (SPEC §1) but not implemented in this version"
+                "scene `{name}` is specified (contract §1) but not implemented in this version"
             ));
         }
         None => {
@@ -745,7 +745,7 @@ impl Checker {
                     "scene",
                     line,
                     format!(
-                        "scene `{s}` is specified (SPEC §1) but not implemented in this version"
+                        "scene `{s}` is specified (contract §1) but not implemented in this version"
                     ),
                 ),
                 None => self.issue(
@@ -987,7 +987,7 @@ impl Checker {
                 "reference",
                 *line,
                 format!(
-                    "scene {} has a closed-form solution (SPEC §1.1): errors are measured against it, a reference run is not used",
+                    "scene {} has a closed-form solution (contract §1.1): errors are measured against it, a reference run is not used",
                     self.scene.map(|s| s.name()).unwrap_or_default()
                 ),
             ),
@@ -1094,7 +1094,7 @@ impl Checker {
         }
     }
 
-    /// [fixed] is the baseline that an axis may override (SPEC §7's own example sets h and dt
+    /// [fixed] is the baseline that an axis may override (contract §7's own example sets h and dt
     /// in both [fixed] and [zip]); two axes setting one parameter would be ambiguous. Returns
     /// the notes of the [fixed] values overridden.
     fn overridden(&mut self, fixed: &[Entry], grid: &[Axis], zip: Option<&Axis>) -> Vec<String> {

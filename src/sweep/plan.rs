@@ -4,7 +4,7 @@
 //! fastest. Each combination is resolved: scheme aliases become a family plus parameters
 //! (`crank-nicolson` = newmark with β = ¼, γ = ½), `courant` becomes dt = ν h / c0, `elements`
 //! becomes h = L/m, defaults are filled in, and a parameter that does not apply to the run's
-//! method (SPEC §3) is dropped. Combinations that are meaningless (Paoli–Schatzman with
+//! method (contract §3) is dropped. Combinations that are meaningless (Paoli–Schatzman with
 //! Nitsche, …) are left out with their reason. Runs whose canonical parameters coincide merge.
 //!
 //! `run_id` is the first 16 hex digits of SHA-256 over the canonical parameter text: scene plus
@@ -159,7 +159,7 @@ fn same(a: &Value, b: &Value) -> bool {
     a.canonical() == b.canonical()
 }
 
-/// The folder mesh files are relative to (SPEC §1.6): the sweep file's.
+/// The folder mesh files are relative to (contract §1.6): the sweep file's.
 fn sweep_dir(sweep: &SweepFile) -> &Path {
     sweep.path.parent().unwrap_or(Path::new(""))
 }
@@ -172,7 +172,7 @@ type MeshFile = (
     std::sync::Arc<crate::space::fe::GmshMesh>,
 );
 
-/// `obstacle` (SPEC §1.6) as the gap it names: the plane x_d = obstacle lies
+/// `obstacle` (contract §1.6) as the gap it names: the plane x_d = obstacle lies
 /// g = (lowest contact node's x_d) − obstacle below the body ([`GmshMesh::contact_floor`], the
 /// engine's plane is that height minus the gap), so the run is the one `gap = g` gives, with
 /// the same id. Exclusive with `gap` (one plane given twice could disagree); a plane above the
@@ -270,7 +270,7 @@ impl Given {
     }
 }
 
-/// What a combination's method keys resolve to (SPEC §2–§3): contact treatment, mass variant,
+/// What a combination's method keys resolve to (contract §2–§3): contact treatment, mass variant,
 /// time scheme and friction law, with the words they were named by.
 struct Method {
     space_name: String,
@@ -375,7 +375,7 @@ fn resolve_given(
     let config = config.with_solver(solver);
     check_memory(given, limits, &config, fe, solver)?;
 
-    // CFL of explicit schemes (SPEC §3): τ ω_max ≤ the scheme's bound, checked on the
+    // CFL of explicit schemes (contract §3): τ ω_max ≤ the scheme's bound, checked on the
     // assembled operators (contact-free and contact-active stiffness).
     match config.explicit_dt_limit() {
         Ok(Some(dt_max)) if dt > dt_max * (1.0 + 1e-12) && !allow_unstable => {
@@ -535,7 +535,7 @@ fn scheme_of(
                 Scheme::GeneralizedAlpha(GeneralizedAlphaParams::hht(0.0))
             }
         },
-        // Moreau–Jean's own defaults (SPEC §3.2): θ = ½, e = 0 — not Paoli–Schatzman's e = 1.
+        // Moreau–Jean's own defaults (contract §3.2): θ = ½, e = 0 — not Paoli–Schatzman's e = 1.
         (None, "moreau-jean") => Scheme::MoreauJean(MoreauJeanParams {
             theta: given
                 .user
@@ -609,7 +609,7 @@ fn mass_of(given: &Given, issues: &mut Vec<Issue>) -> (String, MassVariant) {
     (mass_name, mass)
 }
 
-/// Friction (SPEC §2.5): the law and its parameter; `none` is today's engine (no key of
+/// Friction (contract §2.5): the law and its parameter; `none` is today's engine (no key of
 /// it enters the id). A bound given while friction is fixed at `none` (by default or in
 /// [fixed]) is a mistake, refused; across a `friction` axis it applies to its law only and
 /// the frictionless runs collapse, as every other key.
@@ -664,7 +664,7 @@ fn friction_of(
         if let Err(why) = given.scene.supports_friction() {
             issues.push(Issue::at(&given.origin(Key::Friction), why));
         }
-        // Where the literature defines no frictional version (SPEC §2.5).
+        // Where the literature defines no frictional version (contract §2.5).
         let undefined = match scheme {
             Scheme::PaoliSchatzman(_) => Some("paoli-schatzman"),
             Scheme::Hybrid => Some("the hybrid schemes"),
@@ -673,7 +673,7 @@ fn friction_of(
         };
         if let Some(what) = undefined {
             let why = format!(
-                "{what} has no frictional version in the literature (SPEC §2.5): friction = {} runs with the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean and central-difference",
+                "{what} has no frictional version in the literature (contract §2.5): friction = {} runs with the newmark and theta families, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean and central-difference",
                 friction_kind.name()
             );
             if friction_fixed {
@@ -686,7 +686,7 @@ fn friction_of(
     Ok((friction_kind, friction))
 }
 
-/// Applicability (SPEC §3): whether a run of method `m` uses key `k`; `Err` says why not (the
+/// Applicability (contract §3): whether a run of method `m` uses key `k`; `Err` says why not (the
 /// key is then dropped from the run, and runs that differ only by it merge).
 fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
     let scheme = m.scheme;
@@ -744,7 +744,7 @@ fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
     })
 }
 
-/// Meaningless combinations (SPEC §3): why method `m` is no method at all, if it is not.
+/// Meaningless combinations (contract §3): why method `m` is no method at all, if it is not.
 fn meaningless(m: &Method) -> Option<String> {
     let (scheme, method) = (m.scheme, m.contact);
     let massless = m.mass.massless_contact();
@@ -756,7 +756,7 @@ fn meaningless(m: &Method) -> Option<String> {
             "hybrid with space = mixed needs a massless contact node (mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)".into(),
         );
     }
-    // SPEC §3.2: where each method of the comparison literature applies.
+    // contract §3.2: where each method of the comparison literature applies.
     let family = scheme.family();
     if matches!(
         scheme,
@@ -785,7 +785,7 @@ fn meaningless(m: &Method) -> Option<String> {
             _ => {}
         }
     }
-    // Central difference with `mixed` and a diagonal mass: kinematic contact (SPEC §3.2).
+    // Central difference with `mixed` and a diagonal mass: kinematic contact (contract §3.2).
     let kinematic = scheme == Scheme::Newmark(NewmarkParams::central_difference())
         && m.mass == MassVariant::Lumped;
     if scheme.is_explicit() && method == ContactMethod::Mixed && !massless && !kinematic {
@@ -873,7 +873,7 @@ fn read_mesh_file(
             let read = crate::space::fe::GmshMesh::read_shared(&path)
                 .map_err(|e| Issue::at(o, e.to_string()))
                 .and_then(|m| {
-                    // `obstacle` is the gap under another name (SPEC §1.6).
+                    // `obstacle` is the gap under another name (contract §1.6).
                     if let Some(gap) = gap_from_obstacle(&m, &given.user)? {
                         physics.set("gap", gap);
                     }
@@ -982,7 +982,7 @@ fn steps_of(t_final: f64, dt: f64, dt_origin: &Origin) -> Result<usize, Outcome>
     Ok(steps)
 }
 
-/// The step solver (SPEC §4) is the finite-element engine's choice (`fe`); the 1D engines
+/// The step solver (contract §4) is the finite-element engine's choice (`fe`); the 1D engines
 /// solve tridiagonal systems, and drop the keys.
 fn solver_of(given: &Given, fe: bool, dropped: &mut Vec<String>) -> Solver {
     let solver = match given.get(Key::Solver).as_ref().and_then(Value::as_str) {
@@ -1158,7 +1158,7 @@ impl Columns {
         }
     }
 
-    /// The scene's physics values. `load` says how gravity enters (SPEC §1.3): without
+    /// The scene's physics values. `load` says how gravity enters (contract §1.3): without
     /// gravity it changes nothing, so it is no parameter of the run (null column, never in
     /// the id) and both values are one run.
     fn put_physics(&mut self, given: &Given, physics: &Physics, dropped: &mut Vec<String>) {
@@ -1210,7 +1210,7 @@ impl Columns {
 
     /// The mesh file: its content is its identity (a moved or renamed file keeps its runs'
     /// ids), the column shows the path as written. Derived, not part of the identity: a mesh
-    /// run's plane x_d = `obstacle` whether the sweep gave it or `gap` (SPEC §1.6), so
+    /// run's plane x_d = `obstacle` whether the sweep gave it or `gap` (contract §1.6), so
     /// filters and the plan table see both.
     fn put_mesh_file(&mut self, mesh_file: Option<&MeshFile>, physics: &Physics) {
         if let Some((written, _, m)) = mesh_file {
@@ -1288,7 +1288,7 @@ fn gcd(a: usize, b: usize) -> usize {
 /// courant, gap or obstacle). Returns the reference's spec and the run's (space, time) refinement ratios; the
 /// reference must be nested in time (dt_run/dt_ref whole) and last as long; in space nested
 /// (h_run/h_ref whole) where the scene's meshes are, otherwise at least as fine, stored whole
-/// and interpolated at the run's nodes (SPEC §1.6).
+/// and interpolated at the run's nodes (contract §1.6).
 ///
 /// `reference = { scene = …, … }` (a mesh file's body against the built-in scene it meshes):
 /// the reference is resolved as a run of that scene, with the run's keys that scene accepts

@@ -1,4 +1,4 @@
-//! Time schemes as data (SPEC §3): one engine ([`crate::run`]) runs them all.
+//! Time schemes as data (contract §3): one engine ([`crate::run`]) runs them all.
 //!
 //! Unknowns u^n, v^n, a^n; x^{n+θ} = (1−θ)x^n + θx^{n+1}. Every implicit scheme here has a
 //! constant iteration matrix A = M + c K_lin (c = βτ², θ²τ², τ²/4) factored once per run:
@@ -14,7 +14,7 @@
 //! kinematically (Taylor–Flanagan 1989): a dof that would penetrate is put on the obstacle by
 //! an impulse on its half-step velocity ([`kinematic_impulse`]).
 //!
-//! The methods of the comparison literature (SPEC §3.2), with S = M + τ²/4 K:
+//! The methods of the comparison literature (contract §3.2), with S = M + τ²/4 K:
 //! - `kane` (Kane–Repetto–Ortiz–Marsden 1999): the trapezoidal rule with the contact force
 //!   fully implicit, S Δu = τMvⁿ − τ²/2 Kuⁿ + τ²/2 Bᵀλ^{n+1}, v^{n+1} = 2Δu/τ − vⁿ: the
 //!   contact force λ^{n+1} does the work λ·B Δu ≤ 0 over the step, so E^h never increases;
@@ -101,7 +101,7 @@ pub enum AlphaPreset {
     Hht(f64),
 }
 
-/// Generalized-α parameters (SPEC §3.2): M a^{n+1−α_m} + K u^{n+1−α_f} = F^{n+1−α_f} +
+/// Generalized-α parameters (contract §3.2): M a^{n+1−α_m} + K u^{n+1−α_f} = F^{n+1−α_f} +
 /// (1−α_f) f_c^{n+1} + α_f f_c^n, x^{n+1−α} = (1−α)x^{n+1} + αx^n, Newmark's (β, γ) updates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeneralizedAlphaParams {
@@ -159,7 +159,7 @@ impl GeneralizedAlphaParams {
     }
 }
 
-/// Moreau–Jean parameters (SPEC §3.2): θ (`theta_scheme`, ½ … 1) and Newton's restitution e.
+/// Moreau–Jean parameters (contract §3.2): θ (`theta_scheme`, ½ … 1) and Newton's restitution e.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MoreauJeanParams {
     pub theta: f64,
@@ -183,13 +183,13 @@ pub enum Scheme {
     Theta(ThetaParams),
     PaoliSchatzman(PaoliSchatzmanParams),
     Hybrid,
-    /// Trapezoidal rule with the contact force fully implicit (SPEC §3.2 `kane`).
+    /// Trapezoidal rule with the contact force fully implicit (contract §3.2 `kane`).
     Kane,
-    /// `kane` from the M-projected free flight (SPEC §3.2 `contact-stabilized-newmark`).
+    /// `kane` from the M-projected free flight (contract §3.2 `contact-stabilized-newmark`).
     ContactStabilizedNewmark,
     GeneralizedAlpha(GeneralizedAlphaParams),
     MoreauJean(MoreauJeanParams),
-    /// Midpoint rule with the contact potential's difference quotient (SPEC §3.2).
+    /// Midpoint rule with the contact potential's difference quotient (contract §3.2).
     DiscreteGradient,
 }
 
@@ -254,7 +254,7 @@ impl Scheme {
         }
     }
 
-    /// Whether the scheme is one of the methods of SPEC §3.2 (the comparison literature).
+    /// Whether the scheme is one of the methods of contract §3.2 (the comparison literature).
     pub fn is_comparison(&self) -> bool {
         matches!(
             self,
@@ -266,7 +266,7 @@ impl Scheme {
         )
     }
 
-    /// Whether the scheme needs inertia on every contact dof (SPEC §3.2: the predictor of
+    /// Whether the scheme needs inertia on every contact dof (contract §3.2: the predictor of
     /// contact-stabilized Newmark is an M-projection, generalized-α and Moreau–Jean step the
     /// contact dof's acceleration or velocity).
     pub fn needs_contact_mass(&self) -> bool {

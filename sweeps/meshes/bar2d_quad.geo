@@ -1,4 +1,4 @@
-// The 2D bar of paper 002 / SPEC §1.2 (bar2d): [0, 0.1] x [0, 1] as N x M structured
+// The 2D bar of paper 002 / contract §1.2 (bar2d): [0, 0.1] x [0, 1] as N x M structured
 // quadrilaterals, the same nodes and Q1 elements as bar2d's box at h = 0.1/N = 1/M (N = 2,
 // M = 20: h = 0.05), in Gmsh's numbering. Built by extrusion with layers (structured, as a
 // transfinite surface) because extrusion places node k of a layered segment at k/M of it,

@@ -1,7 +1,7 @@
-// The 2D bar of paper 002 / SPEC §1.2 (bar2d) meshed with triangles: [0, 0.1] x [0, 1] as
+// The 2D bar of paper 002 / contract §1.2 (bar2d) meshed with triangles: [0, 0.1] x [0, 1] as
 // N x M squares of side 0.1/N = 1/M, each cut into two triangles (transfinite, Gmsh's "Left"
 // diagonal), so the nodes at degree 1 are those of bar2d's box at h = 0.1/N but the elements
-// are not: the runs on it are measured against a bar2d reference by interpolation (SPEC §1.6).
+// are not: the runs on it are measured against a bar2d reference by interpolation (contract §1.6).
 // h (the longest edge) = sqrt(2)·0.1/N. contact = bottom y = 0, clamped = top y = 1, body.
 // generate.sh overrides N and M (N = 2, 4, 8 with M = 10 N: bar2d_tri_n*.msh).
 N = 2;

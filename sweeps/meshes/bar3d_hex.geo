@@ -1,4 +1,4 @@
-// The 3D bar of paper 002 / SPEC §1.2 (bar3d): [0, 0.1]^2 x [0, 1] as N x N x M structured
+// The 3D bar of paper 002 / contract §1.2 (bar3d): [0, 0.1]^2 x [0, 1] as N x N x M structured
 // hexahedra, the same nodes and Q1 elements as bar3d's box at h = 0.1/N = 1/M (N = 2, M = 20:
 // h = 0.05), in Gmsh's numbering. Built by extrusion with layers, as bar2d_quad.geo and for
 // its reason (node k of a layered extrusion is at k/M of it: the box's lattice to ~1e-17).

@@ -1,4 +1,4 @@
-// The sliding block of SPEC §1.8 in 2D: the rectangle [0,1] x [0,0.5] as N x M transfinite
+// The sliding block of contract §1.8 in 2D: the rectangle [0,1] x [0,0.5] as N x M transfinite
 // quadrilaterals (recombined): N M quads, (N+1)(M+1) nodes at degree 1; h = sqrt(1/N^2 + 0.25/M^2).
 // Physical groups: contact = bottom y = 0 (N lines), body. Nothing is clamped: the block rests
 // on the plane and slides on it (sweeps/sliding_block.toml, tests/sliding_block.rs).

@@ -1,4 +1,4 @@
-// The sliding block of SPEC §1.8 in 3D: the box [0,1] x [0,0.5] x [0,0.5] as N x M x M
+// The sliding block of contract §1.8 in 3D: the box [0,1] x [0,0.5] x [0,0.5] as N x M x M
 // transfinite hexahedra (the bottom face recombined, extruded in M layers): N M^2 hexahedra,
 // (N+1)(M+1)^2 nodes at degree 1; h = sqrt(1/N^2 + 0.5/M^2).
 // Physical groups: contact = bottom z = 0 (N M quadrilaterals), body. Nothing is clamped: the

@@ -14,7 +14,7 @@ g cube_tet.geo -3 -order 1 -bin -o cube_tet.msh
 g cube_tet.geo -3 -order 2 -o cube_tet_p2.msh
 g bar2d_quad.geo -2 -order 1 -o bar2d_quad.msh
 # The 3D bar of bar3d at h = 0.05 in hexahedra (tests/mesh_scenes.rs: Nitsche, the penalty and
-# SPEC §3.2's methods reproduce bar3d's rows).
+# contract §3.2's methods reproduce bar3d's rows).
 g bar3d_hex.geo -3 -order 1 -o bar3d_hex.msh
 # The same bar at h/2 (N = 4, M = 40): a finer mesh file as the reference of bar2d_quad.msh
 # (tests/mesh_scenes.rs: the interpolating path equals bar2d's node-for-node one).
@@ -66,7 +66,7 @@ for n in 2 3 4 6; do
     conv cube_hex.geo $n 3 1 cube_hex_q1_n$n.msh -bin
     conv cube_hex.geo $n 3 2 cube_hex_q2_n$n.msh -bin
 done
-# The sliding blocks of SPEC §1.8 (nothing clamped, Γ_C the bottom face; sweeps/sliding_block.toml,
+# The sliding blocks of contract §1.8 (nothing clamped, Γ_C the bottom face; sweeps/sliding_block.toml,
 # tests/sliding_block.rs).
 g block2d.geo -2 -order 1 -o block2d.msh
 g block3d.geo -3 -order 1 -o block3d.msh

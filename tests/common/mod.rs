@@ -47,7 +47,7 @@ pub fn bar1d(
     simulate_with(cfg, series_every)
 }
 
-/// As [`bar1d`], with the massless contact node started by `init` (SPEC §2.2 `contact_init`).
+/// As [`bar1d`], with the massless contact node started by `init` (contract §2.2 `contact_init`).
 #[allow(clippy::too_many_arguments)]
 pub fn bar1d_start(
     init: ContactInit,
@@ -90,7 +90,7 @@ pub fn energy_ratio(o: &Outcome) -> f64 {
     o.metrics.energy_final.unwrap() / o.metrics.energy_initial.unwrap()
 }
 
-/// Assert that `x` rounds to the figure printed in SPEC §6. The figures come from two
+/// Assert that `x` rounds to the figure printed in contract §6. The figures come from two
 /// independent implementations that agree to 1e-11, so the only uncertainty is the rounding of
 /// the printed digits: half a unit in the last printed place.
 pub fn assert_printed(what: &str, x: f64, printed: &str) {
@@ -104,7 +104,7 @@ pub fn assert_printed_within(what: &str, x: f64, printed: &str, units: f64) {
     let half_ulp = units * 10f64.powi(-(digits_after_point as i32));
     assert!(
         (x - target).abs() <= half_ulp * (1.0 + 1e-9),
-        "{what}: computed {x:.6e}, SPEC §6 prints {printed} (tolerance ±{half_ulp:e})"
+        "{what}: computed {x:.6e}, contract §6 prints {printed} (tolerance ±{half_ulp:e})"
     );
 }
 
@@ -186,7 +186,7 @@ pub fn run_sweep_text_at(path: &Path, text: &str) -> Vec<contact_sweep::run::Run
 
 /// The energy a contact potential's schemes keep, per step: E_Θ for Nitsche (the run's label
 /// names its space) and E^h for the others (with the penalty, E^h holds the penalty potential
-/// Φ: SPEC §3.2's E^h + Φ).
+/// Φ: contract §3.2's E^h + Φ).
 pub fn kept_energy(label: &str, o: &Outcome) -> Vec<f64> {
     if label.contains("nitsche") {
         o.series

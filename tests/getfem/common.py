@@ -5,7 +5,7 @@ Newmark update, and the Nitsche terms in GetFEM's weak form language (GWFL).
 The bulk: the isoparametric P2 mesh of the file (curved boundary triangles, GT_PK(2,2)), the P2
 vector FEM, a degree-13 triangle rule (exact for the curved cells' mass, whose integrand has
 degree 6); K isotropic linearized elasticity (plane strain, λ = μ = 20); M = ρ ∫ w φ_a·φ_b
-(w = 1 unless the caller gives element weights); F = ∫ρ f·φ, f = −0.1 e_y (SPEC §1.3).
+(w = 1 unless the caller gives element weights); F = ∫ρ f·φ, f = −0.1 e_y (contract §1.3).
 Γ_C: the boundary faces whose nodes all lie at y ≤ y_centre (the lower half circle, the
 engine's `contact` group), integrated by IM_TRIANGLE(5)'s face rule — 3 Gauss points per face,
 the engine's Γ_C rule. The rigid plane y = y_min − gap, its normal N = −e_y; Nitsche's
@@ -137,7 +137,7 @@ def normal_force(u, plane):
 
 
 def nitsche_normal_terms(plane):
-    """SPEC §2.3's normal Nitsche residual, −Θγσ_n(u)σ_n(v) + f_n(v·N − Θγσ_n(v)) (GWFL)."""
+    """contract §2.3's normal Nitsche residual, −Θγσ_n(u)σ_n(v) + f_n(v·N − Θγσ_n(v)) (GWFL)."""
     return (f'-theta*gam*{sn("u")}*{sn("Test_u")} '
             f'+ {normal_force("u", plane)}*(Test_u.[0,-1] - theta*gam*{sn("Test_u")})')
 

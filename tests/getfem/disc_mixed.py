@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The 003 disc on a Gmsh P2 mesh, assembled by GetFEM 5.4 (Debian's python3-getfem), stepped by
 Crank–Nicolson with nodal Signorini contact on the vertical dofs of Γ_C, or with Nitsche's
-contact on the faces of Γ_C — an implementation of SPEC §1.3/§2.1/§2.2/§2.3/§3 that shares no
+contact on the faces of Γ_C — an implementation of contract §1.3/§2.1/§2.2/§2.3/§3 that shares no
 code with the engine, for tests/getfem_disc.rs (issue 34).
 
 What GetFEM computes: the isoparametric P2 mesh of the file (curved boundary triangles, GT_PK(2,2)),
@@ -12,7 +12,7 @@ whose integrand has degree 6):
   cells with a node on Γ_C, layer k + 1 their neighbours; mod1 w₀ = 0; mod2 w₀ = 0, w_k =
   m/(m − m₀); mod3 w₀ = 0, w₁ = 1 + m₀/m₁; zero-contact: the Γ_C nodes' rows and columns of M
   zeroed);
-- F: the body force ∫ρ f·φ, f = −0.1 e_y (SPEC §1.3: whatever the mass variant).
+- F: the body force ∫ρ f·φ, f = −0.1 e_y (contract §1.3: whatever the mass variant).
 Time stepping in numpy: Newmark β = ¼, γ = ½ (Crank–Nicolson), u⁰ = v⁰ = 0, a⁰ from M a⁰ = F on
 the dofs with inertia; each step (M + τ²/4 K) u = M(u + τv + τ²/4 a) + τ²/4 (F + Bᵀλ) with the
 LCP 0 ≤ λ ⊥ u_y + g ≥ 0 on the Γ_C nodes (g = the node's height above the plane y = −gap),

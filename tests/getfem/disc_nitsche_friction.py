@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """The 003 disc on a Gmsh P2 mesh thrown obliquely onto a rigid plane with Coulomb friction,
 Nitsche's contact in GetFEM 5.4's weak form language (Debian's python3-getfem): an
-implementation of SPEC §2.5's frictional Nitsche that shares no code with the engine, for
+implementation of contract §2.5's frictional Nitsche that shares no code with the engine, for
 tests/friction_nitsche.rs (issue 33).
 
 The bulk as tests/getfem/disc_mixed.py (tests/getfem/common.py): the isoparametric P2 mesh of
@@ -9,7 +9,7 @@ the file, P2 vector FEM, IM_TRIANGLE(13) (exact for the curved cells' mass), K (
 plane strain), the consistent M, the body force F = ∫ρ f·φ with f = −0.1 e_y. Initial state u⁰ = 0, v⁰ = V e_x on every node,
 a⁰ from M a⁰ = F. Crank–Nicolson (Newmark β = ¼, γ = ½): each step solves
   (M + τ²/4 K) u + τ²/4 R_c(u) = M(u^n + τv^n + τ²/4 a^n) + τ²/4 F
-by GetFEM's Newton method, with R_c SPEC §2.5's contact residual (GetFEM's
+by GetFEM's Newton method, with R_c contract §2.5's contact residual (GetFEM's
 add_Nitsche_contact_with_rigid_obstacle_brick's full-vector form, Chouly et al.) written out:
   −Θγ σ_n(u)σ_n(v) + f_n (v·N − Θγ σ_n(v)) − Θγ σ_t(u)·σ_t(v) + f_t·(Θγ σ_t(v) − v_t),
   f_n = (1/γ)[u·N − g − γ σ_n(u)]_+,  f_t = proj onto [−μ f_n, μ f_n] of σ_t(u) − (u_t − u_t^n)/(γτ),
@@ -21,15 +21,15 @@ face rule (3 Gauss points per face, the engine's rule).
 
 Reported per step: the energy ½vᵀMv + ½uᵀKu − Fᵀu, the normal force ∫f_n, the tangential
 force ∫f_t (e_x component of the traction on the body, integrated), the slip ∫(u_t − u_t^n),
-the frictional work W_f = −Σ ∫((1−γ)f_t^n + γ f_t^{n+1})(u_t^{n+1} − u_t^n) (SPEC §2.5), the
+the frictional work W_f = −Σ ∫((1−γ)f_t^n + γ f_t^{n+1})(u_t^{n+1} − u_t^n) (contract §2.5), the
 mean tangential velocity 1ᵀMv_x / 1ᵀM1_x (and, at T, the normal one 1ᵀMv_y / 1ᵀM1_y), the
 Γ_C mean of the tangential velocity ∫_ΓC v_x / ∫_ΓC 1 (on Γ_C's face rule, as the forces;
-SPEC §5's `v_t_contact` for Nitsche), the Gauss points of Γ_C in contact (f_n > 0) that
+contract §5's `v_t_contact` for Nitsche), the Gauss points of Γ_C in contact (f_n > 0) that
 stick (|p_t| ≤ μ f_n, p_t the argument of the projection) and that slip, and the displacement
 (u_x, u_y) of every Γ_C node (the vertices and edge midpoints of its faces; their coordinates
 once, as `contact_xy`, since GetFEM numbers its dofs otherwise than the file its nodes).
 The slip is written out in GWFL, (u_t − u_t^n)/(γτ) in full, so GetFEM 5.4's brick's missing
-parenthesis in that expression (SPEC §2.5) does not enter.
+parenthesis in that expression (contract §2.5) does not enter.
 
 The mesh, K, M, F, Γ_C, γ, the Nitsche model and the Newmark update: tests/getfem/common.py
 (shared with tests/getfem/disc_mixed.py).

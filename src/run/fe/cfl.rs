@@ -37,7 +37,7 @@ pub(super) const POWER_ITERATIONS: usize = 80;
 /// The certified ω²_max (and Gershgorin's bound) per geometry and lumped mass.
 pub(super) static FREQUENCIES: Cache<(f64, f64)> = Cache::new();
 
-/// The largest stable step of kinematic central difference, 2/ω_max (τω_max ≤ 2, SPEC §3), with
+/// The largest stable step of kinematic central difference, 2/ω_max (τω_max ≤ 2, contract §3), with
 /// ω²_max = λ_max(M⁻¹K) of the lumped (diagonal) mass certified from above: power iteration on
 /// M^{−½}KM^{−½} gives a Rayleigh quotient θ ≤ λ_max, and σ = θ(1 + δ) is an upper bound as
 /// soon as σM − K is positive definite — one sparse Cholesky with the geometry's symbolic

@@ -1,5 +1,5 @@
 //! A validated finite-element run ([`FeConfig`]), its scheme coefficients, and the predicates
-//! that route it to a time loop (the Newmark/θ/hybrid stepper or a SPEC §3.2 method; frictional
+//! that route it to a time loop (the Newmark/θ/hybrid stepper or a contract §3.2 method; frictional
 //! or not). Low in the engine: every other file reads the configuration, none is read here.
 
 use crate::contact::friction::FrictionLaw;
@@ -10,7 +10,7 @@ use crate::time::{NewmarkParams, Scheme};
 
 /// Steps between two checks of the clock and of an interruption.
 pub(super) const CLOCK_EVERY: usize = 64;
-/// The contact LCP: tolerance relative to the largest gap, and the iteration cap (SPEC §4).
+/// The contact LCP: tolerance relative to the largest gap, and the iteration cap (contract §4).
 pub(super) const LCP_TOL: f64 = 1e-12;
 pub(super) const LCP_MAX_ITER: usize = 100;
 
@@ -28,7 +28,7 @@ pub struct FeConfig {
     /// Ensemble member: relative amplitude of a uniform perturbation of v⁰ (u⁰ = 0 here) and
     /// its seed.
     pub perturbation: Option<(f64, u64)>,
-    /// The friction law on Γ_C (SPEC §2.5; `None`: today's frictionless engine).
+    /// The friction law on Γ_C (contract §2.5; `None`: today's frictionless engine).
     pub friction: FrictionLaw,
 }
 
@@ -95,16 +95,16 @@ impl FeConfig {
 }
 
 /// Whether [`super::newmark::Stepper`] runs `cfg` with `mixed` contact: the Newmark family and the θ-scheme
-/// (the hybrid scheme is Nitsche's and the penalty's; SPEC §3.2's methods have their own loops).
+/// (the hybrid scheme is Nitsche's and the penalty's; contract §3.2's methods have their own loops).
 pub(super) fn mixed_stepper(cfg: &FeConfig) -> bool {
     cfg.method == ContactMethod::Mixed && !handles(cfg) && cfg.coefficients().is_ok()
 }
 
 /// Whether the run takes the frictional engine. A law with μ_f = 0 or s = 0 is the
 /// frictionless problem, which the frictionless engine solves: the "μ_f = 0 gives the
-/// frictionless numbers bit for bit" rule of SPEC §2.5 holds by construction — except Nitsche
+/// frictionless numbers bit for bit" rule of contract §2.5 holds by construction — except Nitsche
 /// with Θ ≠ 0, whose frictional form at μ_f = 0 is the full-vector frictionless Nitsche (σ_t = 0
-/// imposed weakly with its Θ term, SPEC §2.5), not `none`'s: any Coulomb/Tresca law takes
+/// imposed weakly with its Θ term, contract §2.5), not `none`'s: any Coulomb/Tresca law takes
 /// the frictional engine there.
 pub(super) fn frictional(cfg: &FeConfig) -> bool {
     let full_vector = matches!(cfg.method, ContactMethod::Nitsche { theta, .. } if theta != 0.0);

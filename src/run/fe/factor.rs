@@ -40,7 +40,7 @@ pub(super) struct Factored {
     pub(super) h: Vec<f64>,
     /// Nitsche's rows of the run (Θ, γ0 applied); Z's columns are then A⁻¹(−t_q).
     pub(super) nitsche: Option<NitscheOps>,
-    /// Mixed with friction (SPEC §2.5): the tangential rows; Z then holds the tangential
+    /// Mixed with friction (contract §2.5): the tangential rows; Z then holds the tangential
     /// columns after the normal ones.
     pub(super) friction: Option<FrictionFactor>,
 }
@@ -118,7 +118,7 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
     let mut ops = match cfg.method {
         ContactMethod::Nitsche { theta, gamma0 } => NitscheOps::new(points()?, theta, gamma0),
         ContactMethod::Penalty { gamma0 } => {
-            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (SPEC §2.4).
+            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (contract §2.4).
             let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
             let young = m * (3.0 * l + 2.0 * m) / (l + m);
             NitscheOps::penalty(points()?, young, gamma0)

@@ -1,6 +1,6 @@
 //! The operators of one geometry and material shared by every run on it: the mesh (box, mapped
 //! disc/ball, Gmsh), its dofs and pattern, K, the Gram matrices of the error norms, Γ_C's
-//! contact dofs, heights, weights and Nitsche points (SPEC §1.2, §1.6).
+//! contact dofs, heights, weights and Nitsche points (contract §1.2, §1.6).
 
 use std::sync::{Arc, OnceLock};
 
@@ -17,7 +17,7 @@ use crate::space::fe::{
 use crate::space::linalg::{CholeskyOptions, FactorKind, LinalgError, Ordering, SymbolicCholesky};
 
 /// The mesh of a geometry: the bars' box, the mapped disc/ball, or a Gmsh mesh with its mass
-/// layers (SPEC §1.6).
+/// layers (contract §1.6).
 #[derive(Debug)]
 pub(super) enum FeMesh {
     Box(BoxMesh),
@@ -39,7 +39,7 @@ impl FeMesh {
     pub(super) fn dim(&self) -> usize {
         self.mesh().dim()
     }
-    /// Mass layer of element e (SPEC §2.2; layer 0 touches Γ_C).
+    /// Mass layer of element e (contract §2.2; layer 0 touches Γ_C).
     pub(super) fn element_layer(&self, e: usize) -> usize {
         match self {
             FeMesh::Box(m) => m.element_layer(e),
@@ -92,14 +92,14 @@ pub(super) struct Geometry {
     /// Trapezoidal weights of the Γ_C nodes (sum 1): the mean of a nodal field over Γ_C.
     pub(super) contact_weight: Vec<f64>,
     /// |Γ_C|, the measure the weights were normalised by: contact_weight_i·|Γ_C| = ∫_ΓC φ_i,
-    /// Tresca's node weight w_i (SPEC §2.5).
+    /// Tresca's node weight w_i (contract §2.5).
     pub(super) contact_measure: f64,
     /// Reduced dofs that belong to a Γ_C node (all components).
     pub(super) on_contact_node: Vec<bool>,
     /// Reduced indices of the vertical component.
     pub(super) vertical: Vec<usize>,
     /// Reduced indices of the e_1 component (the tangential direction of `velocity_tangential`,
-    /// SPEC §1.8).
+    /// contract §1.8).
     pub(super) tangential: Vec<usize>,
 }
 
@@ -182,7 +182,7 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     }
 }
 
-/// A Gmsh mesh (SPEC §1.6): the `clamped` group's nodes fixed (every component), contact on the
+/// A Gmsh mesh (contract §1.6): the `clamped` group's nodes fixed (every component), contact on the
 /// vertical dofs of the other `contact` nodes, each with its height above the lowest of them
 /// (the run's `gap` is added: the plane is x_d = lowest − gap), Γ_C's mean weighting each node
 /// by its faces' measures, mass layers by topology ([`mesh_layers`]).
@@ -334,7 +334,7 @@ pub(super) fn operators(
 }
 
 /// The disc/ball: nothing clamped; contact on the vertical dofs of the Γ_C nodes, with gaps
-/// their heights above the plane (SPEC §1.3: g(x) = x_d, u_n = −u_d).
+/// their heights above the plane (contract §1.3: g(x) = x_d, u_n = −u_d).
 pub(super) fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String> {
     let d = mesh.dim;
     let dofs = DofMap::all(mesh.coords.len() * d);
@@ -527,7 +527,7 @@ pub(super) fn lowest_contact(g: &Geometry) -> Option<usize> {
         .map(|(&c, _)| c)
 }
 
-/// The body's mean velocities per axis (SPEC §5; [`MeanVelocity`]) with the run's mass matrix:
+/// The body's mean velocities per axis (contract §5; [`MeanVelocity`]) with the run's mass matrix:
 /// a reduced dof's axis is its global dof's component.
 pub(super) fn mean_velocity(g: &Geometry, m: &SymMatrix) -> MeanVelocity {
     let d = g.mesh.dim();

@@ -1,4 +1,4 @@
-//! The volume load of a run with gravity (SPEC §1.3, §1.8): F, the consistent initial
+//! The volume load of a run with gravity (contract §1.3, §1.8): F, the consistent initial
 //! acceleration a⁰ and the free-fall quantities the observers compare the centre of mass with.
 
 use super::config::FeConfig;
@@ -8,7 +8,7 @@ use crate::space::MassVariant;
 use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
 use crate::space::fe::{DofMap, SymMatrix, assemble_load};
 
-/// The volume load of a run with gravity (SPEC §1.3, §1.8) and what its time loop needs of it.
+/// The volume load of a run with gravity (contract §1.3, §1.8) and what its time loop needs of it.
 #[derive(Debug)]
 pub(super) struct GravityLoad {
     /// F on the free dofs: ∫ρ f·φ (`load = "body"`) or M_run f (`"inertial"`), with
@@ -23,8 +23,8 @@ pub(super) struct GravityLoad {
     pub(super) vertical_mass: f64,
     /// The unit relative energies are measured in, the same for every mass variant (m = ∫ρ the
     /// body's mass, |f| = gravity whatever the incline): m·|f|·gap, the work of the weight
-    /// over the gap (SPEC §1.3), plus ½·m·V_t², the kinetic energy of the initial tangential
-    /// velocity (SPEC §1.8; 0 unless `velocity_tangential` is given, so every earlier run keeps
+    /// over the gap (contract §1.3), plus ½·m·V_t², the kinetic energy of the initial tangential
+    /// velocity (contract §1.8; 0 unless `velocity_tangential` is given, so every earlier run keeps
     /// its scale). A body that starts on the plane at rest (both 0) would have no unit at all:
     /// it is measured in m·|f|·H, H its height along e_d, the work of its weight over its own
     /// size.
@@ -33,12 +33,12 @@ pub(super) struct GravityLoad {
 
 /// The load of `cfg`'s gravity on `g` with the run's mass matrix `m` (None without gravity).
 ///
-/// The load per unit mass is f = gravity·(sin α e_1 − cos α e_d) (SPEC §1.8: a plane tilted by
+/// The load per unit mass is f = gravity·(sin α e_1 − cos α e_d) (contract §1.8: a plane tilted by
 /// the `incline` α, seen in the plane's frame; α = 0 is f = −gravity e_d bit for bit, sin 0 = 0
 /// and cos 0 = 1). With `load = "body"` (the papers' model) and a mass variant that keeps
 /// 1ᵀM = ∫ρφ (consistent, lumped), F = M f in exact arithmetic (per component) and a⁰ = f
 /// exactly: the body moves rigidly. A redistributed or removed mass keeps F but not M, so
-/// a⁰ = M⁻¹F is no longer uniform (the body strains in free fall, SPEC §1.3): it is solved on
+/// a⁰ = M⁻¹F is no longer uniform (the body strains in free fall, contract §1.3): it is solved on
 /// the dofs with inertia by conjugate gradients on M (κ = O(1), a few dozen iterations to
 /// round-off).
 pub(super) fn gravity_load(

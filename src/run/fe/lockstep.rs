@@ -36,7 +36,7 @@ use crate::space::step_solver::Solver;
 
 /// The key under which runs may share a lockstep group: equal keys mean the same step matrix
 /// and condensation (the geometry, mass, method, cτ², the direct solver; the gap where the
-/// method puts it into the operators). `None`: the run steps alone — the methods of SPEC §3.2
+/// method puts it into the operators). `None`: the run steps alone — the methods of contract §3.2
 /// (their own loops), CG runs (nothing factored to share), invalid schemes.
 pub fn lockstep_key(cfg: &FeConfig) -> Option<String> {
     if handles(cfg) || cfg.solver != Solver::Direct || frictional(cfg) {

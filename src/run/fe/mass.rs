@@ -1,4 +1,4 @@
-//! The mass variants of SPEC §2.2 on the FE meshes: the consistent and lumped matrices and the
+//! The mass variants of contract §2.2 on the FE meshes: the consistent and lumped matrices and the
 //! redistributions that move the contact layer's mass inward (massless contact dofs).
 
 use super::geometry::{FeMesh, Geometry};
@@ -6,7 +6,7 @@ use crate::scene::FeSetup;
 use crate::space::MassVariant;
 use crate::space::fe::{DofMap, ElementOp, Mesh, SymMatrix, assemble, fe_pattern};
 
-/// How `mod2` and `mod3` put the mass of layer 0 back (SPEC §2.2): the weight of every other
+/// How `mod2` and `mod3` put the mass of layer 0 back (contract §2.2): the weight of every other
 /// layer (mod2) and the weight of layer 1 (mod3).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Redistribution {
@@ -34,7 +34,7 @@ impl Redistribution {
     }
 }
 
-/// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (SPEC §2.2).
+/// The element weight of layer `layer` (layer 0 touches Γ_C) for a mass variant (contract §2.2).
 pub(super) fn layer_weight(mass: &MassVariant, layer: usize, r: Redistribution) -> f64 {
     match (mass, layer) {
         (

@@ -1,5 +1,5 @@
 //! The sparse finite-element engine: every FE scene × mass variant × implicit scheme with nodal
-//! (`mixed`) Signorini contact (SPEC §1.2, §2.1–2.2, §3, §4).
+//! (`mixed`) Signorini contact (contract §1.2, §2.1–2.2, §3, §4).
 //!
 //! Semi-discrete system M ü + K u = F + Bᵀλ on the free dofs (the clamped face removed), with
 //! λ ≥ 0 the upward nodal contact forces on the vertical dofs of Γ_C and u_d + g ≥ 0 there.
@@ -21,17 +21,17 @@
 //!
 //! Massless dofs (the bottom nodes with mod1/mod2/mod3/weights/zero-contact) need no special
 //! case: their rows of M are zero, so their row of the step system is c τ² (K u − F − Bᵀλ) = 0,
-//! the quasi-static equation at t^{n+1} (SPEC §1.2). Their a and v are never used (their M rows
+//! the quasi-static equation at t^{n+1} (contract §1.2). Their a and v are never used (their M rows
 //! and columns vanish), the energy E = ½vᵀMv + ½uᵀKu − Fᵀu is the run's own.
 //!
 //! Errors against a reference run (nested mesh and step): e^n = u^n − I_h u_ref(t^n) at the
 //! coarse nodes, ‖e‖²_L2 = eᵀ G e with the unweighted Gram matrix, H1 = L2 + eᵀ D e with
-//! D = ∫∇e:∇e (SPEC §1.2). The disc/ball's and the mesh files' references may be on another
+//! D = ∫∇e:∇e (contract §1.2). The disc/ball's and the mesh files' references may be on another
 //! mesh (the mapped meshes of different sizes are not nested; another mesh file; the bars' box
 //! for a mesh file of the bar): the reference's function is interpolated at the run's nodes
 //! ([`reference::ball_ref_map`]).
 //!
-//! Observables per step (SPEC §1.3): the parts ½vᵀMv, ½uᵀKu, −Fᵀu of E^h, the lowest Γ_C
+//! Observables per step (contract §1.3): the parts ½vᵀMv, ½uᵀKu, −Fᵀu of E^h, the lowest Γ_C
 //! node's u_d (disc/ball), and the penetration max (u_n − g)_+ = max(−u_d − g)_+ over the Γ_C
 //! nodes (the run's `max_penetration` is its maximum over the steps; Nitsche and the penalty
 //! are measured at the same nodes). Nothing is allocated in the time loop.

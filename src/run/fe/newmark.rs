@@ -77,7 +77,7 @@ pub(super) struct Stepper<'a> {
     pub(super) lambda: Vec<f64>,
     pub(super) lcp: Lcp,
     pub(super) newton_work: NewtonWork,
-    /// Friction with Nitsche/penalty (SPEC §2.5): u_t^n, the previous forces, the tally.
+    /// Friction with Nitsche/penalty (contract §2.5): u_t^n, the previous forces, the tally.
     pub(super) friction: Option<FrictionState>,
     /// Newton's kinks: the gaps (Newmark/θ), or shifted per step (hybrid).
     pub(super) kink: Vec<f64>,
@@ -97,7 +97,7 @@ pub(super) struct Stepper<'a> {
     pub(super) fric: Option<Box<FrictionStep>>,
 }
 
-/// A frictional mixed run's contact workspace and tally (SPEC §2.5, §1.8).
+/// A frictional mixed run's contact workspace and tally (contract §2.5, §1.8).
 pub(super) struct FrictionStep {
     pub(super) solver: FrictionalContact,
     pub(super) law: FrictionLaw,
@@ -118,7 +118,7 @@ pub(super) struct FrictionStep {
     pub(super) mean_v: [f64; 3],
 }
 
-/// Friction with Nitsche/penalty (SPEC §2.5): the frictional state of the points, started
+/// Friction with Nitsche/penalty (contract §2.5): the frictional state of the points, started
 /// from M v⁰, with f̄_t's weight `gamma` of f_t^{n+1}; None without friction rows.
 fn nitsche_friction(
     nit: Option<&NitscheOps>,
@@ -239,7 +239,7 @@ impl<'a> Stepper<'a> {
         fac.m.matvec_into(&v, &mut mv);
         // f̄_t's weight of f_t^{n+1}: Newmark's γ, the θ-scheme's θ.
         let friction = nitsche_friction(nit, cfg, g, &fac.m, gamma, &mv);
-        // Gravity (SPEC §1.3, [`super::load::gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
+        // Gravity (contract §1.3, [`super::load::gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
         // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0).
         let fall = free_fall(cfg);
         let (force_vec, vertical_mass, energy_scale) = match gravity_load(g, cfg, &fac.m) {
@@ -319,7 +319,7 @@ impl<'a> Stepper<'a> {
         })
     }
 
-    /// Observe step n with the current state (u, v) and contact forces λ (SPEC §1.3).
+    /// Observe step n with the current state (u, v) and contact forces λ (contract §1.3).
     pub(super) fn observe(&mut self, step: usize) -> Result<(), Divergence> {
         let Stepper {
             geo,
@@ -383,7 +383,7 @@ impl<'a> Stepper<'a> {
         };
         let [kinetic, elastic, gravity] = [0.5 * kinetic, 0.5 * uku, -fu];
         let e = kinetic + elastic + gravity;
-        // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (SPEC §1.3 decisions): the
+        // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (contract §1.3 decisions): the
         // points where the mixed method enforces the constraint, and where Nitsche/penalty
         // are measured too (their quadrature points carry only a weak constraint).
         let penetration = g
@@ -391,8 +391,8 @@ impl<'a> Stepper<'a> {
             .iter()
             .zip(gaps.iter())
             .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
-        // Nitsche: E_Θ and the total force from u itself (SPEC §2.3); mixed: Σ λ.
-        // Penalty: its potential is part of E^h (SPEC §2.4), and there is no E_Θ.
+        // Nitsche: E_Θ and the total force from u itself (contract §2.3); mixed: Σ λ.
+        // Penalty: its potential is part of E^h (contract §2.4), and there is no E_Θ.
         let (e, theta_term, force) = match nit {
             Some(ops) => {
                 let (pot, t, f) = ops.energy_terms_and_force(u);
@@ -412,7 +412,7 @@ impl<'a> Stepper<'a> {
         if let (Some(fr), Some(ff)) = (fric.as_mut(), fac.friction.as_ref()) {
             // The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v; the stop
             // time and E + W_f in the tally; the series' Σf_t along e_1, the Γ_C mean of v_1
-            // and W_f (SPEC §5).
+            // and W_f (contract §5).
             fr.mean.means_into(mv, &mut fr.mean_v);
             fr.tally.energy(e);
             fr.tally.velocity(step as f64 * tau, fr.mean_v[0]);
@@ -726,7 +726,7 @@ impl<'a> Stepper<'a> {
         metrics.contact_toggles = Some(metrics.contact_switches);
         metrics.energy_scale = self.energy_scale.or(metrics.energy_initial);
         if let Some(fr) = self.fric.as_ref() {
-            // SPEC §5: the e_1 component in 2D, the tangential norm in 3D.
+            // contract §5: the e_1 component in 2D, the tangential norm in 3D.
             let vt = fr.mean.tangential(&fr.mean_v);
             let scale = metrics.energy_scale.unwrap_or(1.0);
             fr.tally.finish(metrics, scale, vt, fr.mean_v[2]);

@@ -1,4 +1,4 @@
-//! Nitsche's contact term in the sparse engine (SPEC §2.3, §4; 003 §2): the operators of one
+//! Nitsche's contact term in the sparse engine (contract §2.3, §4; 003 §2): the operators of one
 //! run and the per-step semismooth Newton on the condensed problem.
 //!
 //! With the contact points q of Γ_C ([`crate::space::fe::nitsche`]), weights w_q, γ_q = γ0·h_K,
@@ -15,22 +15,22 @@
 //! the previous step; tolerance 1e-12 relative to max(|P y|, |g|), at most 100 iterations. The
 //! total contact force is Σ_q φ_q (the integral of the pressure −σ_C = (1/γ)[P_γ − g]_+).
 //!
-//! The hybrid scheme (003 (10)–(11), SPEC §3) is the midpoint rule with the contact term
+//! The hybrid scheme (003 (10)–(11), contract §3) is the midpoint rule with the contact term
 //! (1/γ)Φ P_Θγ(v), Φ = H(P̃ⁿ)[(P̃ⁿ + P̃ⁿ⁺¹)/2]_+ + H(−P̃ⁿ)([P̃ⁿ]_+ + [P̃ⁿ⁺¹]_+)/2, P̃ = P_γ − g.
 //! Its step matrix is Crank–Nicolson's (c = ¼), and since P̃ⁿ is known, Φ = ½[P̃ⁿ⁺¹ − k]_+ with
 //! the kink k = −max(P̃ⁿ, 0) (H(0) = ½ gives the same value as P̃ⁿ < 0): the same Newton with
 //! per-step kinks g − max(P̃ⁿ, 0), the factor ½ absorbed by τ²/2·½ = cτ².
 //!
-//! The penalty (SPEC §2.4) is the same operator with P = P_Θγ = u_n (Θ = 0, no σ_n term) and
+//! The penalty (contract §2.4) is the same operator with P = P_Θγ = u_n (Θ = 0, no σ_n term) and
 //! 1/γ_q = κ_q = E·γ0/h_K: the force φ_q = w_q κ_q [u_n − g_q]_+, its potential
 //! ½Σ w κ [u_n − g]_+² added to E^h ([`NitscheOps::penalty`]).
 
 //!
-//! Friction (SPEC §2.5; [`FrictionOps`]): GetFEM's full-vector Nitsche with Coulomb or Tresca
+//! Friction (contract §2.5; [`FrictionOps`]): GetFEM's full-vector Nitsche with Coulomb or Tresca
 //! friction. Per point, besides P_γ the d − 1 tangential values
 //!   P_t,q(u) = σ_t,q(u) − k_q (u_t,q − u_t,q^n),   k_q = 1/(γ_q τ)  (penalty: k_q = κ_q,
 //! σ_t rows 0), and the tangential traction f_t = proj onto the disc of radius r of P_t, with
-//! r = μ_f f_n (Coulomb, f_n = (1/γ)[P_γ − g]_+) or r = s while f_n > 0 (Tresca, SPEC §2.5:
+//! r = μ_f f_n (Coulomb, f_n = (1/γ)[P_γ − g]_+) or r = s while f_n > 0 (Tresca, contract §2.5:
 //! acting only in contact). The residual's Θ terms add −cτ²Θ Σ w γ σ_t σ_tᵀ to A (Θ ≠ 0) and
 //! the tangential test direction is Θγσ_t(v) − v_t, so C gains the columns u_t − Θγσ_t and P
 //! the rows P_t: the condensed unknowns are x = (P_γ, P_t) per point (d of them), W = P A⁻¹C
@@ -47,7 +47,7 @@ use crate::contact::friction::FrictionLaw;
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
 use crate::space::fe::nitsche::ContactPoint;
 
-/// Semismooth Newton: relative tolerance and iteration cap (SPEC §4).
+/// Semismooth Newton: relative tolerance and iteration cap (contract §4).
 pub(crate) const NEWTON_TOL: f64 = 1e-12;
 pub(crate) const NEWTON_MAX_ITER: usize = 100;
 /// The frictional Newton's acceptance at its round-off floor ([`newton_friction`]): where
@@ -74,7 +74,7 @@ pub(crate) struct NitscheOps {
     pub gamma: Vec<f64>,
     pub gap: Vec<f64>,
     pub theta: f64,
-    /// Penalty (SPEC §2.4) instead of Nitsche: P = u_n, 1/γ_q = κ_q, and the penalty
+    /// Penalty (contract §2.4) instead of Nitsche: P = u_n, 1/γ_q = κ_q, and the penalty
     /// potential ½Σ w κ [u_n − g]_+² belongs to E^h.
     pub penalty: bool,
     /// The tangential rows of a frictional run (module header); `None` without friction, and
@@ -132,7 +132,7 @@ impl NitscheOps {
         o
     }
 
-    /// The penalty of SPEC §2.4 as the same operators: κ_q = E·γ0/h_K with E Young's modulus
+    /// The penalty of contract §2.4 as the same operators: κ_q = E·γ0/h_K with E Young's modulus
     /// and h_K the point's element diameter (the h of Nitsche's γ_h = γ0·h_K), and P_q = t_q =
     /// u_n, Θ = 0 — Nitsche's rows with γ = 0 — so φ_q(s) = w_q κ_q [s − g_q]_+ is the penalty
     /// force and the Newton, the step matrix and the hybrid kinks are unchanged.
@@ -248,8 +248,8 @@ impl NitscheOps {
     }
 
     /// The contact terms of the energies at u and the total contact force Σ φ_q(P_q(u)):
-    /// Nitsche: (0, E_Θ − E^h = −(Θ/2)(Σ w γ σ_n² − Σ (w/γ)[P_γ − g]_+²), force) (SPEC §2.3);
-    /// penalty: (½ Σ w κ [u_n − g]_+², the part of E^h, no E_Θ, force) (SPEC §2.4).
+    /// Nitsche: (0, E_Θ − E^h = −(Θ/2)(Σ w γ σ_n² − Σ (w/γ)[P_γ − g]_+²), force) (contract §2.3);
+    /// penalty: (½ Σ w κ [u_n − g]_+², the part of E^h, no E_Θ, force) (contract §2.4).
     pub fn energy_terms_and_force(&self, u: &[f64]) -> (f64, Option<f64>, f64) {
         let (mut a, mut b, mut f) = (0.0, 0.0, 0.0);
         for q in 0..self.len() {
@@ -717,7 +717,7 @@ pub(crate) fn newton(
     ))
 }
 
-/// A frictional run's state besides the engine's (SPEC §2.5): the slip's reference u_t^n,
+/// A frictional run's state besides the engine's (contract §2.5): the slip's reference u_t^n,
 /// the points' stick/slip states from the contact solve, and the run's
 /// [`FrictionTally`] over the quadrature points (W_f with the scheme's f̄_t, E + W_f, the
 /// apparent coefficient |Σf_t|/Σf_n, `stop_time` — the mixed engines' accounting, with
@@ -743,7 +743,7 @@ pub(crate) struct FrictionState {
 
 impl FrictionState {
     /// For `ops` (with friction), the run's law, the body's mean velocities `mean` and the
-    /// weight of f_t^{n+1} in f̄_t (SPEC §2.5: the scheme's γ or θ, generalized-α's 1 − α_f);
+    /// weight of f_t^{n+1} in f̄_t (contract §2.5: the scheme's γ or θ, generalized-α's 1 − α_f);
     /// `h` the mesh size (the tally's increment rule, unused here: the cone decides).
     pub fn new(
         ops: &NitscheOps,
@@ -844,7 +844,7 @@ impl FrictionState {
         self.tally.energy(energy);
     }
 
-    /// The friction columns (SPEC §5), energies over `scale`.
+    /// The friction columns (contract §5), energies over `scale`.
     pub fn finish(&self, m: &mut crate::run::Metrics, scale: f64) {
         let vt = self.mean.tangential(&self.means);
         self.tally.finish(m, scale, vt, self.means[2]);
@@ -912,7 +912,7 @@ mod tests {
         assert!(lu_solve(&mut [0.0; 4], 2, &mut [0; 2], &mut [1.0, 1.0]).is_err());
     }
 
-    /// SPEC §5's friction columns of a frictional run, by hand: two penalty points in 2D on two
+    /// contract §5's friction columns of a frictional run, by hand: two penalty points in 2D on two
     /// nodes (dofs x, y each), weights 1 and 3, u_t = the node's u_x; identity mass. Forces
     /// λ = w(f_n, f_t) = (1, 0.5) and (3, −1.5): each point on its cone |f_t| = 0.5 f_n, but
     /// |Σλ_t|/Σλ_n = |0.5 − 1.5|/4 = 0.25, the apparent coefficient. v = (1, 0 | 3, 0): the

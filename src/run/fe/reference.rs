@@ -1,4 +1,4 @@
-//! Errors against a reference run and the recording of one (SPEC §1.2): the map from a
+//! Errors against a reference run and the recording of one (contract §1.2): the map from a
 //! reference's lattice (or its mesh, interpolated) to this run's dofs, and the lattice a
 //! reference run records.
 
@@ -134,7 +134,7 @@ pub(super) fn ref_map(
 /// step only) the stored dofs are the run's, read one to one. On another mesh — the mapped
 /// meshes of two sizes are not nested: n_t = 2·round(πR/(4h)) and n_r = round((R − a)/h) give
 /// (8, 3), (16, 5), (32, 10) at h = 4, 2, 1; another mesh file; the bars' box meshed by a mesh
-/// file (SPEC §1.6) — each run node is located in the reference's stored mesh and the
+/// file (contract §1.6) — each run node is located in the reference's stored mesh and the
 /// reference's finite-element function is evaluated there ([`Interpolation`]).
 pub(super) fn ball_ref_map(
     g: &Geometry,
@@ -291,7 +291,7 @@ pub(super) fn record_lattice(
 /// The reference this run records, if it is one: the slots of its stored lattice and the empty
 /// data. Meshes that are not nested store themselves: a coarser run locates its nodes in this
 /// one ([`ball_ref_map`]). So does the bars' box stored whole (stride 1: its lattice is its
-/// node numbering), for the runs on a mesh file of the same bar (SPEC §1.6); a nested bar run
+/// node numbering), for the runs on a mesh file of the same bar (contract §1.6); a nested bar run
 /// still reads it node for node.
 #[allow(clippy::type_complexity)]
 pub(super) fn reference_record(

@@ -1,5 +1,5 @@
 //! The set-up every time loop of the engine shares (the Newmark/θ/hybrid [`super::newmark`]
-//! stepper and the SPEC §3.2 methods): the run's first metrics, the shared geometry and step
+//! stepper and the contract §3.2 methods): the run's first metrics, the shared geometry and step
 //! factor with their cache counters, the reference map, the gaps of the contact dofs, the
 //! initial velocity and its perturbation, the free fall and the observer. One copy, so both
 //! loops start from the same numbers and report the same set-up failures.
@@ -115,7 +115,7 @@ pub(super) fn initial_velocity(g: &Geometry, cfg: &FeConfig, v: &mut [f64]) {
     }
 }
 
-/// The fall along e_d: on an incline (SPEC §1.8) the load's e_d part is −g cos α (cos 0 = 1:
+/// The fall along e_d: on an incline (contract §1.8) the load's e_d part is −g cos α (cos 0 = 1:
 /// the flat runs' numbers unchanged); free_fall_error compares the centre of mass with it.
 pub(super) fn free_fall(cfg: &FeConfig) -> f64 {
     -cfg.setup.gravity * cfg.setup.incline.to_radians().cos()

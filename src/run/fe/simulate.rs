@@ -1,5 +1,5 @@
 //! The engine's entry points: route one run to its time loop (the lockstep stepper alone, or a
-//! SPEC §3.2 method), refuse the friction combinations without a frictional version, and run
+//! contract §3.2 method), refuse the friction combinations without a frictional version, and run
 //! groups sharing a step matrix together.
 
 use std::sync::Arc;
@@ -14,7 +14,7 @@ use crate::time::Scheme;
 
 /// Run one finite-element simulation.
 pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
-    // The methods of SPEC §3.2 solve friction with the nodal multiplier in their own loops.
+    // The methods of contract §3.2 solve friction with the nodal multiplier in their own loops.
     if frictional(cfg) && handles(cfg) && cfg.method == ContactMethod::Mixed {
         return methods::simulate(cfg, opts, ctx);
     }
@@ -28,7 +28,7 @@ pub fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome 
         return Outcome {
             status: Status::Invalid,
             message: Some(format!(
-                "friction = {} with space = {} and scheme = {} has no frictional version (SPEC §2.5)",
+                "friction = {} with space = {} and scheme = {} has no frictional version (contract §2.5)",
                 cfg.friction.kind().name(),
                 cfg.method.name(),
                 cfg.scheme.label()

@@ -1,4 +1,4 @@
-//! The structured mapped meshes of the disc and the ball (SPEC §1.3, `disc2d`/`sphere3d`):
+//! The structured mapped meshes of the disc and the ball (contract §1.3, `disc2d`/`sphere3d`):
 //! a five-block O-grid of the disc and a seven-block cubed sphere of the ball, with isoparametric
 //! Q1 or Q2 elements, the boundary faces of Γ_C and their quadrature.
 //!
@@ -17,7 +17,7 @@
 //! the interior ones follow the blockwise mapping. Each block's reference axes are oriented so
 //! that det J > 0 (axis 0 is reversed in the blocks where the natural order is left-handed).
 //!
-//! Γ_C is the boundary below the centre's height (SPEC §1.3). n_t is always even, so the
+//! Γ_C is the boundary below the centre's height (contract §1.3). n_t is always even, so the
 //! equator is a union of element edges (no face straddles it) and the lowest point of the ball
 //! is a node. Sizes from a nominal h: n_t = 2·max(1, round(πR/(4h))) (an arc of the boundary per
 //! element ≈ h) and n_r = max(1, round((R − a)/h)) (radial thickness ≈ h, rounded half up: the
@@ -27,7 +27,7 @@
 //! paper's disc (R = 20, h = 4) gives n_t = 8, n_r = 3, 160 elements; its ball (h = 8) n_t = 4,
 //! n_r = 1, 160 elements (the paper's 3D mesh has 400).
 //!
-//! Mass layers (SPEC §2.2): layer 0 = the elements with a node on Γ_C (so that every Γ_C node
+//! Mass layers (contract §2.2): layer 0 = the elements with a node on Γ_C (so that every Γ_C node
 //! is massless when layer 0 is), layer k + 1 = the remaining elements sharing a node with layer
 //! k.
 
@@ -427,7 +427,7 @@ impl BallMesh {
     }
 
     /// The Gauss points of boundary face `face` (`points` per direction; 3 gives order 5 ≥ 4,
-    /// SPEC §1.3), with the weight times the discrete face's length/area element and the unit
+    /// contract §1.3), with the weight times the discrete face's length/area element and the unit
     /// normal pointing out of the body (away from the centre: the body is star-shaped about it).
     pub fn face_points(&self, face: &BoundaryFace, points: usize) -> Vec<FacePoint> {
         let d = self.dim;
@@ -590,7 +590,7 @@ mod tests {
         assert_eq!(disc.boundary_faces.len(), 32);
         assert_eq!(disc.contact_faces.len(), 16);
         assert_eq!(disc.contact_nodes.len(), 17);
-        // The lowest node is on the circle at (0, 5): the gap of SPEC §1.3.
+        // The lowest node is on the circle at (0, 5): the gap of contract §1.3.
         let low = disc.coords[disc.lowest_node()];
         assert!(low[0].abs() < 1e-12 && (low[1] - 5.0).abs() < 1e-12);
         // Layer 0: the 16 ring elements below the equator and the 2 above it that share an

@@ -1,6 +1,6 @@
 //! Element matrices of the vector tensor Lagrange elements, isoparametric: Q1 (bilinear squares,
 //! trilinear cubes) and Q2 (9-node quadrilaterals, 27-node hexahedra — the degree-2 elements of
-//! the disc and ball, SPEC §1.3).
+//! the disc and ball, contract §1.3).
 //!
 //! Reference element [−1, 1]^d with (p+1)^d nodes in tensor order (local node a has index
 //! i_k = ⌊a/(p+1)^k⌋ mod (p+1) along axis k, at ξ_k = −1 + 2 i_k/p; for Q1 this is bit k of a) and
@@ -19,10 +19,10 @@
 //!
 //! Quadrature: Gauss–Legendre with p + 1 points per direction (2 for Q1, 3 for Q2) on affine
 //! cells (parallelograms, parallelepipeds), where it is exact for the mass, stiffness and load —
-//! the matrices of SPEC §1.2, never a reduced integration. On a mapped (curved or distorted)
+//! the matrices of contract §1.2, never a reduced integration. On a mapped (curved or distorted)
 //! cell det J is a polynomial too and the mass integrand N_a N_b det J has degree 7 per variable
 //! (Q2, 2D), 9 (Q2, 3D), 4 (Q1, 3D) or 3 (Q1, 2D): such cells take 4, 5, 3 or 2 points per
-//! direction, exact for their mass and load ([`super::quadrature`], SPEC §1.6). The stiffness
+//! direction, exact for their mass and load ([`super::quadrature`], contract §1.6). The stiffness
 //! integrand of a mapped cell is rational; the same rule still integrates ∫ ∇N_a exactly (the
 //! cofactor of J is polynomial), which is what the patch test needs.
 //!
@@ -62,7 +62,7 @@ const GAUSS2: [(f64, f64); 2] = [
 ];
 
 /// Gauss–Legendre rule with `n` points on [−1, 1] (exact to degree 2n − 1), n = 1 … 6: 2 points
-/// for Q1, 3 for Q2 element matrices, 3 (order 5 ≥ 4, SPEC §1.3) on the faces of Γ_C, more for
+/// for Q1, 3 for Q2 element matrices, 3 (order 5 ≥ 4, contract §1.3) on the faces of Γ_C, more for
 /// error norms and the tests' exact measures.
 ///
 /// # Panics
@@ -239,7 +239,7 @@ pub(crate) fn physical_gradients<const D: usize, const NN: usize>(
 
 /// Calls `f(N, ∇N, w·det J)` at each Gauss point of the element with node coordinates `x`: the
 /// element's own rule, n1 points per direction on an affine cell (2 for Q1 — exact on boxes,
-/// SPEC §1.2 — and 3 for Q2), more on a mapped one so that its mass is exact (module header).
+/// contract §1.2 — and 3 for Q2), more on a mapped one so that its mass is exact (module header).
 fn for_each_point<const D: usize, const NN: usize>(
     x: &[[f64; D]; NN],
     f: impl FnMut(&[f64; NN], &[[f64; D]; NN], f64),

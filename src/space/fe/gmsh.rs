@@ -1,5 +1,5 @@
 //! Gmsh MSH 4.1 meshes (ASCII or binary) read into the engine's mesh representation: the body of
-//! the `mesh2d`/`mesh3d` scenes (SPEC §1.6, issue 22), validated before anything is run.
+//! the `mesh2d`/`mesh3d` scenes (contract §1.6, issue 22), validated before anything is run.
 //!
 //! Why here: every scene of the engine reaches assembly through the [`Mesh`] trait ("an element =
 //! its node ids + its node coordinates"), so a Gmsh mesh is one more implementation of that trait
@@ -36,7 +36,7 @@
 //!
 //! Also returned: `h` = the largest cell diameter (largest distance between two nodes of a
 //! cell: for affine cells the longest edge) and the SHA-256 of the file's bytes (the run id
-//! includes it, SPEC §1.6).
+//! includes it, contract §1.6).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -243,7 +243,7 @@ impl GmshMesh {
         self.groups.iter().find(|g| g.name == name)
     }
 
-    /// The nodes that carry contact (SPEC §1.6): those of the `contact` group not in `clamped`
+    /// The nodes that carry contact (contract §1.6): those of the `contact` group not in `clamped`
     /// (a clamped node never moves towards the obstacle), increasing.
     pub fn contact_nodes(&self) -> Vec<usize> {
         let clamped = self.group("clamped").map_or(&[][..], |g| &g.nodes[..]);
@@ -262,7 +262,7 @@ impl GmshMesh {
     }
 
     /// The lowest x_d of the contact nodes ([`GmshMesh::contact_nodes`]), None without any: the
-    /// rigid plane x_d = this − gap (SPEC §1.6), so a run's `gap` and `obstacle` are two names
+    /// rigid plane x_d = this − gap (contract §1.6), so a run's `gap` and `obstacle` are two names
     /// of one plane.
     pub fn contact_floor(&self) -> Option<f64> {
         self.contact_nodes()

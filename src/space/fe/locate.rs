@@ -1,5 +1,5 @@
 //! Point location in a finite-element mesh and evaluation of a nodal field there: how a run is
-//! compared with a reference computed on a finer mesh that is not nested in its own (SPEC §1.6:
+//! compared with a reference computed on a finer mesh that is not nested in its own (contract §1.6:
 //! the disc and ball's mapped meshes of two sizes, any two Gmsh meshes).
 //!
 //! For a point x* the element K containing it and the reference coordinates ξ* with

@@ -24,7 +24,7 @@ pub trait Mesh {
     fn coord(&self, node: usize) -> [f64; 3];
 }
 
-/// Mass layers of a mesh (SPEC §2.2, §1.6): layer 0 = the cells with a node in `seed`, layer
+/// Mass layers of a mesh (contract §2.2, §1.6): layer 0 = the cells with a node in `seed`, layer
 /// k + 1 the cells not yet layered that share a node with layer k. Cells of a part never
 /// reached (a body not connected to Γ_C) take one layer past the last.
 ///

@@ -1,4 +1,4 @@
-//! The finite-element layer of the 2D/3D scenes (SPEC §1.2, §2): meshes, vector Q1 element
+//! The finite-element layer of the 2D/3D scenes (contract §1.2, §2): meshes, vector Q1 element
 //! matrices, and global sparse assembly with the pattern built once and refilled many times.
 //!
 //! - [`mesh`]: the structured box of Q1 squares/cubes (`bar2d`, `bar3d`) behind the [`Mesh`]
@@ -21,7 +21,7 @@
 //!   and load (isoparametric; degree-4 rule on triangles, degree-5 on tetrahedra), the simplices
 //!   of Gmsh meshes, assembled by [`sparse`] like the Q1/Q2 cells;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
-//!   element weights (the layer-weighted masses of SPEC §2.2) and the matrix operations of a
+//!   element weights (the layer-weighted masses of contract §2.2) and the matrix operations of a
 //!   time loop (`matvec_into` allocates nothing).
 //!
 //! Degrees of freedom are node-major interleaved: dof = node·d + component. Constrained dofs

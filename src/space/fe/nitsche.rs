@@ -1,16 +1,16 @@
-//! The contact-boundary operators of Nitsche's method on the disc/ball (SPEC §1.3, §2.3; 003
+//! The contact-boundary operators of Nitsche's method on the disc/ball (contract §1.3, §2.3; 003
 //! §2): at every quadrature point of the faces of Γ_C, the linear functionals u ↦ u_n and
 //! u ↦ σ_n(u) of the element's dofs, the gap and γ_h = γ0·h_K.
 //!
-//! With the obstacle's normal n = −e_d (SPEC §1.3): u_n = −u_d, σ_n(u) = n·σ(u)n = σ_dd =
+//! With the obstacle's normal n = −e_d (contract §1.3): u_n = −u_d, σ_n(u) = n·σ(u)n = σ_dd =
 //! λ div u + 2μ ∂_d u_d, and the gap of a point is its height x_d above the plane. So
 //! P_γ(u) = u_n − γ_h σ_n(u) and P_Θγ(v) = v_n − Θγ_h σ_n(v) are fixed linear combinations of
 //! the two rows stored here, and the Nitsche terms of a step,
 //!   Σ_q w_q (1/γ_q) [P_γ,q(u) − g_q]_+ P_Θγ,q(v)  and  −Θ Σ_q w_q γ_q σ_n,q(u) σ_n,q(v),
 //! only involve the dofs of the elements with a face on Γ_C — what the per-step solve condenses
-//! onto (SPEC §4). The face rule has 3 Gauss points per direction (order 5 ≥ 4, 003 §4.2).
+//! onto (contract §4). The face rule has 3 Gauss points per direction (order 5 ≥ 4, 003 §4.2).
 //!
-//! Friction (SPEC §1.8, §2.5) needs the tangential parts too, in the directions e_i, i < d
+//! Friction (contract §1.8, §2.5) needs the tangential parts too, in the directions e_i, i < d
 //! (e_1 in 2D, e_1 and e_2 in 3D): u_t,i = u_i and σ_t,i(u) = (σ(u)n)_i = −σ_id =
 //! −μ(∂_i u_d + ∂_d u_i) (the tangential part of the traction σ(u)n, n = −e_d). They are d − 1
 //! more rows of each kind per point, made with the same shape values and gradients.
@@ -40,7 +40,7 @@ pub struct ContactPoint {
     pub weight: f64,
     /// γ_h = γ0·h_K of the point's element.
     pub gamma: f64,
-    /// Height x_d of the point above the rigid plane (the gap g of SPEC §1.3).
+    /// Height x_d of the point above the rigid plane (the gap g of contract §1.3).
     pub gap: f64,
     /// Global dofs of the point's element (node-major, d per node).
     pub dofs: Vec<usize>,

@@ -1,4 +1,4 @@
-//! Quadrature rules that are exact on *curved* degree-2 cells (SPEC §1.2, §1.6, issue 34), and
+//! Quadrature rules that are exact on *curved* degree-2 cells (contract §1.2, §1.6, issue 34), and
 //! the test that tells a curved cell from an affine one.
 //!
 //! Why: on an affine cell the element integrands are polynomials of the shape functions' degree

@@ -20,7 +20,7 @@
 //! A curved P2 cell (midside nodes off the straight edges, e.g. on a Gmsh disc's arc) has det J
 //! of degree 2 (triangle) or 3 (tetrahedron), and a mass integrand of degree 6 or 7: it takes
 //! the conical-product rule of degree 7 of [`super::quadrature`] (16 or 64 positive weights), so
-//! its mass and load are exact on its own geometry (SPEC §1.6) — a degree-4 rule left a curved
+//! its mass and load are exact on its own geometry (contract §1.6) — a degree-4 rule left a curved
 //! boundary triangle's mass entries off by up to 2e-4 (issue 34).
 
 use nalgebra::{SMatrix, SVector};

@@ -1,4 +1,4 @@
-//! Kinematic central difference with the lumped mass (SPEC §3.2, module header of [`super`]):
+//! Kinematic central difference with the lumped mass (contract §3.2, module header of [`super`]):
 //! explicit, no solve; a contact dof below the obstacle is put on it by a local impulse, and
 //! with friction each node's tangential force is projected onto its disc.
 

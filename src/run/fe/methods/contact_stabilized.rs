@@ -1,4 +1,4 @@
-//! Contact-stabilized Newmark (SPEC §3.2): an M-projected predictor (an LCP on W_M = BM⁻¹Bᵀ),
+//! Contact-stabilized Newmark (contract §3.2): an M-projected predictor (an LCP on W_M = BM⁻¹Bᵀ),
 //! then kane's trapezoidal corrector from it.
 
 use super::correction::{add_columns, implicit_contact_correction};

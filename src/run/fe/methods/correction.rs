@@ -1,4 +1,4 @@
-//! The condensed contact correction the SPEC §3.2 methods share: y += s Zμ over the nonzero
+//! The condensed contact correction the contract §3.2 methods share: y += s Zμ over the nonzero
 //! multipliers, the contact rows and Nitsche's point columns and Θ-term added to a right-hand
 //! side, and the implicit correction of `kane` and contact-stabilized Newmark.
 

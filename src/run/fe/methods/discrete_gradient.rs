@@ -1,4 +1,4 @@
-//! The discrete gradient (SPEC §3.2): the midpoint rule with each point's difference quotient of
+//! The discrete gradient (contract §3.2): the midpoint rule with each point's difference quotient of
 //! the contact potential, condensed on the points and solved by semismooth Newton.
 
 use super::correction::{add_columns, add_theta_term};

@@ -1,4 +1,4 @@
-//! The time loop of the SPEC §3.2 methods: the set-up ([`MethodRun::new`]), the observation of
+//! The time loop of the contract §3.2 methods: the set-up ([`MethodRun::new`]), the observation of
 //! t = 0, then per step the method's own step (one file of this folder each), the periodic
 //! refresh of the carried products, the friction's bookkeeping and the observation; the
 //! outcome ([`MethodRun::finish`]).
@@ -8,7 +8,7 @@ use super::state::Method;
 use crate::run::fe::config::{CLOCK_EVERY, FeConfig};
 use crate::run::{Outcome, RunContext, RunOptions, Stop};
 
-/// Run one finite-element simulation with a method of SPEC §3.2 (module header of [`super`]).
+/// Run one finite-element simulation with a method of contract §3.2 (module header of [`super`]).
 pub(in crate::run::fe) fn simulate(cfg: &FeConfig, opts: &RunOptions, ctx: &RunContext) -> Outcome {
     let mut run = match MethodRun::new(cfg, opts, ctx) {
         Ok(run) => run,
@@ -68,7 +68,7 @@ fn time_loop(run: &mut MethodRun) -> Result<(), Stop<String>> {
             run.nit_fric.as_mut(),
             run.fac.as_ref().and_then(|f| f.nitsche.as_ref()),
         ) {
-            // W_f with generalized-α's f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ (SPEC §2.5).
+            // W_f with generalized-α's f̄_t = (1 − α_f) f_t^{n+1} + α_f f_tⁿ (contract §2.5).
             let (ft, vt, wf) =
                 st.after_step(ops, &run.u, &run.v, &run.mv, &run.lambda, step as f64 * tau);
             fv = Some([ft, vt, wf]);

@@ -1,4 +1,4 @@
-//! Friction with the nodal multiplier in the SPEC §3.2 methods (module header of
+//! Friction with the nodal multiplier in the contract §3.2 methods (module header of
 //! [`super`]): the tangential dofs of each Γ_C node, the step's forces, the condensed
 //! Coulomb/Tresca problem and the run's [`FrictionTally`].
 
@@ -58,7 +58,7 @@ pub(super) struct Implicit {
 }
 
 impl Friction {
-    /// `weight_new` is f̄_t's weight of f_t^{n+1} (SPEC §2.5).
+    /// `weight_new` is f̄_t's weight of f_t^{n+1} (contract §2.5).
     pub(super) fn new(
         g: &Geometry,
         cfg: &FeConfig,
@@ -279,7 +279,7 @@ impl Friction {
         self.tally.velocity(step as f64 * tau, means[0]);
     }
 
-    /// The friction columns of SPEC §5 (energies over `scale`): the tally's, and the mean
+    /// The friction columns of contract §5 (energies over `scale`): the tally's, and the mean
     /// velocities at T (3D: the tangential norm).
     pub(super) fn report(&self, metrics: &mut Metrics, mv: &[f64], scale: f64) {
         let mut means = [0.0; 3];

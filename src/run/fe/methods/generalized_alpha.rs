@@ -1,4 +1,4 @@
-//! Generalized-α/HHT (SPEC §3.2): the equation at t^{n+1−α} with the history κ_m aⁿ, κ_f Kuⁿ,
+//! Generalized-α/HHT (contract §3.2): the equation at t^{n+1−α} with the history κ_m aⁿ, κ_f Kuⁿ,
 //! κ_f fⁿ, Newmark's updates; one step with the nodal multiplier (LCP or Coulomb/Tresca), one
 //! with Nitsche/penalty (the engine's semismooth Newton, ± friction).
 

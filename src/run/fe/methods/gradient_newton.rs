@@ -1,4 +1,4 @@
-//! The discrete gradient's contact law on the points (SPEC §3.2): semismooth Newton on
+//! The discrete gradient's contact law on the points (contract §3.2): semismooth Newton on
 //! s = s⁰ + cW D(s) with each point's difference quotient D_q of the penalty/Nitsche potential
 //! and its slope ([`crate::contact::gradient`]), the Jacobian restricted to the points with
 //! D_q or D'_q ≠ 0.
@@ -39,7 +39,7 @@ impl GradientWork {
 /// Solve G(s) = s − s⁰ − c₂ W D(s) = 0, D_q = w_q DQ(1/γ_q, a_q, s_q − g_q) (module header);
 /// on exit `wk.d` holds D(s). The residual test is at the round-off of its terms, as in the
 /// scalar solve of [`crate::contact::gradient`]: the energy balance is off by D·r. A residual
-/// that stops decreasing below SPEC §4's 1e-12 (relative) is accepted as converged.
+/// that stops decreasing below contract §4's 1e-12 (relative) is accepted as converged.
 pub(super) fn gradient_newton(
     ops: &NitscheOps,
     w: &[f64],

@@ -1,4 +1,4 @@
-//! Kane's method (SPEC §3.2): the trapezoidal increment on Crank–Nicolson's S = M + τ²/4 K
+//! Kane's method (contract §3.2): the trapezoidal increment on Crank–Nicolson's S = M + τ²/4 K
 //! with the condensed contact correction, v^{n+1} = 2Δu/τ − vⁿ.
 
 use super::correction::implicit_contact_correction;

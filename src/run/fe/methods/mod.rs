@@ -1,4 +1,4 @@
-//! The methods of the comparison literature (SPEC §3.2) in the sparse finite-element engine:
+//! The methods of the comparison literature (contract §3.2) in the sparse finite-element engine:
 //! `kane`, `contact-stabilized-newmark`, `moreau-jean` with the nodal multiplier (`mixed`),
 //! `generalized-alpha`/`hht` with `mixed`, `nitsche` and `penalty`, the `discrete-gradient`
 //! with `penalty` and `nitsche` (Θ = 1), and `central-difference` with `mixed` and the lumped
@@ -48,7 +48,7 @@
 //! Generalized-α with Nitsche/penalty (disc/ball): the linear part K_Θ (Nitsche's Θ-term) sits in
 //! A as for the engine's Newmark steps, the contact force is f_c(u) = Σ_q φ_q(p_q·u) C_q with
 //! f_cⁿ = f_c(uⁿ) (the previous step's Newton values) and f_c^{n+1} solved by the engine's
-//! semismooth Newton with coefficient c ([`crate::run::fe::nitsche`]). With friction (SPEC §2.5,
+//! semismooth Newton with coefficient c ([`crate::run::fe::nitsche`]). With friction (contract §2.5,
 //! issue 33) the same with the engine's frictional operators and Newton: K_Θ in A holds the
 //! tangential Θ rows −Θ Σ w γ σ_t σ_tᵀ too (the history term −κ_f K_Θ uⁿ and M u^{n+1} =
 //! A u^{n+1} − cK_Θ u^{n+1} use them), f_c(u) = Σ_j λ_j C_j over the d unknowns per point
@@ -70,7 +70,7 @@
 //! product, as Crank–Nicolson's does (measured: `benches/fe.rs`, `bar2d-methods`). Every 64
 //! steps the products are recomputed from the state. Nothing is allocated in the time loop.
 //!
-//! Friction (SPEC §2.5, `space = "mixed"`; issue 33). The contact rows grow from B (the
+//! Friction (contract §2.5, `space = "mixed"`; issue 33). The contact rows grow from B (the
 //! vertical dof of each Γ_C node, normal force λ = f_n ≥ 0 on the body) to C = [B; T], T the
 //! node's e_1 (and e_2) dofs carrying the tangential force f_t on the body: the force term
 //! Bᵀλ of every step above becomes Cᵀr, r = (f_n, f_t) per node, and the condensation
@@ -83,7 +83,7 @@
 //! solved by the semismooth Newton method of [`crate::contact::coulomb`] (the Coulomb disc in
 //! 3D). Coulomb's bound b = μ_f μ_n is scale free; Tresca's s·w_j (w_j = ∫_ΓC φ_j, a force) is
 //! multiplied by c_f/c, and by τ where the unknown is an impulse. Per method (the slip is the
-//! scheme's, SPEC §2.5; f̄_t is the tangential force as it enters the momentum equation over
+//! scheme's, contract §2.5; f̄_t is the tangential force as it enters the momentum equation over
 //! the step, which W_f^{n+1} = W_f^n − Σ_j f̄_t,j·(u_t,j^{n+1} − u_t,j^n) uses):
 //! - `kane`: q_n = Buⁿ + g + By, q_t = Ty (slip = u_t^{n+1} − u_tⁿ = TΔu), μ = 2(λ, f_t)^{n+1},
 //!   f̄_t = f_t^{n+1}. The trapezoidal rule gives ΔE = Δuᵀ Cᵀr exactly (massless rows included:
@@ -107,7 +107,7 @@
 //!   (b = μ_f λ_j, Tresca s·w_j, none without a normal impulse): u_t += τ²f_t/m_j,
 //!   v_t^{n+½} += τf_t/m_j. A local projection per node, no solve; f̄_t = f_t^{n+1}.
 //!
-//! Measured per step (SPEC §5): W_f, the rise of E + W_f, the contact node-steps in stick
+//! Measured per step (contract §5): W_f, the rise of E + W_f, the contact node-steps in stick
 //! (|Δu_t| ≤ 1e-12·h) and in slip, |Σf_t|/Σf_n, and the series' σ_t (the total e_1 contact
 //! force), the Γ_C mean of v_1 and W_f; at T the mean velocities 1ᵀMv/1ᵀM1 along e_1 (3D: the
 //! norm over e_1, e_2) and e_d. A law with μ_f = 0 or s = 0 never reaches this module's

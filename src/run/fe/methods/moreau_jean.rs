@@ -1,4 +1,4 @@
-//! Moreau–Jean (SPEC §3.2): the velocity-level θ-step with impulses on the rows predicted
+//! Moreau–Jean (contract §3.2): the velocity-level θ-step with impulses on the rows predicted
 //! active and Newton's restitution (De Saxcé's law with friction).
 
 use super::correction::{add_columns, add_rows};

@@ -1,4 +1,4 @@
-//! One run of a SPEC §3.2 method between its set-up and its outcome ([`MethodRun`]): the
+//! One run of a contract §3.2 method between its set-up and its outcome ([`MethodRun`]): the
 //! shared operators (the step factor of M + cK, or the explicit step's lumped M alone; the
 //! predictor's M⁻¹Bᵀ), the state (u, v, a) with the carried products Mu, Mv, Ma, Ku, Kv, the
 //! contact and friction workspaces, the observer. Each method's step is its own file of this
@@ -40,7 +40,7 @@ type Operators = (
     Option<Arc<MassInverse>>,
 );
 
-/// A run of a SPEC §3.2 method: its operators, state, carried products, workspace and
+/// A run of a contract §3.2 method: its operators, state, carried products, workspace and
 /// observer (module header). Nothing is allocated in the time loop.
 pub(super) struct MethodRun<'a> {
     pub(super) cfg: &'a FeConfig,
@@ -558,7 +558,7 @@ fn friction_parts(
             return Err((
                 Status::Invalid,
                 format!(
-                    "scheme {} has no frictional version with space = {} (SPEC §2.5)",
+                    "scheme {} has no frictional version with space = {} (contract §2.5)",
                     cfg.scheme.label(),
                     cfg.method.name()
                 ),
@@ -585,7 +585,7 @@ fn friction_parts(
             return Err((
                 Status::Invalid,
                 format!(
-                    "scheme {} has no frictional version (SPEC §2.5)",
+                    "scheme {} has no frictional version (contract §2.5)",
                     cfg.scheme.label()
                 ),
             ));

@@ -1,4 +1,4 @@
-//! Which SPEC §3.2 method a configuration runs, the checks the planner also makes (an engine
+//! Which contract §3.2 method a configuration runs, the checks the planner also makes (an engine
 //! entry point gets the same reasons), and the c of its step matrix M + cK.
 
 use crate::run::fe::config::{FeConfig, kinematic};
@@ -28,7 +28,10 @@ pub(super) fn method(cfg: &FeConfig) -> Result<Method, String> {
         Scheme::MoreauJean(p) => Method::MoreauJean(p),
         Scheme::DiscreteGradient => Method::Gradient,
         s => {
-            return Err(format!("scheme {} is not a SPEC §3.2 method", s.label()));
+            return Err(format!(
+                "scheme {} is not a contract §3.2 method",
+                s.label()
+            ));
         }
     };
     // The scene and the planner refuse these first; an engine entry point (tests, benches)
