@@ -33,7 +33,8 @@
 //! `contact_init` changes nothing here.
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene,
+    SceneFacts, SceneSetup,
 };
 use crate::space::fe::BallMesh;
 
@@ -88,14 +89,12 @@ impl Scene for BallScene {
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }
-    fn name(&self) -> &'static str {
-        if self.dim == 2 { "disc2d" } else { "sphere3d" }
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &BALL_PHYSICS
-    }
-    fn default_t(&self) -> f64 {
-        40.0
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: if self.dim == 2 { "disc2d" } else { "sphere3d" },
+            physics: &BALL_PHYSICS,
+            default_t: 40.0,
+        }
     }
     fn wave_speed(&self, p: &Physics) -> f64 {
         ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()

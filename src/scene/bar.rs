@@ -11,7 +11,7 @@
 //! `elements` counts the elements across the height (n_d = 1/h); the width 0.1 must hold a whole
 //! number of elements too, so h ∈ {0.1, 0.05, 0.025, …, 0.1/k}.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
 
 /// The finite-element geometry a scene asks for.
 #[derive(Debug, Clone, PartialEq)]
@@ -191,14 +191,12 @@ impl Scene for BarScene {
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }
-    fn name(&self) -> &'static str {
-        if self.dim == 2 { "bar2d" } else { "bar3d" }
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &BAR_PHYSICS
-    }
-    fn default_t(&self) -> f64 {
-        2.0
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: if self.dim == 2 { "bar2d" } else { "bar3d" },
+            physics: &BAR_PHYSICS,
+            default_t: 2.0,
+        }
     }
     fn wave_speed(&self, p: &Physics) -> f64 {
         ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()

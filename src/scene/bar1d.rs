@@ -20,7 +20,7 @@
 //! elements there, exactly as for the clamped bar. Every tolerance is relative to the bar's own
 //! scales (L, L/c, V), never to a unit bar.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
 
 /// The scene `bar1d` (contract §1.1): physics keys, mesh from h, closed form for a zero gap.
 #[derive(Debug, Clone, Copy)]
@@ -105,14 +105,12 @@ impl Scene for Bar1dScene {
         true
     }
 
-    fn name(&self) -> &'static str {
-        "bar1d"
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &BAR1D_PHYSICS
-    }
-    fn default_t(&self) -> f64 {
-        12.0
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: "bar1d",
+            physics: &BAR1D_PHYSICS,
+            default_t: 12.0,
+        }
     }
     fn wave_speed(&self, physics: &Physics) -> f64 {
         Self::bar(physics).wave_speed()

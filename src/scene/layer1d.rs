@@ -28,7 +28,7 @@
 //! norms exactly by splitting each element at the fronts of both components (§1.4's method).
 //! Energy identity: E(t) = E⁰ − W_f(t), W_f(t) = σ_t*·v_slip·|W ∩ [0, t]|.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
 use crate::contact::friction::FrictionLaw;
 
 /// The scene `layer1d` (contract §1.7).
@@ -83,14 +83,12 @@ impl Layer1dScene {
 }
 
 impl Scene for Layer1dScene {
-    fn name(&self) -> &'static str {
-        "layer1d"
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &LAYER1D_PHYSICS
-    }
-    fn default_t(&self) -> f64 {
-        2.5
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: "layer1d",
+            physics: &LAYER1D_PHYSICS,
+            default_t: 2.5,
+        }
     }
     /// c0 = c_p (the Courant number of the faster, normal, chain).
     fn wave_speed(&self, physics: &Physics) -> f64 {

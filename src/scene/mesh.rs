@@ -41,7 +41,8 @@
 use std::path::Path;
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene,
+    SceneFacts, SceneSetup,
 };
 use crate::space::fe::{GmshMesh, Mesh};
 
@@ -108,15 +109,13 @@ impl Scene for MeshScene {
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }
-    fn name(&self) -> &'static str {
-        if self.dim == 2 { "mesh2d" } else { "mesh3d" }
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &MESH_PHYSICS
-    }
-    /// The bars' T: a body of unit size at the bars' wave speed.
-    fn default_t(&self) -> f64 {
-        2.0
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: if self.dim == 2 { "mesh2d" } else { "mesh3d" },
+            physics: &MESH_PHYSICS,
+            // The bars' T: a body of unit size at the bars' wave speed.
+            default_t: 2.0,
+        }
     }
     fn wave_speed(&self, p: &Physics) -> f64 {
         ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()

@@ -107,15 +107,34 @@ impl SceneSetup {
     }
 }
 
-/// A physical problem, as the planner sees it.
-pub trait Scene: Send + Sync {
+/// What names a scene and frames its runs: data, so a scene states it once.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneFacts {
     /// The `scene` value of sweep files.
-    fn name(&self) -> &'static str;
+    pub name: &'static str,
     /// Physics keys this scene accepts, with their defaults (besides discretisation and method
     /// keys, which every scene accepts).
-    fn physics(&self) -> &'static [PhysicsKey];
+    pub physics: &'static [PhysicsKey],
     /// Default final time T.
-    fn default_t(&self) -> f64;
+    pub default_t: f64,
+}
+
+/// A physical problem, as the planner sees it.
+pub trait Scene: Send + Sync {
+    /// Its name, physics keys and default final time.
+    fn facts(&self) -> SceneFacts;
+    /// The `scene` value of sweep files.
+    fn name(&self) -> &'static str {
+        self.facts().name
+    }
+    /// Physics keys this scene accepts, with their defaults.
+    fn physics(&self) -> &'static [PhysicsKey] {
+        self.facts().physics
+    }
+    /// Default final time T.
+    fn default_t(&self) -> f64 {
+        self.facts().default_t
+    }
     /// Wave speed c0 (courant → dt = ν h / c0): √(E/ρ) in 1D, the P-wave speed √((λ+2μ)/ρ)
     /// in 2D/3D.
     fn wave_speed(&self, physics: &Physics) -> f64;

@@ -21,7 +21,7 @@
 //! The scene has no mesh: `elements` = 1 and h = 1 are reported, and the wave speed is ω, so
 //! `courant` reads as the dimensionless step ω·τ.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneSetup};
+use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
 use crate::time::Scheme;
 
 /// The scene `oscillator` (contract §1.5).
@@ -83,14 +83,12 @@ impl OscillatorScene {
 const NO_MESH: &str = "scene oscillator has no mesh (one mass, one spring): leave h and elements out; give dt, or courant = ω·dt";
 
 impl Scene for OscillatorScene {
-    fn name(&self) -> &'static str {
-        "oscillator"
-    }
-    fn physics(&self) -> &'static [PhysicsKey] {
-        &OSCILLATOR_PHYSICS
-    }
-    fn default_t(&self) -> f64 {
-        10.0
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: "oscillator",
+            physics: &OSCILLATOR_PHYSICS,
+            default_t: 10.0,
+        }
     }
     fn wave_speed(&self, physics: &Physics) -> f64 {
         Self::params(physics).omega()
