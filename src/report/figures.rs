@@ -497,7 +497,8 @@ mod tests {
             (4.0, 3.0),
             (5.0, -0.0),
         ];
-        let by = |f: fn(std::slice::Iter<'_, (f64, f64)>) -> Option<&(f64, f64)>| {
+        type Pick = fn(std::slice::Iter<'_, (f64, f64)>) -> Option<&(f64, f64)>;
+        let by = |f: Pick| {
             let p = f(chunk.iter()).unwrap();
             chunk.iter().position(|q| std::ptr::eq(q, p)).unwrap()
         };

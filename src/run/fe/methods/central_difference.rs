@@ -46,7 +46,7 @@ impl MethodRun<'_> {
         if let Some(fr) = fric.as_mut() {
             fr.kinematic(u, v, diag, tau);
         }
-        g.k.matvec_into(&u, ku);
+        g.k.matvec_into(u, ku);
         for i in 0..n {
             a[i] = (force_vec[i] - ku[i]) / diag[i];
             v[i] += 0.5 * tau * a[i];

@@ -53,19 +53,19 @@ impl MethodRun<'_> {
             *qi = pred[ci] + gi;
         }
         let it = lp
-            .solve(&q, nu, LCP_MAX_ITER, LCP_TOL)
+            .solve(q, nu, LCP_MAX_ITER, LCP_TOL)
             .map_err(|e| Stop::Solver(step, format!("predictor: {e}")))?;
         *iterations += it as i64;
-        add_columns(&mi.zm, &nu, 1.0, pred);
+        add_columns(&mi.zm, nu, 1.0, pred);
         // K u^pred = Kuⁿ + τKvⁿ + (KM⁻¹Bᵀ)ν, from the carried products.
         for i in 0..n {
             tmp[i] = ku[i] + tau * kv[i];
         }
-        add_columns(&mi.kzm, &nu, 1.0, tmp);
+        add_columns(&mi.kzm, nu, 1.0, tmp);
         for i in 0..n {
             y[i] = -c * (ku[i] + tmp[i]) + 2.0 * c * force_vec[i];
         }
-        sd.copy_from_slice(&y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
@@ -76,7 +76,7 @@ impl MethodRun<'_> {
             f,
             &g.contact,
             gaps,
-            &pred,
+            pred,
             |r| pred[r] - u[r],
             c,
             (q, lambda),
@@ -86,7 +86,7 @@ impl MethodRun<'_> {
         .map_err(|e| Stop::Solver(step, e))?;
         *newton_max = (*newton_max).max(it + it2);
         *iterations += it2 as i64;
-        g.k.matvec_into(&y, kd);
+        g.k.matvec_into(y, kd);
         for i in 0..n {
             let md = sd[i] - c * kd[i];
             v[i] += 2.0 * y[i] / tau;

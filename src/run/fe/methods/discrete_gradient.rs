@@ -43,17 +43,17 @@ impl MethodRun<'_> {
         for i in 0..n {
             y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
         }
-        add_theta_term(ops, &u, 2.0 * c, y);
-        sd.copy_from_slice(&y);
+        add_theta_term(ops, u, 2.0 * c, y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         for k in 0..ops.len() {
-            let sn = ops.apply(&ops.p, k, &u);
+            let sn = ops.apply(&ops.p, k, u);
             grad_work.a[k] = sn - ops.gap[k];
-            q[k] = sn + ops.apply(&ops.p, k, &y);
+            q[k] = sn + ops.apply(&ops.p, k, y);
         }
-        let it = gradient_newton(ops, &f.h, 2.0 * c, &q, grad_work)
+        let it = gradient_newton(ops, &f.h, 2.0 * c, q, grad_work)
             .map_err(|e| Stop::Solver(step, e))?;
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
@@ -61,7 +61,7 @@ impl MethodRun<'_> {
         for (l, dq) in lambda.iter_mut().zip(&grad_work.d) {
             *l = 2.0 * dq;
         }
-        add_columns(&f.z, &lambda, c, y);
+        add_columns(&f.z, lambda, c, y);
         for (k, l) in lambda.iter().enumerate() {
             if *l != 0.0 {
                 for (&gd, &ck) in ops.dofs[k * ops.k..(k + 1) * ops.k]
@@ -73,11 +73,11 @@ impl MethodRun<'_> {
             }
         }
         // MΔ = AΔ − cK_ΘΔ with KΔ by one product.
-        g.k.matvec_into(&y, kd);
+        g.k.matvec_into(y, kd);
         for i in 0..n {
             sd[i] -= c * kd[i];
         }
-        add_theta_term(ops, &y, c, sd);
+        add_theta_term(ops, y, c, sd);
         for i in 0..n {
             v[i] = 2.0 * y[i] / tau - v[i];
             mv[i] = 2.0 * sd[i] / tau - mv[i];

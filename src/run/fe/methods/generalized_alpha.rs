@@ -61,9 +61,9 @@ impl MethodRun<'_> {
             pred[i] = u[i] + tau * v[i] + kp * a[i];
             y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
         }
-        add_theta_term(ops, &u, kf, y);
-        add_point_columns(ops, &lambda_prev, kf, y);
-        sd.copy_from_slice(&y);
+        add_theta_term(ops, u, kf, y);
+        add_point_columns(ops, lambda_prev, kf, y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
@@ -71,36 +71,36 @@ impl MethodRun<'_> {
             // Friction (nitsche.rs header, coefficient c): x0 = P y +
             // k u_tⁿ (the slip from uⁿ), λ the previous step's forces
             // (the warm start), kept for f̄_t.
-            st.start_step(ops, &y, &u, q);
+            st.start_step(ops, y, u, q);
             newton_friction(
                 ops,
                 st.law,
                 &f.h,
                 c,
-                &q,
+                q,
                 lambda,
                 &mut st.slides,
                 newton_work,
             )
         } else {
             for (k, qk) in q.iter_mut().enumerate() {
-                *qk = ops.apply(&ops.p, k, &y);
+                *qk = ops.apply(&ops.p, k, y);
             }
-            newton(ops, &f.h, c, &q, &ops.gap, lambda, newton_work)
+            newton(ops, &f.h, c, q, &ops.gap, lambda, newton_work)
         }
         .map_err(|e| Stop::Solver(step, e))?;
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
-        add_columns(&f.z, &lambda, c, y);
-        add_point_columns(ops, &lambda, c, sd);
-        lambda_prev.copy_from_slice(&lambda);
+        add_columns(&f.z, lambda, c, y);
+        add_point_columns(ops, lambda, c, sd);
+        lambda_prev.copy_from_slice(lambda);
         // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
         std::mem::swap(u, y);
-        g.k.matvec_into(&u, ku);
+        g.k.matvec_into(u, ku);
         for i in 0..n {
             sd[i] -= c * ku[i];
         }
-        add_theta_term(ops, &u, c, sd);
+        add_theta_term(ops, u, c, sd);
         let g1 = 1.0 - ga.gamma;
         for i in 0..n {
             let an = (u[i] - pred[i]) / bt2;
@@ -163,17 +163,17 @@ impl MethodRun<'_> {
             pred[i] = u[i] + tau * v[i] + kp * a[i];
             y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
         }
-        add_rows(&g.contact, &lambda_prev, kf, y);
+        add_rows(&g.contact, lambda_prev, kf, y);
         if let Some(fr) = fric.as_ref() {
             fr.add_previous_tangential(kf, y);
         }
-        sd.copy_from_slice(&y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         let it = if let Some(fr) = fric.as_mut() {
             // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
-            fr.set_free(&y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
+            fr.set_free(y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
             let it = fr
                 .solve(c, false, y, sd, lambda)
                 .map_err(|e| Stop::Solver(step, e))?;
@@ -184,19 +184,19 @@ impl MethodRun<'_> {
                 *qi = y[ci] + gi;
             }
             let it = lcp
-                .solve(&q, lambda, LCP_MAX_ITER, LCP_TOL)
+                .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
-            add_columns(&f.z, &lambda, c, y);
-            add_rows(&g.contact, &lambda, c, sd);
+            add_columns(&f.z, lambda, c, y);
+            add_rows(&g.contact, lambda, c, sd);
             it
         };
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
-        lambda_prev.copy_from_slice(&lambda);
+        lambda_prev.copy_from_slice(lambda);
         // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
         // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
         std::mem::swap(u, y);
-        g.k.matvec_into(&u, ku);
+        g.k.matvec_into(u, ku);
         let g1 = 1.0 - ga.gamma;
         for i in 0..n {
             let an = (u[i] - pred[i]) / bt2;

@@ -43,7 +43,7 @@ impl MethodRun<'_> {
         for i in 0..n {
             y[i] = tau * mv[i] - 2.0 * c * ku[i] + 2.0 * c * force_vec[i];
         }
-        sd.copy_from_slice(&y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
@@ -54,7 +54,7 @@ impl MethodRun<'_> {
             f,
             &g.contact,
             gaps,
-            &u,
+            u,
             |_| 0.0,
             c,
             (q, lambda),
@@ -65,7 +65,7 @@ impl MethodRun<'_> {
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
         // One product: KΔ; then MΔ = SΔ − cKΔ (no division by c).
-        g.k.matvec_into(&y, kd);
+        g.k.matvec_into(y, kd);
         for i in 0..n {
             let md = sd[i] - c * kd[i];
             v[i] = 2.0 * y[i] / tau - v[i];

@@ -49,7 +49,7 @@ impl MethodRun<'_> {
         for i in 0..n {
             y[i] = -tau * (ku[i] + mj.theta * tau * kv[i]) + tau * force_vec[i];
         }
-        sd.copy_from_slice(&y);
+        sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
@@ -68,12 +68,12 @@ impl MethodRun<'_> {
             // De Saxcé on velocities over the active nodes: "gap" =
             // Bv^{n+1} + eBvⁿ (q as above), slip = v_t^{n+1} = T(vⁿ + Δv).
             if any {
-                fr.set_free(&y, |r| v[r], |j| q[j]);
+                fr.set_free(y, |r| v[r], |j| q[j]);
                 fr.implicit
                     .as_mut()
                     .expect("attached")
                     .active
-                    .copy_from_slice(&rows);
+                    .copy_from_slice(rows);
                 let it = fr
                     .solve(c, true, y, sd, lambda)
                     .map_err(|e| Stop::Solver(step, e))?;
@@ -87,16 +87,16 @@ impl MethodRun<'_> {
             fr.take_forces(c / tau);
         } else if any {
             let it = lcp
-                .solve_on(&q, lambda, &rows, LCP_MAX_ITER, LCP_TOL)
+                .solve_on(q, lambda, rows, LCP_MAX_ITER, LCP_TOL)
                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
             *newton_max = (*newton_max).max(it);
             *iterations += it as i64;
-            add_columns(&f.z, &lambda, c, y);
-            add_rows(&g.contact, &lambda, c, sd);
+            add_columns(&f.z, lambda, c, y);
+            add_rows(&g.contact, lambda, c, sd);
         } else {
             lambda.iter_mut().for_each(|l| *l = 0.0);
         }
-        g.k.matvec_into(&y, kd);
+        g.k.matvec_into(y, kd);
         for i in 0..n {
             let md = sd[i] - c * kd[i];
             u[i] += tau * (v[i] + mj.theta * y[i]);
