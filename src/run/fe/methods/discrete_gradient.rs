@@ -53,8 +53,8 @@ impl MethodRun<'_> {
             grad_work.a[k] = sn - ops.gap[k];
             q[k] = sn + ops.apply(&ops.p, k, y);
         }
-        let it = gradient_newton(ops, &f.h, 2.0 * c, q, grad_work)
-            .map_err(|e| Stop::Solver(step, e))?;
+        let it =
+            gradient_newton(ops, &f.h, 2.0 * c, q, grad_work).map_err(|e| Stop::Solver(step, e))?;
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
         // Δu = y + τ²/2 Z D = y + c Z (2D); A Δu = b + c Σ 2D_q C_q.

@@ -72,16 +72,7 @@ impl MethodRun<'_> {
             // k u_tⁿ (the slip from uⁿ), λ the previous step's forces
             // (the warm start), kept for f̄_t.
             st.start_step(ops, y, u, q);
-            newton_friction(
-                ops,
-                st.law,
-                &f.h,
-                c,
-                q,
-                lambda,
-                &mut st.slides,
-                newton_work,
-            )
+            newton_friction(ops, st.law, &f.h, c, q, lambda, &mut st.slides, newton_work)
         } else {
             for (k, qk) in q.iter_mut().enumerate() {
                 *qk = ops.apply(&ops.p, k, y);
