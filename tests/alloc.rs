@@ -279,7 +279,7 @@ fn bar2d_comparison_methods_allocate_nothing() {
 /// the active mask), generalized-α (f_tⁿ in the right-hand side), kinematic central
 /// difference's local projection — bar2d (d = 2) and bar3d (the disc's linearised
 /// projection); and generalized-α/HHT with Nitsche (Θ = 0, 1) and the penalty, whose
-/// frictional Newton and state (fe_nitsche) are made at setup.
+/// frictional Newton and state (run/fe/nitsche.rs) are made at setup.
 #[test]
 fn frictional_comparison_methods_allocate_nothing() {
     let methods = [

@@ -590,7 +590,7 @@ fn binary_data_size_of_0_3_or_25_digits_is_refused() {
 #[test]
 fn point_element_in_a_contact_curve_is_refused_at_read() {
     // A point (Gmsh type 15) in the contact curve's block panicked inside every run
-    // (src/run/fe.rs, an index out of bounds on the face's second node).
+    // (src/run/fe/, an index out of bounds on the face's second node).
     let text = edit("1 1 1 1\n1 1 2\n", "1 1 15 1\n1 1\n");
     match refused(&text) {
         GmshError::Parse { error, .. } => {

@@ -8,7 +8,7 @@
 //! 0.5 e_1 and reaches the plane at t = 10 with the normal velocity 1; μ_f = 0.2. The columns
 //! (contract §5): E(T) + W_f − E⁰ (`energy_balance_drift`) and its largest one-step rise over
 //! `energy_scale`, W_f(T) (`friction_work`), max |Σf_t|/Σf_n (`friction_ratio_max`; Nitsche's
-//! sums over its quadrature points in contact, `run::fe_nitsche`), the mean velocities
+//! sums over its quadrature points in contact, `run::fe::nitsche`), the mean velocities
 //! v̄_1(T) and v̄_d(T) (1ᵀMv/1ᵀM1 along e_1, e_d), `max_penetration`, stick/slip node-steps and contact phases. Besides
 //! the printed figures, the properties that hold whatever the digits:
 //! - |Σf_t| ≤ μ_f Σf_n at every contact step, for every method;

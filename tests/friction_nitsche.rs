@@ -615,7 +615,7 @@ fn generalized_alpha_rho_one_is_crank_nicolson_on_the_thrown_disc() {
 
 /// The allowance on a step's own tangential work −Σ f_t^{n+1}·Δu_t ≥ 0, relative to the run's
 /// |W_f|: the tangential rows are solved to their round-off floor, which at stick on bar2d is
-/// ~1e-7 of the traction (x_n = P_γ ≈ g quantises the penetration, fe_nitsche's
+/// ~1e-7 of the traction (x_n = P_γ ≈ g quantises the penetration, run/fe/nitsche.rs's
 /// `NEWTON_FLOOR_TOL`). Measured: −2.7e-10 energy scales against |W_f| = 2.3e-3 (ρ∞ = 0.5,
 /// Θ = 0) and −1.9e-9 against 4.5e-2 (CN, Θ = 1): ≤ 1.2e-7 of |W_f|; 1e-6 leaves a factor 8.
 /// The penalty's and backward Euler's minima are 0 exactly (measured).
@@ -626,7 +626,7 @@ const OWN_WORK_ALLOWANCE: f64 = 1e-6;
 /// each step's own tangential work −Σ f_t^{n+1}·Δu_t is ≥ 0 (the law's sign; for Nitsche
 /// summed over Γ_C), to [`OWN_WORK_ALLOWANCE`], |f_t| ≤ μ_f f_n, and the
 /// rows are ok — ρ∞ = 0.5 with Nitsche Θ = 0 failed at step 65 before the frictional Newton
-/// left the kinks it stalled on (fe_nitsche). W_f itself is not monotone here: its increment
+/// left the kinks it stalled on (run/fe/nitsche.rs). W_f itself is not monotone here: its increment
 /// −Σ f̄_t·Δu_t weighs f_tⁿ by α_f, and where the traction turns within a step the mix has the
 /// other sign (measured: HHT Θ = 0 loses 9.2e-6 of its final W_f 9.8e-5 in one step; ρ∞ = 0.5
 /// Θ = 1 ends at W_f = −9.5e-4). Backward Euler (f̄ = f^{n+1}) has it monotone, above.
@@ -696,7 +696,7 @@ method = [
     }
 }
 
-/// Regression (fe_nitsche's frictional Newton, `NEWTON_FLOOR_TOL`): bar2d, Crank–Nicolson,
+/// Regression (run/fe/nitsche.rs's frictional Newton, `NEWTON_FLOOR_TOL`): bar2d, Crank–Nicolson,
 /// Nitsche Θ = 0 and 1 (γ0 = 1e-3), Coulomb 0.3 failed at step 32 (the impact) with "did not
 /// converge in 100 iterations (residuals 3.6e-16 normal, 1.7e-11 tangential)": every point
 /// stuck, x_n = P_γ ≈ g = 0.2 with a penetration of 1.8e-8, so one ulp of x_n moves a
@@ -738,7 +738,7 @@ method = [
     }
 }
 
-/// Regression (fe_nitsche's frictional Newton, the full step where no halving descends):
+/// Regression (run/fe/nitsche.rs's frictional Newton, the full step where no halving descends):
 /// bar2d with the penalty (γ0 = 100) and Tresca failed at step 34 (backward Euler, s = 0.05:
 /// "residuals 3.7e-3 normal, 4.4e-1 tangential") and at step 32 (Crank–Nicolson, s = 0.02,
 /// 0.05, 0.1; Coulomb 0.3 too). At step 34 every point sat just below its gap (x_n = g − 3e-10,
