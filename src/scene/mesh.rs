@@ -15,7 +15,7 @@
 //! given by its height instead, `obstacle` (exclusive with `gap`): the planner turns it into
 //! the gap it names, so both spellings of one plane are one run with one id. Loads: `gravity`
 //! (per unit mass, towards the obstacle, default 0) and the initial velocity `velocity` e_d on
-//! every node not clamped (default 0; negative moves towards the obstacle). contract §1.8 adds
+//! every node not clamped (default 0; negative moves towards the obstacle). Contract §1.8 adds
 //! `velocity_tangential` (the initial e_1 velocity of every node not clamped) and `incline`
 //! (α in degrees, |α| < 90: the plane tilted by α, the volume load ρ·gravity·(sin α e_1 −
 //! cos α e_d), so the body slides down +e_1), both default 0. Material defaults

@@ -52,7 +52,7 @@ use super::runs::{Run, Runs};
 use super::table::{self, Table, TextTable, text_columns};
 
 /// A one-step increase of a provably non-increasing functional above this fraction of its
-/// initial value is growth. contract §6: the schemes that provably do not gain energy stay below
+/// initial value is growth. Contract §6: the schemes that provably do not gain energy stay below
 /// 1e-12·E⁰ (worst seen 5e-13), so 1e-10 leaves two decades for rounding.
 pub const ENERGY_TOL: f64 = 1e-10;
 
