@@ -32,7 +32,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 use contact_sweep::exec::{self, ExecOptions};
 use contact_sweep::run::bar1d::Bar1dConfig;
-use contact_sweep::run::{RunConfig, RunOptions, simulate};
+use contact_sweep::run::{Grid1d, RunConfig, RunOptions, simulate};
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{Bar1dSpace, ContactMethod, MassVariant, TridiagLu};
 use contact_sweep::sweep::{self, SweepFile};
@@ -42,12 +42,7 @@ fn config(method: ContactMethod, mass: MassVariant, scheme: Scheme) -> RunConfig
     let m = 1000;
     RunConfig::Bar1d(Bar1dConfig::new(
         BarParams::default(),
-        m,
-        1.0 / m as f64,
-        3.0,
-        method,
-        mass,
-        scheme,
+        Grid1d::new(m, 1.0 / m as f64, 3.0, method, mass, scheme),
     ))
 }
 
@@ -182,18 +177,17 @@ fn wanted(name: &str) -> bool {
 /// Thomas side of the ratio tables.
 fn cn_run_and_factor(m: usize, steps: usize) -> (RunConfig, TridiagLu) {
     let dt = 1.0 / m as f64;
-    let cfg = RunConfig::Bar1d(Bar1dConfig {
-        steps,
-        ..Bar1dConfig::new(
-            BarParams::default(),
+    let cfg = RunConfig::Bar1d(Bar1dConfig::new(
+        BarParams::default(),
+        Grid1d::with_steps(
             m,
             dt,
-            1.0,
+            steps,
             ContactMethod::Mixed,
             MassVariant::Mod3,
             Scheme::Newmark(NewmarkParams::crank_nicolson()),
-        )
-    });
+        ),
+    ));
     let sp = Bar1dSpace::new(
         BarParams::default(),
         m,
@@ -396,10 +390,10 @@ fn scheme_ratio(c: &mut Criterion) {
             };
             let dt = nu / m as f64;
             let cfg = |method, mass, scheme| {
-                RunConfig::Bar1d(Bar1dConfig {
-                    steps,
-                    ..Bar1dConfig::new(BarParams::default(), m, dt, 1.0, method, mass, scheme)
-                })
+                RunConfig::Bar1d(Bar1dConfig::new(
+                    BarParams::default(),
+                    Grid1d::with_steps(m, dt, steps, method, mass, scheme),
+                ))
             };
             let (a, b) = (
                 cfg(*method, mass.clone(), *scheme),

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use contact_sweep::contact::friction::FrictionLaw;
 use contact_sweep::run::layer1d::{Layer1dConfig, simulate_with_stats};
-use contact_sweep::run::{RunOptions, Status};
+use contact_sweep::run::{Grid1d, RunOptions, Status};
 use contact_sweep::scene::LayerParams;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
@@ -30,7 +30,7 @@ fn config(
         ..LayerParams::default()
     };
     let dt = 0.5 / m as f64 / layer.c_p();
-    Layer1dConfig::new(layer, m, dt, 2.5, method, mass, scheme)
+    Layer1dConfig::new(layer, Grid1d::new(m, dt, 2.5, method, mass, scheme))
 }
 
 fn time(cfg: &Layer1dConfig, opts: &RunOptions) -> f64 {

@@ -3,6 +3,7 @@
 mod common;
 
 use common::*;
+use contact_sweep::run::Grid1d;
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
@@ -129,22 +130,19 @@ fn non_default_bar_scales_exactly_onto_the_default() {
         let dt_hat = nu / m as f64;
         let d = ok(bar1d(
             BarParams::default(),
-            m,
-            dt_hat,
-            12.0,
-            ContactMethod::Mixed,
-            MassVariant::Mod3,
-            CN,
+            Grid1d::new(m, dt_hat, 12.0, ContactMethod::Mixed, MassVariant::Mod3, CN),
             1,
         ));
         let s = ok(bar1d(
             p,
-            m,
-            dt_hat * p.length / c0,
-            12.0 * p.length / c0,
-            ContactMethod::Mixed,
-            MassVariant::Mod3,
-            CN,
+            Grid1d::new(
+                m,
+                dt_hat * p.length / c0,
+                12.0 * p.length / c0,
+                ContactMethod::Mixed,
+                MassVariant::Mod3,
+                CN,
+            ),
             1,
         ));
         assert_eq!(d.metrics.steps, s.metrics.steps);
@@ -190,12 +188,14 @@ fn non_default_bar_scales_exactly_onto_the_default() {
     let contact_err = |m: usize| {
         let o = ok(bar1d(
             p,
-            m,
-            (1.0 / m as f64) * p.length / c0,
-            12.0 * p.length / c0,
-            ContactMethod::Mixed,
-            MassVariant::Mod3,
-            CN,
+            Grid1d::new(
+                m,
+                (1.0 / m as f64) * p.length / c0,
+                12.0 * p.length / c0,
+                ContactMethod::Mixed,
+                MassVariant::Mod3,
+                CN,
+            ),
             1,
         ));
         o.series
@@ -229,12 +229,7 @@ fn mass_totals_reported_per_run() {
     ] {
         let o = ok(bar1d(
             BarParams::default(),
-            m,
-            0.05,
-            1.0,
-            ContactMethod::Mixed,
-            mass.clone(),
-            CN,
+            Grid1d::new(m, 0.05, 1.0, ContactMethod::Mixed, mass.clone(), CN),
             0,
         ));
         // A sum of 4m entries of size ≤ h: round-off ≤ 4m·ε ≈ 1e-14.

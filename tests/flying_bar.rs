@@ -7,6 +7,7 @@
 mod common;
 
 use common::*;
+use contact_sweep::run::Grid1d;
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, Scheme};
@@ -224,12 +225,7 @@ fn no_closed_form_means_null_errors() {
         assert!(p.exact().is_none());
         let o = ok(bar1d(
             p,
-            10,
-            0.05,
-            1.0,
-            ContactMethod::Mixed,
-            MassVariant::Mod3,
-            CN,
+            Grid1d::new(10, 0.05, 1.0, ContactMethod::Mixed, MassVariant::Mod3, CN),
             0,
         ));
         assert_eq!(o.metrics.err_u_l2l2, None);
@@ -303,12 +299,14 @@ fn siconos_contact_pressure_is_rho_c_v() {
     let p = siconos();
     let o = ok(bar1d(
         p,
-        100,
-        1e-6,
-        1.5e-3,
-        ContactMethod::Mixed,
-        MassVariant::Mod3,
-        CN,
+        Grid1d::new(
+            100,
+            1e-6,
+            1.5e-3,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            CN,
+        ),
         1,
     ));
     let rho_c_v = p.density * p.wave_speed() * -p.velocity;
@@ -347,7 +345,11 @@ fn flying_ladder(
         .iter()
         .map(|&m| {
             let h = 1.0 / m as f64;
-            let o = ok(bar1d(p, m, nu * h, 3.0, method, mass.clone(), scheme, 0));
+            let o = ok(bar1d(
+                p,
+                Grid1d::new(m, nu * h, 3.0, method, mass.clone(), scheme),
+                0,
+            ));
             (
                 h,
                 o.metrics.err_u_l2l2.unwrap(),

@@ -4,7 +4,7 @@
 
 use contact_sweep::contact::friction::FrictionLaw;
 use contact_sweep::run::layer1d::{FrictionStats, Layer1dConfig, simulate_with_stats};
-use contact_sweep::run::{Outcome, RunOptions, Status};
+use contact_sweep::run::{Grid1d, Outcome, RunOptions, Status};
 use contact_sweep::scene::LayerParams;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{
@@ -105,14 +105,16 @@ fn spec_friction_table() {
     for (v_t, mu, mass, scheme, want) in rows {
         let cfg = Layer1dConfig::new(
             layer(v_t, mu),
-            80,
-            1.0 / 320.0,
-            2.5,
-            ContactMethod::Mixed,
-            mass.clone(),
-            scheme,
+            Grid1d::new(
+                80,
+                1.0 / 320.0,
+                2.5,
+                ContactMethod::Mixed,
+                mass.clone(),
+                scheme,
+            ),
         );
-        assert_eq!(cfg.steps, 800);
+        assert_eq!(cfg.grid.steps, 800);
         let (out, st) = run(&cfg);
         let m = &out.metrics;
         let got = [
@@ -140,12 +142,14 @@ fn spec_friction_table() {
 fn consistent_mass_crank_nicolson_gains_energy() {
     let cfg = Layer1dConfig::new(
         layer(1.0, 0.1),
-        80,
-        1.0 / 320.0,
-        2.5,
-        ContactMethod::Mixed,
-        MassVariant::Consistent,
-        CN,
+        Grid1d::new(
+            80,
+            1.0 / 320.0,
+            2.5,
+            ContactMethod::Mixed,
+            MassVariant::Consistent,
+            CN,
+        ),
     );
     let (out, _) = run(&cfg);
     let m = &out.metrics;
@@ -191,13 +195,16 @@ fn energy_plus_friction_work_never_rises() {
         let masses = [MassVariant::Consistent, MassVariant::Lumped];
         let mass = masses[draw % 2].clone();
         for scheme in [Scheme::Kane, MJ0, MJ1, CN, Scheme::ContactStabilizedNewmark] {
-            let cfg = Layer1dConfig::new(p, m, dt, 2.5, ContactMethod::Mixed, mass.clone(), scheme);
+            let cfg = Layer1dConfig::new(
+                p,
+                Grid1d::new(m, dt, 2.5, ContactMethod::Mixed, mass.clone(), scheme),
+            );
             let (_, st) = run(&cfg);
             match scheme {
                 Scheme::Kane => worst_kane = worst_kane.max(st.energy_balance_max_increase),
                 s if s == MJ0 => worst_mj = worst_mj.max(st.energy_balance_max_increase),
                 s if s == MJ1 => {
-                    worst_mj1 = worst_mj1.max(st.energy_balance_drift.abs() / cfg.steps as f64)
+                    worst_mj1 = worst_mj1.max(st.energy_balance_drift.abs() / cfg.grid.steps as f64)
                 }
                 _ => {}
             }
@@ -254,7 +261,8 @@ fn zero_friction_is_frictionless_bit_for_bit() {
                     friction: law,
                     ..LayerParams::default()
                 };
-                let cfg = Layer1dConfig::new(p, 24, 0.01, 1.5, method, mass.clone(), scheme);
+                let cfg =
+                    Layer1dConfig::new(p, Grid1d::new(24, 0.01, 1.5, method, mass.clone(), scheme));
                 run(&cfg)
             };
             let (none, sn) = go(FrictionLaw::None);
@@ -284,7 +292,8 @@ fn zero_friction_is_frictionless_bit_for_bit() {
                 friction: FrictionLaw::Coulomb { coefficient: 0.4 },
                 ..LayerParams::default()
             };
-            let cfg = Layer1dConfig::new(p, 24, 0.01, 1.5, method, mass.clone(), scheme);
+            let cfg =
+                Layer1dConfig::new(p, Grid1d::new(24, 0.01, 1.5, method, mass.clone(), scheme));
             let (fric, _) = run(&cfg);
             let bar =
                 contact_sweep::run::bar1d::simulate(&cfg.normal_chain(), &RunOptions::default());
@@ -336,7 +345,7 @@ fn friction_layer_sweep_matches_the_methods_table() {
         };
         let method = spec.label.split(" · coulomb").next().unwrap().to_string();
         rows.entry((regime.into(), method)).or_default().push([
-            1.0 / cfg.elements as f64,
+            1.0 / cfg.grid.elements as f64,
             m.err_u_l2l2.unwrap(),
             m.err_u_l2h1.unwrap(),
             st.tangential_velocity_final,

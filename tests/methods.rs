@@ -5,6 +5,7 @@
 mod common;
 
 use common::*;
+use contact_sweep::run::Grid1d;
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactInit, ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, PaoliSchatzmanParams, Scheme};
@@ -30,12 +31,7 @@ fn massless_contact_variants_start_quasi_static_and_conserve_energy_with_cn() {
     ] {
         let o = ok(bar1d(
             BarParams::default(),
-            100,
-            0.015,
-            12.0,
-            ContactMethod::Mixed,
-            mass.clone(),
-            CN,
+            Grid1d::new(100, 0.015, 12.0, ContactMethod::Mixed, mass.clone(), CN),
             1,
         ));
         let e0 = o.metrics.energy_initial.unwrap();
@@ -58,12 +54,14 @@ fn penalty_penetration_scales_with_the_inverse_stiffness() {
     let penetration = |g: f64| {
         let o = ok(bar1d(
             BarParams::default(),
-            100,
-            0.01,
-            3.0,
-            ContactMethod::Penalty { gamma0: g },
-            MassVariant::Consistent,
-            Scheme::Hybrid,
+            Grid1d::new(
+                100,
+                0.01,
+                3.0,
+                ContactMethod::Penalty { gamma0: g },
+                MassVariant::Consistent,
+                Scheme::Hybrid,
+            ),
             1,
         ));
         o.series.rows().map(|r| -r.u_contact).fold(0.0, f64::max)
@@ -84,15 +82,17 @@ fn paoli_schatzman_restitution_controls_the_impact_energy() {
     let run = |mass: MassVariant, e: f64| {
         ok(bar1d(
             BarParams::default(),
-            6,
-            0.01,
-            12.0,
-            ContactMethod::Mixed,
-            mass,
-            Scheme::PaoliSchatzman(PaoliSchatzmanParams {
-                beta: 0.25,
-                restitution: e,
-            }),
+            Grid1d::new(
+                6,
+                0.01,
+                12.0,
+                ContactMethod::Mixed,
+                mass,
+                Scheme::PaoliSchatzman(PaoliSchatzmanParams {
+                    beta: 0.25,
+                    restitution: e,
+                }),
+            ),
             0,
         ))
     };
@@ -118,24 +118,28 @@ fn central_difference_below_its_cfl_limit_is_stable() {
     // planner); at ν = 0.5 central difference keeps the energy within 0.1 % (symplectic).
     let o = ok(bar1d(
         BarParams::default(),
-        100,
-        0.005,
-        12.0,
-        ContactMethod::Mixed,
-        MassVariant::Mod3,
-        Scheme::Newmark(NewmarkParams::central_difference()),
+        Grid1d::new(
+            100,
+            0.005,
+            12.0,
+            ContactMethod::Mixed,
+            MassVariant::Mod3,
+            Scheme::Newmark(NewmarkParams::central_difference()),
+        ),
         0,
     ));
     assert!((energy_ratio(&o) - 1.0).abs() < 1e-3);
     // Lumped mass with the penalty: ν = 0.8 below the lumped limit of 1.
     let o = ok(bar1d(
         BarParams::default(),
-        100,
-        0.008,
-        12.0,
-        ContactMethod::Penalty { gamma0: 1.0 },
-        MassVariant::Lumped,
-        Scheme::Newmark(NewmarkParams::central_difference()),
+        Grid1d::new(
+            100,
+            0.008,
+            12.0,
+            ContactMethod::Penalty { gamma0: 1.0 },
+            MassVariant::Lumped,
+            Scheme::Newmark(NewmarkParams::central_difference()),
+        ),
         0,
     ));
     assert!((energy_ratio(&o) - 1.0).abs() < 1e-3);
@@ -151,12 +155,7 @@ fn interpolant_start_costs_energy_once_where_the_node_row_holds_at_the_new_time(
         let o = ok(bar1d_start(
             ContactInit::Interpolant,
             BarParams::default(),
-            100,
-            0.015,
-            12.0,
-            ContactMethod::Mixed,
-            mass.clone(),
-            CN,
+            Grid1d::new(100, 0.015, 12.0, ContactMethod::Mixed, mass.clone(), CN),
             1,
         ));
         // u₀(0) = a and E⁰ = 1/8, the exact energy (round-off only).
@@ -187,12 +186,14 @@ fn interpolant_start_persists_where_the_node_row_holds_at_the_midpoint() {
         ok(bar1d_start(
             init,
             BarParams::default(),
-            100,
-            0.015,
-            12.0,
-            nitsche(1.0, 1e-6),
-            MassVariant::ZeroContact,
-            Scheme::Hybrid,
+            Grid1d::new(
+                100,
+                0.015,
+                12.0,
+                nitsche(1.0, 1e-6),
+                MassVariant::ZeroContact,
+                Scheme::Hybrid,
+            ),
             1,
         ))
     };

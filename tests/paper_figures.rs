@@ -8,7 +8,7 @@
 mod common;
 
 use common::*;
-use contact_sweep::run::Status;
+use contact_sweep::run::{Grid1d, Status};
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactInit, ContactMethod, MassVariant};
 use contact_sweep::time::{NewmarkParams, PaoliSchatzmanParams, Scheme, ThetaParams};
@@ -22,12 +22,7 @@ const CN: Scheme = Scheme::Newmark(NewmarkParams {
 fn fig(method: ContactMethod, mass: MassVariant, scheme: Scheme) -> contact_sweep::run::Outcome {
     bar1d(
         BarParams::default(),
-        100,
-        0.015,
-        12.0,
-        method,
-        mass,
-        scheme,
+        Grid1d::new(100, 0.015, 12.0, method, mass, scheme),
         1,
     )
 }
@@ -215,12 +210,7 @@ fn zero_contact_cn_energy_depends_on_the_start_of_the_contact_node() {
             let o = ok(bar1d_start(
                 init,
                 BarParams::default(),
-                100,
-                0.015,
-                12.0,
-                method,
-                MassVariant::ZeroContact,
-                CN,
+                Grid1d::new(100, 0.015, 12.0, method, MassVariant::ZeroContact, CN),
                 0,
             ));
             let what = format!("{method:?} zero-contact CN, {init:?} start: E(T)/E0");
@@ -248,12 +238,7 @@ fn p000_start(
     ok(bar1d_start(
         init,
         BarParams::default(),
-        6,
-        0.01,
-        t,
-        ContactMethod::Mixed,
-        mass,
-        scheme,
+        Grid1d::new(6, 0.01, t, ContactMethod::Mixed, mass, scheme),
         0,
     ))
 }
@@ -374,12 +359,7 @@ fn fig10_ladder_h_equals_tau() {
             let h = 1.0 / *m as f64;
             let o = ok(bar1d(
                 BarParams::default(),
-                *m,
-                h,
-                12.0,
-                method,
-                mass.clone(),
-                scheme,
+                Grid1d::new(*m, h, 12.0, method, mass.clone(), scheme),
                 0,
             ));
             // One unit in the last place: the contract's 2.373 for mixed+CN at h = 1/4 is the double
@@ -397,22 +377,19 @@ fn fig10_ladder_h_equals_tau() {
         let h = 1.0 / m as f64;
         let a = ok(bar1d(
             BarParams::default(),
-            m,
-            h,
-            12.0,
-            ContactMethod::Mixed,
-            MassVariant::Consistent,
-            CN,
+            Grid1d::new(
+                m,
+                h,
+                12.0,
+                ContactMethod::Mixed,
+                MassVariant::Consistent,
+                CN,
+            ),
             0,
         ));
         let b = ok(bar1d(
             BarParams::default(),
-            m,
-            h,
-            12.0,
-            nitsche(1.0, 1e-6),
-            MassVariant::Consistent,
-            CN,
+            Grid1d::new(m, h, 12.0, nitsche(1.0, 1e-6), MassVariant::Consistent, CN),
             0,
         ));
         let (x, y) = (a.metrics.err_u_l2h1.unwrap(), b.metrics.err_u_l2h1.unwrap());
@@ -486,12 +463,7 @@ fn methods_of_spec_3_2_table() {
     for (what, method, scheme, printed) in rows {
         let o = ok(bar1d(
             BarParams::default(),
-            100,
-            0.015,
-            12.0,
-            method,
-            MassVariant::Consistent,
-            scheme,
+            Grid1d::new(100, 0.015, 12.0, method, MassVariant::Consistent, scheme),
             0,
         ));
         let m = &o.metrics;
@@ -539,12 +511,14 @@ fn methods_of_spec_3_2_table() {
 fn kinematic_central_difference_row_of_spec_3_2_table() {
     let o = ok(bar1d(
         BarParams::default(),
-        100,
-        0.009,
-        12.0,
-        ContactMethod::Mixed,
-        MassVariant::Lumped,
-        Scheme::Newmark(NewmarkParams::central_difference()),
+        Grid1d::new(
+            100,
+            0.009,
+            12.0,
+            ContactMethod::Mixed,
+            MassVariant::Lumped,
+            Scheme::Newmark(NewmarkParams::central_difference()),
+        ),
         0,
     ));
     let m = &o.metrics;

@@ -13,6 +13,7 @@
 mod common;
 
 use common::*;
+use contact_sweep::run::Grid1d;
 use contact_sweep::scene::BarParams;
 use contact_sweep::space::{ContactMethod, MassVariant};
 use contact_sweep::time::{Scheme, ThetaParams};
@@ -66,12 +67,7 @@ fn assert_never_increases(
         let (method, mass, scheme) = setup(i, d);
         let o = ok(bar1d(
             BarParams::default(),
-            d.elements,
-            d.dt,
-            6.0,
-            method,
-            mass.clone(),
-            scheme,
+            Grid1d::new(d.elements, d.dt, 6.0, method, mass.clone(), scheme),
             0,
         ));
         let inc = match energy {
@@ -167,12 +163,7 @@ fn hybrid_schemes_stay_stable_over_a_hundred_impacts_at_large_courant_numbers() 
         for (method, mass, energy) in cases {
             let o = ok(bar1d(
                 BarParams::default(),
-                50,
-                dt,
-                300.0,
-                method,
-                mass.clone(),
-                Scheme::Hybrid,
+                Grid1d::new(50, dt, 300.0, method, mass.clone(), Scheme::Hybrid),
                 0,
             ));
             let inc = match energy {
@@ -243,12 +234,14 @@ fn moreau_jean_midpoint_energy_never_increases() {
         let mass = [MassVariant::Consistent, MassVariant::Lumped][i % 2].clone();
         let o = ok(bar1d(
             BarParams::default(),
-            d.elements,
-            dt,
-            6.0,
-            ContactMethod::Mixed,
-            mass.clone(),
-            mj(0.0),
+            Grid1d::new(
+                d.elements,
+                dt,
+                6.0,
+                ContactMethod::Mixed,
+                mass.clone(),
+                mj(0.0),
+            ),
             0,
         ));
         let inc = o.metrics.energy_max_increase.unwrap();
@@ -285,12 +278,14 @@ fn discrete_gradient_conserves_its_energy_every_step() {
         };
         let o = ok(bar1d(
             BarParams::default(),
-            d.elements,
-            d.dt,
-            6.0,
-            method,
-            MassVariant::Consistent,
-            Scheme::DiscreteGradient,
+            Grid1d::new(
+                d.elements,
+                d.dt,
+                6.0,
+                method,
+                MassVariant::Consistent,
+                Scheme::DiscreteGradient,
+            ),
             1,
         ));
         let e0 = o.metrics.energy_initial.unwrap();
@@ -357,12 +352,14 @@ fn generalized_alpha_with_rho_one_is_crank_nicolson_through_the_first_impact() {
             let run = |scheme| {
                 ok(bar1d(
                     BarParams::default(),
-                    d.elements,
-                    d.dt,
-                    2.0,
-                    method,
-                    MassVariant::Consistent,
-                    scheme,
+                    Grid1d::new(
+                        d.elements,
+                        d.dt,
+                        2.0,
+                        method,
+                        MassVariant::Consistent,
+                        scheme,
+                    ),
                     1,
                 ))
             };
@@ -412,12 +409,14 @@ fn kinematic_contact_never_penetrates() {
         let dt = h * (0.1 + 0.9 * rng.f64());
         let o = ok(bar1d(
             BarParams::default(),
-            elements,
-            dt,
-            6.0,
-            ContactMethod::Mixed,
-            MassVariant::Lumped,
-            Scheme::Newmark(NewmarkParams::central_difference()),
+            Grid1d::new(
+                elements,
+                dt,
+                6.0,
+                ContactMethod::Mixed,
+                MassVariant::Lumped,
+                Scheme::Newmark(NewmarkParams::central_difference()),
+            ),
             0,
         ));
         assert_eq!(o.metrics.max_penetration, Some(0.0), "m={elements} dt={dt}");

@@ -38,6 +38,7 @@
 
 use std::time::Instant;
 
+use super::grid1d::Grid1d;
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::stepping::{Clock, LoopEnd, failed, finished, time_loop};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
@@ -45,19 +46,14 @@ use crate::contact::friction;
 use crate::contact::{self, ContactLaw, ContactSolveError, gradient};
 use crate::scene::{BarExact, BarParams};
 use crate::space::bar1d::Pair;
-use crate::space::{Bar1dSpace, ContactInit, ContactMethod, MassVariant, Tridiag, TridiagLu};
+use crate::space::{Bar1dSpace, ContactInit, ContactMethod, Tridiag, TridiagLu};
 use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme};
 
 /// A validated bar1d run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bar1dConfig {
     pub bar: BarParams,
-    pub elements: usize,
-    pub dt: f64,
-    pub steps: usize,
-    pub method: ContactMethod,
-    pub mass: MassVariant,
-    pub scheme: Scheme,
+    pub grid: Grid1d,
     /// Initial value of a massless contact node (ignored when the contact node has mass).
     pub contact_init: ContactInit,
     /// Ensemble member: relative amplitude of a uniform perturbation of u⁰ and its seed.
@@ -65,25 +61,12 @@ pub struct Bar1dConfig {
 }
 
 impl Bar1dConfig {
-    /// A run of the bar with `elements` elements and step `dt` up to `t_final` (rounded to a
-    /// whole number of steps) — the entry point of tests, benches and examples.
-    pub fn new(
-        bar: BarParams,
-        elements: usize,
-        dt: f64,
-        t_final: f64,
-        method: ContactMethod,
-        mass: MassVariant,
-        scheme: Scheme,
-    ) -> Self {
+    /// A run of the bar on `grid`, its massless contact node (if any) started consistently —
+    /// the entry point of tests, benches and examples.
+    pub fn new(bar: BarParams, grid: Grid1d) -> Self {
         Self {
             bar,
-            elements,
-            dt,
-            steps: (t_final / dt - 1e-9).ceil() as usize,
-            method,
-            mass,
-            scheme,
+            grid,
             contact_init: ContactInit::Consistent,
             perturbation: None,
         }
@@ -101,11 +84,16 @@ impl Bar1dConfig {
     /// scheme's bound, ω_max from the assembled operators with the contact stiffness inactive
     /// and active.
     pub fn explicit_dt_limit(&self) -> Result<Option<f64>, (&'static str, String)> {
-        let Some(bound) = self.scheme.explicit_stability_limit() else {
+        let Some(bound) = self.grid.scheme.explicit_stability_limit() else {
             return Ok(None);
         };
-        let sp = Bar1dSpace::new(self.bar, self.elements, &self.mass, self.method)
-            .map_err(|e| ("mass", e.to_string()))?;
+        let sp = Bar1dSpace::new(
+            self.bar,
+            self.grid.elements,
+            &self.grid.mass,
+            self.grid.method,
+        )
+        .map_err(|e| ("mass", e.to_string()))?;
         Ok(Some(bound / max_frequency_sq(&sp).sqrt()))
     }
 }
@@ -945,11 +933,11 @@ const CLOCK_EVERY: usize = 64;
 pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
     let start = Instant::now();
     let mut metrics = Metrics {
-        dofs: cfg.elements as i64,
+        dofs: cfg.grid.elements as i64,
         length_scale: Some(cfg.bar.length),
         ..Metrics::default()
     };
-    let sp = match Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method) {
+    let sp = match Bar1dSpace::new(cfg.bar, cfg.grid.elements, &cfg.grid.mass, cfg.grid.method) {
         Ok(sp) => sp,
         Err(e) => return failed(Status::Invalid, e.to_string(), metrics),
     };
@@ -957,8 +945,8 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
     if let Some((status, msg)) = opts.setup_stop(start, "the operators") {
         return failed(status, msg, metrics);
     }
-    let tau = cfg.dt;
-    let (eng, starter) = match engines(&sp, cfg.scheme, tau) {
+    let tau = cfg.grid.dt;
+    let (eng, starter) = match engines(&sp, cfg.grid.scheme, tau) {
         Ok(x) => x,
         Err(e) => return failed(Status::SolverFailed, e, metrics),
     };
@@ -978,7 +966,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
         prev01: None,
         exact: cfg.bar.exact(),
         tau,
-        obs: Observer::new(tau, opts.series_every, cfg.steps),
+        obs: Observer::new(tau, opts.series_every, cfg.grid.steps),
         exit_velocity: None,
     };
     let (mut st, sigma0) = match initial_state(&eng, cfg) {
@@ -992,7 +980,7 @@ pub fn simulate(cfg: &Bar1dConfig, opts: &RunOptions) -> Outcome {
             );
         }
     };
-    let steps = cfg.steps;
+    let steps = cfg.grid.steps;
     let end = time_loop(
         opts,
         start,

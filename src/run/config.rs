@@ -5,6 +5,7 @@ use crate::scene::SceneSetup;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
+use super::grid1d::Grid1d;
 use super::{bar1d, fe, layer1d, oscillator};
 
 /// The validated configuration of one run, per discretisation family: the tridiagonal 1D
@@ -28,17 +29,10 @@ impl RunConfig {
         steps: usize,
     ) -> RunConfig {
         match setup {
-            SceneSetup::Bar1d { bar, elements } => RunConfig::Bar1d(bar1d::Bar1dConfig {
+            SceneSetup::Bar1d { bar, elements } => RunConfig::Bar1d(bar1d::Bar1dConfig::new(
                 bar,
-                elements,
-                dt,
-                steps,
-                method,
-                mass,
-                scheme,
-                contact_init: ContactInit::Consistent,
-                perturbation: None,
-            }),
+                Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
+            )),
             SceneSetup::Fe(setup) => RunConfig::Fe(fe::FeConfig {
                 setup,
                 method,
@@ -59,16 +53,12 @@ impl RunConfig {
                 steps,
                 perturbation: None,
             }),
-            SceneSetup::Layer1d { layer, elements } => RunConfig::Layer1d(layer1d::Layer1dConfig {
-                layer,
-                elements,
-                dt,
-                steps,
-                method,
-                mass,
-                scheme,
-                perturbation: None,
-            }),
+            SceneSetup::Layer1d { layer, elements } => {
+                RunConfig::Layer1d(layer1d::Layer1dConfig::new(
+                    layer,
+                    Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
+                ))
+            }
         }
     }
 
@@ -128,10 +118,10 @@ impl RunConfig {
     /// Work estimate: steps × unknowns (saturating: a refused run may exceed u64).
     pub fn work(&self) -> u64 {
         let (steps, unknowns) = match self {
-            RunConfig::Bar1d(c) => (c.steps, c.elements),
+            RunConfig::Bar1d(c) => (c.grid.steps, c.grid.elements),
             RunConfig::Fe(c) => (c.steps, c.unknowns()),
             RunConfig::Oscillator(c) => (c.steps, 1),
-            RunConfig::Layer1d(c) => (c.steps, 2 * c.elements),
+            RunConfig::Layer1d(c) => (c.grid.steps, 2 * c.grid.elements),
         };
         (steps as u64).saturating_mul(unknowns as u64)
     }

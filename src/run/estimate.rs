@@ -58,10 +58,10 @@ impl RunConfig {
     /// Time steps of the run.
     pub fn steps(&self) -> usize {
         match self {
-            RunConfig::Bar1d(c) => c.steps,
+            RunConfig::Bar1d(c) => c.grid.steps,
             RunConfig::Fe(c) => c.steps,
             RunConfig::Oscillator(c) => c.steps,
-            RunConfig::Layer1d(c) => c.steps,
+            RunConfig::Layer1d(c) => c.grid.steps,
         }
     }
 
@@ -76,8 +76,8 @@ impl RunConfig {
         };
         let (unknowns, state_bytes) = match self {
             RunConfig::Bar1d(c) => {
-                let m = c.elements as f64;
-                let engines = if matches!(c.scheme, Scheme::PaoliSchatzman(_)) {
+                let m = c.grid.elements as f64;
+                let engines = if matches!(c.grid.scheme, Scheme::PaoliSchatzman(_)) {
                     1.5
                 } else {
                     1.0
@@ -88,7 +88,7 @@ impl RunConfig {
             RunConfig::Oscillator(_) => (1.0, 4096.0),
             // Two chains of the bar's engine.
             RunConfig::Layer1d(c) => {
-                let m = c.elements as f64;
+                let m = c.grid.elements as f64;
                 (2.0 * m, 2.0 * m * BAR1D_BYTES_PER_ELEMENT)
             }
             RunConfig::Fe(c) => {

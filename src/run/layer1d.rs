@@ -25,6 +25,7 @@
 use std::time::Instant;
 
 use super::bar1d::{self, Bar1dConfig, Engine, State, Tangential, Work};
+use super::grid1d::Grid1d;
 use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::stepping::{failed, finished, time_loop};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
@@ -38,37 +39,19 @@ use crate::time::{NewmarkParams, Scheme};
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layer1dConfig {
     pub layer: LayerParams,
-    pub elements: usize,
-    pub dt: f64,
-    pub steps: usize,
-    pub method: ContactMethod,
-    pub mass: MassVariant,
-    pub scheme: Scheme,
+    /// Both chains' mesh, step and methods (the tangential chain takes the mixed method).
+    pub grid: Grid1d,
     /// Ensemble member: relative amplitude of a uniform perturbation of the initial velocities
     /// and its seed (the layer starts unstrained: its displacement is zero).
     pub perturbation: Option<(f64, u64)>,
 }
 
 impl Layer1dConfig {
-    /// A run of the layer with `elements` elements and step `dt` up to `t_final` (rounded up
-    /// to a whole number of steps) — the entry point of tests and benches.
-    pub fn new(
-        layer: LayerParams,
-        elements: usize,
-        dt: f64,
-        t_final: f64,
-        method: ContactMethod,
-        mass: MassVariant,
-        scheme: Scheme,
-    ) -> Self {
+    /// A run of the layer on `grid` — the entry point of tests and benches.
+    pub fn new(layer: LayerParams, grid: Grid1d) -> Self {
         Self {
             layer,
-            elements,
-            dt,
-            steps: (t_final / dt - 1e-9).ceil() as usize,
-            method,
-            mass,
-            scheme,
+            grid,
             perturbation: None,
         }
     }
@@ -86,7 +69,7 @@ impl Layer1dConfig {
                 free_end: true,
                 velocity: l.velocity,
             },
-            self.method,
+            self.grid.method,
         )
     }
 
@@ -112,12 +95,10 @@ impl Layer1dConfig {
     fn chain(&self, bar: BarParams, method: ContactMethod) -> Bar1dConfig {
         Bar1dConfig {
             bar,
-            elements: self.elements,
-            dt: self.dt,
-            steps: self.steps,
-            method,
-            mass: self.mass.clone(),
-            scheme: self.scheme,
+            grid: Grid1d {
+                method,
+                ..self.grid.clone()
+            },
             contact_init: ContactInit::Consistent,
             perturbation: self.perturbation,
         }
@@ -159,7 +140,7 @@ pub struct FrictionStats {
 /// How the tangential force enters the scheme's momentum equation over a step: f̄ = (1 − c)fⁿ
 /// + c f^{n+1} (contract §2.5's W_f).
 fn work_weight(cfg: &Layer1dConfig) -> f64 {
-    match cfg.scheme {
+    match cfg.grid.scheme {
         Scheme::Newmark(NewmarkParams { gamma, .. }) if !is_kinematic(cfg) => gamma,
         Scheme::Theta(th) => th.theta,
         Scheme::GeneralizedAlpha(ga) => 1.0 - ga.alpha_f,
@@ -172,9 +153,9 @@ fn work_weight(cfg: &Layer1dConfig) -> f64 {
 /// Central difference with `mixed` and the lumped mass: kinematic contact and friction, an
 /// impulse on the half-step velocity (contract §3.2); with the penalty it is a Newmark scheme.
 fn is_kinematic(cfg: &Layer1dConfig) -> bool {
-    cfg.scheme == Scheme::Newmark(NewmarkParams::central_difference())
-        && cfg.method == ContactMethod::Mixed
-        && cfg.mass == MassVariant::Lumped
+    cfg.grid.scheme == Scheme::Newmark(NewmarkParams::central_difference())
+        && cfg.grid.method == ContactMethod::Mixed
+        && cfg.grid.mass == MassVariant::Lumped
 }
 
 /// One chain: its engine, state and work vectors.
@@ -186,9 +167,9 @@ struct Chain {
 
 impl Chain {
     fn new(cfg: &Bar1dConfig, tangential: Option<Tangential>) -> Result<(Chain, f64), String> {
-        let sp = Bar1dSpace::new(cfg.bar, cfg.elements, &cfg.mass, cfg.method)
+        let sp = Bar1dSpace::new(cfg.bar, cfg.grid.elements, &cfg.grid.mass, cfg.grid.method)
             .map_err(|e| e.to_string())?;
-        let mut eng = Engine::new(sp, cfg.scheme, cfg.dt)?;
+        let mut eng = Engine::new(sp, cfg.grid.scheme, cfg.grid.dt)?;
         eng.tangential = tangential;
         let (st, sigma0) =
             bar1d::initial_state(&eng, cfg).map_err(|e| format!("initial state (t = 0): {e}"))?;
@@ -224,12 +205,12 @@ pub fn simulate(cfg: &Layer1dConfig, opts: &RunOptions) -> Outcome {
 pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, FrictionStats) {
     let start = Instant::now();
     let mut metrics = Metrics {
-        dofs: 2 * cfg.elements as i64,
+        dofs: 2 * cfg.grid.elements as i64,
         length_scale: Some(cfg.layer.height),
         ..Metrics::default()
     };
     let law = cfg.layer.friction;
-    let tau = cfg.dt;
+    let tau = cfg.grid.dt;
     let (mut normal, sigma0, mut tang) = match chains(cfg) {
         Ok(c) => c,
         Err(e) => {
@@ -250,7 +231,7 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
         h: normal.eng.space().h,
         gap: cfg.layer.gap,
     };
-    let mut obs = Observer::new(tau, opts.series_every, cfg.steps);
+    let mut obs = Observer::new(tau, opts.series_every, cfg.grid.steps);
     let e0 = normal.energy() + tang.energy();
     let scale = e0;
     obs = obs.with_energy_scale(scale);
@@ -258,13 +239,13 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
     let end = time_loop(
         opts,
         start,
-        (CLOCK_EVERY, tau, cfg.steps),
+        (CLOCK_EVERY, tau, cfg.grid.steps),
         &mut metrics,
         |clock, metrics| {
             obs.set_friction(0.0, tang.st.v[0], 0.0);
             view.record(&mut obs, 0, &normal, &tang, sigma0)
                 .map_err(Stop::Diverged)?;
-            for n in 1..=cfg.steps {
+            for n in 1..=cfg.grid.steps {
                 let (sigma_n, sigma_t) = acc.step(n, &mut normal, &mut tang, &view)?;
                 metrics.iterations += 1;
                 obs.set_friction(sigma_t, tang.st.v[0], acc.work);
@@ -303,9 +284,9 @@ pub fn simulate_with_stats(cfg: &Layer1dConfig, opts: &RunOptions) -> (Outcome, 
 /// The two chains (the normal one with its σ_C⁰): the tangential chain's contact node held by
 /// the friction law, with the penalty's tangential stiffness κ = (λ + 2μ)γ0/h.
 fn chains(cfg: &Layer1dConfig) -> Result<(Chain, f64, Chain), String> {
-    let kappa = match cfg.method {
+    let kappa = match cfg.grid.method {
         ContactMethod::Penalty { gamma0 } => {
-            Some(cfg.layer.p_modulus() * gamma0 * cfg.elements as f64 / cfg.layer.height)
+            Some(cfg.layer.p_modulus() * gamma0 * cfg.grid.elements as f64 / cfg.layer.height)
         }
         _ => None,
     };
@@ -403,8 +384,8 @@ impl Account {
         }
         Account {
             law: cfg.layer.friction,
-            moreau: matches!(cfg.scheme, Scheme::MoreauJean(_)),
-            restitution: match cfg.scheme {
+            moreau: matches!(cfg.grid.scheme, Scheme::MoreauJean(_)),
+            restitution: match cfg.grid.scheme {
                 Scheme::MoreauJean(p) => p.restitution,
                 _ => 0.0,
             },

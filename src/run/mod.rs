@@ -12,6 +12,7 @@ mod dispatch;
 pub mod estimate;
 pub mod fe;
 pub mod friction_tally;
+mod grid1d;
 pub mod impacts;
 pub mod layer1d;
 pub mod observe;
@@ -24,6 +25,7 @@ mod stepping;
 
 pub use config::RunConfig;
 pub use dispatch::{lockstep_key, simulate, simulate_group, simulate_with};
+pub use grid1d::Grid1d;
 pub use observe::{Metrics, Series, SeriesRow};
 pub(crate) use outcome::Stop;
 pub use outcome::{Outcome, RunContext, RunOptions, Status};

@@ -33,8 +33,8 @@
 //! `contact_init` changes nothing here.
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene,
-    SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, MethodNames, Physics, PhysicsKey,
+    Scene, SceneFacts, SceneSetup,
 };
 use crate::space::fe::BallMesh;
 
@@ -116,13 +116,8 @@ impl Scene for BallScene {
         }
         self.mesh_from_h(p, std::f64::consts::PI * RADIUS / (2.0 * elements as f64))
     }
-    fn supports(
-        &self,
-        space: &str,
-        mass: &str,
-        scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
-        super::fe_supports(self.name(), space, mass, scheme)
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        super::fe_supports(self.name(), m)
     }
     /// No closed form; a reference run on the same mesh with a finer step (the mapped meshes
     /// of different sizes are not nested, `run::fe::ball_ref_map`).
@@ -165,6 +160,14 @@ impl Scene for BallScene {
 mod tests {
     use super::*;
 
+    fn names<'a>(space: &'a str, mass: &'a str, scheme: &'a str) -> MethodNames<'a> {
+        MethodNames {
+            space,
+            mass,
+            scheme,
+        }
+    }
+
     fn physics() -> Physics {
         Physics(BALL_PHYSICS.iter().map(|k| (k.name, k.default)).collect())
     }
@@ -179,12 +182,21 @@ mod tests {
         assert!(s.mesh_from_h(&physics(), 0.0).is_err());
         // P-wave speed √((λ+2μ)/ρ) = √60.
         assert!((s.wave_speed(&physics()) - 60f64.sqrt()).abs() < 1e-14);
-        assert!(s.supports("penalty", "consistent", "hybrid").is_ok());
-        assert!(s.supports("mixed", "consistent", "hybrid").is_err());
-        assert!(s.supports("nitsche", "mod1", "newmark").is_ok());
-        assert!(s.supports("mixed", "zero-contact", "newmark").is_ok());
-        assert!(s.supports("mixed", "zero-contact", "hybrid").is_err());
-        assert!(s.supports("mixed", "singular-dynamic", "newmark").is_err());
-        assert!(s.supports("mixed", "lumped", "theta").is_ok());
+        assert!(s.supports(names("penalty", "consistent", "hybrid")).is_ok());
+        assert!(s.supports(names("mixed", "consistent", "hybrid")).is_err());
+        assert!(s.supports(names("nitsche", "mod1", "newmark")).is_ok());
+        assert!(
+            s.supports(names("mixed", "zero-contact", "newmark"))
+                .is_ok()
+        );
+        assert!(
+            s.supports(names("mixed", "zero-contact", "hybrid"))
+                .is_err()
+        );
+        assert!(
+            s.supports(names("mixed", "singular-dynamic", "newmark"))
+                .is_err()
+        );
+        assert!(s.supports(names("mixed", "lumped", "theta")).is_ok());
     }
 }

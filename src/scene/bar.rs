@@ -11,7 +11,9 @@
 //! `elements` counts the elements across the height (n_d = 1/h); the width 0.1 must hold a whole
 //! number of elements too, so h ∈ {0.1, 0.05, 0.025, …, 0.1/k}.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
+use super::{
+    ErrorSource, MeshChoice, MethodNames, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+};
 
 /// The finite-element geometry a scene asks for.
 #[derive(Debug, Clone, PartialEq)]
@@ -213,13 +215,8 @@ impl Scene for BarScene {
         self.mesh_from_h(p, HEIGHT / elements as f64)
             .map_err(|e| format!("elements = {elements} (h = 1/{elements}): {e}"))
     }
-    fn supports(
-        &self,
-        space: &str,
-        mass: &str,
-        scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
-        super::fe_supports(self.name(), space, mass, scheme)
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        super::fe_supports(self.name(), m)
     }
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)

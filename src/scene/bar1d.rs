@@ -20,7 +20,9 @@
 //! elements there, exactly as for the clamped bar. Every tolerance is relative to the bar's own
 //! scales (L, L/c, V), never to a unit bar.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
+use super::{
+    ErrorSource, MeshChoice, MethodNames, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+};
 
 /// The scene `bar1d` (contract §1.1): physics keys, mesh from h, closed form for a zero gap.
 #[derive(Debug, Clone, Copy)]
@@ -57,6 +59,13 @@ const BAR1D_PHYSICS: [PhysicsKey; 7] = [
         default: 0.0,
     },
 ];
+
+/// The scene's name, its physics keys and its default final time.
+const FACTS: SceneFacts = SceneFacts {
+    name: "bar1d",
+    physics: &BAR1D_PHYSICS,
+    default_t: 12.0,
+};
 
 impl Bar1dScene {
     fn bar(physics: &Physics) -> BarParams {
@@ -106,11 +115,7 @@ impl Scene for Bar1dScene {
     }
 
     fn facts(&self) -> SceneFacts {
-        SceneFacts {
-            name: "bar1d",
-            physics: &BAR1D_PHYSICS,
-            default_t: 12.0,
-        }
+        FACTS
     }
     fn wave_speed(&self, physics: &Physics) -> f64 {
         Self::bar(physics).wave_speed()
@@ -121,12 +126,7 @@ impl Scene for Bar1dScene {
     fn mesh_from_elements(&self, physics: &Physics, elements: usize) -> Result<MeshChoice, String> {
         Ok(uniform_elements(physics.get("length"), elements))
     }
-    fn supports(
-        &self,
-        _space: &str,
-        _mass: &str,
-        _scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
+    fn supports(&self, _m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
         Ok(())
     }
     fn error_source(&self, physics: &Physics) -> Option<ErrorSource> {

@@ -28,7 +28,9 @@
 //! norms exactly by splitting each element at the fronts of both components (§1.4's method).
 //! Energy identity: E(t) = E⁰ − W_f(t), W_f(t) = σ_t*·v_slip·|W ∩ [0, t]|.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
+use super::{
+    ErrorSource, MeshChoice, MethodNames, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+};
 use crate::contact::friction::FrictionLaw;
 
 /// The scene `layer1d` (contract §1.7).
@@ -66,6 +68,13 @@ const LAYER1D_PHYSICS: [PhysicsKey; 7] = [
     },
 ];
 
+/// The scene's name, its physics keys and its default final time.
+const FACTS: SceneFacts = SceneFacts {
+    name: "layer1d",
+    physics: &LAYER1D_PHYSICS,
+    default_t: 2.5,
+};
+
 impl Layer1dScene {
     fn layer(physics: &Physics) -> LayerParams {
         LayerParams {
@@ -84,11 +93,7 @@ impl Layer1dScene {
 
 impl Scene for Layer1dScene {
     fn facts(&self) -> SceneFacts {
-        SceneFacts {
-            name: "layer1d",
-            physics: &LAYER1D_PHYSICS,
-            default_t: 2.5,
-        }
+        FACTS
     }
     /// c0 = c_p (the Courant number of the faster, normal, chain).
     fn wave_speed(&self, physics: &Physics) -> f64 {
@@ -106,20 +111,13 @@ impl Scene for Layer1dScene {
     /// `mixed` and `penalty` with every 1D mass variant; the one-step schemes whose frictional
     /// version the literature defines (contract §2.5). Paoli–Schatzman, the hybrid schemes and
     /// the discrete gradient have none, and the layer exists for friction.
-    fn supports(
-        &self,
-        space: &str,
-        _mass: &str,
-        scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "penalty") {
-            return Err((
-                "space",
-                format!(
-                    "space = {space} is not available for scene layer1d (mixed, penalty; frictional Nitsche is issue 33)"
-                ),
-            ));
-        }
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        let (space, scheme) = (m.space, m.scheme);
+        super::require("space", space, &["mixed", "penalty"], || {
+            format!(
+                "space = {space} is not available for scene layer1d (mixed, penalty; frictional Nitsche is issue 33)"
+            )
+        })?;
         if matches!(scheme, "paoli-schatzman" | "hybrid" | "discrete-gradient") {
             return Err((
                 "scheme",

@@ -41,8 +41,8 @@
 use std::path::Path;
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, Physics, PhysicsKey, Scene,
-    SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, MethodNames, Physics, PhysicsKey,
+    Scene, SceneFacts, SceneSetup,
 };
 use crate::space::fe::{GmshMesh, Mesh};
 
@@ -134,13 +134,8 @@ impl Scene for MeshScene {
     fn nested_meshes(&self) -> bool {
         false
     }
-    fn supports(
-        &self,
-        space: &str,
-        mass: &str,
-        scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
-        super::fe_supports(self.name(), space, mass, scheme)
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        super::fe_supports(self.name(), m)
     }
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)

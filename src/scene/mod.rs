@@ -107,6 +107,30 @@ impl SceneSetup {
     }
 }
 
+/// A run's contact treatment (`space`), mass variant and scheme family, as a sweep file names
+/// them: what [`Scene::supports`] judges.
+#[derive(Clone, Copy, Debug)]
+pub struct MethodNames<'a> {
+    pub space: &'a str,
+    pub mass: &'a str,
+    pub scheme: &'a str,
+}
+
+/// `Ok` when `value` is one of `allowed`, else the sweep error of `key` with `why` — the one
+/// shape of every scene's refusal of a method it does not take.
+pub(crate) fn require(
+    key: &'static str,
+    value: &str,
+    allowed: &[&str],
+    why: impl FnOnce() -> String,
+) -> Result<(), (&'static str, String)> {
+    if allowed.contains(&value) {
+        Ok(())
+    } else {
+        Err((key, why()))
+    }
+}
+
 /// What names a scene and frames its runs: data, so a scene states it once.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneFacts {
@@ -150,8 +174,7 @@ pub trait Scene: Send + Sync {
     /// Whether the scene implements this combination of contact method (`space`), mass variant
     /// and scheme family (`newmark`, `theta`, `paoli-schatzman`, `hybrid`); `Err` names the key
     /// at fault and the reason (a sweep error, not a silently dropped run).
-    fn supports(&self, space: &str, mass: &str, scheme: &str)
-    -> Result<(), (&'static str, String)>;
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)>;
     /// Whether the start of a massless contact node (`contact_init`) changes anything: only
     /// where the quasi-static contact value differs from the interpolant of u0 (the 1D bar,
     /// contract §1.1). The FE scenes start at rest or in free flight, where both starts coincide,
@@ -225,18 +248,15 @@ pub trait Scene: Send + Sync {
 /// ([`crate::run::fe`]'s methods module, on any mesh: they act on the assembled M, K and the
 /// Γ_C rows or quadrature points; the planner checks their contact methods and masses), and
 /// hybrid with a contact potential (Nitsche or the penalty on Γ_C's quadrature points).
-pub(crate) fn fe_supports(
-    scene: &str,
-    space: &str,
-    mass: &str,
-    scheme: &str,
-) -> Result<(), (&'static str, String)> {
-    if !matches!(space, "mixed" | "nitsche" | "penalty") {
-        return Err((
-            "space",
-            format!("space = {space} is not available for scene {scene} (mixed, nitsche, penalty)"),
-        ));
-    }
+pub(crate) fn fe_supports(scene: &str, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+    let MethodNames {
+        space,
+        mass,
+        scheme,
+    } = m;
+    require("space", space, &["mixed", "nitsche", "penalty"], || {
+        format!("space = {space} is not available for scene {scene} (mixed, nitsche, penalty)")
+    })?;
     if matches!(mass, "singular-dynamic" | "node-neighbour") {
         return Err((
             "mass",

@@ -21,7 +21,9 @@
 //! The scene has no mesh: `elements` = 1 and h = 1 are reported, and the wave speed is ω, so
 //! `courant` reads as the dimensionless step ω·τ.
 
-use super::{ErrorSource, MeshChoice, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup};
+use super::{
+    ErrorSource, MeshChoice, MethodNames, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+};
 use crate::time::Scheme;
 
 /// The scene `oscillator` (contract §1.5).
@@ -65,6 +67,13 @@ const OSCILLATOR_PHYSICS: [PhysicsKey; 8] = [
     },
 ];
 
+/// The scene's name, its physics keys and its default final time.
+const FACTS: SceneFacts = SceneFacts {
+    name: "oscillator",
+    physics: &OSCILLATOR_PHYSICS,
+    default_t: 10.0,
+};
+
 impl OscillatorScene {
     fn params(p: &Physics) -> OscillatorParams {
         OscillatorParams {
@@ -84,14 +93,7 @@ const NO_MESH: &str = "scene oscillator has no mesh (one mass, one spring): leav
 
 impl Scene for OscillatorScene {
     fn facts(&self) -> SceneFacts {
-        SceneFacts {
-            name: "oscillator",
-            physics: &OSCILLATOR_PHYSICS,
-            default_t: 10.0,
-        }
-    }
-    fn wave_speed(&self, physics: &Physics) -> f64 {
-        Self::params(physics).omega()
+        FACTS
     }
     fn mesh_from_h(&self, _physics: &Physics, _h: f64) -> Result<MeshChoice, String> {
         Err(NO_MESH.into())
@@ -104,6 +106,10 @@ impl Scene for OscillatorScene {
             elements: 1,
             h: 1.0,
         })
+    }
+    /// ω = √(k/m): `courant` is ω·dt (the oscillator has no mesh to take a length from).
+    fn wave_speed(&self, physics: &Physics) -> f64 {
+        Self::params(physics).omega()
     }
     /// The mass meets the obstacle along its one dof: a friction law at the contact has no
     /// direction to act in. Dry friction on the mass is contract §1.5's physics key
@@ -150,28 +156,22 @@ impl Scene for OscillatorScene {
         ))
     }
 
-    fn supports(
-        &self,
-        space: &str,
-        mass: &str,
-        scheme: &str,
-    ) -> Result<(), (&'static str, String)> {
-        if !matches!(space, "mixed" | "penalty") {
-            return Err((
-                "space",
-                format!(
-                    "space = {space} does not apply to the oscillator (contract §1.5: a multiplier on the one dof, `mixed`, or `penalty`)"
-                ),
-            ));
-        }
-        if !matches!(mass, "consistent" | "lumped") {
-            return Err((
-                "mass",
-                format!(
-                    "mass = {mass} does not apply to the oscillator: its one dof is the mass (contract §1.5: mass variants do not apply)"
-                ),
-            ));
-        }
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        let MethodNames {
+            space,
+            mass,
+            scheme,
+        } = m;
+        super::require("space", space, &["mixed", "penalty"], || {
+            format!(
+                "space = {space} does not apply to the oscillator (contract §1.5: a multiplier on the one dof, `mixed`, or `penalty`)"
+            )
+        })?;
+        super::require("mass", mass, &["consistent", "lumped"], || {
+            format!(
+                "mass = {mass} does not apply to the oscillator: its one dof is the mass (contract §1.5: mass variants do not apply)"
+            )
+        })?;
         // The families the oscillator's engine implements (`run::oscillator`); a new family
         // is refused here, with its reason, until its arm is written there.
         if !matches!(

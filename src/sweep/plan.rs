@@ -23,7 +23,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::contact::friction::{FrictionKind, FrictionLaw};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
-use crate::scene::{FileSetup, MeshChoice, Physics, Scene, SceneKind};
+use crate::scene::{FileSetup, MeshChoice, MethodNames, Physics, Scene, SceneKind};
 use crate::space::step_solver::Solver;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{
@@ -440,10 +440,12 @@ fn method_of(
     let scheme = scheme_of(given, dropped, issues)?;
     let (space_name, contact) = contact_method_of(given, issues);
     let (mass_name, mass) = mass_of(given, issues);
-    if let Err((key, why)) = given
-        .scene
-        .supports(&space_name, &mass_name, scheme.family())
-    {
+    let names = MethodNames {
+        space: &space_name,
+        mass: &mass_name,
+        scheme: scheme.family(),
+    };
+    if let Err((key, why)) = given.scene.supports(names) {
         let k = Key::from_name(key).expect("scenes name sweep keys");
         return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
     }

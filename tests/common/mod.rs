@@ -7,10 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use contact_sweep::run::bar1d::Bar1dConfig;
-use contact_sweep::run::{Outcome, RunConfig, RunContext, RunOptions, Status, simulate};
+use contact_sweep::run::{Grid1d, Outcome, RunConfig, RunContext, RunOptions, Status, simulate};
 use contact_sweep::scene::BarParams;
-use contact_sweep::space::{ContactInit, ContactMethod, MassVariant};
-use contact_sweep::time::Scheme;
+use contact_sweep::space::{ContactInit, ContactMethod};
 
 pub fn bin() -> &'static str {
     env!("CARGO_BIN_EXE_contact-sweep")
@@ -31,38 +30,24 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-/// Simulate a bar1d run (the argument list mirrors Bar1dConfig::new plus the series decimation).
-#[allow(clippy::too_many_arguments)]
-pub fn bar1d(
-    bar: BarParams,
-    elements: usize,
-    dt: f64,
-    t_final: f64,
-    method: ContactMethod,
-    mass: MassVariant,
-    scheme: Scheme,
-    series_every: usize,
-) -> Outcome {
-    let cfg = Bar1dConfig::new(bar, elements, dt, t_final, method, mass, scheme);
-    simulate_with(cfg, series_every)
+/// Simulate a bar1d run on `grid`, its contact node started consistently, keeping every
+/// `series_every`-th step.
+pub fn bar1d(bar: BarParams, grid: Grid1d, series_every: usize) -> Outcome {
+    simulate_with(Bar1dConfig::new(bar, grid), series_every)
 }
 
-/// As [`bar1d`], with the massless contact node started by `init` (contract §2.2 `contact_init`).
-#[allow(clippy::too_many_arguments)]
+/// As [`bar1d`], with the massless contact node started by `init` (contract §2.2
+/// `contact_init`).
 pub fn bar1d_start(
     init: ContactInit,
     bar: BarParams,
-    elements: usize,
-    dt: f64,
-    t_final: f64,
-    method: ContactMethod,
-    mass: MassVariant,
-    scheme: Scheme,
+    grid: Grid1d,
     series_every: usize,
 ) -> Outcome {
-    let cfg =
-        Bar1dConfig::new(bar, elements, dt, t_final, method, mass, scheme).with_contact_init(init);
-    simulate_with(cfg, series_every)
+    simulate_with(
+        Bar1dConfig::new(bar, grid).with_contact_init(init),
+        series_every,
+    )
 }
 
 fn simulate_with(cfg: Bar1dConfig, series_every: usize) -> Outcome {
