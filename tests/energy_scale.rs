@@ -100,3 +100,55 @@ fn a_resting_block_has_one_unit_whatever_its_throw() {
         "the three throws end alike: {statuses:?}"
     );
 }
+
+/// The largest one-step rise of E + W_f over the series of a run that keeps every step: the
+/// series holds E and W_f (both in joules, W_f⁰ = 0), the row divides by `energy_scale`.
+/// Returns (the rise of step 1, the largest rise), over the scale.
+fn series_rises(o: &Outcome) -> (f64, f64) {
+    let s = &o.series;
+    let scale = o.metrics.energy_scale.unwrap();
+    assert_eq!(s.step[0], 0);
+    assert!(s.has(9), "a friction_work column");
+    let balance: Vec<f64> = (0..s.len())
+        .map(|k| {
+            assert!(s.valid[9][k], "W_f at step {k}");
+            s.energy[k] + s.optional[9][k]
+        })
+        .collect();
+    let rises: Vec<f64> = balance.windows(2).map(|w| (w[1] - w[0]) / scale).collect();
+    (rises[0], rises.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+}
+
+/// The bug (issue 42): Nitsche and penalty handed E⁰ to their E + W_f tally after the first
+/// step, so it started from E⁰ + W_f¹ and step 1's rise was left out of
+/// `energy_balance_max_increase` (it read E¹ − E⁰, short of the friction's first work); their
+/// series had no W_f at step 0. A run whose first step
+/// gains: the sliding block (V_t = 0.5, Coulomb 0.2) under Newmark β = ¼, γ = 0.4 — γ < ½ is
+/// negative numerical damping, E + W_f grows from the first step (measured +3.6e-6 Nitsche,
+/// +4.1e-6 penalty). Over one step the row's largest rise is step 1's; over ten it is the
+/// series' largest over every step from the first (the same sums of the same doubles in
+/// another order: 1e-12 of the rise). W_f⁰ = 0 exactly.
+#[test]
+fn energy_balance_max_increase_counts_the_first_step_of_nitsche_and_penalty() {
+    for space in [
+        "space = \"nitsche\"\nnitsche_theta = 1.0\nnitsche_gamma0 = 1e-3",
+        "space = \"penalty\"\npenalty_gamma0 = 100.0",
+    ] {
+        for t in [0.05, 0.5] {
+            let o = run(&format!(
+                "name = \"b\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"meshes/block2d.msh\"\nlame_lambda = 10.0\nlame_mu = 10.0\ngravity = {G:?}\ngap = 0.0\nvelocity_tangential = 0.5\nfriction = \"coulomb\"\nfriction_coefficient = 0.2\nscheme = \"newmark\"\nnewmark_beta = 0.25\nnewmark_gamma = 0.4\nT = {t:?}\ndt = 0.05\n{space}\n"
+            ));
+            let what = format!("{space} T = {t}");
+            assert_eq!(o.status.as_str(), "ok", "{what}: {:?}", o.message);
+            assert_eq!(o.series.optional[9][0], 0.0, "{what}: W_f⁰");
+            let (first, max) = series_rises(&o);
+            let row = o.metrics.energy_balance_max_increase.unwrap();
+            assert!(first > 0.0, "{what}: the first step gains ({first:e})");
+            assert!(
+                (row - max).abs() <= 1e-12 * max.abs(),
+                "{what}: energy_balance_max_increase {row:e} vs the series' {max:e}"
+            );
+            assert!(row >= first, "{what}: {row:e} < step 1's {first:e}");
+        }
+    }
+}
