@@ -116,7 +116,10 @@ fn series_rises(o: &Outcome) -> (f64, f64) {
         })
         .collect();
     let rises: Vec<f64> = balance.windows(2).map(|w| (w[1] - w[0]) / scale).collect();
-    (rises[0], rises.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    (
+        rises[0],
+        rises.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    )
 }
 
 /// The bug (issue 42): Nitsche and penalty handed E⁰ to their E + W_f tally after the first
