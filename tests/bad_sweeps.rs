@@ -429,6 +429,49 @@ const CASES: &[(&str, &str, &str)] = &[
         "fixed.incline",
         "`incline` is not a parameter of scene oscillator",
     ),
+    // Issue 42: input never dropped without a word. The other law's bound beside a fixed law
+    // (both ways: it would be ignored), a tilt without the load it tilts, a speed whose
+    // energy the run cannot represent, a fixed method that is no method.
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\ntresca_threshold = 0.1\n",
+        "fixed.tresca_threshold",
+        "tresca_threshold is the bound of friction = \"tresca\", but friction = \"coulomb\" for this run (its bound is friction_coefficient): it would be ignored",
+    ),
+    (
+        "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nelements = 20\ncourant = 0.5\nfriction = \"tresca\"\ntresca_threshold = 0.1\n[grid]\nfriction_coefficient = [0.1, 0.3]\n",
+        "grid.friction_coefficient[0]",
+        "friction_coefficient is the bound of friction = \"coulomb\", but friction = \"tresca\" for this run",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"block2d.msh\"\ndt = 0.01\nincline = 10.0\n",
+        "fixed.incline",
+        "incline = 10 tilts the volume load, but gravity = 0 (the default) for this run: without a load the tilt changes nothing",
+    ),
+    (
+        "name = \"x\"\nscene = \"mesh3d\"\n[fixed]\nmesh = \"block3d.msh\"\ndt = 0.01\ngravity = 0.0\nincline = -5.0\n",
+        "fixed.incline",
+        "incline = -5 tilts the volume load, but gravity = 0 for this run",
+    ),
+    (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nvelocity_tangential = 1e200\n",
+        "fixed.velocity_tangential",
+        "above the 1.341e148 a run can represent",
+    ),
+    (
+        "name = \"x\"\nscene = \"oscillator\"\n[fixed]\ndt = 0.01\nvelocity = -1e100\n",
+        "fixed.velocity",
+        "kinetic energy density ½ρ|v⁰|² = 5.000e199",
+    ),
+    (
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nscheme = \"kane\"\nspace = \"nitsche\"\nnitsche_gamma0 = 1.0\n",
+        "fixed.space",
+        "scheme = kane, space = nitsche together make no method: kane is defined for space = mixed only",
+    ),
+    (
+        "name = \"x\"\nscene = \"disc2d\"\n[fixed]\nh = 8.0\ndt = 0.1\nscheme = \"discrete-gradient\"\n",
+        "fixed.scheme",
+        "scheme = discrete-gradient, space = mixed together make no method: discrete-gradient needs a contact potential (space = penalty, or nitsche with Θ = 1) (space = mixed by default)",
+    ),
 ];
 
 #[test]
@@ -498,6 +541,45 @@ fn line_numbers_are_reported_where_the_parser_knows_them() {
     let o = cli(tmp.path(), &["plan", "s.toml"]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("s.toml:6: key `fixed.newmark_beta`"), "{err}");
+}
+
+/// A fixed combination that is no method (issue 42) is refused at every key that makes it, each
+/// with its line and the reason — where it was once "key `grid`: the sweep expands to no runs",
+/// naming a key the file lacks, without a line or a reason.
+#[test]
+fn a_meaningless_fixed_method_names_its_keys_and_lines() {
+    let tmp = tempfile::tempdir().unwrap();
+    write(
+        tmp.path(),
+        "s.toml",
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nscheme = \"kane\"\nspace = \"nitsche\"\nnitsche_gamma0 = 1.0\n",
+    );
+    let o = cli(tmp.path(), &["plan", "s.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    let why = "scheme = kane, space = nitsche together make no method: kane is defined for space = mixed only";
+    assert!(
+        err.contains(&format!("s.toml:6: key `fixed.scheme`: {why}")),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("s.toml:7: key `fixed.space`: {why}")),
+        "{err}"
+    );
+    assert!(!err.contains("`grid`"), "{err}");
+    // Across an axis the same pair is one combination left out, and the others run.
+    write(
+        tmp.path(),
+        "t.toml",
+        "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.05\ndt = 0.025\nscheme = \"kane\"\nnitsche_gamma0 = 1.0\n[grid]\nspace = [\"mixed\", \"nitsche\"]\n",
+    );
+    let o = cli(tmp.path(), &["plan", "t.toml"]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
 }
 
 #[test]

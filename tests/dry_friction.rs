@@ -373,3 +373,91 @@ fn moreau_jean_e1_with_impacts_balances_energy_and_friction_work() {
     assert!(drift.abs() < 2e-13, "energy_balance_drift {drift:e}");
     assert!(rise < 2e-13, "energy_balance_max_increase {rise:e}");
 }
+
+/// Issue 42 "done when" 5: the dry-friction oscillator's rows carry the frictional columns every
+/// frictional run has — `energy_balance_drift`, `energy_balance_max_increase`, the steps in stick
+/// and in slip — and the summaries judge it by E + W_f: the contract setting (sweeps/
+/// friction_oscillator.toml at τ = 0.04) is "dissipative with friction accounted" for Moreau–Jean
+/// and CN alike (E falls to 0.3 % of E⁰ = 90, the friction's work; δ = ωτ = 0.04, the oscillator
+/// having no mesh). The steps: Moreau–Jean stops within two steps of 22.4236 and holds to T = 30,
+/// so about (30 − 22.4)/τ = 190 of its 750 steps stick (±5: the stop's own steps), the rest slip;
+/// CN creeps on past the stop (its relay on the increment does not hold the mass, see
+/// `crank_nicolson_creeps_after_the_exact_stop`), so it has fewer.
+#[test]
+fn the_friction_oscillator_rows_and_summary_account_for_the_friction() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("sweeps/friction_oscillator.toml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("dt = [0.04, 0.02, 0.01, 0.005]", "dt = [0.04]");
+    assert!(text.contains("dt = [0.04]\n"));
+    std::fs::write(tmp.path().join("f.toml"), &text).unwrap();
+    let bin = env!("CARGO_BIN_EXE_contact-sweep");
+    for args in [
+        &["run", "f.toml", "--out", "out"][..],
+        &["summarize", "out"][..],
+    ] {
+        let o = std::process::Command::new(bin)
+            .args(args)
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+    let csv = std::fs::read_to_string(tmp.path().join("out/summary/energy.csv")).unwrap();
+    // The fields of a CSV line, the quoted ones (the labels hold commas) unquoted.
+    let fields = |line: &str| -> Vec<String> {
+        let (mut out, mut cur, mut quoted) = (Vec::new(), String::new(), false);
+        for ch in line.chars() {
+            match ch {
+                '"' => quoted = !quoted,
+                ',' if !quoted => out.push(std::mem::take(&mut cur)),
+                c => cur.push(c),
+            }
+        }
+        out.push(cur);
+        out
+    };
+    let mut lines = csv.lines();
+    let header = fields(lines.next().unwrap());
+    let at = |name: &str| header.iter().position(|h| h == name).unwrap();
+    let (class, functional) = (at("energy_class"), at("energy_functional"));
+    let rows: Vec<Vec<String>> = lines.map(fields).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for r in &rows {
+        assert_eq!(r[class], "dissipative with friction accounted", "{csv}");
+        assert_eq!(r[functional], "E^h + W_f", "{csv}");
+    }
+
+    // The rows themselves, from the engine.
+    let p = spec_friction();
+    let cn = Scheme::Newmark(NewmarkParams::crank_nicolson());
+    let (mj, cn) = (run(p, 0.04, 30.0, MJ), run(p, 0.04, 30.0, cn));
+    for (what, o) in [("moreau-jean", &mj), ("crank-nicolson", &cn)] {
+        let m = &o.metrics;
+        // E + W_f is conserved by both (the relay's work is the step's energy change, up to
+        // the round-off of 750 steps over E⁰ = 90: 1e-12 relative).
+        let drift = m.energy_balance_drift.unwrap();
+        assert!(
+            drift.abs() < 1e-12,
+            "{what}: energy_balance_drift {drift:e}"
+        );
+        assert!(m.energy_balance_max_increase.unwrap() < 1e-12, "{what}");
+        assert!(
+            m.friction_work.unwrap() > 0.99,
+            "{what}: {:?}",
+            m.friction_work
+        );
+        let (stick, slip) = (m.stick_steps.unwrap(), m.slip_steps.unwrap());
+        assert_eq!(stick + slip, 750, "{what}: every step counts");
+        if what == "moreau-jean" {
+            assert!((stick - 190).abs() <= 5, "{what}: {stick} steps in stick");
+        } else {
+            assert!(stick < 190, "{what}: {stick} steps in stick");
+        }
+    }
+}

@@ -676,7 +676,8 @@ method = [
             m.energy_balance_drift,
             m.energy_balance_max_increase
         );
-        assert_eq!(steps, o.series.energy.len() - 1, "{label}: W_f every step");
+        // Every step, step 0's W_f⁰ = 0 included (issue 42: it was null for Nitsche).
+        assert_eq!(steps, o.series.energy.len(), "{label}: W_f every step");
         assert!(ft_max > 0.0 && last != 0.0, "{label}: friction acts");
         assert!(
             m.tangential_work_min.unwrap() >= -OWN_WORK_ALLOWANCE * m.friction_work.unwrap().abs(),

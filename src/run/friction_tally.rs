@@ -198,8 +198,12 @@ impl FrictionTally {
     }
 
     /// E^n of the state just made (step 0 first): the balance E + W_f and its largest rise.
+    /// The first energy is E⁰, whose balance is E⁰ + W_f⁰ = E⁰ whatever the tally holds: an
+    /// engine that hands E⁰ in only after its first step (Nitsche, penalty: E⁰ with E¹) has
+    /// W_f¹ here already, and E⁰ + W_f¹ as the start hid step 1's rise (+0.35 energy scales
+    /// reported as −4.2e-4, issue 42).
     pub fn energy(&mut self, e: f64) {
-        let balance = e + self.work;
+        let balance = if self.e0.is_none() { e } else { e + self.work };
         if let Some(prev) = self.balance_prev {
             self.max_inc = self.max_inc.max(balance - prev);
         }
@@ -302,6 +306,23 @@ mod tests {
         assert_eq!(m.energy_balance_max_increase, Some(0.0));
         assert_eq!(m.energy_balance_drift, Some(-0.03125));
         assert_eq!(m.tangential_work_min, Some(0.0));
+    }
+
+    /// E⁰ handed in after the first step (the Nitsche/penalty engines: E⁰ with E¹) starts the
+    /// balance at E⁰ + W_f⁰ = E⁰, not at E⁰ + W_f¹: a first step that gains energy is counted
+    /// (issue 42). One point in 2D, binary fractions: exact. E⁰ = 1; step 1 slides 0.5 under
+    /// f_t = −0.5 (γ = 1): W_f¹ = 0.25; E¹ = 1.5, so E + W_f rises by 0.75 — where the balance
+    /// started at E⁰ + W_f¹ it read 0.5.
+    #[test]
+    fn late_initial_energy_counts_the_first_step() {
+        let mut t = FrictionTally::new(1, 2, 1.0, 1.0);
+        assert_eq!(t.step(&[1.0, -0.5], &[0.5]), 0.25);
+        t.energy(1.0);
+        t.energy(1.5);
+        let mut m = Metrics::default();
+        t.finish(&mut m, 1.0, 0.0, 0.0);
+        assert_eq!(m.energy_balance_max_increase, Some(0.75));
+        assert_eq!(m.energy_balance_drift, Some(0.75));
     }
 
     /// The mean velocities from M v: a 3D body of two nodes (dofs node-major x, y, z) with

@@ -189,6 +189,9 @@ pub const OPTIONAL_SERIES: [&str; 10] = [
     "friction_work",
 ];
 
+/// The index of `friction_work` in [`OPTIONAL_SERIES`].
+const FRICTION_WORK: usize = 9;
+
 /// A run's time series, stored by column: the sink hands each column to the Parquet encoder
 /// as it is (moved, never transposed), so the rows a run keeps are written once, here, and
 /// read once, by the encoder — where a vector of [`SeriesRow`]s was transposed again by the
@@ -248,7 +251,10 @@ impl Series {
                 self.optional[k].reserve_exact(cap);
                 self.valid[k].reserve_exact(cap);
                 self.optional[k].resize(n, 0.0);
-                self.valid[k].resize(n, false);
+                // W_f is 0 before the first step for every treatment: an engine whose friction
+                // values start at step 1 (Nitsche, penalty) has W_f⁰ = 0, not a null, so E + W_f
+                // covers every step (issue 42). The other columns have no value there.
+                self.valid[k].resize(n, k == FRICTION_WORK);
                 self.optional[k].push(x);
                 self.valid[k].push(true);
             } else {
@@ -672,5 +678,21 @@ mod tests {
         assert!(s.has(0));
         assert_eq!(s.valid[0], [false, false, true, false, true]);
         assert!((1..10).all(|k| !s.has(k) && s.optional[k].is_empty()));
+    }
+
+    /// W_f starts at 0 for every treatment (issue 42): a `friction_work` column whose first
+    /// value comes at step 1 (the Nitsche/penalty engines) has W_f⁰ = 0 at step 0, valid; the
+    /// other friction columns stay null there.
+    #[test]
+    fn friction_work_starts_at_zero() {
+        let mut r1 = row(1, None);
+        (r1.sigma_t_contact, r1.v_t_contact, r1.friction_work) =
+            (Some(-0.5), Some(1.0), Some(0.25));
+        let s: Series = [row(0, None), r1.clone()].into_iter().collect();
+        assert_eq!(s.valid[9], [true, true]);
+        assert_eq!(s.optional[9], [0.0, 0.25]);
+        assert_eq!(s.valid[7], [false, true]);
+        assert_eq!(s.row(0).friction_work, Some(0.0));
+        assert_eq!(s.row(1), r1);
     }
 }

@@ -581,6 +581,8 @@ pub fn simulate(cfg: &OscillatorConfig, opts: &RunOptions) -> Outcome {
             work: 0.0,
             balance: eng.energy(x0, p.v0),
             balance_rise: f64::NEG_INFINITY,
+            stick: 0,
+            slip: 0,
             watch: StopWatch {
                 tol: 1e-12 * x0.abs().max(p.gap),
                 last_move: None,
@@ -672,11 +674,16 @@ fn initial_state(cfg: &OscillatorConfig, eng: &Osc) -> (State, f64, f64) {
 }
 
 /// Dry friction's accounts (contract §1.5): the work W_f = −Σ f̄_t (x^{n+1} − xⁿ), E + W_f after
-/// the last step and its largest one-step rise, and the stop.
+/// the last step and its largest one-step rise, the steps in stick and in slip, and the stop.
+/// The friction acts on the mass at every step (it does not wait for the obstacle), so every
+/// step counts: in stick when it moves the mass by at most the stop watch's tolerance
+/// 1e-12·max(|x⁰|, g) — the FE tally's increment rule, 1e-12·h, on the one dof — else in slip.
 struct DryAccount {
     work: f64,
     balance: f64,
     balance_rise: f64,
+    stick: i64,
+    slip: i64,
     watch: StopWatch,
 }
 
@@ -695,6 +702,11 @@ impl DryAccount {
         let dx = st.x - x_old;
         let w = eng.work_weight;
         self.work -= (w * ft + (1.0 - w) * ft_old) * dx;
+        if dx.abs() > self.watch.tol {
+            self.slip += 1;
+        } else {
+            self.stick += 1;
+        }
         self.watch.observe(n, dx);
         // E + W_f: what the normal contact (and the scheme) did in the step.
         let b = eng.energy(st.x, st.v) + self.work;
@@ -717,6 +729,8 @@ impl DryAccount {
         } else {
             0.0
         });
+        metrics.stick_steps = Some(self.stick);
+        metrics.slip_steps = Some(self.slip);
         metrics.stop_time = self.watch.stop_time(tau);
         if let Exact::Dry(e) = exact {
             metrics.stop_time_exact = e.stop().map(|(t, _)| t);

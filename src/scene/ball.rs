@@ -10,11 +10,13 @@
 //! circle (even); h and n_t are linked by n_t = 2·round(πR/(4h)).
 //!
 //! `velocity_tangential` (default 0; contract §1.8) gives every node the initial velocity V_t e_1:
-//! the disc thrown obliquely, for friction.
+//! the disc thrown obliquely, for friction; `velocity` (default 0) the initial V_d e_d
+//! (negative towards the plane).
 //!
-//! Energies are measured in `energy_scale` = m·|f|·gap, the kinetic energy of the body
-//! reaching the plane in free fall (E⁰ = 0 here), plus ½·m·V_t² when thrown obliquely. There is no closed form and no reference
-//! run yet: the runs report energies and contact observables, not errors.
+//! Energies are measured in `energy_scale` = m·|f|·gap + ½m(V_t² + V_d²), the kinetic energy
+//! of the body reaching the plane in free fall (E⁰ = 0 at rest) plus that of a throw
+//! ([`super::FeSetup::energy_scale`], contract §1.3). There is no closed form: errors are
+//! measured against a reference run.
 //!
 //! Implemented so far (issue 8, in stages): `mixed`, `nitsche` and `penalty` (κ = E·γ0/h_K)
 //! contact with every mass variant of contract §2.2 but the 1D-only two (`singular-dynamic`,
@@ -47,7 +49,7 @@ pub struct BallScene {
     pub dim: usize,
 }
 
-const BALL_PHYSICS: [PhysicsKey; 8] = [
+const BALL_PHYSICS: [PhysicsKey; 9] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -81,6 +83,12 @@ const BALL_PHYSICS: [PhysicsKey; 8] = [
     // is clamped). Default 0: the runs of contract §1.3 keep their ids.
     PhysicsKey {
         name: "velocity_tangential",
+        default: 0.0,
+    },
+    // The initial e_d velocity of every node (negative towards the plane): the disc thrown
+    // with (V_t, V_d), whose energy scale has both (contract §1.3). Default 0: ids unchanged.
+    PhysicsKey {
+        name: "velocity",
         default: 0.0,
     },
 ];
@@ -149,7 +157,7 @@ impl Scene for BallScene {
             gap,
             gravity: p.get("gravity"),
             load: LoadModel::from_index(p.get("load")),
-            v0: 0.0,
+            v0: p.get("velocity"),
             v0_tangential: p.get("velocity_tangential"),
             incline: 0.0,
         })

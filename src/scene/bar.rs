@@ -114,7 +114,33 @@ impl FeSetup {
         if curved_cells {
             out.push_str("revision=curved-quadrature\n");
         }
+        // The continuous energy scale (issue 42, [`FeSetup::energy_scale`]): it moved where a
+        // body under gravity starts with a normal velocity (which did not enter) or rests on
+        // the plane and is thrown along it (½mV_t² alone, without m·|f|·H).
+        let resting_thrown = self.gap == 0.0 && self.v0_tangential != 0.0;
+        if self.gravity != 0.0 && (self.v0 != 0.0 || resting_thrown) {
+            out.push_str("revision=energy-scale-continuous\n");
+        }
         out
+    }
+
+    /// The unit relative energies are measured in under gravity (contract §1.3):
+    /// m·|f|·d + ½m|v⁰|², m = ∫ρ the body's mass (`body_mass`, the same for every mass
+    /// variant), |f| = gravity (whatever the incline), v⁰ = (V_t, V_d) both components, d the
+    /// gap — or, for a body that starts on the plane (gap 0), `height()`, its height along e_d.
+    /// The work of the weight over the gap plus a thrown body's kinetic energy: continuous in
+    /// v⁰, where a scale of ½mV_t² alone vanished as V_t → 0 and turned a resting block at
+    /// V_t = 1e-6 into a `diverged` run. The terms are added in the order of the earlier
+    /// definition (m·|f|·gap, then ½mV_t²), so the runs it did not change keep their bits.
+    pub fn energy_scale(&self, body_mass: f64, height: impl FnOnce() -> f64) -> f64 {
+        let d = if self.gap != 0.0 { self.gap } else { height() };
+        let mut scale = body_mass * self.gravity.abs() * d;
+        for v in [self.v0_tangential, self.v0] {
+            if v != 0.0 {
+                scale += 0.5 * body_mass * v * v;
+            }
+        }
+        scale
     }
 }
 
@@ -267,5 +293,43 @@ mod tests {
         assert_eq!(s.mesh_from_elements(&physics(), 40).unwrap().h, 0.025);
         // P-wave speed √((λ+2μ)/ρ) = √1.25 with the defaults.
         assert!((s.wave_speed(&physics()) - 1.25f64.sqrt()).abs() < 1e-15);
+    }
+
+    /// contract §1.3's unit m·|f|·d + ½m|v⁰|², continuous in v⁰: binary fractions, exact. A body
+    /// of mass 2 under |f| = 0.5 (the sign of `gravity` aside) at gap 4, thrown with
+    /// (V_t, V_d) = (0.5, −0.25): 4 + 0.3125. On the plane (gap 0) its height 8 takes the gap's
+    /// place, whatever the throw; the height is not computed where the gap serves. The id
+    /// revision marks exactly the runs whose unit moved.
+    #[test]
+    fn energy_scale_is_weight_over_the_gap_plus_the_throw() {
+        let SceneSetup::Fe(mut s) = BarScene { dim: 2 }.setup(
+            &physics(),
+            MeshChoice {
+                elements: 20,
+                h: 0.05,
+            },
+        ) else {
+            unreachable!()
+        };
+        (s.gravity, s.gap, s.v0_tangential, s.v0) = (-0.5, 4.0, 0.5, -0.25);
+        let never = || -> f64 { panic!("the height is not needed with a gap") };
+        assert_eq!(s.energy_scale(2.0, never), 4.0 + 0.3125);
+        s.gap = 0.0;
+        assert_eq!(s.energy_scale(2.0, || 8.0), 8.0 + 0.3125);
+        let revised = |s: &FeSetup| s.id_revision().contains("energy-scale-continuous");
+        assert!(revised(&s));
+        // At rest on the plane: m·|f|·H as before, the same id.
+        (s.v0_tangential, s.v0) = (0.0, 0.0);
+        assert_eq!(s.energy_scale(2.0, || 8.0), 8.0);
+        assert!(!revised(&s));
+        // Continuous at V_t → 0 (the unit was ½mV_t² = 1e-18 at V_t = 1e-9).
+        s.v0_tangential = 1e-9;
+        assert_eq!(s.energy_scale(2.0, || 8.0), 8.0 + 1e-18);
+        assert!(revised(&s));
+        // Above the plane, thrown along it only: m·|f|·gap + ½mV_t² as before, the same id.
+        s.gap = 4.0;
+        s.v0_tangential = 0.5;
+        assert_eq!(s.energy_scale(2.0, never), 4.0 + 0.25);
+        assert!(!revised(&s));
     }
 }

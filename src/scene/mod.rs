@@ -100,6 +100,10 @@ impl SceneSetup {
     pub fn id_revision(&self) -> String {
         match self {
             SceneSetup::Fe(s) => s.id_revision(),
+            // Dry friction's rows gained the stick/slip counts (issue 42).
+            SceneSetup::Oscillator(p) if p.friction > 0.0 => {
+                "revision=dry-friction-stick-slip\n".into()
+            }
             SceneSetup::Bar1d { .. } | SceneSetup::Layer1d { .. } | SceneSetup::Oscillator(_) => {
                 String::new()
             }

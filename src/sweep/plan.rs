@@ -317,8 +317,8 @@ fn resolve_given(
             dropped.push(format!("{} {why}", k.name()));
         }
     }
-    if let Some(why) = meaningless(&m) {
-        return Err(Outcome::Inapplicable(why));
+    if let Some((why, keys)) = meaningless(&m) {
+        return Err(refuse_meaningless(given, why, keys));
     }
     let massless = m.mass.massless_contact();
     let contact_init = given
@@ -361,7 +361,13 @@ fn resolve_given(
         Some((_, setup)) => setup,
         None => scene.setup(&physics, mesh),
     };
-    let revision = setup.id_revision();
+    let mut revision = setup.id_revision();
+    // Issue 42: a frictional Nitsche/penalty run's E + W_f starts from E⁰ (its step 1 had been
+    // left out of `energy_balance_max_increase`) and its series has W_f⁰ = 0 (was null).
+    let fe_scene = scene.fe_dim().is_some();
+    if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
+        revision.push_str("revision=friction-balance-step-1\n");
+    }
     let scheme = m.scheme;
     let config = RunConfig::new(setup, m.contact, m.mass.clone(), scheme, dt, steps)
         .with_friction(m.friction)
@@ -641,26 +647,27 @@ fn friction_of(
             }
             FrictionLaw::None
         }
-        FrictionKind::Coulomb => match given.num(Key::FrictionCoefficient) {
-            Some(coefficient) => FrictionLaw::Coulomb { coefficient },
-            None => {
+        FrictionKind::Coulomb | FrictionKind::Tresca => {
+            // The other law's bound beside a fixed law would be dropped and change nothing:
+            // a mistake, as a bound beside `none` is.
+            let (other, other_law, own) = if friction_kind == FrictionKind::Coulomb {
+                (Key::TrescaThreshold, "tresca", Key::FrictionCoefficient)
+            } else {
+                (Key::FrictionCoefficient, "coulomb", Key::TrescaThreshold)
+            };
+            if given.has(other) && friction_fixed {
                 issues.push(Issue::at(
-                    &given.origin(Key::Friction),
-                    "friction = coulomb needs friction_coefficient (μ_f ≥ 0: |f_t| ≤ μ_f f_n)",
+                    &given.origin(other),
+                    format!(
+                        "{} is the bound of friction = \"{other_law}\", but friction = \"{}\" for this run (its bound is {}): it would be ignored; drop it, or set friction = \"{other_law}\"",
+                        other.name(),
+                        friction_kind.name(),
+                        own.name(),
+                    ),
                 ));
-                FrictionLaw::None
             }
-        },
-        FrictionKind::Tresca => match given.num(Key::TrescaThreshold) {
-            Some(threshold) => FrictionLaw::Tresca { threshold },
-            None => {
-                issues.push(Issue::at(
-                    &given.origin(Key::Friction),
-                    "friction = tresca needs tresca_threshold (s ≥ 0, a traction: |f_t| ≤ s while in contact)",
-                ));
-                FrictionLaw::None
-            }
-        },
+            law_of(given, friction_kind, issues)
+        }
     };
     if friction_kind != FrictionKind::None {
         if let Err(why) = given.scene.supports_friction() {
@@ -686,6 +693,33 @@ fn friction_of(
         }
     }
     Ok((friction_kind, friction))
+}
+
+/// The law of a `coulomb` or `tresca` run with its bound (a missing bound joins `issues`).
+fn law_of(given: &Given, kind: FrictionKind, issues: &mut Vec<Issue>) -> FrictionLaw {
+    match kind {
+        FrictionKind::Coulomb => match given.num(Key::FrictionCoefficient) {
+            Some(coefficient) => FrictionLaw::Coulomb { coefficient },
+            None => {
+                issues.push(Issue::at(
+                    &given.origin(Key::Friction),
+                    "friction = coulomb needs friction_coefficient (μ_f ≥ 0: |f_t| ≤ μ_f f_n)",
+                ));
+                FrictionLaw::None
+            }
+        },
+        FrictionKind::Tresca => match given.num(Key::TrescaThreshold) {
+            Some(threshold) => FrictionLaw::Tresca { threshold },
+            None => {
+                issues.push(Issue::at(
+                    &given.origin(Key::Friction),
+                    "friction = tresca needs tresca_threshold (s ≥ 0, a traction: |f_t| ≤ s while in contact)",
+                ));
+                FrictionLaw::None
+            }
+        },
+        FrictionKind::None => FrictionLaw::None,
+    }
 }
 
 /// Applicability (contract §3): whether a run of method `m` uses key `k`; `Err` says why not (the
@@ -746,17 +780,25 @@ fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
     })
 }
 
-/// Meaningless combinations (contract §3): why method `m` is no method at all, if it is not.
-fn meaningless(m: &Method) -> Option<String> {
+/// Meaningless combinations (contract §3): why method `m` is no method at all, if it is not,
+/// with the method keys whose values together make it so (for the refusal of a combination
+/// the file fixes, [`refuse_meaningless`]).
+fn meaningless(m: &Method) -> Option<(String, &'static [Key])> {
+    const SCHEME_SPACE: &[Key] = &[Key::Scheme, Key::Space];
+    const SCHEME_SPACE_MASS: &[Key] = &[Key::Scheme, Key::Space, Key::Mass];
     let (scheme, method) = (m.scheme, m.contact);
     let massless = m.mass.massless_contact();
     if matches!(scheme, Scheme::PaoliSchatzman(_)) && method != ContactMethod::Mixed {
-        return Some("paoli-schatzman is defined for space = mixed only".into());
+        return Some((
+            "paoli-schatzman is defined for space = mixed only".into(),
+            SCHEME_SPACE,
+        ));
     }
     if matches!(scheme, Scheme::Hybrid) && method == ContactMethod::Mixed && !massless {
-        return Some(
+        return Some((
             "hybrid with space = mixed needs a massless contact node (mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)".into(),
-        );
+            SCHEME_SPACE_MASS,
+        ));
     }
     // contract §3.2: where each method of the comparison literature applies.
     let family = scheme.family();
@@ -765,24 +807,30 @@ fn meaningless(m: &Method) -> Option<String> {
         Scheme::Kane | Scheme::ContactStabilizedNewmark | Scheme::MoreauJean(_)
     ) && method != ContactMethod::Mixed
     {
-        return Some(format!("{family} is defined for space = mixed only"));
+        return Some((
+            format!("{family} is defined for space = mixed only"),
+            SCHEME_SPACE,
+        ));
     }
     if scheme.needs_contact_mass() && massless {
-        return Some(format!(
-            "{family} needs inertia on the contact dof (mass = consistent or lumped)"
+        return Some((
+            format!("{family} needs inertia on the contact dof (mass = consistent or lumped)"),
+            &[Key::Scheme, Key::Mass],
         ));
     }
     if scheme == Scheme::DiscreteGradient {
         match method {
             ContactMethod::Mixed => {
-                return Some(
+                return Some((
                     "discrete-gradient needs a contact potential (space = penalty, or nitsche with Θ = 1)".into(),
-                );
+                    SCHEME_SPACE,
+                ));
             }
             ContactMethod::Nitsche { theta, .. } if theta != 1.0 => {
-                return Some(
+                return Some((
                     "discrete-gradient with space = nitsche needs nitsche_theta = 1 (only then is the Nitsche term a potential)".into(),
-                );
+                    &[Key::Scheme, Key::NitscheTheta],
+                ));
             }
             _ => {}
         }
@@ -791,11 +839,44 @@ fn meaningless(m: &Method) -> Option<String> {
     let kinematic = scheme == Scheme::Newmark(NewmarkParams::central_difference())
         && m.mass == MassVariant::Lumped;
     if scheme.is_explicit() && method == ContactMethod::Mixed && !massless && !kinematic {
-        return Some(
+        return Some((
             "an explicit scheme cannot enforce the multiplier constraint on a contact node with mass".into(),
-        );
+            SCHEME_SPACE_MASS,
+        ));
     }
     None
+}
+
+/// A meaningless method (`why`, from the keys `keys`) is one combination left out when one of
+/// those keys varies along an axis or a search — the axis crosses values that do not go
+/// together —, and a mistake in the file when none does: every run would be left out, so it
+/// is refused at each key the file gives, with its line (a key left at its default is named in
+/// the reason).
+fn refuse_meaningless(given: &Given, why: String, keys: &[Key]) -> Outcome {
+    let varies = |k: Key| given.on_axis(k) || given.origin(k).path.starts_with("search");
+    if keys.iter().any(|&k| varies(k)) {
+        return Outcome::Inapplicable(why);
+    }
+    let (set, defaulted): (Vec<Key>, Vec<Key>) = keys.iter().partition(|&&k| given.has(k));
+    let values = |ks: &[Key]| -> String {
+        ks.iter()
+            .map(|&k| {
+                let v = given.get(k).map_or_else(String::new, |v| v.to_string());
+                format!("{} = {v}", k.name())
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let mut reason = format!("{} together make no method: {why}", values(keys));
+    if !defaulted.is_empty() {
+        reason.push_str(&format!(" ({} by default)", values(&defaulted)));
+    }
+    let at: Vec<Key> = if set.is_empty() { keys.to_vec() } else { set };
+    Outcome::Invalid(
+        at.iter()
+            .map(|&k| Issue::at(&given.origin(k), reason.clone()))
+            .collect(),
+    )
 }
 
 /// The scene's physics values of a combination (a choice key's word as its index, a key not
@@ -831,7 +912,83 @@ fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
         }
         return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
     }
+    let issues = physics_magnitudes(given, &physics);
+    if !issues.is_empty() {
+        return Err(Outcome::Invalid(issues));
+    }
+    incline_without_gravity(given, &physics)?;
     Ok(physics)
+}
+
+/// The largest kinetic energy density ½ρ|v⁰|² a run may start with (contract §7): √MAX / 1e6,
+/// MAX the largest double. Every energy the engines report is a quadratic form of the state
+/// summed over the body (vᵀMv, uᵀKu once the body has moved by v⁰t), and a run is stopped as
+/// diverged above 1e6·energy_scale (`run::observe::DIVERGENCE_FACTOR`). Below this bound the
+/// squares of the state and the divergence threshold stay representable with a margin of
+/// √MAX for the body's size and the operators' entries; above it the first step can already
+/// overflow (`velocity_tangential = 1e200` ended "non-finite value at step 0"). It allows any
+/// physical speed: |v⁰| ≤ 1.6e74 at ρ = 1.
+pub const MAX_KINETIC_DENSITY: f64 =
+    1.3407807929942596e154 / crate::run::observe::DIVERGENCE_FACTOR;
+
+/// Initial speeds whose energy the run could not represent ([`MAX_KINETIC_DENSITY`]), refused
+/// at each velocity key the file gives: both components count, |v⁰|² = v_n² + v_t², with the
+/// scene's density (the oscillator's point mass).
+fn physics_magnitudes(given: &Given, physics: &Physics) -> Vec<Issue> {
+    let value = |name: &str| physics.0.iter().find(|(n, _)| *n == name).map(|p| p.1);
+    let keys = [Key::Velocity, Key::VelocityTangential];
+    let speed = keys
+        .iter()
+        .filter_map(|k| value(k.name()))
+        .fold(0.0, f64::hypot);
+    let rho = value("density")
+        .or_else(|| value("point_mass"))
+        .unwrap_or(1.0);
+    let density = 0.5 * rho * speed * speed;
+    if density <= MAX_KINETIC_DENSITY {
+        return Vec::new();
+    }
+    keys.iter()
+        .filter(|k| given.has(**k) && value(k.name()).is_some_and(|v| v != 0.0))
+        .map(|k| {
+            Issue::at(
+                &given.origin(*k),
+                format!(
+                    "{} = {:e} starts the body with a kinetic energy density ½ρ|v⁰|² = {density:.3e} (ρ = {rho}, |v⁰| = {speed:.3e}), above the {MAX_KINETIC_DENSITY:.3e} a run can represent: its energies (quadratic in the state, judged against 1e6·energy_scale) would overflow (contract §7)",
+                    k.name(),
+                    value(k.name()).unwrap_or(0.0),
+                ),
+            )
+        })
+        .collect()
+}
+
+/// `incline` tilts the volume load (contract §1.8): without gravity there is none, and the tilt
+/// would change nothing. A mistake where both are fixed; one combination left out where
+/// either varies along an axis.
+fn incline_without_gravity(given: &Given, physics: &Physics) -> Result<(), Outcome> {
+    let value = |name: &str| physics.0.iter().find(|(n, _)| *n == name).map(|p| p.1);
+    let (Some(incline), Some(gravity)) = (value("incline"), value("gravity")) else {
+        return Ok(());
+    };
+    if incline == 0.0 || gravity != 0.0 {
+        return Ok(());
+    }
+    let why = format!(
+        "incline = {incline} tilts the volume load, but gravity = 0{} for this run: without a load the tilt changes nothing; set gravity > 0 or drop incline",
+        if given.has(Key::Gravity) {
+            ""
+        } else {
+            " (the default)"
+        }
+    );
+    if given.on_axis(Key::Incline) || given.on_axis(Key::Gravity) {
+        return Err(Outcome::Inapplicable(why));
+    }
+    Err(Outcome::Invalid(vec![Issue::at(
+        &given.origin(Key::Incline),
+        why,
+    )]))
 }
 
 /// A mesh scene's body: the file of the `mesh` key, read and validated before any run, with

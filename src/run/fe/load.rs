@@ -21,13 +21,9 @@ pub(super) struct GravityLoad {
     pub(super) m_ed: Vec<f64>,
     /// e_dᵀ M e_d.
     pub(super) vertical_mass: f64,
-    /// The unit relative energies are measured in, the same for every mass variant (m = ∫ρ the
-    /// body's mass, |f| = gravity whatever the incline): m·|f|·gap, the work of the weight
-    /// over the gap (contract §1.3), plus ½·m·V_t², the kinetic energy of the initial tangential
-    /// velocity (contract §1.8; 0 unless `velocity_tangential` is given, so every earlier run keeps
-    /// its scale). A body that starts on the plane at rest (both 0) would have no unit at all:
-    /// it is measured in m·|f|·H, H its height along e_d, the work of its weight over its own
-    /// size.
+    /// The unit relative energies are measured in, the same for every mass variant:
+    /// m·|f|·d + ½m|v⁰|² ([`crate::scene::FeSetup::energy_scale`], contract §1.3), d the gap or,
+    /// for a body that starts on the plane, its height H along e_d.
     pub(super) energy_scale: f64,
 }
 
@@ -145,18 +141,14 @@ pub(super) fn gravity_load(
         .map_err(|e| format!("initial acceleration M a⁰ = F: {e}"))?;
         a
     };
-    let v_t = s.v0_tangential;
-    let mut energy_scale = body_mass * fall.abs() * s.gap;
-    if v_t != 0.0 {
-        energy_scale += 0.5 * body_mass * v_t * v_t;
-    }
-    if energy_scale == 0.0 {
+    // contract §1.3: m·|f|·d + ½m|v⁰|², d the gap or the body's height on the plane.
+    let energy_scale = s.energy_scale(body_mass, || {
         let heights = (0..mesh.num_nodes()).map(|a| mesh.coord(a)[d - 1]);
         let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), z| {
             (lo.min(z), hi.max(z))
         });
-        energy_scale = body_mass * fall.abs() * (hi - lo);
-    }
+        hi - lo
+    });
     Ok(Some(GravityLoad {
         force,
         a0,
