@@ -867,3 +867,213 @@ fn messages_are_one_line_without_dumps() {
     // The section is named right after the file.
     refused_by_the_binary(&cases[0], "mesh2d", "body.msh: $");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Issue 42: the geometric check. A cell laid over others without sharing a face with them
+// passed every topological check and ran, its region counted twice. Refused naming both cells;
+// shared vertices do not excuse an overlap, and cells merely touching along a boundary pass.
+
+/// The two cells an [`GmshError::Overlap`] names, and its depth.
+fn overlap_of(e: GmshError) -> (u64, u64, f64) {
+    match e {
+        GmshError::Overlap { a, b, depth, .. } => (a, b, depth),
+        other => panic!("expected Overlap, got {other:?}"),
+    }
+}
+
+#[test]
+fn p1_triangle_laid_inside_another_is_refused() {
+    // A fourth triangle (0.6, 0.1), (0.9, 0.1), (0.9, 0.4) of its own nodes, inside element 2
+    // (the lower right half of the square, x ≥ y) and away from element 3.
+    let text = edit("2 4 1 4\n", "2 7 1 7\n")
+        .replacen(
+            "2 1 0 2\n3\n4\n1 1 0\n0 1 0\n",
+            "2 1 0 5\n3\n4\n5\n6\n7\n1 1 0\n0 1 0\n0.6 0.1 0\n0.9 0.1 0\n0.9 0.4 0\n",
+            1,
+        )
+        .replacen("2 3 1 3\n", "2 4 1 4\n", 1)
+        .replacen("2 1 2 2\n", "2 1 2 3\n", 1)
+        .replacen("3 1 3 4\n", "3 1 3 4\n4 5 6 7\n", 1);
+    let (a, b, depth) = overlap_of(refused(&text));
+    assert_eq!((a, b), (2, 4));
+    // The inner triangle is contained: its projections overlap element 2's by its own widths,
+    // 0.3 along x and y and 0.3/√2 along the common hypotenuse normal (1, −1)/√2 — the depth.
+    // Round-off: a few ulps (5.6e-17) of the coordinates' differences (0.1 is not a double).
+    assert!((depth - 0.3 / 2f64.sqrt()).abs() < 1e-15, "{depth}");
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "elements 2 and 4 overlap");
+}
+
+/// A P2 triangle `A` (corners (0,0), (1,0), (0,1), straight; nodes 1–6) and a second one `B`
+/// (nodes 7–12: `corners`, then the midside nodes of edges 01, 12, 20, straight except edge 01's
+/// at `m01`); `contact` = A's bottom edge.
+fn two_p2_triangles(corners: [[f64; 2]; 3], m01: [f64; 2]) -> String {
+    let mid = |a: [f64; 2], b: [f64; 2]| [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+    let c = corners;
+    let b_nodes = [c[0], c[1], c[2], m01, mid(c[1], c[2]), mid(c[2], c[0])];
+    let mut nodes = String::from("0 0 0\n1 0 0\n0 1 0\n0.5 0 0\n0.5 0.5 0\n0 0.5 0\n");
+    for p in b_nodes {
+        nodes.push_str(&format!("{:?} {:?} 0\n", p[0], p[1]));
+    }
+    let tags: String = (1..=12).map(|t| format!("{t}\n")).collect();
+    format!(
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n1 1 \"contact\"\n$EndPhysicalNames\n\
+         $Entities\n0 1 1 0\n1 0 0 0 1 0 0 1 1 0\n1 -1 -1 0 2 2 0 0 1 1\n$EndEntities\n\
+         $Nodes\n1 12 1 12\n2 1 0 12\n{tags}{nodes}$EndNodes\n\
+         $Elements\n2 3 1 3\n1 1 8 1\n1 1 2 4\n2 1 9 2\n2 1 2 3 4 5 6\n3 7 8 9 10 11 12\n$EndElements\n"
+    )
+}
+
+#[test]
+fn curved_p2_edge_reaching_into_another_cell_is_refused() {
+    // B's corners (0.1, 1.1), (1.1, 0.1), (1.1, 1.1): its edge 01 runs along x + y = 1.2, a gap
+    // of 0.2/√2 from A's hypotenuse x + y = 1 — the straight-sided cells are apart. Its midside
+    // node at (0.45, 0.45) bends the edge into A (x + y = 0.9 at its middle; B's det J stays
+    // positive, the bulge is outwards from B). Only a test of the curved cell sees it.
+    let corners = [[0.1, 1.1], [1.1, 0.1], [1.1, 1.1]];
+    let text = two_p2_triangles(corners, [0.45, 0.45]);
+    let (a, b, depth) = overlap_of(refused(&text));
+    assert_eq!((a, b), (2, 3));
+    // The node is 0.1/√2 = 0.0707 inside A; the pieces through it reach no deeper, and a
+    // penetration below 10⁻⁶ of a cell would not have been refused.
+    assert!(
+        depth > 1e-3 && depth <= 0.1 / 2f64.sqrt() + 1e-12,
+        "{depth}"
+    );
+    refused_by_the_binary(text.as_bytes(), "mesh2d", "elements 2 and 3 overlap");
+    // The same B straight (midside node at the edge's middle, (0.6, 0.6)) is 0.14 away: read.
+    let (r, _, _d) = read(&two_p2_triangles(corners, [0.6, 0.6]));
+    r.unwrap_or_else(|e| panic!("{e}"));
+    // B touching A along A's whole hypotenuse (B's edge 01 on x + y = 1 from (−0.3, 1.3) to
+    // (1.5, −0.5), A's corners on it, no node shared): merely touching, read.
+    let touching = [[-0.3, 1.3], [1.5, -0.5], [1.5, 1.3]];
+    let (r, _, _d) = read(&two_p2_triangles(touching, [0.6, 0.4]));
+    r.unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn p1_tetrahedron_inside_another_sharing_a_vertex_is_refused() {
+    // Element 2 = the unit corner tetrahedron; element 3 shares its vertex 1 (the origin) and
+    // lies inside it ((0.6, 0.2, 0.1), (0.2, 0.6, 0.1), (0.2, 0.2, 0.5): x + y + z = 0.9 < 1),
+    // positively oriented (det = 0.144): no face shared, no topological check sees it.
+    let text = "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n2 1 \"contact\"\n$EndPhysicalNames\n\
+         $Entities\n0 0 1 1\n1 0 0 0 1 1 0 1 1 0\n1 0 0 0 1 1 1 0 1 1\n$EndEntities\n\
+         $Nodes\n1 7 1 7\n3 1 0 7\n1\n2\n3\n4\n5\n6\n7\n\
+         0 0 0\n1 0 0\n0 1 0\n0 0 1\n0.6 0.2 0.1\n0.2 0.6 0.1\n0.2 0.2 0.5\n$EndNodes\n\
+         $Elements\n2 3 1 3\n2 1 2 1\n1 1 3 2\n3 1 4 2\n2 1 2 3 4\n3 1 5 6 7\n$EndElements\n";
+    let (a, b, depth) = overlap_of(refused(text));
+    assert_eq!((a, b), (2, 3));
+    // Contained: the depth is element 3's smallest width over the separating axes, positive and
+    // below its longest side (0.4 + round-off).
+    assert!(depth > 0.01 && depth < 0.4 + 1e-12, "{depth}");
+    refused_by_the_binary(text.as_bytes(), "mesh3d", "elements 2 and 3 overlap");
+}
+
+/// A committed mesh with a copy of its cell nearest the corner (1, 1[, 1]) shifted by 0.4 of
+/// the cell's extent along each axis (new nodes, a new element): the copy sticks out of the
+/// body and overlaps that cell alone on a structured mesh. Returns the file, the corner cell's
+/// tag and the copy's.
+fn shifted_corner_copy(name: &str) -> (Vec<u8>, u64, u64) {
+    use contact_sweep::space::fe::msh;
+    let mut m = msh::parse(&committed(name)).unwrap();
+    let coord: std::collections::HashMap<u64, [f64; 3]> = m
+        .node_blocks
+        .iter()
+        .flat_map(|b| b.tags.iter().copied().zip(b.coords.iter().copied()))
+        .collect();
+    let d = m.element_blocks.iter().map(|b| b.entity_dim).max().unwrap();
+    let bi = m
+        .element_blocks
+        .iter()
+        .position(|b| b.entity_dim == d)
+        .unwrap();
+    let blk = &m.element_blocks[bi];
+    let score = |i: usize| -> f64 {
+        let e = blk.element(i);
+        e.iter().map(|t| coord[t].iter().sum::<f64>()).sum::<f64>() / e.len() as f64
+    };
+    let corner = (0..blk.tags.len())
+        .max_by(|&i, &j| score(i).total_cmp(&score(j)))
+        .unwrap();
+    let nodes = blk.element(corner).to_vec();
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for t in &nodes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(coord[t][k]);
+            hi[k] = hi[k].max(coord[t][k]);
+        }
+    }
+    let next_node = coord.keys().max().unwrap() + 1;
+    let new_nodes: Vec<u64> = (0..nodes.len() as u64).map(|k| next_node + k).collect();
+    let corner_tag = blk.tags[corner];
+    let new_tag = m
+        .element_blocks
+        .iter()
+        .flat_map(|b| b.tags.iter().copied())
+        .max()
+        .unwrap()
+        + 1;
+    let (dim, entity) = (blk.entity_dim, blk.entity_tag);
+    m.node_blocks.push(msh::NodeBlock {
+        entity_dim: dim,
+        entity_tag: entity,
+        tags: new_nodes.clone(),
+        coords: nodes
+            .iter()
+            .map(|t| std::array::from_fn(|k| coord[t][k] + 0.4 * (hi[k] - lo[k])))
+            .collect(),
+    });
+    let blk = &mut m.element_blocks[bi];
+    blk.tags.push(new_tag);
+    blk.nodes.extend(new_nodes);
+    let bytes = msh_io::write(&m, &msh_io::Style::default());
+    (bytes, corner_tag, new_tag)
+}
+
+#[test]
+fn shifted_copies_of_quadrilaterals_and_hexahedra_are_refused() {
+    // Q1 and Q2 quadrilaterals (2D), Q1 and Q2 hexahedra (3D): the copy of the corner cell,
+    // shifted by 0.4 of its extent, overlaps it over 0.6 of its extent along each axis. The
+    // unmodified meshes are read (the committed files; `the_committed_meshes_are_read` of
+    // gmsh_meshes.rs covers them all).
+    for name in [
+        "square_quad_q1.msh",
+        "square_quad_q2.msh",
+        "cube_hex_q1.msh",
+        "cube_hex_q2.msh",
+    ] {
+        let (bytes, corner, copy) = shifted_corner_copy(name);
+        let (a, b, depth) = overlap_of(refused_bytes(&bytes));
+        let mut named = [a, b];
+        named.sort_unstable();
+        assert_eq!(named, [corner, copy], "{name}");
+        // Boxes overlapping by 0.6 of the cell's sides (0.25 × 0.5 rectangles, cubes of side
+        // 0.5): two pieces of them (triangles, tetrahedra) overlap by at most the boxes'
+        // overlap along x, 0.15 or 0.3 (a penetration depth is at most the overlap of the
+        // projections on any axis); the 1e-12 is round-off.
+        let bound = if name.starts_with("square") {
+            0.15
+        } else {
+            0.3
+        };
+        assert!(depth > 0.0 && depth <= bound + 1e-12, "{name}: {depth}");
+    }
+    let (bytes, _, _) = shifted_corner_copy("cube_hex_q2.msh");
+    refused_by_the_binary(&bytes, "mesh3d", "overlap");
+}
+
+#[test]
+fn shifted_copies_of_p2_tetrahedra_and_triangles_are_refused() {
+    // On unstructured simplex meshes the copy may reach more than the corner cell: the error
+    // names the copy and one existing cell it overlaps.
+    for (name, scene) in [
+        ("cube_tet_p2.msh", "mesh3d"),
+        ("cube_tet.msh", "mesh3d"),
+        ("square_tri_p2.msh", "mesh2d"),
+    ] {
+        let (bytes, _, copy) = shifted_corner_copy(name);
+        let (a, b, depth) = overlap_of(refused_bytes(&bytes));
+        assert!(a != b && (a == copy || b == copy), "{name}: {a}, {b}");
+        assert!(depth > 0.0, "{name}: {depth}");
+        refused_by_the_binary(&bytes, scene, "overlap");
+    }
+}

@@ -30,7 +30,8 @@
 //! checks of [`super::check`]: cells listed twice, faces shared by more than two cells or by
 //! two on one side (overlaps), neighbours not sharing their midside nodes, coincident distinct
 //! nodes (a crack), and `contact`/`clamped` elements that are not boundary faces of the cells'
-//! type. A 2D mesh whose cells are all clockwise in the (x, y) plane (a surface oriented
+//! type; and the geometric check of [`super::overlap`]: cells that intersect other than along
+//! shared faces, edges or vertices (found with a bounding-box tree, O(n log n)). A 2D mesh whose cells are all clockwise in the (x, y) plane (a surface oriented
 //! towards −z) is
 //! reoriented rather than refused; a cell of the other orientation is then inverted.
 //!
@@ -49,7 +50,7 @@ pub use super::element_kind::ElementKind;
 use super::element_kind::{det_from_gradients, jacobian_det};
 pub use super::gmsh_error::GmshError;
 use super::mesh::Mesh;
-use super::{check, msh};
+use super::{check, msh, overlap};
 
 /// Node tag → node index of a file.
 enum TagIndex {
@@ -688,7 +689,9 @@ impl Cells {
 
 /// Topology (issue 36): no cell twice, every face shared by at most two cells lying on either
 /// side of it with the same midside nodes, no distinct nodes at one point, and det J certified
-/// positive on the whole of every curved cell. Returns the cells' faces, which the boundary
+/// positive on the whole of every curved cell; then geometry (issue 42): no two cells
+/// overlapping other than along what they share (last: it cuts the cells into straight pieces,
+/// which only valid cells make meaningful). Returns the cells' faces, which the boundary
 /// groups are checked against.
 fn check_topology<'a>(
     file: &str,
@@ -708,6 +711,15 @@ fn check_topology<'a>(
     })?;
     check::certify_jacobians(cells.kind, &nodes.coords, &cells.elements)
         .map_err(|e| e.into_gmsh(f(), &cells.tags))?;
+    overlap::overlapping_cells(cells.kind, &nodes.coords, &cells.elements).map_err(|o| {
+        GmshError::Overlap {
+            file: f(),
+            a: cells.tags[o.a],
+            b: cells.tags[o.b],
+            depth: o.depth,
+            relative: o.relative,
+        }
+    })?;
     Ok(topo)
 }
 

@@ -141,6 +141,16 @@ pub enum GmshError {
         distance: f64,
     },
     #[error(
+        "{file}: elements {a} and {b} overlap (depth {depth:e}, {relative:e} of the smaller cell); cells of one body may meet only along shared faces, edges or vertices"
+    )]
+    Overlap {
+        file: String,
+        a: u64,
+        b: u64,
+        depth: f64,
+        relative: f64,
+    },
+    #[error(
         "{file}: element {element}: det J could not be certified positive over the cell (smallest Bernstein coefficient {min:e} after {pieces} subdivisions); straighten or refine it"
     )]
     NotCertified {

@@ -12,7 +12,7 @@
 //!   that cannot panic) of the `mesh2d`/`mesh3d` scenes: P1/P2 triangles and tetrahedra, Q1/Q2
 //!   quadrilaterals and hexahedra, physical groups by name, validated (typed [`GmshError`]s,
 //!   in `gmsh_error`; the whole-mesh checks — conformity, coincident nodes, boundary groups,
-//!   certified det J — in `check`), with `h` and the file's content hash; the facts of the
+//!   certified det J — in `check`; the geometric one, cells overlapping, in `overlap`), with `h` and the file's content hash; the facts of the
 //!   reference cells both stand on ([`ElementKind`]: node orders, shape gradients, det J) in
 //!   `element_kind`, below both;
 //! - [`element`]: isoparametric Q1/Q2 mass, elasticity stiffness, grad-grad and load with nalgebra
@@ -39,6 +39,7 @@ pub mod locate;
 pub mod mesh;
 pub mod msh;
 pub mod nitsche;
+mod overlap;
 pub mod quadrature;
 pub mod simplex;
 pub mod sparse;
