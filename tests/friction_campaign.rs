@@ -670,7 +670,7 @@ fn moreau_jean_resting_block_against_siconos() {
         .map(|x| x.as_f64().unwrap())
         .collect();
     let text = format!(
-        "{}\nspace = \"mixed\"\nmass = \"consistent\"\nscheme = \"moreau-jean\"\nrestitution = 0.0\n{}",
+        "name = \"siconos\"\n{}\nspace = \"mixed\"\nmass = \"consistent\"\nscheme = \"moreau-jean\"\nrestitution = 0.0\n{}",
         block(2, 0.0, 0.05, 5.0, 0.2),
         Law::Coulomb(0.3).toml()
     );
@@ -690,7 +690,11 @@ fn moreau_jean_resting_block_against_siconos() {
             .fold(f64::NEG_INFINITY, f64::max)
     };
     let first = |e: &[f64]| e.windows(2).position(|w| w[1] - w[0] > 1e-12 * scale);
-    eprintln!("largest rise: engine {:.4}, Siconos {:.4}", rise(&engine), rise(&siconos));
+    eprintln!(
+        "largest rise: engine {:.4}, Siconos {:.4}",
+        rise(&engine),
+        rise(&siconos)
+    );
     assert_eq!(first(&engine), Some(3));
     assert_eq!(first(&siconos), Some(3));
     // Both raise E + W_f by about a tenth of the energy scale in one step (measured 0.0948 and
