@@ -405,7 +405,11 @@ friction = [
         let contact_sweep::run::RunConfig::Fe(cfg) = &spec.config else {
             unreachable!("the block is an FE scene")
         };
-        let what = format!("{}-{}", cfg.method.name(), cfg.friction.name());
+        let law = match cfg.friction {
+            contact_sweep::contact::friction::FrictionLaw::None => "none",
+            _ => "coulomb-0.2",
+        };
+        let what = format!("{}-{law}", cfg.method.name());
         bench_steps(&mut g, &what, cfg);
     }
     g.finish();
