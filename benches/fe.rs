@@ -36,6 +36,19 @@
 //!   Tresca; the engine's stepping time per step, factor cached. The target: frictional ÷
 //!   frictionless ≤ 1.5.
 //!
+//! - `block3d-friction/…` (issue 43, done-when 3): one step of Nitsche (Θ = 1, γ0 = 1e-3) and of
+//!   the penalty (γ0 = 100) + Crank–Nicolson on the 3D sliding block at 5 187 dofs
+//!   (sweeps/meshes/block3d_5k.msh: 12 × 6 × 18 Q1 hexahedra, 648 contact quadrature points),
+//!   resting on the plane under gravity and thrown at V = 0.5, τ = 0.05, 10 steps (every point
+//!   in contact and sliding), frictionless against Coulomb μ_f = 0.2: the engine's stepping time
+//!   per step, factor cached, the Newton iterations printed. The frictional Newton has 3 × 648
+//!   unknowns; its step goes through the full-space sparse LU (run/fe/nitsche.rs,
+//!   `SparseNewton`). The target: frictional ÷ frictionless ≤ 1.5. Measured (session 28, two
+//!   cores shared with builds): Nitsche frictionless 259 ms per step (1 Newton iteration a
+//!   step, its dense active block of 648), Coulomb 6.51 s (57 iterations over the 10 steps,
+//!   at most 11; one sparse LU of the 5 187-dof Newton matrix each): 25×, not met; penalty
+//!   frictionless 284 ms.
+//!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).
 
@@ -360,7 +373,54 @@ fn bench_friction(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 43's cost of Nitsche/penalty friction per step in 3D (module header, `block3d-friction`).
+fn bench_friction_3d(c: &mut Criterion) {
+    let mut g = c.benchmark_group("block3d-friction");
+    g.sample_size(10).warm_up_time(Duration::from_millis(500));
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let text = r#"
+name = "block3d-friction"
+scene = "mesh3d"
+[fixed]
+mesh = "meshes/block3d_5k.msh"
+density = 1.0
+lame_lambda = 10.0
+lame_mu = 10.0
+gravity = 0.1
+gap = 0.0
+velocity_tangential = 0.5
+T = 0.5
+dt = 0.05
+scheme = "crank-nicolson"
+[grid]
+method = [
+  { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 },
+  { space = "penalty", penalty_gamma0 = 100.0 },
+]
+friction = [
+  { friction = "none" },
+  { friction = "coulomb", friction_coefficient = 0.2 },
+]
+"#;
+    let path = root.join("sweeps/block3d-friction.toml");
+    let sweep = contact_sweep::sweep::SweepFile::parse(&path, text).expect("valid sweep");
+    let plan = contact_sweep::sweep::expand(&sweep).expect("plan");
+    for spec in &plan.runs {
+        let contact_sweep::run::RunConfig::Fe(cfg) = &spec.config else {
+            unreachable!("the block is an FE scene")
+        };
+        let law = match cfg.friction {
+            contact_sweep::contact::friction::FrictionLaw::None => "none",
+            _ => "coulomb-0.2",
+        };
+        let what = format!("{}-{law}", cfg.method.name());
+        bench_steps(&mut g, &what, cfg);
+    }
+    g.finish();
+}
+
 fn fe(c: &mut Criterion) {
+    bench_friction_3d(c);
     bench_friction(c);
     bench_methods(c);
     bench_ball(c, "disc2d-q2-h4", 2, 4.0);

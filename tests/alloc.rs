@@ -297,6 +297,25 @@ fn frictional_comparison_methods_allocate_nothing() {
     }
 }
 
+/// Nitsche and penalty friction in 3D with the Newmark family (issue 43): bar3d at h = 0.1
+/// (36 contact points: the Newton's dense active block) and at h = 0.025 (144 points, 432
+/// unknowns: from 384 active unknowns on, the Newton's step goes through the full-space sparse
+/// LU, run/fe/nitsche.rs `SparseNewton`, refactored per iteration in buffers sized at setup)
+/// — nothing allocated in the time loop.
+#[test]
+fn nitsche_3d_frictional_time_loops_allocate_nothing() {
+    let methods = [
+        r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 0.001, scheme = "crank-nicolson", friction = "coulomb", friction_coefficient = 0.3 }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 100.0, scheme = "backward-euler", friction = "tresca", tresca_threshold = 0.02 }"#,
+    ];
+    for fixed in [BAR, "h = 0.025\ndt = 0.01"] {
+        assert_loop_allocates_nothing(
+            &fe_sweep("alloc-fe-friction", "bar3d", fixed, &methods),
+            1.0,
+        );
+    }
+}
+
 /// The discrete gradient's condensed Newton on the disc (penalty, Nitsche Θ = 1), and
 /// generalized-α/hht with Nitsche and the penalty (the engine's Newton, f_cⁿ carried).
 #[test]

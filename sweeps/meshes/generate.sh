@@ -70,3 +70,9 @@ done
 # tests/sliding_block.rs).
 g block2d.geo -2 -order 1 -o block2d.msh
 g block3d.geo -3 -order 1 -o block3d.msh
+# The frictional step's cost on a 3D block (benches/fe.rs, issue 43): 12 x 6 x 18 hexahedra,
+# 13 x 7 x 19 nodes (5 187 dofs), 72 contact faces (648 Nitsche points).
+tmp=$(mktemp --suffix .geo)
+sed -e "s/^N = .*/N = 12;/" -e "s/^M = .*/M = 6;/" -e "s/^L = .*/L = 18;/" block3d.geo >"$tmp"
+g "$tmp" -3 -order 1 -o block3d_5k.msh
+rm -f "$tmp"

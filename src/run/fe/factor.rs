@@ -43,6 +43,9 @@ pub(super) struct Factored {
     /// Mixed with friction (contract §2.5): the tangential rows; Z then holds the tangential
     /// columns after the normal ones.
     pub(super) friction: Option<FrictionFactor>,
+    /// Frictional Nitsche/penalty: the step matrix A itself, for the Newton's full-space sparse
+    /// LU on large active sets ([`super::nitsche::SparseNewton`]); `None` otherwise.
+    pub(super) a_friction: Option<SymMatrix>,
 }
 
 /// The mixed method's condensation over the normal and tangential rows C of Γ_C.
@@ -202,6 +205,7 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
         h,
         nitsche: None,
         friction,
+        a_friction: None,
     })
 }
 
@@ -261,6 +265,7 @@ pub(super) fn factor_nitsche(
     }
     // The condensed unknowns: the points' P_γ (and P_t with friction).
     let nq = ops.unknowns();
+    let a_friction = ops.friction.is_some().then(|| a.clone());
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
     })?;
@@ -292,5 +297,6 @@ pub(super) fn factor_nitsche(
         h,
         nitsche: Some(ops),
         friction: None,
+        a_friction,
     })
 }

@@ -230,7 +230,12 @@ impl<'a> Stepper<'a> {
             },
         );
         let newton_work = match nit {
-            Some(o) if o.friction.is_some() => NewtonWork::frictional(nc, o.per_point()),
+            Some(o) if o.friction.is_some() => {
+                match NewtonWork::frictional_for(o, fac.a_friction.as_ref()) {
+                    Ok(w) => w,
+                    Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+                }
+            }
             _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
         };
         let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());

@@ -45,7 +45,9 @@
 
 use crate::contact::friction::FrictionLaw;
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
+use crate::space::fe::SymMatrix;
 use crate::space::fe::nitsche::ContactPoint;
+use crate::space::sparse_lu::SparseLu;
 
 /// Semismooth Newton: relative tolerance and iteration cap (contract §4).
 pub(crate) const NEWTON_TOL: f64 = 1e-12;
@@ -288,6 +290,15 @@ pub(crate) struct NewtonWork {
     /// The full Newton step and the iterate it starts from (the line search's).
     step: Vec<f64>,
     x_old: Vec<f64>,
+    /// Large frictional problems: the full-space sparse Newton matrix ([`SparseNewton`]).
+    sparse: Option<SparseNewton>,
+    /// The last forces a [`continuation`] stage solved for, and those of its narrowest
+    /// Tresca ramp before a restart.
+    lambda_ok: Vec<f64>,
+    lambda_best: Vec<f64>,
+    /// The iterations of [`newton_friction`]'s stages over the run: from the previous forces,
+    /// from rest, the continuation in the bound.
+    pub stages: [usize; 3],
 }
 
 impl NewtonWork {
@@ -305,6 +316,10 @@ impl NewtonWork {
             d_delta: Vec::new(),
             step: Vec::new(),
             x_old: Vec::new(),
+            sparse: None,
+            lambda_ok: Vec::new(),
+            lambda_best: Vec::new(),
+            stages: [0; 3],
         }
     }
 
@@ -316,7 +331,20 @@ impl NewtonWork {
         w.d_delta = vec![0.0; nu];
         w.step = vec![0.0; nu];
         w.x_old = vec![0.0; nu];
+        w.lambda_ok = vec![0.0; nu];
+        w.lambda_best = vec![0.0; nu];
         w
+    }
+
+    /// [`NewtonWork::frictional`] for the rows `ops`, with the full-space sparse Newton
+    /// ([`SparseNewton`]) where the active set can reach [`SPARSE_MIN_ACTIVE`] and the step
+    /// matrix `a` is at hand.
+    pub fn frictional_for(ops: &NitscheOps, a: Option<&SymMatrix>) -> Result<NewtonWork, String> {
+        let mut w = NewtonWork::frictional(ops.unknowns(), ops.per_point());
+        if let Some(a) = a.filter(|_| ops.unknowns() >= SPARSE_MIN_ACTIVE) {
+            w.sparse = Some(SparseNewton::new(ops, a)?);
+        }
+        Ok(w)
     }
 }
 
@@ -330,6 +358,7 @@ fn point_forces(
     w: f64,
     gamma: f64,
     law: FrictionLaw,
+    ramp: f64,
     lambda: &mut [f64],
     block: &mut [f64],
 ) -> (bool, bool) {
@@ -346,6 +375,10 @@ fn point_forces(
     // The disc's radius and its derivative in x_n.
     let (r, dr) = match law {
         FrictionLaw::Coulomb { coefficient } => (coefficient * f_n, coefficient / gamma),
+        // Tresca's onset ramp (`ramp` > 0, [`newton_friction`]'s fallback): s·min(1, pen/ramp).
+        FrictionLaw::Tresca { threshold } if pen < ramp => {
+            (threshold * pen / ramp, threshold / ramp)
+        }
         FrictionLaw::Tresca { threshold } => (threshold, 0.0),
         FrictionLaw::None => (0.0, 0.0),
     };
@@ -381,6 +414,8 @@ struct Scales {
     n: f64,
     /// max |x0_t|: the tangential rows' fixed scale (the merit's weight).
     t0: f64,
+    /// Tresca's onset ramp width in x_n − g (0: the literal law; [`newton_friction`]).
+    ramp: f64,
 }
 
 /// Λ(x), the blocks, G(x) into `work` at x = `work.s`; returns (max |G_n|, max |G_t|, the
@@ -409,6 +444,7 @@ fn evaluate(
             ops.w[q],
             ops.gamma[q],
             law,
+            sc.ramp,
             &mut lambda[q * d..(q + 1) * d],
             &mut work.blocks[q * d * d..(q + 1) * d * d],
         );
@@ -480,41 +516,334 @@ pub(crate) fn newton_friction(
     // slip. Started cold (λ = 0: x = x0, the free predictor) it converges (in ≤ 69 more
     // iterations on the block's runs); the counts of both attempts are reported
     // (`backward_euler_stops_the_block_at_the_rigid_time`).
-    match newton_friction_from(ops, law, w, c_tau2, x0, lambda, slides, work) {
-        Ok(it) => Ok(it),
-        Err(first) => {
-            lambda.iter_mut().for_each(|l| *l = 0.0);
-            newton_friction_from(ops, law, w, c_tau2, x0, lambda, slides, work)
-                .map(|it| it + NEWTON_MAX_ITER)
-                .map_err(|_| first)
+    let p = Problem { ops, w, c_tau2, x0 };
+    let first = match newton_friction_from(&p, law, 0.0, lambda, slides, work) {
+        Ok(it) => {
+            work.stages[0] += it;
+            return Ok(it);
         }
+        Err(e) => e,
+    };
+    work.stages[0] += NEWTON_MAX_ITER;
+    lambda.iter_mut().for_each(|l| *l = 0.0);
+    if let Ok(it) = newton_friction_from(&p, law, 0.0, lambda, slides, work) {
+        work.stages[1] += it;
+        return Ok(it + NEWTON_MAX_ITER);
+    }
+    work.stages[1] += NEWTON_MAX_ITER;
+    match continuation(&p, law, lambda, slides, work) {
+        Ok(it) => {
+            work.stages[2] += it;
+            Ok(it + 2 * NEWTON_MAX_ITER)
+        }
+        Err(e) => Err(format!("{first}; continuation in the bound: {e}")),
     }
 }
 
-/// [`newton_friction`]'s iteration from the start `lambda` holds.
-#[allow(clippy::too_many_arguments)]
-fn newton_friction_from(
-    ops: &NitscheOps,
-    law: FrictionLaw,
-    w: &[f64],
+/// One step's condensed frictional problem: the rows, W, cτ² and x0 ([`newton_friction`]).
+struct Problem<'a> {
+    ops: &'a NitscheOps,
+    w: &'a [f64],
     c_tau2: f64,
-    x0: &[f64],
+    x0: &'a [f64],
+}
+
+/// The law with its bound (μ_f or s) scaled by `t` ∈ [0, 1].
+fn scaled(law: FrictionLaw, t: f64) -> FrictionLaw {
+    match law {
+        FrictionLaw::Coulomb { coefficient } => FrictionLaw::Coulomb {
+            coefficient: t * coefficient,
+        },
+        FrictionLaw::Tresca { threshold } => FrictionLaw::Tresca {
+            threshold: t * threshold,
+        },
+        FrictionLaw::None => FrictionLaw::None,
+    }
+}
+
+/// [`newton_friction`]'s third stage, where the Newton from the previous forces and from
+/// rest both failed: a homotopy in the friction bound. The bound (μ_f or s) is scaled by t
+/// from 0 (frictionless in the tangential forces: the normal problem alone, which Newton
+/// solves) to 1, each stage's Newton started from the last solved one's forces, the
+/// increment doubled after a success and quartered after a failure (down to 2⁻¹²). Tresca's
+/// bound jumps from 0 to s at contact onset, and on coupled rows the literal law can then
+/// have no solution (contract §2.5): the stages run with the bound ramped over a width ε of
+/// x_n − g, s·min(1, (x_n − g)/ε), ε from 1e-2 of the normal scale down by 100 per stage
+/// (milder where a reduction fails) to [`NEWTON_TOL`] of it, or to [`NEWTON_FLOOR_TOL`] of it
+/// where no milder reduction goes further — a point left inside the ramp is at its gap to the tolerance with a
+/// bound in [0, s], contract §2.5's closure (a grazing point); elsewhere the law is the
+/// literal one. Returns the iterations of all its stages.
+fn continuation(
+    p: &Problem,
+    law: FrictionLaw,
     lambda: &mut [f64],
     slides: &mut [bool],
     work: &mut NewtonWork,
 ) -> Result<usize, String> {
-    let (nq, d) = (ops.len(), ops.per_point());
-    let nu = nq * d;
+    let sc = scales(p.ops, p.x0, 0.0);
+    let tresca = matches!(law, FrictionLaw::Tresca { .. });
+    let (ramp_end, ramp_ok) = (NEWTON_TOL * sc.n, NEWTON_FLOOR_TOL * sc.n);
+    let mut ramp = if tresca { 1e-2 * sc.n } else { 0.0 };
+    let (mut prev, mut shrink, mut restarts) = (ramp, 1e-2, 0);
+    let (mut t, mut dt, mut total) = (0.0f64, 0.25f64, 0usize);
+    lambda.iter_mut().for_each(|l| *l = 0.0);
+    work.lambda_ok.copy_from_slice(lambda);
+    loop {
+        let next = if t < 1.0 { (t + dt).min(1.0) } else { 1.0 };
+        match newton_friction_from(p, scaled(law, next), ramp, lambda, slides, work) {
+            Ok(it) => {
+                total += it;
+                work.lambda_ok.copy_from_slice(lambda);
+                t = next;
+                if t < 1.0 {
+                    dt *= 2.0;
+                } else if ramp > ramp_end {
+                    prev = ramp;
+                    ramp = (ramp * shrink).max(ramp_end);
+                } else {
+                    return Ok(total);
+                }
+            }
+            Err(e) => {
+                total += NEWTON_MAX_ITER;
+                lambda.copy_from_slice(&work.lambda_ok);
+                if t == 1.0 {
+                    // A reduction of the ramp failed: retried with a milder one (1e-2, 0.1,
+                    // 0.32, 0.56 of the width; measured on the sliding block at 5°, Tresca
+                    // s = 0.04, Nitsche and penalty: 1e-2 stalled at 1e-4 and 1e-6 of the
+                    // scale). At the mildest, the last solved width, if it is within the floor
+                    // tolerance of the gap, is the closure (its state restored by a Newton
+                    // started at its solution).
+                    if shrink < 0.5 {
+                        shrink = shrink.sqrt();
+                        ramp = (prev * shrink).max(ramp_end);
+                        continue;
+                    }
+                    // Then the homotopy in t once more from rest at the narrower width
+                    // (measured: the penalty's block at 5°, s = 0.04, stalled at 3e-5 of the
+                    // scale from the wider width's solution).
+                    if restarts < 2 {
+                        restarts += 1;
+                        work.lambda_best.copy_from_slice(&work.lambda_ok);
+                        (t, dt, shrink) = (0.0, 0.25, 1e-2);
+                        lambda.iter_mut().for_each(|l| *l = 0.0);
+                        work.lambda_ok.copy_from_slice(lambda);
+                        continue;
+                    }
+                    if prev <= ramp_ok {
+                        let it = newton_friction_from(p, law, prev, lambda, slides, work)?;
+                        return Ok(total + it);
+                    }
+                    return Err(format!("the Tresca ramp stalled at width {ramp:.1e}: {e}"));
+                }
+                dt *= 0.25;
+                if dt < 1.0 / 4096.0 {
+                    // After a restart: the closure already solved, if within the floor.
+                    if restarts > 0 && prev <= ramp_ok {
+                        lambda.copy_from_slice(&work.lambda_best);
+                        let it = newton_friction_from(p, law, prev, lambda, slides, work)?;
+                        return Ok(total + it);
+                    }
+                    return Err(format!("stalled at t = {t:.4} (ramp {ramp:.1e}): {e}"));
+                }
+            }
+        }
+    }
+}
+
+/// The solve's scales at the start x0 ([`Scales`]) with Tresca's onset `ramp`.
+fn scales(ops: &NitscheOps, x0: &[f64], ramp: f64) -> Scales {
+    let d = ops.per_point();
     let mut sc = Scales {
         n: f64::MIN_POSITIVE,
         t0: f64::MIN_POSITIVE,
+        ramp,
     };
-    for q in 0..nq {
+    for q in 0..ops.len() {
         sc.n = sc.n.max(x0[q * d].abs()).max(ops.gap[q].abs());
         for a in 1..d {
             sc.t0 = sc.t0.max(x0[q * d + a].abs());
         }
     }
+    sc
+}
+
+/// Active unknowns from which the frictional Newton solves its step through the full-space
+/// sparse LU ([`SparseNewton`]) instead of the dense LU of its active block: the dense LU costs
+/// (2/3)·n_a³ (n_a = d × the active points), the sparse one what the body's factor costs, and
+/// below this size the dense one is the cheaper (and every run of the test suite keeps its
+/// bits: their active sets are smaller).
+pub(crate) const SPARSE_MIN_ACTIVE: usize = 384;
+
+/// The frictional Newton's step through the full space (contract §4's condensation kept for
+/// the residual): with r = −G and D the points' derivative blocks, J δ = r for
+/// J = I − cτ² P A⁻¹ C D is, with z = A⁻¹ C D δ,
+///   (A − cτ² Σ_q C_q D_q P_qᵀ) z = C D r,   δ = r + cτ² P z
+/// — a matrix in A's pattern (each point's rows sit on one element's dofs), non-symmetric,
+/// refactored per iteration by faer's sparse LU ([`SparseLu`]). Inactive points have D = 0,
+/// so the sum runs over the active points: the cost follows the active set, not the cube of
+/// the contact unknowns.
+#[derive(Debug)]
+pub(crate) struct SparseNewton {
+    lu: SparseLu,
+    /// A's values (the step matrix before its factorisation) and the Newton matrix's.
+    a: Vec<f64>,
+    values: Vec<f64>,
+    /// Per point, the k × k positions in the values of (its dof i, its dof j).
+    pos: Vec<usize>,
+    /// z (n), and D_q P_qᵀ of one point (d × k).
+    z: Vec<f64>,
+    dp: Vec<f64>,
+}
+
+impl SparseNewton {
+    /// For the contact rows `ops` and the step matrix `a` (its pattern holds every point's
+    /// element block).
+    pub(crate) fn new(ops: &NitscheOps, a: &SymMatrix) -> Result<SparseNewton, String> {
+        let k = ops.k;
+        let mut pos = Vec::with_capacity(ops.dofs.len() * k);
+        for q in 0..ops.len() {
+            let dofs = &ops.dofs[q * k..(q + 1) * k];
+            for &i in dofs {
+                for &j in dofs {
+                    pos.push(
+                        a.pattern
+                            .position(i, j)
+                            .ok_or("a contact point's dofs outside the step matrix's pattern")?,
+                    );
+                }
+            }
+        }
+        Ok(SparseNewton {
+            lu: SparseLu::new(&a.pattern)?,
+            a: a.values.clone(),
+            values: a.values.clone(),
+            pos,
+            z: vec![0.0; a.n()],
+            dp: vec![0.0; ops.per_point() * k],
+        })
+    }
+}
+
+/// [`newton_step`] through [`SparseNewton`] (its formula there).
+fn sparse_step(ops: &NitscheOps, c_tau2: f64, work: &mut NewtonWork) -> Result<(), String> {
+    let (nq, d, k) = (ops.len(), ops.per_point(), ops.k);
+    let sp = work.sparse.as_mut().expect("checked by the caller");
+    sp.values.copy_from_slice(&sp.a);
+    sp.z.iter_mut().for_each(|z| *z = 0.0);
+    for q in (0..nq).filter(|&q| work.point_active[q]) {
+        let blk = &work.blocks[q * d * d..(q + 1) * d * d];
+        let dofs = &ops.dofs[q * k..(q + 1) * k];
+        // (D P_qᵀ)[b] = Σ_a D[b][a] p_a, and C D r into z.
+        for b in 0..d {
+            for jj in 0..k {
+                sp.dp[b * k + jj] = (0..d)
+                    .map(|a| blk[b * d + a] * ops.p_row(q * d + a).0[jj])
+                    .sum();
+            }
+            let dr: f64 = (0..d).map(|a| -blk[b * d + a] * work.g[q * d + a]).sum();
+            let (cb, _) = ops.c_row(q * d + b);
+            for (&gi, &ci) in dofs.iter().zip(cb) {
+                sp.z[gi] += ci * dr;
+            }
+        }
+        let pos = &sp.pos[q * k * k..(q + 1) * k * k];
+        for b in 0..d {
+            let (cb, _) = ops.c_row(q * d + b);
+            for (ii, &ci) in cb.iter().enumerate() {
+                if ci == 0.0 {
+                    continue;
+                }
+                for jj in 0..k {
+                    sp.values[pos[ii * k + jj]] -= c_tau2 * ci * sp.dp[b * k + jj];
+                }
+            }
+        }
+    }
+    sp.lu.factor(&sp.values)?;
+    sp.lu.solve_in_place(&mut sp.z);
+    for j in 0..nq * d {
+        let (row, dofs) = ops.p_row(j);
+        let pz: f64 = row.iter().zip(dofs).map(|(a, &g)| a * sp.z[g]).sum();
+        work.step[j] = -work.g[j] + c_tau2 * pz;
+    }
+    Ok(())
+}
+
+/// The full semismooth Newton step into `work.step` at the iterate `work.s` (its G, blocks
+/// and active set from [`evaluate`]): J δ = −G with J = I − cτ² W D. Small active sets solve the
+/// active block densely and the inactive rows from it; from [`SPARSE_MIN_ACTIVE`] active
+/// unknowns on, where the dense LU's cube dominates the step, the full-space sparse LU
+/// ([`SparseNewton`]) does the same solve.
+fn newton_step(
+    ops: &NitscheOps,
+    w: &[f64],
+    c_tau2: f64,
+    work: &mut NewtonWork,
+) -> Result<(), String> {
+    if work.active.len() >= SPARSE_MIN_ACTIVE && work.sparse.is_some() {
+        return sparse_step(ops, c_tau2, work);
+    }
+    let (nq, d) = (ops.len(), ops.per_point());
+    let nu = nq * d;
+    let na = work.active.len();
+    // J_AA = I − cτ² W_AA D_A, D block diagonal over the active points.
+    for (i, &ji) in work.active.iter().enumerate() {
+        let row = &w[ji * nu..(ji + 1) * nu];
+        for (c, &jc) in work.active.iter().enumerate() {
+            let (q, a) = (jc / d, jc % d);
+            let blk = &work.blocks[q * d * d..(q + 1) * d * d];
+            let wd: f64 = (0..d).map(|b| row[q * d + b] * blk[b * d + a]).sum();
+            work.jac[i * na + c] = f64::from(u8::from(i == c)) - c_tau2 * wd;
+        }
+        work.delta[i] = -work.g[ji];
+    }
+    lu_solve(
+        &mut work.jac[..na * na],
+        na,
+        &mut work.perm[..na],
+        &mut work.delta[..na],
+    )?;
+    // The full step: (D δ)_A, δ_I = −G_I + cτ² W_IA (D δ)_A, δ_A from the LU.
+    for (i, &ji) in work.active.iter().enumerate() {
+        let (q, b) = (ji / d, ji % d);
+        let blk = &work.blocks[q * d * d..(q + 1) * d * d];
+        let base = i - b;
+        work.d_delta[i] = (0..d).map(|a| blk[b * d + a] * work.delta[base + a]).sum();
+    }
+    for q in 0..nq {
+        if work.point_active[q] {
+            continue;
+        }
+        for j in q * d..(q + 1) * d {
+            let row = &w[j * nu..(j + 1) * nu];
+            let mut acc = -work.g[j];
+            for (i, &ji) in work.active.iter().enumerate() {
+                acc += c_tau2 * row[ji] * work.d_delta[i];
+            }
+            work.step[j] = acc;
+        }
+    }
+    for (i, &ji) in work.active.iter().enumerate() {
+        work.step[ji] = work.delta[i];
+    }
+    Ok(())
+}
+
+/// [`newton_friction`]'s iteration from the start `lambda` holds, for the law `law` with
+/// Tresca's onset `ramp` (0: the literal law; [`continuation`]).
+fn newton_friction_from(
+    p: &Problem,
+    law: FrictionLaw,
+    ramp: f64,
+    lambda: &mut [f64],
+    slides: &mut [bool],
+    work: &mut NewtonWork,
+) -> Result<usize, String> {
+    let (ops, w, c_tau2, x0) = (p.ops, p.w, p.c_tau2, p.x0);
+    let (nq, d) = (ops.len(), ops.per_point());
+    let nu = nq * d;
+    let sc = scales(ops, x0, ramp);
     // Warm start from the previous step's forces.
     work.nonzero.clear();
     work.nonzero.extend((0..nu).filter(|&r| lambda[r] != 0.0));
@@ -532,48 +861,8 @@ fn newton_friction_from(
         if it == NEWTON_MAX_ITER {
             break;
         }
-        let na = work.active.len();
-        // J_AA = I − cτ² W_AA D_A, D block diagonal over the active points.
-        for (i, &ji) in work.active.iter().enumerate() {
-            let row = &w[ji * nu..(ji + 1) * nu];
-            for (c, &jc) in work.active.iter().enumerate() {
-                let (q, a) = (jc / d, jc % d);
-                let blk = &work.blocks[q * d * d..(q + 1) * d * d];
-                let wd: f64 = (0..d).map(|b| row[q * d + b] * blk[b * d + a]).sum();
-                work.jac[i * na + c] = f64::from(u8::from(i == c)) - c_tau2 * wd;
-            }
-            work.delta[i] = -work.g[ji];
-        }
-        lu_solve(
-            &mut work.jac[..na * na],
-            na,
-            &mut work.perm[..na],
-            &mut work.delta[..na],
-        )
-        .map_err(|e| format!("semismooth Newton (friction): {e} (iteration {it})"))?;
-        // The full step: (D δ)_A, δ_I = −G_I + cτ² W_IA (D δ)_A, δ_A from the LU.
-        for (i, &ji) in work.active.iter().enumerate() {
-            let (q, b) = (ji / d, ji % d);
-            let blk = &work.blocks[q * d * d..(q + 1) * d * d];
-            let base = i - b;
-            work.d_delta[i] = (0..d).map(|a| blk[b * d + a] * work.delta[base + a]).sum();
-        }
-        for q in 0..nq {
-            if work.point_active[q] {
-                continue;
-            }
-            for j in q * d..(q + 1) * d {
-                let row = &w[j * nu..(j + 1) * nu];
-                let mut acc = -work.g[j];
-                for (i, &ji) in work.active.iter().enumerate() {
-                    acc += c_tau2 * row[ji] * work.d_delta[i];
-                }
-                work.step[j] = acc;
-            }
-        }
-        for (i, &ji) in work.active.iter().enumerate() {
-            work.step[ji] = work.delta[i];
-        }
+        newton_step(ops, w, c_tau2, work)
+            .map_err(|e| format!("semismooth Newton (friction): {e} (iteration {it})"))?;
         work.x_old[..nu].copy_from_slice(&work.s[..nu]);
         // A Newton step of round-off size (≤ 1e-13 of the iterate) is the floor too, even
         // where the merit still falls by noise: the iterate cannot move in floating point, and
@@ -954,6 +1243,140 @@ mod tests {
             (metrics.stick_steps, metrics.slip_steps),
             (Some(2), Some(0))
         );
+    }
+
+    /// Tresca on coupled rows without a solution (contract §2.5), by hand: one 2D point,
+    /// w = γ = 1, gap 0, s = 1, cτ² = 1, W = [[−1, −4], [0, −1]], x0 = (1, 10). In contact the
+    /// sliding force λ_t = 1 pulls x_n to −1.5 (out of contact; stick would need |x_t| = 5 ≤ 1);
+    /// out of contact λ = 0 leaves x_n = 1 (in contact): no root, so the Newton from the
+    /// previous forces and from rest both fail, and the continuation with Tresca's onset ramp
+    /// finds the closure — the point grazing (x_n = ε/(2ε + 4) ≈ ε/4 → 0, λ_n = x_n) with the
+    /// bound λ_t = (1 − 2x_n)/4 → 1/4 ∈ [0, s]. Its residual G = x − x0 − WΛ meets §4's 1e-12
+    /// relative to the normal scale max(|x0_n|, |g|) = 1; x_n is within the floor tolerance
+    /// 1e-8 of the gap and λ_t within 1e-8 of 1/4 (λ_t = 1/4 − x_n/2 exactly).
+    #[test]
+    fn tresca_without_a_root_takes_the_grazing_closure() {
+        let ops = NitscheOps {
+            k: 1,
+            dofs: vec![0],
+            p: vec![1.0],
+            c: vec![-1.0],
+            s: vec![0.0],
+            w: vec![1.0],
+            gamma: vec![1.0],
+            gap: vec![0.0],
+            theta: 0.0,
+            penalty: true,
+            friction: Some(FrictionOps {
+                td: 1,
+                ut: vec![1.0],
+                st: vec![0.0],
+                pt: vec![-1.0],
+                ct: vec![1.0],
+                kt: vec![1.0],
+            }),
+        };
+        let w = [-1.0, -4.0, 0.0, -1.0];
+        let x0 = [1.0, 10.0];
+        let law = FrictionLaw::Tresca { threshold: 1.0 };
+        let mut work = NewtonWork::frictional(2, 2);
+        let (mut lambda, mut slides) = ([0.0; 2], [false]);
+        let it =
+            newton_friction(&ops, law, &w, 1.0, &x0, &mut lambda, &mut slides, &mut work).unwrap();
+        assert!(
+            it > 2 * NEWTON_MAX_ITER,
+            "{it}: the fallback was not needed"
+        );
+        assert_eq!(work.stages[0], NEWTON_MAX_ITER);
+        assert!(work.stages[2] > 0);
+        let x = [work.s[0], work.s[1]];
+        for j in 0..2 {
+            let g = x[j] - x0[j] - (w[2 * j] * lambda[0] + w[2 * j + 1] * lambda[1]);
+            assert!(g.abs() <= 1e-12, "G_{j} = {g:e}");
+        }
+        assert!((0.0..=1e-8).contains(&x[0]), "x_n = {:e}", x[0]);
+        assert!((lambda[1] - 0.25).abs() <= 1e-8, "{lambda:?}");
+        assert!(slides[0]);
+    }
+
+    /// The full-space sparse step ([`SparseNewton`]) is the dense one: two 2D points on a
+    /// 4-dof body (A a dense SPD 4 × 4, rows p, c, P_t, C_t made up), W = P A⁻¹ C computed
+    /// here, an iterate with point 0 sticking and point 1 sliding (Coulomb μ_f = 0.5, its
+    /// coupled block); the two steps agree to 1e-12 relative (both are LU solves of
+    /// well-conditioned 4 × 4 systems: round-off ~1e-15).
+    #[test]
+    fn sparse_step_equals_the_dense_step() {
+        let a_dense = [
+            4.0, 1.0, 0.5, 0.2, 1.0, 5.0, 0.3, 0.4, 0.5, 0.3, 6.0, 1.0, 0.2, 0.4, 1.0, 3.0,
+        ];
+        let a = SymMatrix::from_dense(4, &a_dense).unwrap();
+        let ops = NitscheOps {
+            k: 2,
+            dofs: vec![0, 1, 2, 3],
+            p: vec![0.3, 1.0, -0.2, 1.1],
+            c: vec![-0.3, -1.0, 0.1, -0.9],
+            s: vec![0.0; 4],
+            w: vec![0.5, 0.7],
+            gamma: vec![0.1, 0.2],
+            gap: vec![0.0, 0.0],
+            theta: 0.0,
+            penalty: false,
+            friction: Some(FrictionOps {
+                td: 1,
+                ut: vec![1.0, 0.0, 1.0, 0.1],
+                st: vec![0.0; 4],
+                pt: vec![-2.0, 0.3, -1.5, 0.0],
+                ct: vec![1.0, -0.1, 0.9, 0.2],
+                kt: vec![2.0, 1.5],
+            }),
+        };
+        // W[j][r] = p_j · A⁻¹ c_r.
+        let mut w = [0.0; 16];
+        for r in 0..4 {
+            let mut col = [0.0; 4];
+            let (c, dofs) = ops.c_row(r);
+            for (&g, &v) in dofs.iter().zip(c) {
+                col[g] += v;
+            }
+            let mut m = a_dense;
+            lu_solve(&mut m, 4, &mut [0; 4], &mut col).unwrap();
+            for j in 0..4 {
+                let (p, dofs) = ops.p_row(j);
+                w[j * 4 + r] = p.iter().zip(dofs).map(|(a, &g)| a * col[g]).sum();
+            }
+        }
+        let law = FrictionLaw::Coulomb { coefficient: 0.5 };
+        let x0 = [0.4, 0.01, 0.3, 2.0];
+        let sc = scales(&ops, &x0, 0.0);
+        let mut work = NewtonWork::frictional(4, 2);
+        // Point 0: x_n − g = 0.2 > 0, |x_t| = 0.05 ≤ μ_f f_n = 1 (stick); point 1: f_n = 0.5,
+        // |x_t| = 1 > 0.25 (slip).
+        work.s[..4].copy_from_slice(&[0.2, 0.05, 0.1, 1.0]);
+        let (mut lambda, mut slides) = ([0.0; 4], [false; 2]);
+        evaluate(
+            &ops,
+            law,
+            &w,
+            0.7,
+            &x0,
+            &sc,
+            &mut lambda,
+            &mut slides,
+            &mut work,
+        );
+        assert_eq!(slides, [false, true]);
+        newton_step(&ops, &w, 0.7, &mut work).unwrap();
+        let dense = [work.step[0], work.step[1], work.step[2], work.step[3]];
+        work.sparse = Some(SparseNewton::new(&ops, &a).unwrap());
+        sparse_step(&ops, 0.7, &mut work).unwrap();
+        let size = dense.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for j in 0..4 {
+            assert!(
+                (work.step[j] - dense[j]).abs() <= 1e-12 * size,
+                "{j}: sparse {:?} dense {dense:?}",
+                &work.step[..4]
+            );
+        }
     }
 
     #[test]

@@ -161,7 +161,13 @@ impl<'a> MethodRun<'a> {
             .as_ref()
             .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
         let newton_work = match nit {
-            Some(o) if o.friction.is_some() => NewtonWork::frictional(nc, o.per_point()),
+            Some(o) if o.friction.is_some() => {
+                let a = fac.as_ref().and_then(|f| f.a_friction.as_ref());
+                match NewtonWork::frictional_for(o, a) {
+                    Ok(w) => w,
+                    Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+                }
+            }
             _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
         };
         let diag = m.diagonal();
