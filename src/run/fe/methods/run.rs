@@ -25,6 +25,7 @@ use crate::run::fe::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
     reference_map, shared_factor,
 };
+use crate::run::fe::start::quasi_static_start;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::reference::ReferenceData;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
@@ -189,6 +190,27 @@ impl<'a> MethodRun<'a> {
             }
         };
         m.matvec_into(&v, &mut mv);
+        // Loaded massless dofs (kane, discrete-gradient with mod1/…/zero-contact) start
+        // quasi-static ([`crate::run::fe::start`]); λ holds the nodal normal forces of that
+        // start (the force observed at t = 0).
+        let mut u = vec![0.0; n];
+        let mut mu = vec![0.0; n];
+        let mut lambda = vec![0.0; nc];
+        match quasi_static_start(g, cfg, m, nit, &force_vec, &gaps, &v, &a) {
+            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            Ok(None) => {}
+            Ok(Some(st)) => {
+                (u, a) = (st.u, st.a);
+                m.matvec_into(&u, &mut mu);
+                m.matvec_into(&a, &mut ma);
+                if nit.is_none() {
+                    let d = g.mesh.dim();
+                    for (l, f) in lambda.iter_mut().zip(st.forces.iter().step_by(d)) {
+                        *l = *f;
+                    }
+                }
+            }
+        }
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(r) => r,
@@ -208,10 +230,10 @@ impl<'a> MethodRun<'a> {
             start,
             loop_start: Instant::now(),
             gaps,
-            u: vec![0.0; n],
+            u,
             v,
             a,
-            mu: vec![0.0; n],
+            mu,
             mv,
             ma,
             ku: vec![0.0; n],
@@ -223,7 +245,7 @@ impl<'a> MethodRun<'a> {
             tmp: vec![0.0; n],
             err: vec![0.0; n],
             q: vec![0.0; nc],
-            lambda: vec![0.0; nc],
+            lambda,
             lambda_prev: vec![0.0; nc],
             nu: vec![0.0; g.contact.len()],
             rows: vec![false; g.contact.len()],
