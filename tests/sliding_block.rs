@@ -224,6 +224,19 @@ fn trace_with(
 }
 
 impl Trace {
+    /// The forward-sliding steps again, a Γ_C node counting as forward only if its Δu_1 exceeds
+    /// `tol` (a stuck massless node moves by round-off).
+    fn forward_beyond(mut self, tol: f64) -> Trace {
+        let mesh = GmshMesh::read(&mesh_path(self.dim)).expect("the committed block mesh");
+        let (n, dim) = (mesh.num_nodes(), self.dim);
+        let contact = mesh.contact_nodes();
+        let u = |k: usize, a: usize| self.u[k * n * dim + a * dim];
+        self.all_forward = (0..self.all_forward.len())
+            .map(|k| contact.iter().all(|&a| u(k + 1, a) - u(k, a) > tol))
+            .collect();
+        self
+    }
+
     /// P^{n+½} again with the run's own mass: `rows[a]` = (M 1_c)_a, the row sum of node a's
     /// component-c row over component c (the same for every c; a mass variant that zeroes or
     /// reweights rows changes it — contract §1.8's P is 1ᵀM v with the run's M).
@@ -545,11 +558,18 @@ const WEIGHTS: [f64; 2] = [1.5, 1.0];
 /// Issue 42 "done when" 2: the invariant of the previous test for Crank–Nicolson with every
 /// massless variant (mixed contact, 2D, flat and on the incline), P with the run's own mass
 /// ([`mass_rows`]). The Γ_C nodes have no inertia: their equation is quasi-static at every
-/// level, t = 0 included, so the momentum balance of the module header holds only if the start
-/// is the quasi-static one with the sliding nodes' friction f_t⁰ = −μ_f f_n⁰ (contract §2.2):
-/// without f_t⁰, CN's f̄_t of the first step misses half a step's friction and Q is off by a
-/// constant from then on (measured 1.3e-4·mV with mod3 before issue 42). Tolerance 1e-10·mV as
-/// for the other methods, the same round-off.
+/// level, t = 0 included, so the momentum balance of the module header holds from the first
+/// step only if the start is the quasi-static one with the sliding nodes' friction
+/// f_t⁰ = −μ_f f_n⁰ (contract §2.2): without f_t⁰, CN's f̄_t of the first step misses half a
+/// step's friction and Q is off by a constant from then on (1.3e-4·mV with mod3 before issue
+/// 42). Asserted: the first step keeps Q to 1e-14·mV (measured ≤ 9e-16), and the window to
+/// 1e-9·mV. A massless node that stops has Δu_1 at round-off (2.7e-15 measured, mod1), not 0:
+/// the window ends where some Γ_C node's Δu_1 falls below the engine's stick threshold
+/// 1e-12·h (contract §5, h = 0.125). Over the window Q drifts steadily, growing like t² (mod1 at
+/// 5°: 1.7e-12, 9.5e-12, 2.4e-11, 1.5e-10·mV after 100, 200, 300, 595 steps; at most 5.2e-10,
+/// mod2 at 5° over 736 steps), which is what the round-off of the rigid translation through the
+/// assembled K gives (1ᵀK = O(ε‖K‖), times u_1 ≈ V·t): the windows here are 1.5–2× the
+/// consistent mass's, so 1e-10 (the consistent mass's bound) is not held over them.
 #[test]
 fn sliding_block_keeps_the_frictional_invariant_with_every_massless_variant() {
     for mass in ["zero-contact", "mod1", "mod2", "mod3", "weights"] {
@@ -565,10 +585,23 @@ fn sliding_block_keeps_the_frictional_invariant_with_every_massless_variant() {
         for incline in [0.0, INCLINE] {
             let (s, c) = incline.to_radians().sin_cos();
             let t_rigid = V / (GRAVITY * (MU_F * c - s));
-            let tr =
-                trace(2, (mass, &bundle), incline, Some(MU_F), 1.2 * t_rigid).with_mass_rows(&rows);
+            let tr = trace(2, (mass, &bundle), incline, Some(MU_F), 1.2 * t_rigid)
+                .with_mass_rows(&rows)
+                .forward_beyond(1e-12 * 0.125);
+            let (f1, fd) = tr.load_sum(incline);
+            let q = |k: usize| {
+                let p = tr.p_half[k];
+                p[0] + MU_F * p[1] - (f1 + MU_F * fd) * tr.t_half[k]
+            };
+            let first = ((q(1) - q(0)) / (tr.mass * V)).abs();
+            println!("{}: first step |ΔQ|/(mV) = {first:.2e}", tr.what);
+            assert!(
+                first <= 1e-14,
+                "{}: the first step moved Q by {first:e}·mV",
+                tr.what
+            );
             let (_, dev) = frictional_invariant(&tr, incline, t_rigid);
-            assert!(dev <= 1e-10, "{}: Q moved by {dev:e}·mV", tr.what);
+            assert!(dev <= 1e-9, "{}: Q moved by {dev:e}·mV", tr.what);
         }
     }
 }
