@@ -16,7 +16,7 @@ use super::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
     reference_map, shared_factor,
 };
-use super::start::quasi_static_start;
+use super::start::start_state;
 use crate::contact::friction::FrictionLaw;
 use crate::contact::{FrictionalContact, Lcp};
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
@@ -286,25 +286,23 @@ impl<'a> Stepper<'a> {
                 (load.force, load.vertical_mass, Some(load.energy_scale))
             }
         };
-        let mut u = vec![0.0; n];
-        let mut mu = vec![0.0; n];
         // Frictional: the tangential forces after the normal ones (Z's columns).
         let mut lambda = vec![0.0; nc * fac.friction.as_ref().map_or(1, |_| g.mesh.dim())];
         let mut fric = fac
             .friction
             .as_ref()
             .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
-        match quasi_static_start(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &a) {
+        let (u, mu) = match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma)
+        {
             Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-            Ok(None) => {}
-            Ok(Some(st)) => {
-                (u, a) = (st.u, st.a);
-                fac.m.matvec_into(&u, &mut mu);
-                fac.m.matvec_into(&a, &mut ma);
-                let fr = (fric.as_deref_mut(), friction.as_mut());
-                start_forces(g, nit.is_none(), &st.forces, &mut lambda, fr);
+            Ok((u, mu, forces)) => {
+                if let Some(f) = forces {
+                    let fr = (fric.as_deref_mut(), friction.as_mut());
+                    start_forces(g, nit.is_none(), &f, &mut lambda, fr);
+                }
+                (u, mu)
             }
-        }
+        };
         // The reference lattice this run records, if it is one.
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),

@@ -50,6 +50,33 @@ pub(super) struct Start {
     pub(super) forces: Vec<f64>,
 }
 
+/// The state a time loop starts from: (u⁰, M u⁰, the start's forces) with `a` and `ma` = M a
+/// replaced, where the quasi-static start applies; (0, 0, None) and both kept otherwise.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn start_state(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+    nit: Option<&NitscheOps>,
+    force: &[f64],
+    gaps: &[f64],
+    v0: &[f64],
+    a: &mut Vec<f64>,
+    ma: &mut [f64],
+) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<f64>>), String> {
+    let n = a.len();
+    let (mut u, mut mu) = (vec![0.0; n], vec![0.0; n]);
+    match quasi_static_start(g, cfg, m, nit, force, gaps, v0, a)? {
+        None => Ok((u, mu, None)),
+        Some(st) => {
+            (u, *a) = (st.u, st.a);
+            m.matvec_into(&u, &mut mu);
+            m.matvec_into(a, ma);
+            Ok((u, mu, Some(st.forces)))
+        }
+    }
+}
+
 /// K̃_cc, the run's stiffness on the massless dofs, factored; `index[j]` is dof j's row in it.
 struct Massless {
     dofs: Vec<usize>,
@@ -257,17 +284,7 @@ fn signorini_start(
         }
     };
     let dm = nc * rows;
-    // W column by column: K̃_cc⁻¹ of each unit row, read at every row.
-    let mut w = vec![0.0; dm * dm];
-    let mut e = vec![0.0; n];
-    for s in 0..dm {
-        e[dof(s)] = 1.0;
-        let z = ml.solve(&e);
-        e[dof(s)] = 0.0;
-        for r in 0..dm {
-            w[r * dm + s] = z[dof(r)];
-        }
-    }
+    let w = condensed(ml, &dof, dm, n);
     // Per node: the slip direction of a sliding node (None: it sticks, or no friction).
     let slip: Vec<Option<Vec<f64>>> = (0..nc)
         .map(|i| {
@@ -481,4 +498,19 @@ fn points_start(
         }
     }
     Ok((u, contact, forces))
+}
+
+/// W = C K̃_cc⁻¹ Cᵀ (dm × dm, row-major) over the unit rows at `dof(k)`, column by column.
+fn condensed(ml: &mut Massless, dof: &dyn Fn(usize) -> usize, dm: usize, n: usize) -> Vec<f64> {
+    let mut w = vec![0.0; dm * dm];
+    let mut e = vec![0.0; n];
+    for s in 0..dm {
+        e[dof(s)] = 1.0;
+        let z = ml.solve(&e);
+        e[dof(s)] = 0.0;
+        for r in 0..dm {
+            w[r * dm + s] = z[dof(r)];
+        }
+    }
+    w
 }

@@ -25,7 +25,7 @@ use crate::run::fe::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
     reference_map, shared_factor,
 };
-use crate::run::fe::start::quasi_static_start;
+use crate::run::fe::start::start_state;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::reference::ReferenceData;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
@@ -193,24 +193,19 @@ impl<'a> MethodRun<'a> {
         // Loaded massless dofs (kane, discrete-gradient with mod1/…/zero-contact) start
         // quasi-static ([`crate::run::fe::start`]); λ holds the nodal normal forces of that
         // start (the force observed at t = 0).
-        let mut u = vec![0.0; n];
-        let mut mu = vec![0.0; n];
         let mut lambda = vec![0.0; nc];
-        match quasi_static_start(g, cfg, m, nit, &force_vec, &gaps, &v, &a) {
+        let (u, mu) = match start_state(g, cfg, m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
             Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-            Ok(None) => {}
-            Ok(Some(st)) => {
-                (u, a) = (st.u, st.a);
-                m.matvec_into(&u, &mut mu);
-                m.matvec_into(&a, &mut ma);
-                if nit.is_none() {
+            Ok((u, mu, forces)) => {
+                if let (Some(f), None) = (forces, nit) {
                     let d = g.mesh.dim();
-                    for (l, f) in lambda.iter_mut().zip(st.forces.iter().step_by(d)) {
-                        *l = *f;
+                    for (l, x) in lambda.iter_mut().zip(f.iter().step_by(d)) {
+                        *l = *x;
                     }
                 }
+                (u, mu)
             }
-        }
+        };
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(r) => r,
