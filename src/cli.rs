@@ -621,13 +621,16 @@ fn shard_runs<'p>(plan: &'p Plan, shard: Option<&ShardSpec>) -> Vec<&'p sweep::R
 /// definition change (issue 34): their numbers are not this version's, and new rows beside
 /// them would make two answers to one question in every table.
 fn refuse_superseded(dir: &Path, mine: &[&sweep::RunSpec], done: &HashSet<String>) -> Result<()> {
+    // An old id that is also a planned run's own (an FE run's u⁰ = 0 start kept its id as
+    // `contact_init = "interpolant"`, issue 42) holds that run's rows, not superseded ones.
+    let planned: HashSet<&str> = mine.iter().map(|r| r.run_id.as_str()).collect();
     let superseded: Vec<&sweep::RunSpec> = mine
         .iter()
         .copied()
         .filter(|r| {
             r.superseded_id
                 .as_ref()
-                .is_some_and(|old| done.contains(old))
+                .is_some_and(|old| done.contains(old) && !planned.contains(old.as_str()))
         })
         .collect();
     if let Some(first) = superseded.first() {

@@ -207,3 +207,63 @@ fn an_old_folder_is_never_resumed_into_with_new_numbers() {
     );
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// Issue 42: a body-loaded FE run with a massless variant starts its massless dofs quasi-static
+/// (contract §1.3, §2.2), which moved its numbers: it has a new id and knows the old one, which
+/// is now the id of its `contact_init = "interpolant"` twin — the u⁰ = 0 start that ran under
+/// it, unchanged, so it keeps it. `contact_init` applies there and nowhere the massless dofs
+/// carry no load (no gravity, `load = "inertial"`), where it is dropped and ids stay.
+#[test]
+fn the_quasi_static_start_moves_the_loaded_massless_runs_only() {
+    let p = plan(&format!(
+        "{DISC}[grid]\nmass = [\"consistent\", \"mod1\"]\ncontact_init = [\"consistent\", \"interpolant\"]\n"
+    ));
+    // The consistent mass: one run (the key dropped), its issue-34 id as before.
+    assert_eq!(p.runs.len(), 3, "{:?}", p.collapsed);
+    let consistent = &p.runs[0];
+    assert!(!consistent.params.contains_key(&Key::ContactInit));
+    let before_34 = id_before(
+        SceneKind::Disc2d,
+        &[
+            (Key::T, canonical_number(1.0)),
+            (Key::Elements, "8".into()),
+            (Key::Dt, canonical_number(0.1)),
+            (Key::Scheme, "newmark".into()),
+        ],
+    );
+    assert_eq!(
+        consistent.superseded_id.as_deref(),
+        Some(before_34.as_str())
+    );
+    let (quasi, zero) = (&p.runs[1], &p.runs[2]);
+    assert_eq!(
+        quasi.params[&Key::ContactInit],
+        Value::Str("consistent".into())
+    );
+    assert_eq!(
+        zero.params[&Key::ContactInit],
+        Value::Str("interpolant".into())
+    );
+    assert_ne!(quasi.run_id, zero.run_id);
+    assert_eq!(quasi.superseded_id.as_deref(), Some(zero.run_id.as_str()));
+    // The u⁰ = 0 run's id is the mod1 run's of before issue 42: the same canonical text (no
+    // contact_init) and issue 34's revisions alone.
+    let alone = plan(&format!(
+        "{DISC}mass = \"mod1\"\ncontact_init = \"interpolant\"\n"
+    ));
+    assert_eq!(alone.runs[0].run_id, zero.run_id);
+    // No load on the massless dofs: the key is dropped and nothing moved.
+    for extra in ["load = \"inertial\"\n", "gravity = 0.0\n"] {
+        let q = plan(&format!(
+            "{DISC}{extra}mass = \"mod1\"\n[grid]\ncontact_init = [\"consistent\", \"interpolant\"]\n"
+        ));
+        assert_eq!(q.runs.len(), 1, "{extra}: {:?}", q.collapsed);
+        assert!(!q.runs[0].params.contains_key(&Key::ContactInit), "{extra}");
+        let why: Vec<&String> = q.collapsed.keys().collect();
+        assert!(
+            why.iter()
+                .any(|w| w.contains("contact_init changes nothing")),
+            "{extra}: {why:?}"
+        );
+    }
+}

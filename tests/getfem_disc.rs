@@ -24,6 +24,16 @@
 //!   Crank–Nicolson is chaotic afterwards (contract §2.1: ill-posed in practice, 1e-14 moves it).
 //! - `energy_scale` = ρ|Ω_h|·|f|·gap with GetFEM's body mass, whatever the variant (contract §1.3).
 //!
+//! The start (contract §1.3, §2.2; issue 42). The massless dofs of zero-contact and mod1–3 carry
+//! the body load; the engine starts them quasi-static (`contact_init = "consistent"`, the
+//! default), K_cc u⁰_c = F_c, and GetFEM's script solves that equation with its own K and F
+//! (no contact at t = 0: the disc is 5 above the plane); with `contact_init = "interpolant"`
+//! both start them at u⁰ = 0 (the script's `MASS@zero`). Each start is compared with its own
+//! GetFEM twin at every step, so the test fails if either start changes: the two differ by
+//! 1e-5 (zero-contact) to 2e-4 (mod1–3) energy scales at t = 0 and by as much at T. E⁰ =
+//! −½F_cᵀK_cc⁻¹F_c is held to 1e-12 energy scales: the stiffness of the curved cells of layer 0
+//! agrees to ~1e-11 relative, E⁰ is ~2e-4 scales, so their product is ~1e-15 scales.
+//!
 //! Before issue 34 the engine missed by far more: its load followed the modified mass (mod1's
 //! body 16.5 % lighter than the paper's, the first contact force 460 → 402) and its degree-4
 //! rule left the curved cells' mass 2e-4 off.
@@ -40,18 +50,26 @@ fn root() -> PathBuf {
 }
 
 const MASSES: [&str; 5] = ["consistent", "zero-contact", "mod1", "mod2", "mod3"];
-/// The variants of the GetFEM script: the five masses with mixed contact, then Nitsche.
-const VARIANTS: [&str; 6] = [
+/// The massless variants, also run from u⁰ = 0 (`contact_init = "interpolant"`).
+const MASSLESS: [&str; 4] = ["zero-contact", "mod1", "mod2", "mod3"];
+/// The variants of the GetFEM script: the five masses with mixed contact, Nitsche, then the
+/// massless ones from u⁰ = 0 (the engine's order: [`engine_runs`]).
+const VARIANTS: [&str; 10] = [
     "consistent",
     "zero-contact",
     "mod1",
     "mod2",
     "mod3",
     "nitsche",
+    "zero-contact@zero",
+    "mod1@zero",
+    "mod2@zero",
+    "mod3@zero",
 ];
 
-/// One variant as GetFEM ran it: mass_total, and per step the energy and the contact force.
-type GetfemRun = (f64, Vec<f64>, Vec<f64>);
+/// One variant as GetFEM ran it: mass_total, per step the energy and the contact force, and
+/// −½F_cᵀK_cc⁻¹F_c of its quasi-static start (0 from u⁰ = 0 or without massless dofs).
+type GetfemRun = (f64, Vec<f64>, Vec<f64>, f64);
 
 /// GetFEM's run of every variant, with the body's mass.
 fn getfem_runs() -> (f64, Vec<GetfemRun>) {
@@ -65,6 +83,7 @@ fn getfem_runs() -> (f64, Vec<GetfemRun>) {
                 r["mass_total"].as_f64().unwrap(),
                 floats(&r["energy"]),
                 floats(&r["force"]),
+                r["energy_initial"].as_f64().unwrap_or(0.0),
             )
         })
         .collect();
@@ -76,6 +95,11 @@ fn engine_runs() -> Vec<(String, Outcome)> {
         .iter()
         .map(|m| format!("{{ mass = \"{m}\" }},"))
         .chain([r#"{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 },"#.into()])
+        .chain(
+            MASSLESS
+                .iter()
+                .map(|m| format!("{{ mass = \"{m}\", contact_init = \"interpolant\" }},")),
+        )
         .collect::<String>();
     let runs = common::outcomes_at(
         &root().join("t.toml"),
@@ -86,13 +110,20 @@ fn engine_runs() -> Vec<(String, Outcome)> {
 }
 
 #[test]
-fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
+fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche_from_either_start() {
     let (body_mass, getfem) = getfem_runs();
     let engine = engine_runs();
     let scale = body_mass * 0.1 * 5.0;
-    for ((mass, (label, o)), (gf_mass, gf_energy, gf_force)) in
+    for ((variant, (label, o)), (gf_mass, gf_energy, gf_force, gf_e0)) in
         VARIANTS.iter().zip(&engine).zip(&getfem)
     {
+        let (mass, start) = variant.split_once('@').unwrap_or((variant, ""));
+        let massless = MASSLESS.contains(&mass);
+        assert_eq!(
+            label.contains("interpolant"),
+            start == "zero",
+            "{label}: the engine's run of {variant}"
+        );
         let m = &o.metrics;
         let mt = m.mass_total.unwrap();
         assert!(
@@ -112,7 +143,7 @@ fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
         assert!(fmax > 0.0, "{label}: GetFEM's disc never touches");
         // The steps compared: all of them, or through the first contact phase (consistent).
         let first = gf_force.iter().position(|f| *f > 0.0).unwrap();
-        let end = if *mass == "consistent" && !label.contains("nitsche") {
+        let end = if mass == "consistent" && !label.contains("nitsche") {
             first
                 + gf_force[first..]
                     .iter()
@@ -129,7 +160,7 @@ fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
             rows.iter().all(|r| r.u_lowest.is_some()),
             "{label}: u_lowest"
         );
-        if *mass == "consistent" {
+        if mass == "consistent" {
             for r in rows.iter().take(first) {
                 let exact = -0.5 * 0.1 * r.t * r.t;
                 let u = r.u_lowest.unwrap();
@@ -145,9 +176,29 @@ fn engine_equals_getfem_on_the_p2_disc_for_every_mass_and_nitsche() {
             de = de.max((energy[n] - gf_energy[n]).abs() / scale);
             df = df.max((force[n] - gf_force[n]).abs() / fmax);
         }
+        let drift = (energy[energy.len() - 1] - energy[0]) / scale;
         eprintln!(
-            "{mass}: steps 0..{end}, max |ΔE|/scale = {de:.2e}, max |Δforce|/max = {df:.2e}, first contact step {first}, max force {fmax:.4}"
+            "{variant}: steps 0..{end}, max |ΔE|/scale = {de:.2e}, max |Δforce|/max = {df:.2e}, first contact step {first}, max force {fmax:.4}, E⁰/scale = {:.3e}, drift {drift:.3e}",
+            energy[0] / scale
         );
+        // The start: E⁰ = −½F_cᵀK_cc⁻¹F_c with GetFEM's K and F (quasi-static), 0 from u⁰ = 0.
+        let e0 = m.energy_initial.expect("reported");
+        eprintln!(
+            "{variant}: |E⁰ − GetFEM's −½F_cᵀK_cc⁻¹F_c|/scale = {:.2e}",
+            (e0 - gf_e0).abs() / scale
+        );
+        assert!(
+            (e0 - gf_e0).abs() <= 1e-12 * scale,
+            "{label}: energy_initial {e0} against GetFEM's −½F_cᵀK_cc⁻¹F_c = {gf_e0}"
+        );
+        if massless && start.is_empty() {
+            assert!(
+                *gf_e0 < -1e-6 * scale,
+                "{label}: the massless dofs' quasi-static start has E⁰ = {gf_e0}"
+            );
+        } else {
+            assert_eq!(e0, 0.0, "{label}: u⁰ = 0 has E⁰ = 0");
+        }
         assert!(
             de <= 1e-8,
             "{label}: energy off GetFEM's by {de:.3e} scales"

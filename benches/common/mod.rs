@@ -33,6 +33,7 @@ pub fn config(dim: usize, h: f64, steps: usize) -> FeConfig {
         solver: Solver::Direct,
         perturbation: None,
         friction: contact_sweep::contact::friction::FrictionLaw::None,
+        contact_init: contact_sweep::space::ContactInit::Consistent,
     }
 }
 

@@ -43,6 +43,7 @@ impl RunConfig {
                 solver: crate::space::step_solver::Solver::Direct,
                 perturbation: None,
                 friction: crate::contact::friction::FrictionLaw::None,
+                contact_init: ContactInit::Consistent,
             }),
             // The oscillator's one dof is its mass: no mass variant to keep.
             SceneSetup::Oscillator(params) => RunConfig::Oscillator(oscillator::OscillatorConfig {
@@ -74,12 +75,14 @@ impl RunConfig {
         self
     }
 
-    /// The initial value of a massless contact node (contract §2.2). The FE scenes start from
-    /// rest and unloaded, where the interpolant of u⁰ = 0 is already the quasi-static value:
-    /// both starts are the same state there.
+    /// The initial value of a massless contact node (contract §2.2): the 1D bar's contact node;
+    /// the FE scenes' massless dofs, which differ from u⁰ = 0 under the body load (contract
+    /// §1.3). The other engines have no massless dof.
     pub fn with_contact_init(mut self, init: ContactInit) -> RunConfig {
-        if let RunConfig::Bar1d(c) = &mut self {
-            c.contact_init = init;
+        match &mut self {
+            RunConfig::Bar1d(c) => c.contact_init = init,
+            RunConfig::Fe(c) => c.contact_init = init,
+            _ => {}
         }
         self
     }

@@ -150,6 +150,16 @@ impl FrictionTally {
         }
     }
 
+    /// The forces at t = 0 (`points`·d, node-major), f_t⁰ of the first step's f̄_t: a
+    /// quasi-static start's (contract §2.2), zero otherwise.
+    pub fn start_forces(&mut self, forces: &[f64]) {
+        let (d, t) = (self.d, self.d - 1);
+        assert_eq!(forces.len(), self.points * d, "d forces per point");
+        for i in 0..self.points {
+            self.ft_prev[i * t..(i + 1) * t].copy_from_slice(&forces[i * d + 1..(i + 1) * d]);
+        }
+    }
+
     /// Step n → n+1: the forces f^{n+1} (`points`·d, node-major) and the increments Δu_t
     /// (`points`·(d − 1), node-major). Returns W_f^{n+1}.
     pub fn step(&mut self, forces: &[f64], du_t: &[f64]) -> f64 {

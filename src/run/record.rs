@@ -130,7 +130,7 @@ schema! {
         space: String => "", "contact treatment: mixed | nitsche | penalty";
         mass: String => "", "mass variant (contract §2.2)";
         mass_weights: Option<String> => "", "user element weights w1,w2,… (mass = weights)";
-        contact_init: Option<String> => "", "start of a massless contact node: consistent (its quasi-static value) or interpolant (u0(0)); null when the contact node has mass";
+        contact_init: Option<String> => "", "start of the massless dofs: consistent (their quasi-static value) or interpolant (u0); null where both are the same state (the contact node has mass; an FE scene without gravity and the body load)";
         scheme: String => "", "scheme family: newmark | theta | paoli-schatzman | hybrid | kane | contact-stabilized-newmark | generalized-alpha | hht | moreau-jean | discrete-gradient";
         scheme_label: String => "", "preset name when the parameters are a preset's (crank-nicolson, backward-euler, …)";
         nitsche_theta: Option<f64> => "", "Nitsche Θ";
@@ -165,7 +165,7 @@ schema! {
         solver_failures: i64 => "", "steps whose contact problem had no or several solutions";
         contact_switches: i64 => "", "times the contact pressure switched on or off";
         mass_total: Option<f64> => "kg", "1ᵀM1, the total mass the mass matrix represents";
-        energy_initial: Option<f64> => "J", "E⁰ of the initial discrete state (a massless contact node as contact_init says)";
+        energy_initial: Option<f64> => "J", "E⁰ of the initial discrete state (the massless dofs as contact_init says)";
         energy_final: Option<f64> => "J", "E^N";
         energy_drift: Option<f64> => "", "(E^N − E⁰)/E⁰";
         energy_max_dev: Option<f64> => "", "max_n |E^n − E⁰|/E⁰";

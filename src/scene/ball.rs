@@ -27,12 +27,12 @@
 //! neighbours (by shared nodes); the layers' masses differ, so `mod2` scales every other
 //! element by m/(m − m₀) and `mod3` gives layer 1 the weight 1 + m₀/m₁ (total mass conserved);
 //! `zero-contact` zeroes the rows and columns of every dof of the Γ_C nodes (003 §4.1.2d, the
-//! paper's "modified mass"). Gravity is F = M_run·f e_d, the load of the run's own mass: the
-//! rigid fall u = ½ f t² e_d then solves M ü + K u = F for every variant (K·rigid = 0, and
-//! the massless rows read 0 = 0), so the free fall stays exact and E⁰ = 0; with `mod1` the
-//! removed mass carries no weight either (m = 1ᵀM1 is the run's `mass_total`). The massless
-//! nodes start at rest at u = 0, which is their quasi-static state (no contact at t = 0), so
-//! `contact_init` changes nothing here.
+//! paper's "modified mass"). Gravity is the body force F = ∫ρ f·φ whatever the variant
+//! (contract §1.3, `load = "body"`), so the massless dofs carry load: they start quasi-static,
+//! K̃_cc u⁰_c = F_c (`contact_init = "consistent"`, the default; E⁰ = −½F_cᵀK̃_cc⁻¹F_c), or at
+//! u⁰ = 0 (`"interpolant"`) — [`crate::run`]'s FE engine, `start.rs`. With `load = "inertial"`
+//! (F = M_run f e_d) the rigid fall solves M ü + K u = F for every variant, E⁰ = 0 and
+//! `contact_init` changes nothing.
 
 use super::{
     ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, MethodNames, Physics, PhysicsKey,
@@ -94,6 +94,9 @@ const BALL_PHYSICS: [PhysicsKey; 9] = [
 ];
 
 impl Scene for BallScene {
+    fn contact_init_matters(&self, p: &Physics) -> bool {
+        LoadModel::loads_massless_dofs(p)
+    }
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }

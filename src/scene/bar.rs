@@ -84,6 +84,14 @@ impl LoadModel {
             LoadModel::Body
         }
     }
+
+    /// Whether a scene's physics (keys `gravity`, `load`) put a load on its massless dofs: the
+    /// body load under gravity (contract §1.3), which makes their quasi-static start differ from
+    /// u⁰ = 0 and `contact_init` matter ([`super::Scene::contact_init_matters`]). The inertial
+    /// load M_run f vanishes on the massless rows.
+    pub fn loads_massless_dofs(p: &Physics) -> bool {
+        p.get("gravity") != 0.0 && LoadModel::from_index(p.get("load")) == LoadModel::Body
+    }
 }
 
 impl FeSetup {

@@ -110,7 +110,7 @@ pub(super) fn uniform_elements(extent: f64, elements: usize) -> MeshChoice {
 }
 
 impl Scene for Bar1dScene {
-    fn contact_init_matters(&self) -> bool {
+    fn contact_init_matters(&self, _physics: &Physics) -> bool {
         true
     }
 

@@ -106,6 +106,9 @@ impl MeshScene {
 }
 
 impl Scene for MeshScene {
+    fn contact_init_matters(&self, p: &Physics) -> bool {
+        LoadModel::loads_massless_dofs(p)
+    }
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }

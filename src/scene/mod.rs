@@ -95,6 +95,11 @@ pub enum SceneSetup {
 pub type FileSetup = (MeshChoice, SceneSetup);
 
 impl SceneSetup {
+    /// Whether this is a finite-element scene's setup (the sparse engine).
+    pub fn is_fe(&self) -> bool {
+        matches!(self, SceneSetup::Fe(_))
+    }
+
     /// Lines every id of this run carries for definition changes that moved its numbers
     /// ([`FeSetup::id_revision`]); empty for the runs no change touched, whose ids stay.
     pub fn id_revision(&self) -> String {
@@ -179,11 +184,15 @@ pub trait Scene: Send + Sync {
     /// and scheme family (`newmark`, `theta`, `paoli-schatzman`, `hybrid`); `Err` names the key
     /// at fault and the reason (a sweep error, not a silently dropped run).
     fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)>;
-    /// Whether the start of a massless contact node (`contact_init`) changes anything: only
-    /// where the quasi-static contact value differs from the interpolant of u0 (the 1D bar,
-    /// contract §1.1). The FE scenes start at rest or in free flight, where both starts coincide,
-    /// so the key is inapplicable there and a sweep over it makes no duplicate runs.
-    fn contact_init_matters(&self) -> bool {
+    /// Whether the start of a massless contact node (`contact_init`) changes anything with
+    /// these physics: only where the quasi-static value of the massless dofs differs from the
+    /// interpolant of u0 (contract §2.2) — the 1D bar (contract §1.1), and the FE scenes under
+    /// gravity with the body load, whose massless dofs carry load (contract §1.3). Elsewhere
+    /// (no load, or `load = inertial`, whose load vanishes on the massless rows) both starts
+    /// are the same state, so the key is inapplicable and a sweep over it makes no duplicate
+    /// runs.
+    fn contact_init_matters(&self, physics: &Physics) -> bool {
+        let _ = physics;
         false
     }
     /// Where the errors come from.

@@ -104,6 +104,11 @@ struct Resolved {
     /// Lines of the id for definition changes that moved this run's numbers
     /// ([`crate::scene::SceneSetup::id_revision`]).
     revision: String,
+    /// The revision lines of its id before the latest change that moved it: empty (the ids of
+    /// before issue 34), or, for a run a change of this version moved (issue 42), its lines
+    /// without this version's ([`previous_revision`]) — the id a folder of the previous
+    /// version holds.
+    revision_before: String,
     config: RunConfig,
     label: String,
     scheme_label: String,
@@ -312,19 +317,28 @@ fn resolve_given(
     let mut issues = Vec::new();
     let mut dropped = Vec::new();
     let m = method_of(given, &mut dropped, &mut issues)?;
+    // Whether `contact_init` changes this run: a massless contact with the scene's physics
+    // loading the massless dofs (contract §2.2).
+    let init_matters =
+        m.mass.massless_contact() && scene.contact_init_matters(&physics_values(given));
     for k in given.user.keys() {
-        if let Err(why) = applies(*k, &m, scene) {
+        if let Err(why) = applies(*k, &m, scene, init_matters) {
             dropped.push(format!("{} {why}", k.name()));
         }
     }
     if let Some((why, keys)) = meaningless(&m) {
         return Err(refuse_meaningless(given, why, keys));
     }
-    let massless = m.mass.massless_contact();
-    let contact_init = given
-        .get(Key::ContactInit)
-        .and_then(|v| v.as_str().and_then(ContactInit::from_name))
-        .expect("checked");
+    // The start the run makes: the given one where it matters, else the default (the same
+    // state), so the label and the columns say what ran.
+    let contact_init = if init_matters {
+        given
+            .get(Key::ContactInit)
+            .and_then(|v| v.as_str().and_then(ContactInit::from_name))
+            .expect("checked")
+    } else {
+        ContactInit::Consistent
+    };
 
     // Physics, mesh and time step: the scene's.
     let mut physics = physics_of(given, &m.scheme)?;
@@ -368,14 +382,16 @@ fn resolve_given(
     if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
         revision.push_str("revision=friction-balance-step-1\n");
     }
+    if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
+        // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
+        // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
+        revision.push_str("revision=quasi-static-start\n");
+    }
+    let revision_before = previous_revision(&revision);
     let scheme = m.scheme;
     let config = RunConfig::new(setup, m.contact, m.mass.clone(), scheme, dt, steps)
         .with_friction(m.friction)
-        .with_contact_init(if massless && scene.contact_init_matters() {
-            contact_init
-        } else {
-            ContactInit::Consistent
-        });
+        .with_contact_init(contact_init);
     let fe = matches!(config, RunConfig::Fe(_));
     let solver = solver_of(given, fe, &mut dropped);
     let config = config.with_solver(solver);
@@ -406,7 +422,7 @@ fn resolve_given(
     columns.put(Key::T, Value::Num(t_final), false);
     columns.put(Key::Elements, Value::Int(mesh.elements as i64), true);
     columns.put(Key::Dt, Value::Num(dt), true);
-    columns.put_method(&m, contact_init);
+    columns.put_method(&m, contact_init, init_matters);
     columns.put_physics(given, &physics, &mut dropped);
     columns.put_friction(&m);
     columns.put_solver(solver, fe);
@@ -424,6 +440,7 @@ fn resolve_given(
         params,
         canonical,
         revision,
+        revision_before,
         label: run_label(&m, contact_init, &scheme_label),
         scheme_names: [scheme.family().to_string(), scheme_label.clone()],
         scheme_label,
@@ -695,6 +712,29 @@ fn friction_of(
     Ok((friction_kind, friction))
 }
 
+/// The revision lines of this version's definition changes (issue 42): a run that carries one
+/// had, in the previous version, the id of its other lines.
+const THIS_VERSION: [&str; 4] = [
+    "revision=energy-scale-continuous",
+    "revision=friction-balance-step-1",
+    "revision=dry-friction-stick-slip",
+    "revision=quasi-static-start",
+];
+
+/// The revision lines of a run's id in the previous version: its lines without this version's
+/// when it carries one of them; else empty — the ids of before issue 34, which a folder of any
+/// earlier version may hold.
+fn previous_revision(revision: &str) -> String {
+    if !revision.lines().any(|l| THIS_VERSION.contains(&l)) {
+        return String::new();
+    }
+    revision
+        .lines()
+        .filter(|l| !THIS_VERSION.contains(l))
+        .map(|l| format!("{l}\n"))
+        .collect()
+}
+
 /// The law of a `coulomb` or `tresca` run with its bound (a missing bound joins `issues`).
 fn law_of(given: &Given, kind: FrictionKind, issues: &mut Vec<Issue>) -> FrictionLaw {
     match kind {
@@ -724,7 +764,7 @@ fn law_of(given: &Given, kind: FrictionKind, issues: &mut Vec<Issue>) -> Frictio
 
 /// Applicability (contract §3): whether a run of method `m` uses key `k`; `Err` says why not (the
 /// key is then dropped from the run, and runs that differ only by it merge).
-fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
+fn applies(k: Key, m: &Method, scene: &dyn Scene, init_matters: bool) -> Result<(), &'static str> {
     let scheme = m.scheme;
     let ok = match k {
         Key::FrictionCoefficient => m.friction_kind == FrictionKind::Coulomb,
@@ -752,7 +792,7 @@ fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
             })
         ),
         Key::MassWeights => m.mass_name == "weights",
-        Key::ContactInit => m.mass.massless_contact() && scene.contact_init_matters(),
+        Key::ContactInit => init_matters,
         _ => true,
     };
     if ok {
@@ -770,8 +810,10 @@ fn applies(k: Key, m: &Method, scene: &dyn Scene) -> Result<(), &'static str> {
         Key::FrictionCoefficient => "applies to friction = coulomb only",
         Key::TrescaThreshold => "applies to friction = tresca only",
         Key::ContactInit => {
-            if scene.contact_init_matters() {
+            if !m.mass.massless_contact() {
                 "applies to a massless contact node only (mass = mod1/mod2/mod3/weights/zero-contact/singular-dynamic/node-neighbour)"
+            } else if scene.fe_dim().is_some() {
+                "changes nothing without gravity and the body load (the massless dofs carry no load: the quasi-static and interpolant starts coincide)"
             } else {
                 "changes nothing in this scene (its contact nodes start at rest or in free flight, where the quasi-static and interpolant starts coincide)"
             }
@@ -885,7 +927,27 @@ fn refuse_meaningless(given: &Given, why: String, keys: &[Key]) -> Outcome {
 /// an axis.
 fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
     let scene = given.scene;
-    let physics = Physics(
+    let physics = physics_values(given);
+    if let Err((key, why)) = scene.supports_physics(&physics, scheme) {
+        let k = Key::from_name(key).expect("scenes name sweep keys");
+        if given.on_axis(k) {
+            return Err(Outcome::Inapplicable(why));
+        }
+        return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
+    }
+    let issues = physics_magnitudes(given, &physics);
+    if !issues.is_empty() {
+        return Err(Outcome::Invalid(issues));
+    }
+    incline_without_gravity(given, &physics)?;
+    Ok(physics)
+}
+
+/// The scene's physics keys as given (a choice key as its index), defaults elsewhere; not
+/// yet checked.
+fn physics_values(given: &Given) -> Physics {
+    let scene = given.scene;
+    Physics(
         scene
             .physics()
             .iter()
@@ -904,20 +966,7 @@ fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
                 )
             })
             .collect(),
-    );
-    if let Err((key, why)) = scene.supports_physics(&physics, scheme) {
-        let k = Key::from_name(key).expect("scenes name sweep keys");
-        if given.on_axis(k) {
-            return Err(Outcome::Inapplicable(why));
-        }
-        return Err(Outcome::Invalid(vec![Issue::at(&given.origin(k), why)]));
-    }
-    let issues = physics_magnitudes(given, &physics);
-    if !issues.is_empty() {
-        return Err(Outcome::Invalid(issues));
-    }
-    incline_without_gravity(given, &physics)?;
-    Ok(physics)
+    )
 }
 
 /// The largest kinetic energy density ½ρ|v⁰|² a run may start with (contract §7): √MAX / 1e6,
@@ -1267,19 +1316,22 @@ impl Columns {
     }
 
     /// The method's keys: space, mass and scheme family, and the parameters of each.
-    fn put_method(&mut self, m: &Method, contact_init: ContactInit) {
+    fn put_method(&mut self, m: &Method, contact_init: ContactInit, init_matters: bool) {
         self.put(Key::Space, Value::Str(m.space_name.clone()), false);
         self.put(Key::Mass, Value::Str(m.mass_name.clone()), false);
         self.put(Key::Scheme, Value::Str(m.scheme.family().into()), true);
         if let MassVariant::Weights(w) = &m.mass {
             self.put(Key::MassWeights, Value::List(w.clone()), true);
         }
-        if m.mass.massless_contact() && self.scene.contact_init_matters() {
-            self.put(
-                Key::ContactInit,
-                Value::Str(contact_init.name().into()),
-                false,
-            );
+        if init_matters {
+            let v = Value::Str(contact_init.name().into());
+            if contact_init == ContactInit::Interpolant && self.scene.fe_dim().is_some() {
+                // An FE run's u⁰ = 0 start is what ran under its id before the key applied
+                // there (issue 42): the id stays (its column says which start it made).
+                self.params.insert(Key::ContactInit, v);
+            } else {
+                self.put(Key::ContactInit, v, false);
+            }
         }
         match m.contact {
             ContactMethod::Nitsche { theta, gamma0 } => {
@@ -1657,8 +1709,13 @@ impl Resolved {
         old_extra: &str,
         reference_changed: bool,
     ) -> Option<String> {
-        (!self.revision.is_empty() || reference_changed)
-            .then(|| run_id(scene, &self.canonical, old_extra))
+        (!self.revision.is_empty() || reference_changed).then(|| {
+            run_id(
+                scene,
+                &self.canonical,
+                &format!("{}{old_extra}", self.revision_before),
+            )
+        })
     }
 }
 

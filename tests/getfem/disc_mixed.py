@@ -13,8 +13,12 @@ whose integrand has degree 6):
   m/(m − m₀); mod3 w₀ = 0, w₁ = 1 + m₀/m₁; zero-contact: the Γ_C nodes' rows and columns of M
   zeroed);
 - F: the body force ∫ρ f·φ, f = −0.1 e_y (contract §1.3: whatever the mass variant).
-Time stepping in numpy: Newmark β = ¼, γ = ½ (Crank–Nicolson), u⁰ = v⁰ = 0, a⁰ from M a⁰ = F on
-the dofs with inertia; each step (M + τ²/4 K) u = M(u + τv + τ²/4 a) + τ²/4 (F + Bᵀλ) with the
+Time stepping in numpy: Newmark β = ¼, γ = ½ (Crank–Nicolson), v⁰ = 0. The start (contract §1.3,
+§2.2): with a mass that has zero rows the massless dofs c (M's zero diagonal) carry load, and
+start quasi-static — u⁰_c solves K_cc u⁰_c = F_c here, with the dofs with inertia at 0 (the
+disc starts 5 above the plane: no contact at t = 0, checked), so E⁰ = −½F_cᵀK_cc⁻¹F_c; the
+variant `NAME@zero` starts them at u⁰ = 0 instead (the engine's contact_init = "interpolant").
+Every variant's a⁰ from M_ff a⁰_f = (F − K u⁰)_f on the dofs with inertia. Each step (M + τ²/4 K) u = M(u + τv + τ²/4 a) + τ²/4 (F + Bᵀλ) with the
 LCP 0 ≤ λ ⊥ u_y + g ≥ 0 on the Γ_C nodes (g = the node's height above the plane y = −gap),
 condensed onto Γ_C and solved exactly (active set, Murty's least-index rule). Energy
 E = ½vᵀMv + ½uᵀKu − Fᵀu, contact force Σλ.
@@ -31,7 +35,7 @@ as the engine's Γ_C rule. The contact force reported is ∫_ΓC (1/γ)[P_γ(u) 
 The mesh, K, M, F, Γ_C, γ, the Nitsche model and the Newmark update: tests/getfem/common.py
 (shared with tests/getfem/disc_nitsche_friction.py).
 
-Usage: disc_mixed.py MESH OUT.json [T dt gap [VARIANTS]]
+Usage: disc_mixed.py MESH OUT.json [T dt gap [VARIANTS]] (a variant: a mass, `MASS@zero`, or nitsche)
 """
 import json
 import sys
@@ -113,7 +117,21 @@ def lcp(H, q, active, tol):
     raise RuntimeError('LCP: no convergence')
 
 
+def start(M):
+    """The quasi-static start of the massless dofs (the module's docstring): u⁰, and
+    −½F_cᵀK_cc⁻¹F_c (0 without massless dofs)."""
+    massless = np.where(np.diag(M) == 0.0)[0]
+    u = np.zeros(n)
+    if len(massless) == 0:
+        return u, 0.0
+    u[massless] = sla.cho_solve(sla.cho_factor(K[np.ix_(massless, massless)]), F[massless])
+    if np.any(u[vertical] + gaps < 0.0):
+        raise RuntimeError('the quasi-static start touches the plane: not this script\'s case')
+    return u, float(-0.5 * F[massless] @ u[massless])
+
+
 def run(name):
+    name, _, how = name.partition('@')
     M = variant(name)
     beta = c.BETA
     A = M + beta * TAU**2 * K
@@ -125,11 +143,11 @@ def run(name):
     H = beta * TAU**2 * (B @ Z)
     diag = np.diag(M)
     free = np.where(diag != 0.0)[0]
-    u = np.zeros(n)
+    u, e0 = (np.zeros(n), 0.0) if how == 'zero' else start(M)
     v = np.zeros(n)
     a = np.zeros(n)
-    a[free] = np.linalg.solve(M[np.ix_(free, free)], F[free])
-    energy = [0.0]
+    a[free] = np.linalg.solve(M[np.ix_(free, free)], (F - K @ u)[free])
+    energy = [c.energy(M, K, F, u, v)]
     force = [0.0]
     active = []
     for _ in range(STEPS):
@@ -140,7 +158,8 @@ def run(name):
         u, v, a = c.advance(ufree + beta * TAU**2 * (Z @ lam), p, v, a, TAU)
         energy.append(c.energy(M, K, F, u, v))
         force.append(float(lam.sum()))
-    return {'mass_total': float(M[0::2, 0::2].sum()), 'energy': energy, 'force': force}
+    return {'mass_total': float(M[0::2, 0::2].sum()), 'energy': energy, 'force': force,
+            'energy_initial': e0}
 
 
 def run_nitsche(theta=1.0, gamma0=1e-3):

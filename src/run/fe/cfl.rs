@@ -167,6 +167,7 @@ mod tests {
                 perturbation: None,
                 solver: Solver::Direct,
                 friction: crate::contact::friction::FrictionLaw::None,
+                contact_init: crate::space::ContactInit::Consistent,
             };
             let (sigma, gersh) = kinematic_frequency_sq(&cfg).unwrap();
             eprintln!(

@@ -5,7 +5,7 @@
 use crate::contact::friction::FrictionLaw;
 use crate::scene::{FeGeometry, FeSetup};
 use crate::space::step_solver::Solver;
-use crate::space::{ContactMethod, MassVariant};
+use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{NewmarkParams, Scheme};
 
 /// Steps between two checks of the clock and of an interruption.
@@ -30,6 +30,10 @@ pub struct FeConfig {
     pub perturbation: Option<(f64, u64)>,
     /// The friction law on Γ_C (contract §2.5; `None`: today's frictionless engine).
     pub friction: FrictionLaw,
+    /// The start of the massless dofs under a body load (contract §1.3, §2.2): quasi-static
+    /// (`Consistent`, [`super::start`]) or u⁰ = 0 (`Interpolant`). Without such a load both
+    /// are the same state.
+    pub contact_init: ContactInit,
 }
 
 impl FeConfig {

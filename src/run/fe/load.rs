@@ -112,34 +112,7 @@ pub(super) fn gravity_load(
     let a0 = if s.load == LoadModel::Inertial || keeps_row_sums {
         rigid
     } else {
-        // (M + I_massless) a = F with F = 0 on the massless rows: M's massless rows and
-        // columns are zero (module header of the mass variants), so a_f = M_ff⁻¹ F_f, a_c = 0.
-        let mut shifted = m.clone();
-        let diag = m.diagonal();
-        let mut rhs = force.clone();
-        for (j, &dj) in diag.iter().enumerate() {
-            if dj == 0.0 {
-                let k = shifted
-                    .pattern
-                    .position(j, j)
-                    .expect("the pattern holds the diagonal");
-                shifted.values[k] = 1.0;
-                rhs[j] = 0.0;
-            }
-        }
-        let inv = jacobi(&shifted).map_err(|e| format!("initial acceleration: {e}"))?;
-        let mut a = rigid;
-        let mut work = CgWork::new(n);
-        pcg_into(
-            &shifted,
-            &inv,
-            &rhs,
-            &mut a,
-            CgOptions::new(1e-14),
-            &mut work,
-        )
-        .map_err(|e| format!("initial acceleration M a⁰ = F: {e}"))?;
-        a
+        inertial_solve(m, &force, rigid)?
     };
     // contract §1.3: m·|f|·d + ½m|v⁰|², d the gap or the body's height on the plane.
     let energy_scale = s.energy_scale(body_mass, || {
@@ -156,4 +129,43 @@ pub(super) fn gravity_load(
         vertical_mass,
         energy_scale,
     }))
+}
+
+/// a with M_ff a_f = r_f on the dofs with inertia and a = 0 on the massless ones, by conjugate
+/// gradients on M + I_massless (κ = O(1), a few dozen iterations to round-off) from `guess`:
+/// M's massless rows and columns are zero (module header of the mass variants), so the shifted
+/// system with r = 0 on the massless rows is M_ff a_f = r_f, a_c = 0. The initial acceleration
+/// of a redistributed or removed mass ([`gravity_load`], [`super::start`]).
+pub(super) fn inertial_solve(
+    m: &SymMatrix,
+    r: &[f64],
+    guess: Vec<f64>,
+) -> Result<Vec<f64>, String> {
+    let n = r.len();
+    let mut shifted = m.clone();
+    let diag = m.diagonal();
+    let mut rhs = r.to_vec();
+    for (j, &dj) in diag.iter().enumerate() {
+        if dj == 0.0 {
+            let k = shifted
+                .pattern
+                .position(j, j)
+                .expect("the pattern holds the diagonal");
+            shifted.values[k] = 1.0;
+            rhs[j] = 0.0;
+        }
+    }
+    let inv = jacobi(&shifted).map_err(|e| format!("initial acceleration: {e}"))?;
+    let mut a = guess;
+    let mut work = CgWork::new(n);
+    pcg_into(
+        &shifted,
+        &inv,
+        &rhs,
+        &mut a,
+        CgOptions::new(1e-14),
+        &mut work,
+    )
+    .map_err(|e| format!("initial acceleration M a⁰ = F − K̃u⁰: {e}"))?;
+    Ok(a)
 }

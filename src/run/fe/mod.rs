@@ -51,6 +51,7 @@ mod products;
 mod reference;
 mod setup;
 mod simulate;
+mod start;
 
 pub use config::FeConfig;
 pub use geometry::cholesky_options;

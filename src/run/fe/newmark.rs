@@ -16,6 +16,7 @@ use super::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
     reference_map, shared_factor,
 };
+use super::start::start_state;
 use crate::contact::friction::FrictionLaw;
 use crate::contact::{FrictionalContact, Lcp};
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
@@ -172,6 +173,39 @@ impl FrictionStep {
     }
 }
 
+/// The contact forces of the quasi-static start ([`super::start::Start::forces`]) into the run's
+/// λ (mixed: the normal forces, then with friction the tangential ones, Z's column order;
+/// Nitsche/penalty: the points' unknowns as they are) and, with friction, the tallies' f_t⁰
+/// (f̄_t of the first step) and the mixed solver's warm start.
+fn start_forces(
+    g: &Geometry,
+    mixed: bool,
+    forces: &[f64],
+    lambda: &mut [f64],
+    (fric, nitsche_friction): (Option<&mut FrictionStep>, Option<&mut FrictionState>),
+) {
+    let (nc, d) = (g.contact.len(), g.mesh.dim());
+    if mixed {
+        for i in 0..nc {
+            lambda[i] = forces[i * d];
+            if lambda.len() == nc * d {
+                for c in 1..d {
+                    lambda[nc + i * (d - 1) + c - 1] = forces[i * d + c];
+                }
+            }
+        }
+    } else {
+        lambda.copy_from_slice(forces);
+    }
+    if let Some(fr) = fric {
+        fr.forces.copy_from_slice(forces);
+        fr.tally.start_forces(forces);
+    }
+    if let Some(fr) = nitsche_friction {
+        fr.start_forces(forces);
+    }
+}
+
 impl<'a> Stepper<'a> {
     /// The setup: operators and factor from the shared caches, the reference map, the workspace
     /// and the initial state. A run that cannot start is returned as its outcome.
@@ -243,9 +277,10 @@ impl<'a> Stepper<'a> {
         initial_velocity(g, cfg, &mut v);
         fac.m.matvec_into(&v, &mut mv);
         // f̄_t's weight of f_t^{n+1}: Newmark's γ, the θ-scheme's θ.
-        let friction = nitsche_friction(nit, cfg, g, &fac.m, gamma, &mv);
+        let mut friction = nitsche_friction(nit, cfg, g, &fac.m, gamma, &mv);
         // Gravity (contract §1.3, [`super::load::gravity_load`]): F and a⁰ with M a⁰ = F on the dofs with
-        // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0).
+        // inertia (u⁰ = 0); M a⁰ is carried as `ma`. The bars have no load (F = 0). Loaded
+        // massless dofs then start quasi-static ([`super::start`]).
         let fall = free_fall(cfg);
         let (force_vec, vertical_mass, energy_scale) = match gravity_load(g, cfg, &fac.m) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
@@ -254,6 +289,23 @@ impl<'a> Stepper<'a> {
                 a.copy_from_slice(&load.a0);
                 fac.m.matvec_into(&a, &mut ma);
                 (load.force, load.vertical_mass, Some(load.energy_scale))
+            }
+        };
+        // Frictional: the tangential forces after the normal ones (Z's columns).
+        let mut lambda = vec![0.0; nc * fac.friction.as_ref().map_or(1, |_| g.mesh.dim())];
+        let mut fric = fac
+            .friction
+            .as_ref()
+            .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
+        let (u, mu) = match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma)
+        {
+            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            Ok((u, mu, forces)) => {
+                if let Some(f) = forces {
+                    let fr = (fric.as_deref_mut(), friction.as_mut());
+                    start_forces(g, nit.is_none(), &f, &mut lambda, fr);
+                }
+                (u, mu)
             }
         };
         // The reference lattice this run records, if it is one.
@@ -265,10 +317,6 @@ impl<'a> Stepper<'a> {
             return Err(fail(status, msg, metrics));
         }
         let lowest = lowest_contact(g);
-        let fric = fac
-            .friction
-            .as_ref()
-            .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some();
         let obs = observer(cfg, opts, energy_scale);
@@ -291,10 +339,10 @@ impl<'a> Stepper<'a> {
             energy_scale,
             gaps,
             lowest,
-            u: vec![0.0; n],
+            u,
             v,
             a,
-            mu: vec![0.0; n],
+            mu,
             mv,
             ma,
             pred: vec![0.0; n],
@@ -303,8 +351,7 @@ impl<'a> Stepper<'a> {
             tmp: vec![0.0; n],
             err: vec![0.0; n],
             q: vec![0.0; nc],
-            // Frictional: the tangential forces after the normal ones (Z's columns).
-            lambda: vec![0.0; nc * fac.friction.as_ref().map_or(1, |_| g.mesh.dim())],
+            lambda,
             lcp,
             newton_work,
             friction,

@@ -1117,6 +1117,11 @@ impl FrictionState {
         (self.tally.total_tangential()[0], v_contact, work)
     }
 
+    /// The points' forces at t = 0 (point-major [λ_n, λ_t…]): f̄_t's f_t⁰ in the first step.
+    pub fn start_forces(&mut self, forces: &[f64]) {
+        self.tally.start_forces(forces);
+    }
+
     /// Step 0: the initial mean velocities.
     pub fn start(&mut self, mv: &[f64]) {
         self.mean.means_into(mv, &mut self.means);

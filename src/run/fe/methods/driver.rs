@@ -39,7 +39,9 @@ fn time_loop(run: &mut MethodRun) -> Result<(), Stop<String>> {
         }
     } else {
         let fv = run.fric.as_ref().map(|fr| fr.series(&run.v));
-        let e = run.observe(0, 0.0, fv).map_err(Stop::Diverged)?;
+        // The nodal forces of a quasi-static start in contact (zero otherwise).
+        let force = run.lambda.iter().sum();
+        let e = run.observe(0, force, fv).map_err(Stop::Diverged)?;
         if let Some(fr) = run.fric.as_mut() {
             fr.observed(0, tau, e, &run.mv);
         }

@@ -25,6 +25,7 @@ use crate::run::fe::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
     reference_map, shared_factor,
 };
+use crate::run::fe::start::start_state;
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::reference::ReferenceData;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
@@ -195,6 +196,22 @@ impl<'a> MethodRun<'a> {
             }
         };
         m.matvec_into(&v, &mut mv);
+        // Loaded massless dofs (kane, discrete-gradient with mod1/…/zero-contact) start
+        // quasi-static ([`crate::run::fe::start`]); λ holds the nodal normal forces of that
+        // start (the force observed at t = 0).
+        let mut lambda = vec![0.0; nc];
+        let (u, mu) = match start_state(g, cfg, m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
+            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            Ok((u, mu, forces)) => {
+                if let (Some(f), None) = (forces, nit) {
+                    let d = g.mesh.dim();
+                    for (l, x) in lambda.iter_mut().zip(f.iter().step_by(d)) {
+                        *l = *x;
+                    }
+                }
+                (u, mu)
+            }
+        };
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(r) => r,
@@ -214,10 +231,10 @@ impl<'a> MethodRun<'a> {
             start,
             loop_start: Instant::now(),
             gaps,
-            u: vec![0.0; n],
+            u,
             v,
             a,
-            mu: vec![0.0; n],
+            mu,
             mv,
             ma,
             ku: vec![0.0; n],
@@ -229,7 +246,7 @@ impl<'a> MethodRun<'a> {
             tmp: vec![0.0; n],
             err: vec![0.0; n],
             q: vec![0.0; nc],
-            lambda: vec![0.0; nc],
+            lambda,
             lambda_prev: vec![0.0; nc],
             nu: vec![0.0; g.contact.len()],
             rows: vec![false; g.contact.len()],
