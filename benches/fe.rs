@@ -341,6 +341,7 @@ fn bench_methods(c: &mut Criterion) {
                 perturbation: None,
                 solver: Solver::Direct,
                 friction: contact_sweep::contact::friction::FrictionLaw::None,
+                contact_init: contact_sweep::space::ContactInit::Consistent,
             };
             bench_steps(&mut g, &format!("{space}-{what}"), &cfg);
         }

@@ -41,6 +41,12 @@ pub struct Lcp {
 }
 
 impl Lcp {
+    /// The problem with matrix `h` if given, else with the zero matrix: the idle workspace of a
+    /// run whose contact is not a multiplier LCP (Nitsche, penalty), sized alike.
+    pub fn new_or_idle(n: usize, h: Option<&[f64]>) -> Lcp {
+        Lcp::new(n, h.map_or_else(|| vec![0.0; n * n], <[f64]>::to_vec))
+    }
+
     /// The problem with matrix `h` (n × n, row-major, symmetric positive definite).
     pub fn new(n: usize, h: Vec<f64>) -> Lcp {
         assert_eq!(h.len(), n * n, "H must be n × n");

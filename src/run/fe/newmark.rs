@@ -255,22 +255,11 @@ impl<'a> Stepper<'a> {
         let mut a = vec![0.0; n];
         let mut mv = vec![0.0; n];
         let mut ma = vec![0.0; n];
-        let lcp = Lcp::new(
-            g.contact.len(),
-            if nit.is_some() {
-                vec![0.0; g.contact.len().pow(2)]
-            } else {
-                fac.h.clone()
-            },
-        );
-        let newton_work = match nit {
-            Some(o) if o.friction.is_some() => {
-                match NewtonWork::frictional_for(o, fac.a_friction.as_ref()) {
-                    Ok(w) => w,
-                    Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-                }
-            }
-            _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
+        let mixed_h = nit.is_none().then_some(fac.h.as_slice());
+        let lcp = Lcp::new_or_idle(g.contact.len(), mixed_h);
+        let newton_work = match NewtonWork::for_run(nit, fac.a_friction.as_ref()) {
+            Ok(w) => w,
+            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
         };
         let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
         let work: StepWork = fac.chol.work();

@@ -339,6 +339,15 @@ impl NewtonWork {
     /// [`NewtonWork::frictional`] for the rows `ops`, with the full-space sparse Newton
     /// ([`SparseNewton`]) where the active set can reach [`SPARSE_MIN_ACTIVE`] and the step
     /// matrix `a` is at hand.
+    /// The workspace a run's contact solve needs: none for mixed (`ops` None), the frictional
+    /// one (sparse over `a` when large, [`NewtonWork::frictional_for`]) or the frictionless one.
+    pub fn for_run(ops: Option<&NitscheOps>, a: Option<&SymMatrix>) -> Result<NewtonWork, String> {
+        match ops {
+            Some(o) if o.friction.is_some() => NewtonWork::frictional_for(o, a),
+            _ => Ok(NewtonWork::new(ops.map_or(0, NitscheOps::len))),
+        }
+    }
+
     pub fn frictional_for(ops: &NitscheOps, a: Option<&SymMatrix>) -> Result<NewtonWork, String> {
         let mut w = NewtonWork::frictional(ops.unknowns(), ops.per_point());
         if let Some(a) = a.filter(|_| ops.unknowns() >= SPARSE_MIN_ACTIVE) {

@@ -112,6 +112,40 @@ pub(super) struct MethodRun<'a> {
     pub(super) e_last: f64,
 }
 
+/// The initial motion of a run: v⁰ (and M v⁰), and under gravity a⁰ with M a⁰ = F on the dofs
+/// with inertia (and M a⁰) with the load (F, M e_d, the vertical mass, the energy scale).
+struct Motion {
+    v: Vec<f64>,
+    a: Vec<f64>,
+    mv: Vec<f64>,
+    ma: Vec<f64>,
+    load: (Vec<f64>, Vec<f64>, f64, Option<f64>),
+}
+
+/// Gravity as in the engine ([`crate::run::fe::load::gravity_load`]): F, and a⁰ with
+/// M a⁰ = F − Ku⁰ on the dofs with inertia (u⁰ = 0, no contact at t = 0), the start of
+/// generalized-α and of central difference; loaded massless dofs are then started
+/// quasi-static by the caller.
+fn initial_motion(g: &Geometry, cfg: &FeConfig, m: &SymMatrix) -> Result<Motion, String> {
+    let n = g.dofs.n_free();
+    let mut v = vec![0.0; n];
+    let mut a = vec![0.0; n];
+    let mut mv = vec![0.0; n];
+    let mut ma = vec![0.0; n];
+    initial_velocity(g, cfg, &mut v);
+    let load = match gravity_load(g, cfg, m)? {
+        None => (vec![0.0; n], vec![0.0; n], 0.0, None),
+        Some(load) => {
+            a.copy_from_slice(&load.a0);
+            m.matvec_into(&a, &mut ma);
+            let scale = Some(load.energy_scale);
+            (load.force, load.m_ed, load.vertical_mass, scale)
+        }
+    };
+    m.matvec_into(&v, &mut mv);
+    Ok(Motion { v, a, mv, ma, load })
+}
+
 impl<'a> MethodRun<'a> {
     /// The set-up: operators and factor from the shared caches, the reference map, the
     /// workspace and the initial state. A run that cannot start is returned as its outcome.
@@ -151,51 +185,36 @@ impl<'a> MethodRun<'a> {
         let nc = nit.map_or(g.contact.len(), NitscheOps::unknowns);
         metrics.contact_dofs = Some(nc as i64);
         let gaps = contact_gaps(g, cfg);
-        let lcp = Lcp::new(
-            g.contact.len(),
-            match (&fac, nit) {
-                (Some(f), None) => f.h.clone(),
-                _ => vec![0.0; g.contact.len().pow(2)],
-            },
-        );
+        let mixed_h = fac
+            .as_ref()
+            .filter(|_| nit.is_none())
+            .map(|f| f.h.as_slice());
+        let lcp = Lcp::new_or_idle(g.contact.len(), mixed_h);
         let lcp_pred = minv
             .as_ref()
             .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
-        let newton_work = match nit {
-            Some(o) if o.friction.is_some() => {
-                let a = fac.as_ref().and_then(|f| f.a_friction.as_ref());
-                match NewtonWork::frictional_for(o, a) {
-                    Ok(w) => w,
-                    Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-                }
-            }
-            _ => NewtonWork::new(nit.map_or(0, NitscheOps::len)),
+        let a_friction = fac.as_ref().and_then(|f| f.a_friction.as_ref());
+        let newton_work = match NewtonWork::for_run(nit, a_friction) {
+            Ok(w) => w,
+            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
         };
         let diag = m.diagonal();
         let (nit_fric, fric) = match friction_parts(cfg, meth, g, fac.as_ref(), m, c) {
             Ok(x) => x,
             Err((status, msg)) => return Err(fail(status, msg, metrics)),
         };
-        let mut v = vec![0.0; n];
-        let mut a = vec![0.0; n];
-        let mut mv = vec![0.0; n];
-        let mut ma = vec![0.0; n];
-        initial_velocity(g, cfg, &mut v);
-        // Gravity as in the engine ([`crate::run::fe::load::gravity_load`]): F, and a⁰ with M a⁰ = F − Ku⁰ on the dofs
-        // with inertia (u⁰ = 0, no contact at t = 0), the start of generalized-α and of central
-        // difference.
         let fall = free_fall(cfg);
-        let (force_vec, m_ed, vertical_mass, energy_scale) = match gravity_load(g, cfg, m) {
+        let Motion {
+            v,
+            mut a,
+            mv,
+            mut ma,
+            load,
+        } = match initial_motion(g, cfg, m) {
+            Ok(x) => x,
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
-            Ok(None) => (vec![0.0; n], vec![0.0; n], 0.0, None),
-            Ok(Some(load)) => {
-                a.copy_from_slice(&load.a0);
-                m.matvec_into(&a, &mut ma);
-                let (f, e, v, s) = (load.force, load.m_ed, load.vertical_mass, load.energy_scale);
-                (f, e, v, Some(s))
-            }
         };
-        m.matvec_into(&v, &mut mv);
+        let (force_vec, m_ed, vertical_mass, energy_scale) = load;
         // Loaded massless dofs (kane, discrete-gradient with mod1/…/zero-contact) start
         // quasi-static ([`crate::run::fe::start`]); λ holds the nodal normal forces of that
         // start (the force observed at t = 0).
@@ -204,10 +223,8 @@ impl<'a> MethodRun<'a> {
             Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
             Ok((u, mu, forces)) => {
                 if let (Some(f), None) = (forces, nit) {
-                    let d = g.mesh.dim();
-                    for (l, x) in lambda.iter_mut().zip(f.iter().step_by(d)) {
-                        *l = *x;
-                    }
+                    let normal = f.iter().step_by(g.mesh.dim());
+                    lambda.iter_mut().zip(normal).for_each(|(l, x)| *l = *x);
                 }
                 (u, mu)
             }
