@@ -316,12 +316,16 @@ struct Report {
     twin: Option<Status>,
 }
 
-/// The case's report, or None where the planner finds the combination inapplicable (a mass
-/// variant a scheme does not take: the product below lists them all, the planner decides).
+/// The case's report, or None where the planner finds the combination meaningless (a mass
+/// variant a scheme does not take: the product below lists them all, the planner decides — as
+/// one combination left out of an axis, or, the case's methods being fixed keys, refused at
+/// them as making no method).
 fn evaluate(c: &Case) -> Option<Report> {
     let o = match run(&c.text(Some(c.law))) {
         Ok(o) => o,
-        Err(e) if e.contains("inapplicable") => return None,
+        Err(e) if e.contains("inapplicable") || e.contains("together make no method") => {
+            return None;
+        }
         Err(e) => panic!("{}: the planner refused the case: {e}", c.label()),
     };
     let drift = c.sticks.and_then(|v| {
@@ -490,7 +494,6 @@ fn sliding_block_toml_with_tresca() {
 
 /// The Nitsche and penalty runs of [`sliding_block_toml_with_tresca`] (20, all failing on main).
 #[test]
-#[ignore = "needs nitsche43"]
 fn sliding_block_toml_with_tresca_nitsche_and_penalty() {
     let runs = statuses(&sliding_block_tresca_text());
     assert_eq!(all_ok(&runs, |l| !l.starts_with("mixed")), 20);
@@ -552,7 +555,6 @@ fn block_with_mu_5() {
 /// Newton fails as the block stops (measured: step 116, t = 5.8, "did not converge in 100
 /// iterations"). The mixed twin runs too.
 #[test]
-#[ignore = "needs nitsche43"]
 fn sliding_block_nitsche_mod3_backward_euler_at_its_stop() {
     let text = r#"name = "stop"
 scene = "mesh2d"
@@ -580,7 +582,6 @@ space = [{ space = "mixed" }, { space = "nitsche", nitsche_theta = 1.0, nitsche_
 /// Nitsche (Θ = 1, γ0 = 1e-3) + CN, μ_f = 0.86 (issue 43: failed at step 96 in the issue's
 /// campaign; this reconstruction of its settings ran ok on main too — a guard), and mixed.
 #[test]
-#[ignore = "needs nitsche43"]
 fn p2_disc_on_a_26_degree_incline() {
     let text = r#"name = "disc26"
 scene = "mesh2d"
@@ -608,7 +609,6 @@ space = [{ space = "mixed" }, { space = "nitsche", nitsche_theta = 1.0, nitsche_
 /// μ_f = 0.61 (issue 43: failed at step 8 in the issue's campaign; these reconstructions of its
 /// settings ran ok on main — a guard), and the mixed twin.
 #[test]
-#[ignore = "needs nitsche43"]
 fn slow_block_on_an_18_degree_incline_penalty_hht() {
     let text = r#"name = "slow18"
 scene = "mesh2d"
@@ -701,7 +701,10 @@ fn moreau_jean_resting_block_against_siconos() {
     );
     assert_eq!(first(&engine), Some(3));
     assert_eq!(first(&siconos), Some(3));
-    // Both raise E + W_f by about a tenth of the energy scale in one step (measured 0.0948 and
-    // 0.1004; the trajectories part at step 2, so the figures agree in size, not in digits).
-    assert!(rise(&engine) > 0.05 && rise(&siconos) > 0.05);
+    // Both raise E + W_f in one step by about a fortieth of the block's weight work m·g·H (the
+    // energy scale since issue 42 made it continuous, m·g·H + ½m|v⁰|²; measured 0.0023 and
+    // 0.0024 of it — 0.0948 and 0.1004 of the former ½m·V_t²). The trajectories part at step 2,
+    // so the figures agree in size, not in digits: both above 1e-3, against the frictionless
+    // twin's 1e-14.
+    assert!(rise(&engine) > 1e-3 && rise(&siconos) > 1e-3);
 }
