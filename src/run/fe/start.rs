@@ -50,6 +50,9 @@ pub(super) struct Start {
     pub(super) forces: Vec<f64>,
 }
 
+/// u⁰, M u⁰ and the contact forces of the start, if it has any.
+pub(super) type StartState = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
+
 /// The state a time loop starts from: (u⁰, M u⁰, the start's forces) with `a` and `ma` = M a
 /// replaced, where the quasi-static start applies; (0, 0, None) and both kept otherwise.
 #[allow(clippy::too_many_arguments)]
@@ -63,7 +66,7 @@ pub(super) fn start_state(
     v0: &[f64],
     a: &mut Vec<f64>,
     ma: &mut [f64],
-) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<f64>>), String> {
+) -> Result<StartState, String> {
     let n = a.len();
     let (mut u, mut mu) = (vec![0.0; n], vec![0.0; n]);
     match quasi_static_start(g, cfg, m, nit, force, gaps, v0, a)? {
