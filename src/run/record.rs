@@ -203,7 +203,7 @@ schema! {
         iterations_max_step: Option<i64> => "", "most contact-solver iterations in one step: LCP pivots (mixed), semismooth Newton iterations (mixed with friction: the Alart–Curnier Newton; Nitsche, penalty) (2D/3D)";
         max_penetration: Option<f64> => "m", "max over the steps n = 0…N and the contact nodes of (u_n − g)_+ with u_n = −u_d, g the node's gap (2D/3D: the Γ_C nodes, g = x_d; bar1d: the contact node x = 0); a Nitsche/penalty run measured at the nodes, not at its quadrature points";
         right_end: Option<String> => "", "bar1d's end x = L: clamped (contract §1.1) or free (the flying bar, contract §1.4)";
-        velocity: Option<f64> => "m/s", "uniform initial velocity v0 (bar1d, oscillator; negative towards the obstacle)";
+        velocity: Option<f64> => "m/s", "initial normal velocity, negative towards the obstacle: bar1d and the oscillator's uniform v0; layer1d's V_n; disc2d, sphere3d, mesh2d, mesh3d: the e_d velocity of every node not clamped";
         point_mass: Option<f64> => "kg", "oscillator mass m (contract §1.5)";
         stiffness: Option<f64> => "N/m", "oscillator spring stiffness k";
         force: Option<f64> => "N", "oscillator constant force f (negative towards the obstacle)";
