@@ -54,7 +54,6 @@ const PHYSICS_AXES: &[&str] = &[
     "stiffness",
     "force",
     "impact_law",
-    "];",
 ];
 
 fn axes() -> impl Iterator<Item = &'static str> {
