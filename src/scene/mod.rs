@@ -15,6 +15,7 @@
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod bars1d_exact;
 pub mod layer1d;
 pub mod mesh;
 pub mod oscillator;
