@@ -301,18 +301,16 @@ impl<'a> Stepper<'a> {
             .friction
             .as_ref()
             .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
-        let (u, mu, started) =
+        let (u, mu, forces) =
             match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
                 Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-                Ok((u, mu, forces)) => {
-                    let started = forces.is_some();
-                    if let Some(f) = forces {
-                        let fr = (fric.as_deref_mut(), friction.as_mut());
-                        start_forces(g, nit.is_none(), &f, &mut lambda, fr);
-                    }
-                    (u, mu, started)
-                }
+                Ok(s) => s,
             };
+        let incr = forces.is_some() && nit.is_none();
+        if let Some(f) = forces {
+            let fr = (fric.as_deref_mut(), friction.as_mut());
+            start_forces(g, nit.is_none(), &f, &mut lambda, fr);
+        }
         // The reference lattice this run records, if it is one.
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
@@ -323,9 +321,6 @@ impl<'a> Stepper<'a> {
         }
         let lowest = lowest_contact(g);
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
-        // Mixed runs that start quasi-static step in increments (module header); K uⁿ is then
-        // the group's product, as for the hybrid scheme and Nitsche.
-        let incr = started && nit.is_none() && !hybrid;
         let needs_ku = hybrid || nit.is_some() || incr;
         let obs = observer(cfg, opts, energy_scale);
         metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
