@@ -563,13 +563,15 @@ const WEIGHTS: [f64; 2] = [1.5, 1.0];
 /// f_t⁰ = −μ_f f_n⁰ (contract §2.2): without f_t⁰, CN's f̄_t of the first step misses half a
 /// step's friction and Q is off by a constant from then on (1.3e-4·mV with mod3 before issue
 /// 42). Asserted: the first step keeps Q to 1e-14·mV (measured ≤ 9e-16), and the window to
-/// 1e-9·mV. A massless node that stops has Δu_1 at round-off (2.7e-15 measured, mod1), not 0:
-/// the window ends where some Γ_C node's Δu_1 falls below the engine's stick threshold
-/// 1e-12·h (contract §5, h = 0.125). Over the window Q drifts steadily, growing like t² (mod1 at
-/// 5°: 1.7e-12, 9.5e-12, 2.4e-11, 1.5e-10·mV after 100, 200, 300, 595 steps; at most 5.2e-10,
-/// mod2 at 5° over 736 steps), which is what the round-off of the rigid translation through the
-/// assembled K gives (1ᵀK = O(ε‖K‖), times u_1 ≈ V·t): the windows here are 1.5–2× the
-/// consistent mass's, so 1e-10 (the consistent mass's bound) is not held over them.
+/// 1e-10·mV, the bound of the consistent mass and of the frictionless test (the same
+/// round-off argument: the contact solves are exact to round-off; measured ≤ 5.8e-12·mV, mod2 at
+/// 5° over 736 steps). A massless node that stops has Δu_1 at round-off (2.7e-15 measured,
+/// mod1), not 0: the window ends where some Γ_C node's Δu_1 falls below the engine's stick
+/// threshold 1e-12·h (contract §5, h = 0.125). These runs step in increments
+/// (`run::fe::newmark`'s header): solved for the totals u^{n+1}, the solve's round-off is
+/// relative to the distance travelled (u_1 ≈ V·t ≫ Vτ) and Q random-walked with growing steps
+/// (mod1 at 5°: 1.7e-12, 9.5e-12, 2.4e-11, 1.5e-10·mV after 100, 200, 300, 595 steps; 5.2e-10
+/// for mod2 at 5°), while the engine's Coulomb sums Σf_t + μ_f Σf_n are ≤ 7e-18 at every step.
 #[test]
 fn sliding_block_keeps_the_frictional_invariant_with_every_massless_variant() {
     for mass in ["zero-contact", "mod1", "mod2", "mod3", "weights"] {
@@ -601,7 +603,7 @@ fn sliding_block_keeps_the_frictional_invariant_with_every_massless_variant() {
                 tr.what
             );
             let (_, dev) = frictional_invariant(&tr, incline, t_rigid);
-            assert!(dev <= 1e-9, "{}: Q moved by {dev:e}·mV", tr.what);
+            assert!(dev <= 1e-10, "{}: Q moved by {dev:e}·mV", tr.what);
         }
     }
 }
@@ -660,7 +662,9 @@ fn sliding_block_stops_near_the_rigid_time() {
             for incline in [0.0, INCLINE] {
                 let (s, c) = incline.to_radians().sin_cos();
                 let t_rigid = V / (GRAVITY * (MU_F * c - s));
-                let tr = trace(dim, method, incline, Some(MU_F), 1.2 * t_rigid);
+                let mod3_run = method.0.starts_with("mixed mod3");
+                let t_end = if mod3_run { 1.6 } else { 1.2 } * t_rigid;
+                let tr = trace(dim, method, incline, Some(MU_F), t_end);
                 let stop = tr.outcome.metrics.stop_time.unwrap_or(f64::NAN);
                 println!("{}: stop_time {stop:.4} (rigid {t_rigid:.4})", tr.what);
                 // Measured (stop_time / rigid): kane 1.043, 1.084 (5°) in 2D, 1.041, 1.072 in
@@ -673,13 +677,31 @@ fn sliding_block_stops_near_the_rigid_time() {
                 // block's stick–slip end weighs more).
                 // Crank–Nicolson with the redistributed mass mod3 (002's remedy for the
                 // spurious oscillations: no inertia at Γ_C, the block does not hop,
-                // energy_balance_max_increase ≤ 5e-4 of the scale) stops 3.3 % (2D) and 4.9 %
-                // (3D) late on the flat plane, a little after kane and Moreau–Jean: asserted
-                // within 6 %; at 5° it has not stopped by 1.2·t_rigid (printed). That is the
-                // massless Γ_C nodes started at u⁰ = 0 (`contact_init = "interpolant"`): started
-                // quasi-static (issue 42, the default), the same run has not stopped by
-                // 1.2·t_rigid on the flat plane either (measured in 2D and 3D) — printed, not
-                // asserted, and open under issue 42.
+                // energy_balance_max_increase ≤ 5e-4 of the scale), flat plane: started at
+                // u⁰ = 0 (`contact_init = "interpolant"`) it stops 3.3 % (2D) and 4.9 % (3D)
+                // late, asserted within 6 % as before; started quasi-static (issue 42, the
+                // default) 39.7 % (2D) and 23.3 % (3D) late. Not a defect of the start (its f_t⁰
+                // reaches the tallies and CN's f̄_t: the first step keeps contract §1.8's
+                // invariant to 9e-16·mV, the previous test), but what this stop is: the
+                // vertical vibration of the suddenly loaded block, which CN does not damp (Σf_n
+                // swings between 0.04 and 3 times the weight), makes the elastic block creep at
+                // ~2 % of V once its Γ_C nodes start to stick, the friction of the sticking
+                // nodes even pointing forward — so the stop after t_rigid is ill-conditioned.
+                // Measured (stop/t_rigid) at τ = 0.05, 0.04, 0.025: u⁰ = 0 1.033, 1.099, 1.106
+                // (2D), 1.049, 1.067, 1.194 (3D); quasi-static 1.397, 1.130, 1.196 (2D), 1.233,
+                // 1.084, 1.167 (3D). Asserted for both starts: a stop in [0.99, 1.5]·t_rigid.
+                // The lower end is a theorem: Coulomb's cone |Σf_t| ≤ μ_f Σf_n holds sliding or
+                // stuck, and ∫Σf_n = m·g·t + ΔP_d, so the mean velocity is ≥ V − μ_f g t −
+                // μ_f|Δv̄_d| and cannot reach 0 before t_rigid − |Δv̄_d|/g, |v̄_d| ≲ 1e-2 (the
+                // rest test's settlement bound): 0.99·t_rigid. The upper end is the envelope of
+                // the τ scan above (1.40) with room, run to 1.6·t_rigid.
+                if mod3_run && incline == 0.0 {
+                    assert!(
+                        (0.99 * t_rigid..=1.5 * t_rigid).contains(&stop),
+                        "{}: stop_time {stop} vs rigid {t_rigid}",
+                        tr.what
+                    );
+                }
                 let bound = match (method.0, incline == 0.0) {
                     ("kane" | "moreau-jean", true) => Some(0.05),
                     ("kane", false) => Some(0.10),

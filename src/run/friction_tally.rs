@@ -150,13 +150,18 @@ impl FrictionTally {
         }
     }
 
-    /// The forces at t = 0 (`points`·d, node-major), f_t⁰ of the first step's f̄_t: a
-    /// quasi-static start's (contract §2.2), zero otherwise.
+    /// The forces at t = 0 (`points`·d, node-major), f_t⁰ of the first step's f̄_t and the
+    /// series' Σf_t at step 0: a quasi-static start's (contract §2.2), zero otherwise.
     pub fn start_forces(&mut self, forces: &[f64]) {
         let (d, t) = (self.d, self.d - 1);
         assert_eq!(forces.len(), self.points * d, "d forces per point");
+        self.total_t = [0.0; 2];
         for i in 0..self.points {
-            self.ft_prev[i * t..(i + 1) * t].copy_from_slice(&forces[i * d + 1..(i + 1) * d]);
+            let ft = &forces[i * d + 1..(i + 1) * d];
+            self.ft_prev[i * t..(i + 1) * t].copy_from_slice(ft);
+            for (s, f) in self.total_t.iter_mut().zip(ft) {
+                *s += f;
+            }
         }
     }
 

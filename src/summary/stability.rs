@@ -54,6 +54,12 @@ const PHYSICS_AXES: &[&str] = &[
     "stiffness",
     "force",
     "impact_law",
+    "height",
+    "velocity_tangential",
+    "friction_force",
+    "incline",
+    "friction_coefficient",
+    "tresca_threshold",
 ];
 
 fn axes() -> impl Iterator<Item = &'static str> {

@@ -545,6 +545,11 @@ pub(crate) fn error_abbrev(column: &str) -> (&'static str, &'static str) {
         ),
         "err_energy_l2" => ("E l2(τ)", "energy error E^h − E, l2(0,T)"),
         "err_u_contact_max" => ("u_C max", "max error of the contact displacement"),
+        "err_sigma_t_l2" => (
+            "σ_t l2(τ)",
+            "tangential stress error of the layer's base, l2(0,T)",
+        ),
+        "err_vt_final" => ("v_t(T)", "error of the mean tangential velocity at T"),
         _ => ("?", "unknown error column"),
     }
 }

@@ -386,6 +386,11 @@ fn resolve_given(
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
         revision.push_str("revision=quasi-static-start\n");
+        // The mixed Newmark/θ runs among them step in increments (`run::fe::newmark`'s
+        // header): the same equations, round-off relative to the step's increment.
+        if m.contact == ContactMethod::Mixed && !m.scheme.is_comparison() {
+            revision.push_str("revision=increment-step\n");
+        }
     }
     let revision_before = previous_revision(&revision);
     let scheme = m.scheme;
@@ -714,11 +719,12 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 4] = [
+const THIS_VERSION: [&str; 5] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
     "revision=quasi-static-start",
+    "revision=increment-step",
 ];
 
 /// The revision lines of a run's id in the previous version: its lines without this version's

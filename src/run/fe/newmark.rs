@@ -1,6 +1,18 @@
 //! The Newmark family, the θ-scheme and the hybrid midpoint scheme ([`Stepper`]): one run between
 //! its set-up and its outcome, split around its one linear solve so lockstep groups
 //! ([`super::lockstep`]) can share the solve and every other read of a shared operator.
+//!
+//! Totals or increments. The Newmark step solves A u^{n+1} = M pⁿ + cτ²(F + Cᵀf^{n+1}),
+//! A = M + cτ²K. Its round-off is relative to what it solves for: a body that travels (the
+//! sliding block, u ≈ V·t ≫ the step's Vτ) loses ~ε‖A‖‖uⁿ‖ of momentum per step, a random walk
+//! whose steps grow with the distance travelled (contract §1.8's invariant of the block with a
+//! massless Γ_C drifted 5.2e-10·mV over 736 steps; issue 42). Solved for the increment,
+//!   A (u^{n+1} − uⁿ) = M(pⁿ − uⁿ) + cτ²(F − K uⁿ + Cᵀf^{n+1}),  pⁿ − uⁿ = τvⁿ + c₁τ²aⁿ,
+//! the same equation in exact arithmetic, the round-off is relative to the increment (the
+//! invariant then holds to 5.8e-12·mV), at one more product with K per step (K uⁿ from the
+//! stored uⁿ, so no residual accumulates: the massless rows' K u^{n+1} = F + f^{n+1} is imposed
+//! afresh every step). The mixed runs that start quasi-static ([`super::start`], new in issue
+//! 42 with their own ids) step in increments; the others keep the totals and their numbers.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -96,6 +108,9 @@ pub(super) struct Stepper<'a> {
     /// friction observables. `lambda` then holds the normal forces, then the tangential ones
     /// (Z's column order, [`FrictionFactor`]).
     pub(super) fric: Option<Box<FrictionStep>>,
+    /// Whether the step solves for the increment u^{n+1} − u^n (module header): the mixed runs
+    /// that start quasi-static.
+    pub(super) incr: bool,
 }
 
 /// A frictional mixed run's contact workspace and tally (contract §2.5, §1.8).
@@ -286,17 +301,16 @@ impl<'a> Stepper<'a> {
             .friction
             .as_ref()
             .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
-        let (u, mu) = match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma)
-        {
-            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-            Ok((u, mu, forces)) => {
-                if let Some(f) = forces {
-                    let fr = (fric.as_deref_mut(), friction.as_mut());
-                    start_forces(g, nit.is_none(), &f, &mut lambda, fr);
-                }
-                (u, mu)
-            }
-        };
+        let (u, mu, forces) =
+            match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
+                Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+                Ok(s) => s,
+            };
+        let incr = forces.is_some() && nit.is_none();
+        if let Some(f) = forces {
+            let fr = (fric.as_deref_mut(), friction.as_mut());
+            start_forces(g, nit.is_none(), &f, &mut lambda, fr);
+        }
         // The reference lattice this run records, if it is one.
         let record = match reference_record(g, cfg, ctx) {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
@@ -307,7 +321,7 @@ impl<'a> Stepper<'a> {
         }
         let lowest = lowest_contact(g);
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
-        let needs_ku = hybrid || nit.is_some();
+        let needs_ku = hybrid || nit.is_some() || incr;
         let obs = observer(cfg, opts, energy_scale);
         metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
         Ok(Stepper {
@@ -357,6 +371,7 @@ impl<'a> Stepper<'a> {
             fric,
             geo,
             fac,
+            incr,
         })
     }
 
@@ -533,6 +548,19 @@ impl<'a> Stepper<'a> {
             for i in 0..n {
                 y[i] = mu[i] + tau * mv[i] - c_tau2 * kt[i] + 2.0 * c_tau2 * f[i];
             }
+        } else if self.incr {
+            // The increment's right-hand side (module header): M(pⁿ − uⁿ) + cτ²(F − K uⁿ), p − u
+            // = τv + c₁τ²a into `pred`, M(p − u) from the carried products, K uⁿ the group's.
+            let ct2 = self.c1 * tau * tau;
+            let (v, a, mv, ma) = (&self.v[..n], &self.a[..n], &self.mv[..n], &self.ma[..n]);
+            let (ku, f) = (&self.ku[..n], &self.force_vec[..n]);
+            let (pred, mu) = (&mut self.pred[..n], &mut self.mu[..n]);
+            for i in 0..n {
+                pred[i] = tau * v[i] + ct2 * a[i];
+                let dm = tau * mv[i] + ct2 * ma[i];
+                y[i] = dm + c_tau2 * (f[i] - ku[i]);
+                mu[i] += dm;
+            }
         } else {
             // p^n and M p^n (the right-hand side) from the carried products. M p^n is
             // M u^{n+1} before the correction by a^{n+1}: kept in `mu`. Then + cτ²F. (Slices cut
@@ -611,13 +639,16 @@ impl<'a> Stepper<'a> {
         } else if let (Some(fr), Some(ff)) = (self.fric.as_mut(), fac.friction.as_ref()) {
             // q_n = y_d + gap, q_t = y_t − u_t^n (the contact-free step's slip increment);
             // u^{n+1} = y + cτ²Z f over the normal and tangential columns ([`super::lockstep`]).
+            // Stepping in increments, y is y − uⁿ: q_n = (uⁿ_d + y_d) + gap, q_t = y_t.
             let g = &*self.geo;
+            let (incr, u) = (self.incr, &self.u);
+            let total = |i: usize| if incr { u[i] + y[i] } else { y[i] };
             for ((qi, &ci), gi) in fr.q_n.iter_mut().zip(&g.contact).zip(&self.gaps) {
-                *qi = y[ci] + gi;
+                *qi = total(ci) + gi;
             }
             for ((qt, up), &ct) in fr.q_t.iter_mut().zip(&mut fr.ut_prev).zip(&ff.tangential) {
-                *up = self.u[ct];
-                *qt = y[ct] - *up;
+                *up = u[ct];
+                *qt = if incr { y[ct] } else { y[ct] - *up };
             }
             let it = fr
                 .solver
@@ -643,8 +674,10 @@ impl<'a> Stepper<'a> {
             self.iterations += it as i64;
         } else {
             let g = &*self.geo;
+            let (incr, u) = (self.incr, &self.u);
+            let total = |i: usize| if incr { u[i] + y[i] } else { y[i] };
             for ((qi, &ci), gi) in self.q.iter_mut().zip(&g.contact).zip(&self.gaps) {
-                *qi = y[ci] + gi;
+                *qi = total(ci) + gi;
             }
             let it = self
                 .lcp
@@ -656,7 +689,7 @@ impl<'a> Stepper<'a> {
         Ok(())
     }
 
-    /// With `y` = u^{n+1}: the acceleration a^{n+1} = (u^{n+1} − p^n)/(cτ²) into `tmp`
+    /// With `y` = u^{n+1} (or u^{n+1} − uⁿ, [`Stepper::incr`]): the acceleration a^{n+1} = (u^{n+1} − p^n)/(cτ²) into `tmp`
     /// (Newmark/θ), or v^{n+1} = 2(u^{n+1} − u^n)/τ − v^n (hybrid); then u ← u^{n+1}, in the
     /// same pass. The products with M (and K) that follow are the group's
     /// ([`Stepper::mass_pairs`], [`Stepper::k_pair`]).
@@ -671,10 +704,18 @@ impl<'a> Stepper<'a> {
                 u[i] = y[i];
             }
         } else {
+            // Stepping in increments, y and p are u^{n+1} − uⁿ and pⁿ − uⁿ.
             let (t, p) = (&mut self.tmp[..n], &self.pred[..n]);
-            for i in 0..n {
-                t[i] = (y[i] - p[i]) / c_tau2;
-                u[i] = y[i];
+            if self.incr {
+                for i in 0..n {
+                    t[i] = (y[i] - p[i]) / c_tau2;
+                    u[i] += y[i];
+                }
+            } else {
+                for i in 0..n {
+                    t[i] = (y[i] - p[i]) / c_tau2;
+                    u[i] = y[i];
+                }
             }
         }
     }
