@@ -6,7 +6,7 @@ use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
 use super::grid1d::Grid1d;
-use super::{bar1d, fe, layer1d, oscillator};
+use super::{bar1d, bars1d, fe, layer1d, oscillator};
 
 /// The validated configuration of one run, per discretisation family: the tridiagonal 1D
 /// engine or the sparse finite-element engine (which runs every FE scene).
@@ -16,6 +16,7 @@ pub enum RunConfig {
     Fe(fe::FeConfig),
     Oscillator(oscillator::OscillatorConfig),
     Layer1d(layer1d::Layer1dConfig),
+    Bars1d(bars1d::Bars1dConfig),
 }
 
 impl RunConfig {
@@ -60,6 +61,10 @@ impl RunConfig {
                     Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
                 ))
             }
+            SceneSetup::Bars1d { bars, elements } => RunConfig::Bars1d(bars1d::Bars1dConfig::new(
+                bars,
+                Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
+            )),
         }
     }
 
@@ -103,6 +108,7 @@ impl RunConfig {
             RunConfig::Fe(c) => c.perturbation = p,
             RunConfig::Oscillator(c) => c.perturbation = p,
             RunConfig::Layer1d(c) => c.perturbation = p,
+            RunConfig::Bars1d(c) => c.perturbation = p,
         }
     }
 
@@ -115,6 +121,7 @@ impl RunConfig {
             RunConfig::Fe(c) => c.explicit_dt_limit(),
             RunConfig::Oscillator(c) => c.explicit_dt_limit(),
             RunConfig::Layer1d(c) => c.explicit_dt_limit(),
+            RunConfig::Bars1d(c) => c.explicit_dt_limit(),
         }
     }
 
@@ -125,6 +132,7 @@ impl RunConfig {
             RunConfig::Fe(c) => (c.steps, c.unknowns()),
             RunConfig::Oscillator(c) => (c.steps, 1),
             RunConfig::Layer1d(c) => (c.grid.steps, 2 * c.grid.elements),
+            RunConfig::Bars1d(c) => (c.grid.steps, c.grid.elements + c.elements_b()),
         };
         (steps as u64).saturating_mul(unknowns as u64)
     }
