@@ -242,13 +242,13 @@ schema! {
         density_b: Option<f64> => "kg/m", "bars1d: bar B's density ρ_b";
         velocity_b: Option<f64> => "m/s", "bars1d: bar B's initial velocity V_b along x (A's is `velocity`, towards B)";
         far_end: Option<String> => "", "bars1d: B's far end, free or clamped (contract §1.9)";
-        mass_side: Option<String> => "", "two bodies: the bodies the mass variant modifies, both | a | b (contract §2.6)";
+        mass_side: Option<String> => "", "two bodies: the bodies the mass variant modifies: both, a or b (contract §2.6)";
         nitsche_sides: Option<String> => "", "two bodies: the Nitsche sides' weights, unbiased (w_a = w_b = ½) or a (A the slave) (contract §2.6)";
-        momentum_drift: Option<f64> => "", "two bodies: max_n |Pⁿ − P⁰| / Σ_i m_i|V_i|, P = Σ_i 1ᵀM_iv along x (1D) or e_d; null when a clamp acts or every initial velocity is 0 (contract §5)";
+        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along x (1D) or e_d; null when a clamp acts or every initial velocity is 0 (contract §5)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T";
-        err_velocity_a_final: Option<f64> => "m/s", "bars1d: |velocity_a_final − the exact mean velocity of A at T| (contract §1.9)";
-        err_velocity_b_final: Option<f64> => "m/s", "bars1d: |velocity_b_final − the exact mean velocity of B at T|";
+        err_velocity_a_final: Option<f64> => "m/s", "bars1d: abs(velocity_a_final − the exact mean velocity of A at T) (contract §1.9)";
+        err_velocity_b_final: Option<f64> => "m/s", "bars1d: abs(velocity_b_final − the exact mean velocity of B at T)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }

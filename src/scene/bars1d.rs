@@ -184,6 +184,9 @@ impl Scene for Bars1dScene {
         }
         Ok(())
     }
+    fn supports_friction(&self) -> Result<(), String> {
+        Err("scene bars1d has no tangential direction: the two bars' one displacement is normal to their contact (contract §2.6's friction acts on a relative tangential slip, in 2D/3D)".into())
+    }
     fn error_source(&self, _physics: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::Exact)
     }
