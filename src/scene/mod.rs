@@ -16,6 +16,7 @@ pub mod ball;
 pub mod bar;
 pub mod bar1d;
 pub mod bars1d;
+pub mod bars1d_exact;
 pub mod layer1d;
 pub mod mesh;
 pub mod oscillator;
