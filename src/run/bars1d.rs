@@ -33,10 +33,11 @@
 use std::time::Instant;
 
 use super::grid1d::Grid1d;
-use super::observe::{Divergence, Observer, StepValues};
+use super::observe::{Divergence, ExactValues, Observer, StepValues};
 use super::stepping::{failed, finished, time_loop};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::{self, ContactLaw, ContactSolveError};
+use crate::scene::bars1d_exact::{Body as Side, TwoBarsExact};
 use crate::scene::{BarParams, Bars1dParams, MassSide, NitscheSides};
 use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag, TridiagLu};
 use crate::time::{GeneralizedAlphaParams, NewmarkParams, Scheme, ThetaParams};
@@ -595,23 +596,74 @@ struct Momentum {
     unit: f64,
 }
 
-/// Observe one state.
+/// What the observation of a step needs besides the state: the exact solution, the step and a
+/// buffer for one body's nodal values in x order (no allocation per step but the exact
+/// solution's kink lists).
+struct View {
+    exact: TwoBarsExact,
+    tau: f64,
+    nodal: Vec<f64>,
+}
+
+impl View {
+    /// Body `i`'s nodal displacements in the global frame, in increasing x, into `nodal`
+    /// (a clamped far node included, at 0), as [`TwoBarsExact::error_sq`] takes them.
+    fn fill_nodal(&mut self, sys: &System, i: usize, x: &[f64]) {
+        let b = &sys.bodies[i];
+        let local = &x[b.range()];
+        self.nodal.clear();
+        if b.sign < 0.0 {
+            // A, mirrored: its node m (far end x = 0) first.
+            self.nodal.extend(local.iter().rev().map(|u| -u));
+        } else {
+            self.nodal.extend_from_slice(local);
+            if !b.sp.bar.free_end {
+                self.nodal.push(0.0);
+            }
+        }
+    }
+
+    /// The exact values at step `step` for the state u: the contact end, σ_c (and at the
+    /// midpoint), the energy, and the error norms summed over both bars.
+    fn exact_values(&mut self, sys: &System, step: usize, u: &[f64]) -> ExactValues {
+        let t = step as f64 * self.tau;
+        let (mut l2_sq, mut h1_semi_sq) = (0.0, 0.0);
+        for (i, side) in [Side::A, Side::B].into_iter().enumerate() {
+            self.fill_nodal(sys, i, u);
+            let (l2, h1) = self.exact.error_sq(side, &self.nodal, t);
+            l2_sq += l2;
+            h1_semi_sq += h1;
+        }
+        let ex = &self.exact;
+        ExactValues {
+            u_contact: ex.u(Side::A, ex.interval(Side::A).1, t),
+            sigma_contact: ex.contact_stress(t),
+            sigma_contact_mid: (step > 0).then(|| ex.contact_stress(t - 0.5 * self.tau)),
+            energy: ex.energy(),
+            l2_sq,
+            h1_semi_sq,
+        }
+    }
+}
+
+/// Observe one state (with its contact pressure); returns its momentum.
 fn record(
     eng: &Engine,
     obs: &mut Observer,
-    (step, tau): (usize, f64),
-    st: &State,
-    sigma: f64,
+    view: &mut View,
+    step: usize,
+    (st, sigma): (&State, f64),
 ) -> Result<f64, Divergence> {
     let sys = &eng.sys;
     let (oa, ob) = (sys.bodies[0].off, sys.bodies[1].off);
     let (energy, energy_theta) = sys.energies(&st.u, &st.v);
     let p = sys.momentum(&st.v);
+    let exact = view.exact_values(sys, step, &st.u);
     obs.set_two_body(st.u[ob], p);
     obs.observe(
         StepValues {
             step,
-            t: step as f64 * tau,
+            t: step as f64 * view.tau,
             u_contact: -st.u[oa],
             v_contact: -st.v[oa],
             sigma_contact: sigma,
@@ -624,7 +676,7 @@ fn record(
             u_lowest: None,
             penetration: Some((-(st.u[oa] + st.u[ob] + sys.gap)).max(0.0)),
         },
-        None,
+        Some(exact),
     )?;
     Ok(p)
 }
@@ -663,6 +715,12 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
     };
     let mut st = eng.initial_state(cfg.perturbation);
     let mut obs = Observer::new(tau, opts.series_every, cfg.grid.steps);
+    let steps = cfg.grid.steps;
+    let mut view = View {
+        exact: TwoBarsExact::new(cfg.bars.exact_spec(), steps as f64 * tau),
+        tau,
+        nodal: Vec::with_capacity(n + 1),
+    };
     // Σ m_i|V_i| with the run's masses: the unit of the drift (null without motion or with a
     // clamp, contract §5).
     let unit: f64 = eng
@@ -676,14 +734,13 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
         max_dev: 0.0,
         unit,
     };
-    let steps = cfg.grid.steps;
     let end = time_loop(
         opts,
         start,
         (CLOCK_EVERY, tau, steps),
         &mut metrics,
         |clock, metrics| {
-            mom.p0 = record(&eng, &mut obs, (0, tau), &st, 0.0).map_err(Stop::Diverged)?;
+            mom.p0 = record(&eng, &mut obs, &mut view, 0, (&st, 0.0)).map_err(Stop::Diverged)?;
             for k in 1..=steps {
                 let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(k, e))?;
                 metrics.iterations += 1;
@@ -691,7 +748,7 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
                 let p = eng.sys.momentum(&st.v);
                 mom.max_dev = mom.max_dev.max((p - mom.p0).abs());
                 clock.observe(k, || {
-                    record(&eng, &mut obs, (k, tau), &st, sigma).map(|_| ())
+                    record(&eng, &mut obs, &mut view, k, (&st, sigma)).map(|_| ())
                 })?;
                 clock.completed(k)?;
             }
@@ -702,7 +759,18 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
     if !cfg.bars.clamped && mom.unit > 0.0 {
         metrics.momentum_drift = Some(mom.max_dev / mom.unit);
     }
-    metrics.velocity_a_final = Some(eng.sys.mean_velocity(0, &st.v));
-    metrics.velocity_b_final = Some(eng.sys.mean_velocity(1, &st.v));
+    let (va, vb) = (
+        eng.sys.mean_velocity(0, &st.v),
+        eng.sys.mean_velocity(1, &st.v),
+    );
+    metrics.velocity_a_final = Some(va);
+    metrics.velocity_b_final = Some(vb);
+    if end.status == Status::Ok {
+        // The exact mean velocities at the last step's time (contract §1.9).
+        let t = end.done as f64 * tau;
+        let ex = &view.exact;
+        metrics.err_velocity_a_final = Some((va - ex.mean_velocity(Side::A, t)).abs());
+        metrics.err_velocity_b_final = Some((vb - ex.mean_velocity(Side::B, t)).abs());
+    }
     finished(end.status, end.message, metrics, &mut obs)
 }

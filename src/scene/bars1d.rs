@@ -66,6 +66,27 @@ impl Bars1dParams {
         self.a.wave_speed().max(self.b.wave_speed())
     }
 
+    /// The exact solution's description (contract §1.9, [`super::bars1d_exact`]).
+    pub fn exact_spec(&self) -> super::bars1d_exact::TwoBarsSpec {
+        use super::bars1d_exact::{BarSpec, FarEnd, TwoBarsSpec};
+        let bar = |m: BarMaterial| BarSpec {
+            length: m.length,
+            young: m.young,
+            density: m.density,
+            velocity: m.velocity,
+        };
+        TwoBarsSpec {
+            a: bar(self.a),
+            b: bar(self.b),
+            gap: self.gap,
+            far_end: if self.clamped {
+                FarEnd::Clamped
+            } else {
+                FarEnd::Free
+            },
+        }
+    }
+
     /// B's element count for A's `elements`: one h on both bars, round(elements·L_b/L_a).
     pub fn elements_b(&self, elements: usize) -> usize {
         (elements as f64 * self.b.length / self.a.length).round() as usize
