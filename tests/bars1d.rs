@@ -9,7 +9,9 @@ use contact_sweep::run::bars1d::{Bars1dConfig, simulate};
 use contact_sweep::run::{Grid1d, Outcome, RunOptions, Status};
 use contact_sweep::scene::{BarMaterial, Bars1dParams, MassSide, NitscheSides};
 use contact_sweep::space::{ContactMethod, MassVariant};
-use contact_sweep::time::{GeneralizedAlphaParams, NewmarkParams, Scheme, ThetaParams};
+use contact_sweep::time::{
+    GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme, ThetaParams,
+};
 
 const CN: Scheme = Scheme::Newmark(NewmarkParams {
     beta: 0.25,
@@ -85,6 +87,25 @@ fn schemes() -> Vec<(Scheme, bool, bool, bool)> {
         (Scheme::Theta(ThetaParams { theta: 0.6 }), true, true, false),
         (Scheme::Hybrid, false, true, false),
         (Scheme::Kane, true, false, false),
+        (Scheme::ContactStabilizedNewmark, true, false, true),
+        (
+            Scheme::MoreauJean(MoreauJeanParams {
+                theta: 0.5,
+                restitution: 0.0,
+            }),
+            true,
+            false,
+            true,
+        ),
+        (
+            Scheme::MoreauJean(MoreauJeanParams {
+                theta: 1.0,
+                restitution: 0.5,
+            }),
+            true,
+            false,
+            true,
+        ),
         (
             Scheme::GeneralizedAlpha(GeneralizedAlphaParams::from_rho_inf(0.5)),
             true,

@@ -71,9 +71,9 @@ const CASES: &[(&str, &str, &str)] = &[
         "scene bars1d has no tangential direction",
     ),
     (
-        "name = \"x\"\nscene = \"bars1d\"\n[fixed]\nelements = 10\ndt = 0.1\nscheme = \"moreau-jean\"\n",
+        "name = \"x\"\nscene = \"bars1d\"\n[fixed]\nelements = 10\ndt = 0.1\nscheme = \"paoli-schatzman\"\n",
         "fixed.scheme",
-        "scheme = moreau-jean is not available for scene bars1d",
+        "scheme = paoli-schatzman is not available for scene bars1d",
     ),
     (
         "name = \"x\"\nscene = \"bars1d\"\n[fixed]\nelements = 10\ndt = 0.01\nmass = \"lumped\"\nscheme = \"central-difference\"\n",

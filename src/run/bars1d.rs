@@ -40,7 +40,7 @@ use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::bars1d_exact::{Body as Side, TwoBarsExact};
 use crate::scene::{BarParams, Bars1dParams, MassSide, NitscheSides};
 use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag, TridiagLu};
-use crate::time::{GeneralizedAlphaParams, NewmarkParams, Scheme, ThetaParams};
+use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme, ThetaParams};
 
 /// A validated bars1d run.
 #[derive(Debug, Clone, PartialEq)]
@@ -339,6 +339,10 @@ pub(super) struct Engine {
     /// z_r = A⁻¹(c_f q_r) and W[r][c] = p_r·z_c.
     z: Vec<Vec<f64>>,
     w: [[f64; 2]; 2],
+    /// Contact-stabilized Newmark's M-projection: M⁻¹q of its one row and p·M⁻¹q (empty
+    /// otherwise).
+    zm: Vec<f64>,
+    wm: f64,
 }
 
 /// State: u, v, a (stacked, local frames) and the rows' previous arguments and forces.
@@ -382,6 +386,23 @@ impl Engine {
                 w[r][col] = dot(&row.p, zc);
             }
         }
+        let (zm, wm) = if scheme == Scheme::ContactStabilizedNewmark {
+            // The M-projection onto the admissible set (one mixed row, contact ends with mass:
+            // the planner's), M⁻¹q once per run.
+            let m_lu = sys
+                .mass
+                .factor()
+                .ok_or("the mass matrix of the two bars is singular")?;
+            let mut zm = vec![0.0; sys.n];
+            for &(i, qv) in &sys.rows[0].q {
+                zm[i] += qv;
+            }
+            m_lu.solve_in_place(&mut zm);
+            let wm = dot(&sys.rows[0].p, &zm);
+            (zm, wm)
+        } else {
+            (Vec::new(), 0.0)
+        };
         Ok(Self {
             sys,
             scheme,
@@ -389,6 +410,8 @@ impl Engine {
             a_lu,
             z,
             w,
+            zm,
+            wm,
         })
     }
 
@@ -493,6 +516,8 @@ impl Engine {
                 phi
             }
             Scheme::GeneralizedAlpha(ga) => self.gen_alpha(st, wk, ga, laws, shift)?,
+            Scheme::ContactStabilizedNewmark => self.stabilized(st, wk)?,
+            Scheme::MoreauJean(mj) => self.moreau_jean(st, wk, mj)?,
             _ => unreachable!("refused at plan time (scene bars1d)"),
         };
         for &i in &sys.massless {
@@ -522,6 +547,81 @@ impl Engine {
         for (b, ku) in wk.b.iter_mut().zip(&wk.y) {
             *b -= c * ku;
         }
+    }
+
+    /// Contact-stabilized Newmark (one mixed row), as the one-bar engine: the M-projection of
+    /// the free flight uⁿ + τvⁿ onto the admissible set, then kane's step from it,
+    /// S Δ = −τ²/4 K(uⁿ + u^pred) + τ²/2 φ q with Δ = u^{n+1} − u^pred, v^{n+1} = vⁿ + 2Δ/τ.
+    /// Leaves the increment u^{n+1} − uⁿ in wk.y (as every step).
+    fn stabilized(&self, st: &mut State, wk: &mut Work) -> Result<[f64; 2], ContactSolveError> {
+        let tau = self.tau;
+        let sys = &self.sys;
+        let row = &sys.rows[0];
+        for ((p, u), v) in wk.pred.iter_mut().zip(&st.u).zip(&st.v) {
+            *p = u + tau * v;
+        }
+        let pred = contact::solve(
+            &ContactLaw::Complementarity,
+            dot(&row.p, &wk.pred) + row.p0,
+            self.wm,
+        )?;
+        if pred.phi != 0.0 {
+            for (x, z) in wk.pred.iter_mut().zip(&self.zm) {
+                *x += pred.phi * z;
+            }
+        }
+        for ((y, u), p) in wk.y.iter_mut().zip(&st.u).zip(&wk.pred) {
+            *y = u + p;
+        }
+        sys.klin.mul_into(&wk.y, &mut wk.b);
+        let c = 0.25 * tau * tau;
+        for b in wk.b.iter_mut() {
+            *b *= -c;
+        }
+        let shift = [dot(&row.p, &wk.pred), 0.0];
+        let phi = self.solve(wk, [ContactLaw::Complementarity; 2], shift)?;
+        for i in 0..sys.n {
+            st.v[i] += 2.0 * wk.y[i] / tau;
+            // The increment from uⁿ: u^pred − uⁿ + Δ.
+            wk.y[i] += wk.pred[i] - st.u[i];
+        }
+        Ok(phi)
+    }
+
+    /// Moreau–Jean (one mixed row), as the one-bar engine: (M + θ²τ²K)Δv = −τK(uⁿ + θτvⁿ) + p q,
+    /// the row active when its predicted gap (p·uⁿ + g) + ½τ p·vⁿ closes, and then
+    /// 0 ≤ p·v^{n+1} + e p·vⁿ ⊥ impulse; u^{n+1} = uⁿ + τ(vⁿ + θΔv). Returns the impulse
+    /// (σ_c is it over τ) and leaves the increment in wk.y.
+    fn moreau_jean(
+        &self,
+        st: &mut State,
+        wk: &mut Work,
+        MoreauJeanParams { theta, restitution }: MoreauJeanParams,
+    ) -> Result<[f64; 2], ContactSolveError> {
+        let tau = self.tau;
+        let sys = &self.sys;
+        let row = &sys.rows[0];
+        for ((y, u), v) in wk.y.iter_mut().zip(&st.u).zip(&st.v) {
+            *y = u + theta * tau * v;
+        }
+        sys.klin.mul_into(&wk.y, &mut wk.b);
+        for b in wk.b.iter_mut() {
+            *b *= -tau;
+        }
+        let vn = dot(&row.p, &st.v);
+        let law = if dot(&row.p, &st.u) + row.p0 + 0.5 * tau * vn <= 0.0 {
+            ContactLaw::Complementarity
+        } else {
+            ContactLaw::PositivePart { k: 0.0 }
+        };
+        // The row's argument is p·Δv + (1 + e) p·vⁿ: no gap in it.
+        let phi = self.solve(wk, [law; 2], [(1.0 + restitution) * vn - row.p0, 0.0])?;
+        for i in 0..sys.n {
+            let dv = wk.y[i];
+            wk.y[i] = tau * (st.v[i] + theta * dv);
+            st.v[i] += dv;
+        }
+        Ok(phi)
     }
 
     /// Generalized-α (HHT), the one-bar engine's equation at t^{n+1−α} for the increment:
@@ -744,7 +844,11 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
             for k in 1..=steps {
                 let phi = eng.step(&mut st, &mut wk).map_err(|e| Stop::Solver(k, e))?;
                 metrics.iterations += 1;
-                let sigma = eng.sys.sigma(&st.u, &phi);
+                let sigma = match cfg.grid.scheme {
+                    // The impulse of the step: the force is p/τ (contract §3.2).
+                    Scheme::MoreauJean(_) => phi[0] / tau,
+                    _ => eng.sys.sigma(&st.u, &phi),
+                };
                 let p = eng.sys.momentum(&st.v);
                 mom.max_dev = mom.max_dev.max((p - mom.p0).abs());
                 clock.observe(k, || {

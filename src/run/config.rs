@@ -5,8 +5,9 @@ use crate::scene::SceneSetup;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
+use super::bars1d;
 use super::grid1d::Grid1d;
-use super::{bar1d, bars1d, fe, layer1d, oscillator};
+use super::{bar1d, fe, layer1d, oscillator};
 
 /// The validated configuration of one run, per discretisation family: the tridiagonal 1D
 /// engine or the sparse finite-element engine (which runs every FE scene).

@@ -126,13 +126,15 @@ const FACTS: SceneFacts = SceneFacts {
 };
 
 /// The schemes the two-bar engine steps (contract §3, §3.2 where they apply to two bodies).
-const SCHEMES: [&str; 6] = [
+const SCHEMES: [&str; 8] = [
     "newmark",
     "theta",
     "hybrid",
     "kane",
+    "contact-stabilized-newmark",
     "generalized-alpha",
     "hht",
+    "moreau-jean",
 ];
 
 impl Bars1dScene {
@@ -195,7 +197,7 @@ impl Scene for Bars1dScene {
         let MethodNames { space, scheme, .. } = m;
         super::require("scheme", scheme, &SCHEMES, || {
             format!(
-                "scheme = {scheme} is not available for scene bars1d (newmark with β > 0, theta, hybrid with nitsche or penalty, kane, generalized-alpha, hht): paoli-schatzman's, contact-stabilized-newmark's and moreau-jean's contact rows are stated for one body against an obstacle, and the two-bar engine does not step them yet (issue 44)"
+                "scheme = {scheme} is not available for scene bars1d (newmark with β > 0, theta, hybrid with nitsche or penalty, kane, contact-stabilized-newmark, generalized-alpha, hht, moreau-jean): paoli-schatzman's two-step contact row and discrete-gradient's difference quotients are stated for one body against an obstacle, and the two-bar engine does not step them yet (issue 44)"
             )
         })?;
         if scheme == "hybrid" {
