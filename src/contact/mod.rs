@@ -176,6 +176,66 @@ pub fn solve(law: &ContactLaw, s_free: f64, w: f64) -> Result<ContactSolution, C
     found.ok_or(ContactSolveError::NoSolution { w })
 }
 
+/// Solve two coupled rows s_r = s_free_r + Σ_c w[r][c] φ_c(s_c) exactly (the two sides'
+/// rows of the unbiased Nitsche term between two bodies, contract §2.6): each law is
+/// piecewise linear ([`ContactLaw::pieces`]), so every pair of pieces is a 2×2 linear system,
+/// accepted when both roots lie on their pieces (with [`solve`]'s slack). One solution or an
+/// error, as for one row. The complementarity graph has no pieces: two multiplier rows are
+/// [`lcp`]'s.
+pub fn solve_pair(
+    laws: [&ContactLaw; 2],
+    s_free: [f64; 2],
+    w: [[f64; 2]; 2],
+) -> Result<[ContactSolution; 2], ContactSolveError> {
+    let (p0, n0) = laws[0].pieces();
+    let (p1, n1) = laws[1].pieces();
+    let scale = s_free[0].abs().max(s_free[1].abs()).max(1e-300);
+    let wmax = w[0][0].abs().max(w[1][1].abs());
+    let mut found: Option<[ContactSolution; 2]> = None;
+    for a in &p0[..n0] {
+        for b in &p1[..n1] {
+            // (I − W diag(slope)) s = s_free + W intercept
+            let m = [
+                [1.0 - w[0][0] * a.slope, -w[0][1] * b.slope],
+                [-w[1][0] * a.slope, 1.0 - w[1][1] * b.slope],
+            ];
+            let r = [
+                s_free[0] + w[0][0] * a.intercept + w[0][1] * b.intercept,
+                s_free[1] + w[1][0] * a.intercept + w[1][1] * b.intercept,
+            ];
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            if det == 0.0 {
+                continue;
+            }
+            let s = [
+                (r[0] * m[1][1] - m[0][1] * r[1]) / det,
+                (m[0][0] * r[1] - m[1][0] * r[0]) / det,
+            ];
+            let tol = 1e-13 * s[0].abs().max(s[1].abs()).max(scale);
+            let on = |s: f64, pc: &Piece| s >= pc.lo - tol && s <= pc.hi + tol;
+            if on(s[0], a) && on(s[1], b) {
+                let sol = [
+                    ContactSolution {
+                        s: s[0],
+                        phi: a.slope * s[0] + a.intercept,
+                    },
+                    ContactSolution {
+                        s: s[1],
+                        phi: b.slope * s[1] + b.intercept,
+                    },
+                ];
+                match found {
+                    None => found = Some(sol),
+                    Some(prev)
+                        if (prev[0].s - s[0]).abs() <= tol && (prev[1].s - s[1]).abs() <= tol => {}
+                    Some(_) => return Err(ContactSolveError::Multiple { w: wmax }),
+                }
+            }
+        }
+    }
+    found.ok_or(ContactSolveError::NoSolution { w: wmax })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -208,6 +268,20 @@ mod tests {
             solve(&law, 1.0, 1.0),
             Err(ContactSolveError::NoSolution { .. })
         ));
+    }
+
+    /// Two decoupled rows are two scalar solves; a coupled pair matches its active branch
+    /// solved by hand. Exact arithmetic up to one division: 1e-15.
+    #[test]
+    fn pair_of_rows_solves_its_active_branch() {
+        let law = ContactLaw::PositivePart { k: -10.0 };
+        let r = solve_pair([&law, &law], [1.0, -1.0], [[0.5, 0.0], [0.0, 0.5]]).unwrap();
+        assert!((r[0].s - 1.0 / 6.0).abs() < 1e-15);
+        assert_eq!((r[1].s, r[1].phi), (-1.0, 0.0));
+        // Both active: s = (1, 1) + W(−10 s), W = [[0.5, 0.25], [0.25, 0.5]]: (I + 10W) s = 1,
+        // [[6, 2.5], [2.5, 6]] s = (1, 1), s = 1/8.5 each.
+        let r = solve_pair([&law, &law], [1.0, 1.0], [[0.5, 0.25], [0.25, 0.5]]).unwrap();
+        assert!((r[0].s - 1.0 / 8.5).abs() < 1e-15 && (r[1].s - 1.0 / 8.5).abs() < 1e-15);
     }
 
     #[test]

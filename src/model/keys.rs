@@ -80,6 +80,17 @@ pub enum Key {
     /// The plane's tilt α in degrees (mesh2d/mesh3d, contract §1.8): the volume load becomes
     /// ρ·gravity·(sin α e_1 − cos α e_d). Default 0, so every existing run keeps its id.
     Incline,
+    /// Bar B of `bars1d` (contract §1.9, §7): its length, modulus, density and initial velocity.
+    LengthB,
+    YoungB,
+    DensityB,
+    VelocityB,
+    /// B's far end (`bars1d`): `free` (default) or `clamped`.
+    FarEnd,
+    /// Which bodies a mass variant modifies (contract §2.6): `both` (default), `a` or `b`.
+    MassSide,
+    /// The weights of the two sides' Nitsche terms (contract §2.6): `unbiased` (default) or `a`.
+    NitscheSides,
 }
 
 /// What a key's value must look like.
@@ -165,7 +176,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 46] = [
+    pub const ALL: [Key; 53] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -212,6 +223,13 @@ impl Key {
         Key::VelocityTangential,
         Key::FrictionForce,
         Key::Incline,
+        Key::LengthB,
+        Key::YoungB,
+        Key::DensityB,
+        Key::VelocityB,
+        Key::FarEnd,
+        Key::MassSide,
+        Key::NitscheSides,
     ];
 
     pub fn name(self) -> &'static str {
@@ -262,6 +280,13 @@ impl Key {
             Key::VelocityTangential => "velocity_tangential",
             Key::FrictionForce => "friction_force",
             Key::Incline => "incline",
+            Key::LengthB => "length_b",
+            Key::YoungB => "young_b",
+            Key::DensityB => "density_b",
+            Key::VelocityB => "velocity_b",
+            Key::FarEnd => "far_end",
+            Key::MassSide => "mass_side",
+            Key::NitscheSides => "nitsche_sides",
         }
     }
 
@@ -289,6 +314,13 @@ impl Key {
                 | Key::VelocityTangential
                 | Key::FrictionForce
                 | Key::Incline
+                | Key::LengthB
+                | Key::YoungB
+                | Key::DensityB
+                | Key::VelocityB
+                | Key::FarEnd
+                | Key::MassSide
+                | Key::NitscheSides
         )
     }
 
@@ -299,6 +331,9 @@ impl Key {
         match self {
             Key::RightEnd => Some(&["clamped", "free"]),
             Key::Load => Some(&["body", "inertial"]),
+            Key::FarEnd => Some(&["free", "clamped"]),
+            Key::MassSide => Some(&["both", "a", "b"]),
+            Key::NitscheSides => Some(&["unbiased", "a"]),
             _ => None,
         }
     }
@@ -318,7 +353,10 @@ impl Key {
             | Key::Load
             | Key::Solver
             | Key::Mesh
-            | Key::Friction => ValueType::Str,
+            | Key::Friction
+            | Key::FarEnd
+            | Key::MassSide
+            | Key::NitscheSides => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -425,6 +463,18 @@ impl Key {
                     ))
                 }
             }
+            Key::FarEnd | Key::MassSide | Key::NitscheSides => {
+                let words = self.choices().expect("choice keys");
+                if words.contains(&s) {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "unknown {} `{s}` (expected {}; contract §1.9, §2.6)",
+                        self.name(),
+                        words.join(" or ")
+                    ))
+                }
+            }
             _ => Err("wrong type".into()),
         }
     }
@@ -435,6 +485,8 @@ impl Key {
             Key::T | Key::H | Key::Dt | Key::Courant => positive(x),
             Key::NitscheGamma0 | Key::PenaltyGamma0 => positive(x),
             Key::Length | Key::Young | Key::Density | Key::Height => positive(x),
+            Key::LengthB | Key::YoungB | Key::DensityB => positive(x),
+            Key::VelocityB => finite(x).map(|_| ()),
             Key::VelocityTangential => finite(x).map(|_| ()),
             // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
             // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the

@@ -5,6 +5,7 @@ use crate::scene::SceneSetup;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::Scheme;
 
+use super::bars1d;
 use super::grid1d::Grid1d;
 use super::{bar1d, fe, layer1d, oscillator};
 
@@ -16,6 +17,7 @@ pub enum RunConfig {
     Fe(fe::FeConfig),
     Oscillator(oscillator::OscillatorConfig),
     Layer1d(layer1d::Layer1dConfig),
+    Bars1d(bars1d::Bars1dConfig),
 }
 
 impl RunConfig {
@@ -60,6 +62,10 @@ impl RunConfig {
                     Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
                 ))
             }
+            SceneSetup::Bars1d { bars, elements } => RunConfig::Bars1d(bars1d::Bars1dConfig::new(
+                bars,
+                Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
+            )),
         }
     }
 
@@ -103,6 +109,7 @@ impl RunConfig {
             RunConfig::Fe(c) => c.perturbation = p,
             RunConfig::Oscillator(c) => c.perturbation = p,
             RunConfig::Layer1d(c) => c.perturbation = p,
+            RunConfig::Bars1d(c) => c.perturbation = p,
         }
     }
 
@@ -115,6 +122,7 @@ impl RunConfig {
             RunConfig::Fe(c) => c.explicit_dt_limit(),
             RunConfig::Oscillator(c) => c.explicit_dt_limit(),
             RunConfig::Layer1d(c) => c.explicit_dt_limit(),
+            RunConfig::Bars1d(c) => c.explicit_dt_limit(),
         }
     }
 
@@ -125,6 +133,7 @@ impl RunConfig {
             RunConfig::Fe(c) => (c.steps, c.unknowns()),
             RunConfig::Oscillator(c) => (c.steps, 1),
             RunConfig::Layer1d(c) => (c.grid.steps, 2 * c.grid.elements),
+            RunConfig::Bars1d(c) => (c.grid.steps, c.grid.elements + c.elements_b()),
         };
         (steps as u64).saturating_mul(unknowns as u64)
     }

@@ -3,7 +3,7 @@
 
 use super::config::RunConfig;
 use super::outcome::{Outcome, RunContext, RunOptions};
-use super::{bar1d, fe, layer1d, oscillator};
+use super::{bar1d, bars1d, fe, layer1d, oscillator};
 
 /// Run one simulation.
 pub fn simulate(config: &RunConfig, options: &RunOptions) -> Outcome {
@@ -17,6 +17,7 @@ pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext)
         RunConfig::Fe(c) => fe::simulate(c, options, ctx),
         RunConfig::Oscillator(c) => oscillator::simulate(c, options),
         RunConfig::Layer1d(c) => layer1d::simulate(c, options),
+        RunConfig::Bars1d(c) => bars1d::simulate(c, options),
     }
 }
 
@@ -27,7 +28,10 @@ pub fn simulate_with(config: &RunConfig, options: &RunOptions, ctx: &RunContext)
 pub fn lockstep_key(config: &RunConfig) -> Option<String> {
     match config {
         RunConfig::Fe(c) => fe::lockstep_key(c),
-        RunConfig::Bar1d(_) | RunConfig::Oscillator(_) | RunConfig::Layer1d(_) => None,
+        RunConfig::Bar1d(_)
+        | RunConfig::Oscillator(_)
+        | RunConfig::Layer1d(_)
+        | RunConfig::Bars1d(_) => None,
     }
 }
 

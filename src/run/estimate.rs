@@ -62,6 +62,7 @@ impl RunConfig {
             RunConfig::Fe(c) => c.steps,
             RunConfig::Oscillator(c) => c.steps,
             RunConfig::Layer1d(c) => c.grid.steps,
+            RunConfig::Bars1d(c) => c.grid.steps,
         }
     }
 
@@ -90,6 +91,11 @@ impl RunConfig {
             RunConfig::Layer1d(c) => {
                 let m = c.grid.elements as f64;
                 (2.0 * m, 2.0 * m * BAR1D_BYTES_PER_ELEMENT)
+            }
+            // One engine over both bars' unknowns.
+            RunConfig::Bars1d(c) => {
+                let m = (c.grid.elements + c.elements_b()) as f64;
+                (m, m * BAR1D_BYTES_PER_ELEMENT)
             }
             RunConfig::Fe(c) => {
                 // (unknowns, dimension, matrix entries per row, contact columns of Z), in f64.

@@ -7,6 +7,7 @@
 //! point is kept.
 
 pub mod bar1d;
+pub mod bars1d;
 mod config;
 mod dispatch;
 pub mod estimate;

@@ -104,6 +104,13 @@ pub struct Metrics {
     /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, contract §1.7).
     pub err_sigma_t_l2: Option<f64>,
     pub err_vt_final: Option<f64>,
+    /// Two bodies (contract §5): max_n |Pⁿ − P⁰|/Σ m_i|V_i| (null with a clamp or at rest),
+    /// each body's mean velocity 1ᵀM_iv/m_i at T and its error against the exact one (bars1d).
+    pub momentum_drift: Option<f64>,
+    pub velocity_a_final: Option<f64>,
+    pub velocity_b_final: Option<f64>,
+    pub err_velocity_a_final: Option<f64>,
+    pub err_velocity_b_final: Option<f64>,
     /// Dry friction on the oscillator (contract §1.5): the time after which the mass never moves
     /// again (null while it moves at T), and the exact rest time (null if after T).
     pub stop_time: Option<f64>,
@@ -173,10 +180,14 @@ pub struct SeriesRow {
     pub sigma_t_contact: Option<f64>,
     pub v_t_contact: Option<f64>,
     pub friction_work: Option<f64>,
+    /// Two bodies (contract §5): B's contact end (1D; Γ^b's mean normal displacement in 2D/3D)
+    /// and the total momentum Pⁿ.
+    pub u_contact_b: Option<f64>,
+    pub momentum: Option<f64>,
 }
 
 /// The optional series columns, in schema order (null where a run has no such quantity).
-pub const OPTIONAL_SERIES: [&str; 10] = [
+pub const OPTIONAL_SERIES: [&str; 12] = [
     "energy_theta",
     "u_contact_exact",
     "sigma_contact_exact",
@@ -187,6 +198,8 @@ pub const OPTIONAL_SERIES: [&str; 10] = [
     "sigma_t_contact",
     "v_t_contact",
     "friction_work",
+    "u_contact_b",
+    "momentum",
 ];
 
 /// The index of `friction_work` in [`OPTIONAL_SERIES`].
@@ -207,9 +220,9 @@ pub struct Series {
     pub sigma_contact: Vec<f64>,
     pub energy: Vec<f64>,
     /// Values of the optional columns (0 where null); empty for a column never given.
-    pub optional: [Vec<f64>; 10],
+    pub optional: [Vec<f64>; 12],
     /// Whether each value of an optional column is given; empty for a column never given.
-    pub valid: [Vec<bool>; 10],
+    pub valid: [Vec<bool>; 12],
     cap: usize,
 }
 
@@ -290,6 +303,8 @@ impl Series {
             sigma_t_contact: opt(7),
             v_t_contact: opt(8),
             friction_work: opt(9),
+            u_contact_b: opt(10),
+            momentum: opt(11),
         }
     }
 
@@ -316,7 +331,7 @@ impl FromIterator<SeriesRow> for Series {
 
 impl SeriesRow {
     /// The optional columns' values, in [`OPTIONAL_SERIES`] order.
-    pub fn optional(&self) -> [Option<f64>; 10] {
+    pub fn optional(&self) -> [Option<f64>; 12] {
         [
             self.energy_theta,
             self.u_contact_exact,
@@ -328,6 +343,8 @@ impl SeriesRow {
             self.sigma_t_contact,
             self.v_t_contact,
             self.friction_work,
+            self.u_contact_b,
+            self.momentum,
         ]
     }
 }
@@ -410,6 +427,8 @@ pub struct Observer {
     /// The friction values of the next observed step (σ_t, slip velocity, W_f), set by a
     /// frictional engine before [`Observer::observe`] ([`Observer::set_friction`]).
     friction: Option<[f64; 3]>,
+    /// The two-body series values (u_contact_b, P) of the step observed next.
+    two_body: Option<[f64; 2]>,
     pub series: Series,
 }
 
@@ -450,6 +469,7 @@ impl Observer {
             impacts: super::impacts::PhaseTracker::new(),
             max_penetration: None,
             friction: None,
+            two_body: None,
             series: Series::with_capacity(cap),
         }
     }
@@ -465,6 +485,12 @@ impl Observer {
     /// observed next.
     pub fn set_friction(&mut self, sigma_t: f64, v_t: f64, work: f64) {
         self.friction = Some([sigma_t, v_t, work]);
+    }
+
+    /// The two-body series values (B's contact displacement, the total momentum) of the step
+    /// observed next.
+    pub fn set_two_body(&mut self, u_contact_b: f64, momentum: f64) {
+        self.two_body = Some([u_contact_b, momentum]);
     }
 
     /// The energy of the last observed step (a frictional engine's E + W_f balance).
@@ -568,9 +594,12 @@ impl Observer {
                 sigma_t_contact: self.friction.map(|f| f[0]),
                 v_t_contact: self.friction.map(|f| f[1]),
                 friction_work: self.friction.map(|f| f[2]),
+                u_contact_b: self.two_body.map(|b| b[0]),
+                momentum: self.two_body.map(|b| b[1]),
             });
         }
         self.friction = None;
+        self.two_body = None;
         let scale = self.energy_unit().abs().max(f64::MIN_POSITIVE);
         if v.energy > DIVERGENCE_FACTOR * scale {
             return Err(Divergence(format!(
@@ -658,6 +687,8 @@ mod tests {
             sigma_t_contact: None,
             v_t_contact: None,
             friction_work: None,
+            u_contact_b: None,
+            momentum: None,
         }
     }
 
@@ -677,7 +708,7 @@ mod tests {
         assert_eq!(s.rows().collect::<Vec<_>>(), rows);
         assert!(s.has(0));
         assert_eq!(s.valid[0], [false, false, true, false, true]);
-        assert!((1..10).all(|k| !s.has(k) && s.optional[k].is_empty()));
+        assert!((1..12).all(|k| !s.has(k) && s.optional[k].is_empty()));
     }
 
     /// W_f starts at 0 for every treatment (issue 42): a `friction_work` column whose first

@@ -237,6 +237,18 @@ schema! {
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (contract §1.5; 0: frictionless)";
         stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
+        length_b: Option<f64> => "m", "bars1d: bar B's length L_b (contract §1.9)";
+        young_b: Option<f64> => "Pa", "bars1d: bar B's Young modulus E_b";
+        density_b: Option<f64> => "kg/m", "bars1d: bar B's density ρ_b";
+        velocity_b: Option<f64> => "m/s", "bars1d: bar B's initial velocity V_b along x (A's is `velocity`, towards B)";
+        far_end: Option<String> => "", "bars1d: B's far end, free or clamped (contract §1.9)";
+        mass_side: Option<String> => "", "two bodies: the bodies the mass variant modifies: both, a or b (contract §2.6)";
+        nitsche_sides: Option<String> => "", "two bodies: the Nitsche sides' weights, unbiased (w_a = w_b = ½) or a (A the slave) (contract §2.6)";
+        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along x (1D) or e_d; null when a clamp acts or every initial velocity is 0 (contract §5)";
+        velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T";
+        velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T";
+        err_velocity_a_final: Option<f64> => "m/s", "bars1d: abs(velocity_a_final − the exact mean velocity of A at T) (contract §1.9)";
+        err_velocity_b_final: Option<f64> => "m/s", "bars1d: abs(velocity_b_final − the exact mean velocity of B at T)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -330,6 +342,18 @@ pub const SERIES_COLUMNS: &[(&str, &str, &str, &str)] = &[
         "J",
         "friction: the frictional work W_f^n = −Σ f̄_t·Δu_t so far (contract §2.5); energy + friction_work − its initial value is the normal contact's work",
     ),
+    (
+        "u_contact_b",
+        "Option<f64>",
+        "m",
+        "two bodies: B's contact end's displacement along x (bars1d: u_b(L_a + g); 2D/3D: the mean normal displacement of Γ^b); u_contact is A's",
+    ),
+    (
+        "momentum",
+        "Option<f64>",
+        "kg·m/s",
+        "two bodies: the total momentum Pⁿ = Σ_i 1ᵀM_iv (contract §2.6)",
+    ),
 ];
 
 /// Timing of a run over its repeats.
@@ -358,25 +382,12 @@ impl RunRecord {
             message: out.message.clone(),
             T: f(Key::T).unwrap_or(f64::NAN),
             h: f(Key::H).unwrap_or(f64::NAN),
-            elements: p
-                .get(&Key::Elements)
-                .and_then(|v| match v {
-                    Value::Int(i) => Some(*i),
-                    _ => None,
-                })
-                .unwrap_or(0),
+            elements: elements_of(p),
             dt: f(Key::Dt).unwrap_or(f64::NAN),
             courant: f(Key::Courant).unwrap_or(f64::NAN),
             space: s(Key::Space),
             mass: s(Key::Mass),
-            mass_weights: p.get(&Key::MassWeights).map(|v| match v {
-                Value::List(w) => w
-                    .iter()
-                    .map(|x| x.to_string())
-                    .collect::<Vec<_>>()
-                    .join(","),
-                other => other.to_string(),
-            }),
+            mass_weights: p.get(&Key::MassWeights).map(weights_text),
             contact_init: p.get(&Key::ContactInit).map(|v| v.to_string()),
             scheme: s(Key::Scheme),
             scheme_label: spec.scheme_label.clone(),
@@ -484,8 +495,42 @@ impl RunRecord {
             friction_force: f(Key::FrictionForce),
             stop_time: m.stop_time,
             stop_time_exact: m.stop_time_exact,
+            length_b: f(Key::LengthB),
+            young_b: f(Key::YoungB),
+            density_b: f(Key::DensityB),
+            velocity_b: f(Key::VelocityB),
+            far_end: p.get(&Key::FarEnd).map(|v| v.to_string()),
+            mass_side: p.get(&Key::MassSide).map(|v| v.to_string()),
+            nitsche_sides: p.get(&Key::NitscheSides).map(|v| v.to_string()),
+            momentum_drift: m.momentum_drift,
+            velocity_a_final: m.velocity_a_final,
+            velocity_b_final: m.velocity_b_final,
+            err_velocity_a_final: m.err_velocity_a_final,
+            err_velocity_b_final: m.err_velocity_b_final,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
+    }
+}
+
+/// The `elements` column: the run's element count (0 where none was resolved).
+fn elements_of(p: &BTreeMap<Key, Value>) -> i64 {
+    p.get(&Key::Elements)
+        .and_then(|v| match v {
+            Value::Int(i) => Some(*i),
+            _ => None,
+        })
+        .unwrap_or(0)
+}
+
+/// The `mass_weights` column: the weights joined by commas.
+fn weights_text(v: &Value) -> String {
+    match v {
+        Value::List(w) => w
+            .iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(","),
+        other => other.to_string(),
     }
 }
 

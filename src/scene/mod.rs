@@ -15,6 +15,7 @@
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod bars1d;
 pub mod bars1d_exact;
 pub mod layer1d;
 pub mod mesh;
@@ -23,6 +24,7 @@ pub mod oscillator;
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup, LoadModel};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
+pub use bars1d::{BarMaterial, Bars1dParams, Bars1dScene, MassSide, NitscheSides};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
@@ -89,6 +91,8 @@ pub enum SceneSetup {
     Oscillator(OscillatorParams),
     /// The frictional layer: two P1 chains on the same nodes (contract §1.7).
     Layer1d { layer: LayerParams, elements: usize },
+    /// Two bars colliding (contract §1.9): A's element count (B's follows from one h).
+    Bars1d { bars: Bars1dParams, elements: usize },
 }
 
 /// What [`Scene::setup_from_file`] gives for a mesh file: the mesh choice and the run's setup
@@ -110,9 +114,10 @@ impl SceneSetup {
             SceneSetup::Oscillator(p) if p.friction > 0.0 => {
                 "revision=dry-friction-stick-slip\n".into()
             }
-            SceneSetup::Bar1d { .. } | SceneSetup::Layer1d { .. } | SceneSetup::Oscillator(_) => {
-                String::new()
-            }
+            SceneSetup::Bar1d { .. }
+            | SceneSetup::Layer1d { .. }
+            | SceneSetup::Bars1d { .. }
+            | SceneSetup::Oscillator(_) => String::new(),
         }
     }
 }
@@ -323,6 +328,8 @@ pub enum SceneKind {
     Mesh3d,
     /// The frictional layer with its exact solution (contract §1.7).
     Layer1d,
+    /// Two bars colliding, with their exact solution (contract §1.9).
+    Bars1d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -334,10 +341,11 @@ static OSCILLATOR: OscillatorScene = OscillatorScene;
 static MESH2D: MeshScene = MeshScene { dim: 2 };
 static MESH3D: MeshScene = MeshScene { dim: 3 };
 static LAYER1D: Layer1dScene = Layer1dScene;
+static BARS1D: Bars1dScene = Bars1dScene;
 
 impl SceneKind {
     /// Every scene name of contract §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 9] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 10] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
@@ -347,6 +355,7 @@ impl SceneKind {
         ("mesh2d", Some(SceneKind::Mesh2d)),
         ("mesh3d", Some(SceneKind::Mesh3d)),
         ("layer1d", Some(SceneKind::Layer1d)),
+        ("bars1d", Some(SceneKind::Bars1d)),
     ];
 
     /// The scene behind this name.
@@ -361,6 +370,7 @@ impl SceneKind {
             SceneKind::Mesh2d => &MESH2D,
             SceneKind::Mesh3d => &MESH3D,
             SceneKind::Layer1d => &LAYER1D,
+            SceneKind::Bars1d => &BARS1D,
         }
     }
 

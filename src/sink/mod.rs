@@ -1072,6 +1072,8 @@ mod tests {
             sigma_t_contact: None,
             v_t_contact: None,
             friction_work: exact.map(|e| 2.0 * e),
+            u_contact_b: None,
+            momentum: None,
         }
     }
 

@@ -27,7 +27,8 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &columns![
     point_mass: F64, stiffness: F64, force: F64, impact_law: F64, solver: Str, cg_tol: F64,
     T: F64, ensemble_sample: I64, ensemble_perturbation: F64, friction: Str,
     friction_coefficient: F64, tresca_threshold: F64, height: F64, velocity_tangential: F64,
-    friction_force: F64, incline: F64,
+    friction_force: F64, incline: F64, length_b: F64, young_b: F64, density_b: F64,
+    velocity_b: F64, far_end: Str, mass_side: Str, nitsche_sides: Str,
 ];
 
 /// The parameters already spelled out in a run's `label` (contact method · mass · scheme);

@@ -261,11 +261,22 @@ impl Checker {
         if let Some(scene) = self.scene
             && !accepted(scene, key)
         {
+            // Name the scenes that do take it: a second body's key (`length_b`, …) on a
+            // one-body scene says where it belongs.
+            let takers: Vec<&str> = SceneKind::NAMES
+                .iter()
+                .filter_map(|(n, k)| k.filter(|k| accepted(*k, key)).map(|_| *n))
+                .collect();
+            let hint = if takers.is_empty() {
+                String::new()
+            } else {
+                format!(" (scenes that take it: {})", takers.join(", "))
+            };
             self.issue(
                 path,
                 node.line,
                 format!(
-                    "`{}` is not a parameter of scene {}",
+                    "`{}` is not a parameter of scene {}{hint}",
                     key.name(),
                     scene.name()
                 ),
