@@ -40,7 +40,9 @@
 //! active; in stick (|P_t| ≤ r) ∂λ_t/∂P_t = w I; in slip λ_t = w r P̂_t, whose derivative is
 //! w (r/|P_t|)(I − P̂_t P̂_tᵀ) (2D: 0, the clamp) and, for Coulomb, ∂λ_t/∂x_n = w (μ_f/γ) P̂_t.
 //! A point without normal contact has λ = 0 and a zero block, so only the active points' d × d
-//! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
+//! blocks enter the dense LU. Large problems (from [`SPARSE_MIN_ACTIVE`] unknowns) make their
+//! steps and W Λ in the space of the contact dofs instead ([`super::schur`]): W = P_R S C_R with
+//! S = R A⁻¹ Rᵀ, and each Newton step an m × m solve (GMRES with a reused LU). With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
 //! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
 
 use super::schur::{ContactSchur, SchurNewton};
@@ -793,8 +795,9 @@ fn scales(ops: &NitscheOps, x0: &[f64], ramp: f64) -> Scales {
 /// Active unknowns from which the frictional Newton solves its step in the contact dofs'
 /// space ([`SchurNewton`]) instead of by the dense LU of its active block, whose (2/3)·n_a³
 /// (n_a = d × the active points) dominates the step from about this size on; below it the
-/// dense LU is the cheaper (and every run of the test suite keeps its bits: their active sets
-/// are smaller). Runs with at least this many unknowns make S at set-up ([`ContactSchur`]).
+/// dense LU is the cheaper. Runs with at least this many unknowns make S at set-up
+/// ([`ContactSchur`]) and their residuals' W Λ with it at every step; smaller runs keep the
+/// dense W and their bits.
 pub(crate) const SPARSE_MIN_ACTIVE: usize = 384;
 
 /// The full semismooth Newton step into `work.step` at the iterate `work.s` (its G, blocks
