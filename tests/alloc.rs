@@ -299,9 +299,9 @@ fn frictional_comparison_methods_allocate_nothing() {
 
 /// Nitsche and penalty friction in 3D with the Newmark family (issue 43): bar3d at h = 0.1
 /// (36 contact points: the Newton's dense active block) and at h = 0.025 (144 points, 432
-/// unknowns: from 384 active unknowns on, the Newton's step goes through the full-space sparse
-/// LU, run/fe/nitsche.rs `SparseNewton`, refactored per iteration in buffers sized at setup)
-/// — nothing allocated in the time loop.
+/// unknowns: from 384 active unknowns on, the Newton's step is made in the contact dofs' space,
+/// run/fe/schur.rs — GMRES and K's dense LU in buffers sized at setup) — nothing allocated in
+/// the time loop.
 #[test]
 fn nitsche_3d_frictional_time_loops_allocate_nothing() {
     let methods = [

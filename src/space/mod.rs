@@ -11,7 +11,6 @@ pub mod bar1d;
 pub mod cg;
 pub mod fe;
 pub mod linalg;
-pub mod sparse_lu;
 pub mod step_solver;
 pub mod tridiag;
 

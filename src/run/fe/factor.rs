@@ -6,7 +6,8 @@ use super::cache::{Cache, geometry_key};
 use super::config::{FeConfig, frictional};
 use super::geometry::{Geometry, tangential_dofs};
 use super::mass::mass_matrix;
-use super::nitsche::NitscheOps;
+use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
+use super::schur::ContactSchur;
 use crate::run::Status;
 use crate::space::ContactMethod;
 use crate::space::fe::SymMatrix;
@@ -43,9 +44,9 @@ pub(super) struct Factored {
     /// Mixed with friction (contract §2.5): the tangential rows; Z then holds the tangential
     /// columns after the normal ones.
     pub(super) friction: Option<FrictionFactor>,
-    /// Frictional Nitsche/penalty: the step matrix A itself, for the Newton's full-space sparse
-    /// LU on large active sets ([`super::nitsche::SparseNewton`]); `None` otherwise.
-    pub(super) a_friction: Option<SymMatrix>,
+    /// Frictional Nitsche/penalty with at least [`SPARSE_MIN_ACTIVE`] unknowns: S = R A⁻¹ Rᵀ over
+    /// the points' dofs, for the Newton on large active sets ([`super::schur`]); `None` otherwise.
+    pub(super) schur: Option<ContactSchur>,
 }
 
 /// The mixed method's condensation over the normal and tangential rows C of Γ_C.
@@ -205,7 +206,7 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
         h,
         nitsche: None,
         friction,
-        a_friction: None,
+        schur: None,
     })
 }
 
@@ -265,7 +266,6 @@ pub(super) fn factor_nitsche(
     }
     // The condensed unknowns: the points' P_γ (and P_t with friction).
     let nq = ops.unknowns();
-    let a_friction = ops.friction.is_some().then(|| a.clone());
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
     })?;
@@ -280,6 +280,18 @@ pub(super) fn factor_nitsche(
     chol.try_solve_many_in_place(&mut z, nq, &mut work).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) (Θ = {theta}, γ0 = {gamma0}), its condensation columns: {e}")
     })?;
+    let schur = (ops.friction.is_some() && nq >= SPARSE_MIN_ACTIVE)
+        .then(|| {
+            ContactSchur::new(n, &ops.dofs, |cols, ncols| {
+                chol.try_solve_many_in_place(cols, ncols, &mut chol.work_for(ncols))
+                    .map_err(|e| {
+                        format!(
+                            "the contact dofs' columns of the Nitsche step matrix's inverse: {e}"
+                        )
+                    })
+            })
+        })
+        .transpose()?;
     let mut h = vec![0.0; nq * nq];
     for q in 0..nq {
         let (p_row, dofs) = ops.p_row(q);
@@ -297,6 +309,6 @@ pub(super) fn factor_nitsche(
         h,
         nitsche: Some(ops),
         friction: None,
-        a_friction,
+        schur,
     })
 }

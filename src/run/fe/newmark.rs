@@ -272,7 +272,7 @@ impl<'a> Stepper<'a> {
         let mut ma = vec![0.0; n];
         let mixed_h = nit.is_none().then_some(fac.h.as_slice());
         let lcp = Lcp::new_or_idle(g.contact.len(), mixed_h);
-        let newton_work = match NewtonWork::for_run(nit, fac.a_friction.as_ref()) {
+        let newton_work = match NewtonWork::for_run(nit, fac.schur.as_ref()) {
             Ok(w) => w,
             Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
         };

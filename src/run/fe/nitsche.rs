@@ -40,14 +40,15 @@
 //! active; in stick (|P_t| ≤ r) ∂λ_t/∂P_t = w I; in slip λ_t = w r P̂_t, whose derivative is
 //! w (r/|P_t|)(I − P̂_t P̂_tᵀ) (2D: 0, the clamp) and, for Coulomb, ∂λ_t/∂x_n = w (μ_f/γ) P̂_t.
 //! A point without normal contact has λ = 0 and a zero block, so only the active points' d × d
-//! blocks enter the dense LU. With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
+//! blocks enter the dense LU. Large problems (from [`SPARSE_MIN_ACTIVE`] unknowns) make their
+//! steps and W Λ in the space of the contact dofs instead ([`super::schur`]): W = P_R S C_R with
+//! S = R A⁻¹ Rᵀ, and each Newton step an m × m solve (GMRES with a reused LU). With μ_f = 0 and Θ ≠ 0 this is the full-vector frictionless
 //! Nitsche (the Θ terms of σ_t stay), which is why such runs take this path.
 
+use super::schur::{ContactSchur, SchurNewton};
 use crate::contact::friction::FrictionLaw;
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
-use crate::space::fe::SymMatrix;
 use crate::space::fe::nitsche::ContactPoint;
-use crate::space::sparse_lu::SparseLu;
 
 /// Semismooth Newton: relative tolerance and iteration cap (contract §4).
 pub(crate) const NEWTON_TOL: f64 = 1e-12;
@@ -290,8 +291,8 @@ pub(crate) struct NewtonWork {
     /// The full Newton step and the iterate it starts from (the line search's).
     step: Vec<f64>,
     x_old: Vec<f64>,
-    /// Large frictional problems: the full-space sparse Newton matrix ([`SparseNewton`]).
-    sparse: Option<SparseNewton>,
+    /// Large frictional problems: the Newton steps in the contact dofs' space ([`SchurNewton`]).
+    schur: Option<SchurNewton>,
     /// The last forces a [`continuation`] stage solved for, and those of its narrowest
     /// Tresca ramp before a restart.
     lambda_ok: Vec<f64>,
@@ -316,7 +317,7 @@ impl NewtonWork {
             d_delta: Vec::new(),
             step: Vec::new(),
             x_old: Vec::new(),
-            sparse: None,
+            schur: None,
             lambda_ok: Vec::new(),
             lambda_best: Vec::new(),
             stages: [0; 3],
@@ -336,24 +337,52 @@ impl NewtonWork {
         w
     }
 
-    /// [`NewtonWork::frictional`] for the rows `ops`, with the full-space sparse Newton
-    /// ([`SparseNewton`]) where the active set can reach [`SPARSE_MIN_ACTIVE`] and the step
-    /// matrix `a` is at hand.
     /// The workspace a run's contact solve needs: none for mixed (`ops` None), the frictional
-    /// one (sparse over `a` when large, [`NewtonWork::frictional_for`]) or the frictionless one.
-    pub fn for_run(ops: Option<&NitscheOps>, a: Option<&SymMatrix>) -> Result<NewtonWork, String> {
+    /// one (with the Newton in the contact dofs' space where `schur` is at hand,
+    /// [`NewtonWork::frictional_for`]) or the frictionless one.
+    pub fn for_run(
+        ops: Option<&NitscheOps>,
+        schur: Option<&ContactSchur>,
+    ) -> Result<NewtonWork, String> {
         match ops {
-            Some(o) if o.friction.is_some() => NewtonWork::frictional_for(o, a),
+            Some(o) if o.friction.is_some() => NewtonWork::frictional_for(o, schur),
             _ => Ok(NewtonWork::new(ops.map_or(0, NitscheOps::len))),
         }
     }
 
-    pub fn frictional_for(ops: &NitscheOps, a: Option<&SymMatrix>) -> Result<NewtonWork, String> {
+    /// [`NewtonWork::frictional`] for the rows `ops`, with the Newton steps through S = R A⁻¹ Rᵀ
+    /// ([`SchurNewton`]) where the run made it (its active set can reach [`SPARSE_MIN_ACTIVE`]).
+    pub fn frictional_for(
+        ops: &NitscheOps,
+        schur: Option<&ContactSchur>,
+    ) -> Result<NewtonWork, String> {
         let mut w = NewtonWork::frictional(ops.unknowns(), ops.per_point());
-        if let Some(a) = a.filter(|_| ops.unknowns() >= SPARSE_MIN_ACTIVE) {
-            w.sparse = Some(SparseNewton::new(ops, a)?);
+        if let Some(s) = schur {
+            let nu = ops.unknowns();
+            let (mut prow, mut crow) = (
+                Vec::with_capacity(nu * ops.k),
+                Vec::with_capacity(nu * ops.k),
+            );
+            for j in 0..nu {
+                prow.extend_from_slice(ops.p_row(j).0);
+                crow.extend_from_slice(ops.c_row(j).0);
+            }
+            w.schur = Some(SchurNewton::new(
+                s.clone(),
+                ops.k,
+                ops.per_point(),
+                prow,
+                crow,
+            )?);
         }
         Ok(w)
+    }
+
+    /// The Newton's linear solves over the run, when made in the contact dofs' space: (K's
+    /// factorisations, GMRES iterations) ([`SchurNewton`]).
+    #[cfg(test)]
+    pub fn schur_counts(&self) -> Option<(usize, usize)> {
+        self.schur.as_ref().map(|s| (s.refactors, s.krylov))
     }
 }
 
@@ -427,9 +456,9 @@ struct Scales {
     ramp: f64,
 }
 
-/// Λ(x), the blocks, G(x) into `work` at x = `work.s`; returns (max |G_n|, max |G_t|, the
-/// tangential rows' scale max(|x0_t|, |x_t|, Σ_r |cτ² W_jr Λ_r|), the merit Σ (G/scale)² with the
-/// fixed scales).
+/// Λ(x), the blocks, G(x) into `work` at x = `work.s`; returns the residual's sizes
+/// ([`Residuals`]: max |G_n| relative, max |G_t|, the tangential rows' scale
+/// max(|x0_t|, |x_t|, Σ_r |cτ² W_jr Λ_r|), the merit Σ (G/scale)² with the fixed scales).
 #[allow(clippy::too_many_arguments)]
 fn evaluate(
     ops: &NitscheOps,
@@ -441,7 +470,7 @@ fn evaluate(
     lambda: &mut [f64],
     slides: &mut [bool],
     work: &mut NewtonWork,
-) -> (f64, f64, f64, f64) {
+) -> Residuals {
     let (nq, d) = (ops.len(), ops.per_point());
     let nu = nq * d;
     work.nonzero.clear();
@@ -465,30 +494,116 @@ fn evaluate(
                 .extend((q * d..(q + 1) * d).filter(|&r| lambda[r] != 0.0));
         }
     }
+    // W Λ in the contact dofs' space on large problems ([`SchurNewton::apply_w`]): the
+    // terms' sizes are then bounds (`Residuals::strict`).
+    if let Some(sn) = work.schur.as_mut() {
+        sn.apply_w(lambda, &work.nonzero);
+    }
     let (mut res_n, mut res_t, mut scale_t, mut merit) = (0.0f64, 0.0f64, sc.t0, 0.0);
+    let (mut n_strict, mut t_strict) = (0.0f64, sc.t0);
     for j in 0..nu {
-        let row = &w[j * nu..(j + 1) * nu];
         // (WΛ)_j and Σ_r |W_jr Λ_r|: the size of the terms the sum cancels (its rounding).
-        let (mut wl, mut wabs) = (0.0, 0.0);
-        for &r in &work.nonzero {
-            let t = row[r] * lambda[r];
-            wl += t;
-            wabs += t.abs();
-        }
+        let (wl, wabs) = match &work.schur {
+            Some(sn) => (sn.wl[j], sn.wabs[j]),
+            None => {
+                let row = &w[j * nu..(j + 1) * nu];
+                let (mut wl, mut wabs) = (0.0, 0.0);
+                for &r in &work.nonzero {
+                    let t = row[r] * lambda[r];
+                    wl += t;
+                    wabs += t.abs();
+                }
+                (wl, wabs)
+            }
+        };
         let (wl, wabs) = (c_tau2 * wl, c_tau2 * wabs);
         let g = work.s[j] - x0[j] - wl;
         work.g[j] = g;
         if j % d == 0 {
             // Relative to the fixed normal scale, or to the terms if they are larger.
             res_n = res_n.max(g.abs() * (sc.n / sc.n.max(wabs)));
+            n_strict = n_strict.max(g.abs());
             merit += (g / sc.n).powi(2);
         } else {
             res_t = res_t.max(g.abs());
             scale_t = scale_t.max(work.s[j].abs()).max(wabs);
+            t_strict = t_strict.max(work.s[j].abs());
             merit += (g / sc.t0).powi(2);
         }
     }
-    (res_n, res_t, scale_t, merit)
+    Residuals {
+        n: res_n,
+        t: res_t,
+        scale_t,
+        merit,
+        strict: work.schur.is_some().then_some((n_strict, t_strict)),
+    }
+}
+
+/// The residual's sizes at an iterate ([`evaluate`]): max_j |G_j| over the normal rows
+/// relative as [`newton_friction`] states, max |G_t|, the tangential rows' scale and the
+/// merit. Where W Λ was made in the contact dofs' space ([`SchurNewton::apply_w`]) the terms'
+/// sizes Σ_r |W_jr Λ_r| are bounds from above: `n` and `scale_t` are then the most lenient
+/// values the exact sizes can give, and `strict` holds the least lenient ones (the sizes 0);
+/// [`passes`] decides with the exact sizes where the two disagree.
+#[derive(Clone, Copy, Debug)]
+struct Residuals {
+    n: f64,
+    t: f64,
+    scale_t: f64,
+    merit: f64,
+    strict: Option<(f64, f64)>,
+}
+
+/// Whether `test(res_n, res_t, scale_t)` holds — monotone: easier for a smaller `res_n`, a
+/// larger `scale_t` — at the exact residual sizes. With bounds ([`Residuals`]) the test at
+/// the lenient values failing or at the strict ones holding decides; between them the exact
+/// sizes are made from W's rows (once, then kept in `r`).
+fn passes(
+    r: &mut Residuals,
+    p: &Problem,
+    sc: &Scales,
+    lambda: &[f64],
+    work: &NewtonWork,
+    test: impl Fn(f64, f64, f64) -> bool,
+) -> bool {
+    let Some((n_strict, t_strict)) = r.strict else {
+        return test(r.n, r.t, r.scale_t);
+    };
+    if !test(r.n, r.t, r.scale_t) {
+        return false;
+    }
+    if test(n_strict, r.t, t_strict) {
+        return true;
+    }
+    (r.n, r.scale_t) = exact_sizes(p, sc, lambda, work);
+    r.strict = None;
+    test(r.n, r.t, r.scale_t)
+}
+
+/// The relative normal residual and the tangential scale of [`evaluate`] with the exact
+/// Σ_r |cτ² W_jr Λ_r| from W's rows, at the residual `work.g` (the same sums as the dense
+/// evaluation's: the zero forces add exact zeros).
+fn exact_sizes(p: &Problem, sc: &Scales, lambda: &[f64], work: &NewtonWork) -> (f64, f64) {
+    let nu = p.ops.unknowns();
+    let d = p.ops.per_point();
+    let (mut res_n, mut scale_t) = (0.0f64, sc.t0);
+    for j in 0..nu {
+        let row = &p.w[j * nu..(j + 1) * nu];
+        let wabs = p.c_tau2
+            * row
+                .iter()
+                .zip(lambda)
+                .map(|(a, l)| (a * l).abs())
+                .sum::<f64>();
+        let g = work.g[j];
+        if j % d == 0 {
+            res_n = res_n.max(g.abs() * (sc.n / sc.n.max(wabs)));
+        } else {
+            scale_t = scale_t.max(work.s[j].abs()).max(wabs);
+        }
+    }
+    (res_n, scale_t)
 }
 
 /// The frictional condensed problem G(x) = x − x0 − cτ² W Λ(x) = 0 (module header) over the
@@ -677,121 +792,39 @@ fn scales(ops: &NitscheOps, x0: &[f64], ramp: f64) -> Scales {
     sc
 }
 
-/// Active unknowns from which the frictional Newton solves its step through the full-space
-/// sparse LU ([`SparseNewton`]) instead of the dense LU of its active block: the dense LU costs
-/// (2/3)·n_a³ (n_a = d × the active points), the sparse one what the body's factor costs, and
-/// below this size the dense one is the cheaper (and every run of the test suite keeps its
-/// bits: their active sets are smaller).
+/// Active unknowns from which the frictional Newton solves its step in the contact dofs'
+/// space ([`SchurNewton`]) instead of by the dense LU of its active block, whose (2/3)·n_a³
+/// (n_a = d × the active points) dominates the step from about this size on; below it the
+/// dense LU is the cheaper. Runs with at least this many unknowns make S at set-up
+/// ([`ContactSchur`]) and their residuals' W Λ with it at every step; smaller runs keep the
+/// dense W and their bits.
 pub(crate) const SPARSE_MIN_ACTIVE: usize = 384;
-
-/// The frictional Newton's step through the full space (contract §4's condensation kept for
-/// the residual): with r = −G and D the points' derivative blocks, J δ = r for
-/// J = I − cτ² P A⁻¹ C D is, with z = A⁻¹ C D δ,
-///   (A − cτ² Σ_q C_q D_q P_qᵀ) z = C D r,   δ = r + cτ² P z
-/// — a matrix in A's pattern (each point's rows sit on one element's dofs), non-symmetric,
-/// refactored per iteration by faer's sparse LU ([`SparseLu`]). Inactive points have D = 0,
-/// so the sum runs over the active points: the cost follows the active set, not the cube of
-/// the contact unknowns.
-#[derive(Debug)]
-pub(crate) struct SparseNewton {
-    lu: SparseLu,
-    /// A's values (the step matrix before its factorisation) and the Newton matrix's.
-    a: Vec<f64>,
-    values: Vec<f64>,
-    /// Per point, the k × k positions in the values of (its dof i, its dof j).
-    pos: Vec<usize>,
-    /// z (n), and D_q P_qᵀ of one point (d × k).
-    z: Vec<f64>,
-    dp: Vec<f64>,
-}
-
-impl SparseNewton {
-    /// For the contact rows `ops` and the step matrix `a` (its pattern holds every point's
-    /// element block).
-    pub(crate) fn new(ops: &NitscheOps, a: &SymMatrix) -> Result<SparseNewton, String> {
-        let k = ops.k;
-        let mut pos = Vec::with_capacity(ops.dofs.len() * k);
-        for q in 0..ops.len() {
-            let dofs = &ops.dofs[q * k..(q + 1) * k];
-            for &i in dofs {
-                for &j in dofs {
-                    pos.push(
-                        a.pattern
-                            .position(i, j)
-                            .ok_or("a contact point's dofs outside the step matrix's pattern")?,
-                    );
-                }
-            }
-        }
-        Ok(SparseNewton {
-            lu: SparseLu::new(&a.pattern)?,
-            a: a.values.clone(),
-            values: a.values.clone(),
-            pos,
-            z: vec![0.0; a.n()],
-            dp: vec![0.0; ops.per_point() * k],
-        })
-    }
-}
-
-/// [`newton_step`] through [`SparseNewton`] (its formula there).
-fn sparse_step(ops: &NitscheOps, c_tau2: f64, work: &mut NewtonWork) -> Result<(), String> {
-    let (nq, d, k) = (ops.len(), ops.per_point(), ops.k);
-    let sp = work.sparse.as_mut().expect("checked by the caller");
-    sp.values.copy_from_slice(&sp.a);
-    sp.z.iter_mut().for_each(|z| *z = 0.0);
-    for q in (0..nq).filter(|&q| work.point_active[q]) {
-        let blk = &work.blocks[q * d * d..(q + 1) * d * d];
-        let dofs = &ops.dofs[q * k..(q + 1) * k];
-        // (D P_qᵀ)[b] = Σ_a D[b][a] p_a, and C D r into z.
-        for b in 0..d {
-            for jj in 0..k {
-                sp.dp[b * k + jj] = (0..d)
-                    .map(|a| blk[b * d + a] * ops.p_row(q * d + a).0[jj])
-                    .sum();
-            }
-            let dr: f64 = (0..d).map(|a| -blk[b * d + a] * work.g[q * d + a]).sum();
-            let (cb, _) = ops.c_row(q * d + b);
-            for (&gi, &ci) in dofs.iter().zip(cb) {
-                sp.z[gi] += ci * dr;
-            }
-        }
-        let pos = &sp.pos[q * k * k..(q + 1) * k * k];
-        for b in 0..d {
-            let (cb, _) = ops.c_row(q * d + b);
-            for (ii, &ci) in cb.iter().enumerate() {
-                if ci == 0.0 {
-                    continue;
-                }
-                for jj in 0..k {
-                    sp.values[pos[ii * k + jj]] -= c_tau2 * ci * sp.dp[b * k + jj];
-                }
-            }
-        }
-    }
-    sp.lu.factor(&sp.values)?;
-    sp.lu.solve_in_place(&mut sp.z);
-    for j in 0..nq * d {
-        let (row, dofs) = ops.p_row(j);
-        let pz: f64 = row.iter().zip(dofs).map(|(a, &g)| a * sp.z[g]).sum();
-        work.step[j] = -work.g[j] + c_tau2 * pz;
-    }
-    Ok(())
-}
 
 /// The full semismooth Newton step into `work.step` at the iterate `work.s` (its G, blocks
 /// and active set from [`evaluate`]): J δ = −G with J = I − cτ² W D. Small active sets solve the
 /// active block densely and the inactive rows from it; from [`SPARSE_MIN_ACTIVE`] active
-/// unknowns on, where the dense LU's cube dominates the step, the full-space sparse LU
-/// ([`SparseNewton`]) does the same solve.
+/// unknowns on, where the dense LU's cube dominates the step, [`SchurNewton`] makes the same
+/// step in the contact dofs' space.
 fn newton_step(
     ops: &NitscheOps,
     w: &[f64],
     c_tau2: f64,
     work: &mut NewtonWork,
 ) -> Result<(), String> {
-    if work.active.len() >= SPARSE_MIN_ACTIVE && work.sparse.is_some() {
-        return sparse_step(ops, c_tau2, work);
+    if work.active.len() >= SPARSE_MIN_ACTIVE
+        && let Some(sn) = work.schur.as_mut()
+    {
+        let nu = ops.unknowns();
+        for (r, g) in work.delta[..nu].iter_mut().zip(&work.g) {
+            *r = -g;
+        }
+        return sn.step(
+            &work.point_active,
+            &work.blocks,
+            &work.delta[..nu],
+            c_tau2,
+            &mut work.step[..nu],
+        );
     }
     let (nq, d) = (ops.len(), ops.per_point());
     let nu = nq * d;
@@ -856,15 +889,23 @@ fn newton_friction_from(
     // Warm start from the previous step's forces.
     work.nonzero.clear();
     work.nonzero.extend((0..nu).filter(|&r| lambda[r] != 0.0));
-    for j in 0..nu {
-        let row = &w[j * nu..(j + 1) * nu];
-        let wl: f64 = work.nonzero.iter().map(|&r| row[r] * lambda[r]).sum();
-        work.s[j] = x0[j] + c_tau2 * wl;
+    if let Some(sn) = work.schur.as_mut() {
+        sn.apply_w(lambda, &work.nonzero);
+        for j in 0..nu {
+            work.s[j] = x0[j] + c_tau2 * sn.wl[j];
+        }
+    } else {
+        for j in 0..nu {
+            let row = &w[j * nu..(j + 1) * nu];
+            let wl: f64 = work.nonzero.iter().map(|&r| row[r] * lambda[r]).sum();
+            work.s[j] = x0[j] + c_tau2 * wl;
+        }
     }
-    let (mut res_n, mut res_t, mut scale_t, mut merit) =
-        evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
+    let mut res = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
     for it in 0..=NEWTON_MAX_ITER {
-        if res_n <= NEWTON_TOL * sc.n && res_t <= NEWTON_TOL * scale_t {
+        if passes(&mut res, p, &sc, lambda, work, |n, t, st| {
+            n <= NEWTON_TOL * sc.n && t <= NEWTON_TOL * st
+        }) {
             return Ok(it);
         }
         if it == NEWTON_MAX_ITER {
@@ -885,8 +926,9 @@ fn newton_friction_from(
         let step_size = work.step[..nu].iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let size = work.x_old[..nu].iter().fold(0.0f64, |m, x| m.max(x.abs()));
         if step_size <= 1e-13 * size
-            && res_n <= NEWTON_FLOOR_TOL * sc.n
-            && res_t <= NEWTON_FLOOR_TOL * sc.n.max(scale_t)
+            && passes(&mut res, p, &sc, lambda, work, |n, t, st| {
+                n <= NEWTON_FLOOR_TOL * sc.n && t <= NEWTON_FLOOR_TOL * sc.n.max(st)
+            })
         {
             return Ok(it + 1);
         }
@@ -897,12 +939,16 @@ fn newton_friction_from(
                 work.s[j] = work.x_old[j] + alpha * work.step[j];
             }
             let r = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
-            (res_n, res_t, scale_t) = (r.0, r.1, r.2);
-            if r.3 < merit {
-                merit = r.3;
+            if r.merit < res.merit {
+                res = r;
                 descended = true;
                 break;
             }
+            // The merit stays the last accepted iterate's.
+            res = Residuals {
+                merit: res.merit,
+                ..r
+            };
             alpha *= 0.5;
         }
         // No step along the Newton direction lowers the merit, down to 2⁻²⁹ of it. Either the
@@ -915,19 +961,20 @@ fn newton_friction_from(
         // stayed on the kink to the iteration cap. The full step leaves the kink: the next
         // Jacobian is the active side's (`bar2d_penalty_tresca_newton_leaves_the_gap_kink`).
         if !descended {
-            if res_n <= NEWTON_FLOOR_TOL * sc.n && res_t <= NEWTON_FLOOR_TOL * scale_t {
+            if passes(&mut res, p, &sc, lambda, work, |n, t, st| {
+                n <= NEWTON_FLOOR_TOL * sc.n && t <= NEWTON_FLOOR_TOL * st
+            }) {
                 return Ok(it + 1);
             }
             for j in 0..nu {
                 work.s[j] = work.x_old[j] + work.step[j];
             }
-            let r = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
-            (res_n, res_t, scale_t, merit) = r;
+            res = evaluate(ops, law, w, c_tau2, x0, &sc, lambda, slides, work);
         }
     }
     Err(format!(
-        "semismooth Newton (friction) did not converge in {NEWTON_MAX_ITER} iterations (residuals {res_n:.3e} normal, {res_t:.3e} tangential; scale {:.3e})",
-        sc.n
+        "semismooth Newton (friction) did not converge in {NEWTON_MAX_ITER} iterations (residuals {:.3e} normal, {:.3e} tangential; scale {:.3e})",
+        res.n, res.t, sc.n
     ))
 }
 
@@ -1313,17 +1360,20 @@ mod tests {
         assert!(slides[0]);
     }
 
-    /// The full-space sparse step ([`SparseNewton`]) is the dense one: two 2D points on a
-    /// 4-dof body (A a dense SPD 4 × 4, rows p, c, P_t, C_t made up), W = P A⁻¹ C computed
-    /// here, an iterate with point 0 sticking and point 1 sliding (Coulomb μ_f = 0.5, its
-    /// coupled block); the two steps agree to 1e-12 relative (both are LU solves of
-    /// well-conditioned 4 × 4 systems: round-off ~1e-15).
+    /// The step in the contact dofs' space ([`SchurNewton`]) is the dense one: two 2D points
+    /// on a 4-dof body (A a dense SPD 4 × 4, rows p, c, P_t, C_t made up), W = P A⁻¹ C and
+    /// S = A⁻¹ (every dof is a contact dof) computed here. First an iterate with point 0
+    /// sticking and point 1 sliding (Coulomb μ_f = 0.5, its coupled block): K is factored and
+    /// the step solved with it; then an iterate with both points sliding, whose step GMRES
+    /// solves with the first K's LU as its preconditioner (no second factorisation). Each
+    /// agrees with the dense LU's step to 1e-10 relative (LU solves of well-conditioned 4 × 4
+    /// systems: round-off ~1e-15; GMRES stops at [`super::super::schur::KRYLOV_TOL`] = 1e-10
+    /// of its right-hand side, and exactly after at most 4 iterations in 4 dimensions).
     #[test]
-    fn sparse_step_equals_the_dense_step() {
+    fn schur_step_equals_the_dense_step() {
         let a_dense = [
             4.0, 1.0, 0.5, 0.2, 1.0, 5.0, 0.3, 0.4, 0.5, 0.3, 6.0, 1.0, 0.2, 0.4, 1.0, 3.0,
         ];
-        let a = SymMatrix::from_dense(4, &a_dense).unwrap();
         let ops = NitscheOps {
             k: 2,
             dofs: vec![0, 1, 2, 3],
@@ -1344,6 +1394,10 @@ mod tests {
                 kt: vec![2.0, 1.5],
             }),
         };
+        let solve = |col: &mut [f64]| {
+            let mut m = a_dense;
+            lu_solve(&mut m, 4, &mut [0; 4], col).unwrap();
+        };
         // W[j][r] = p_j · A⁻¹ c_r.
         let mut w = [0.0; 16];
         for r in 0..4 {
@@ -1352,45 +1406,60 @@ mod tests {
             for (&g, &v) in dofs.iter().zip(c) {
                 col[g] += v;
             }
-            let mut m = a_dense;
-            lu_solve(&mut m, 4, &mut [0; 4], &mut col).unwrap();
+            solve(&mut col);
             for j in 0..4 {
                 let (p, dofs) = ops.p_row(j);
                 w[j * 4 + r] = p.iter().zip(dofs).map(|(a, &g)| a * col[g]).sum();
             }
         }
+        let schur = ContactSchur::new(4, &ops.dofs, |z, m| {
+            z.chunks_mut(4).take(m).for_each(solve);
+            Ok(())
+        })
+        .unwrap();
         let law = FrictionLaw::Coulomb { coefficient: 0.5 };
         let x0 = [0.4, 0.01, 0.3, 2.0];
         let sc = scales(&ops, &x0, 0.0);
-        let mut work = NewtonWork::frictional(4, 2);
+        let mut work = NewtonWork::frictional_for(&ops, Some(&schur)).unwrap();
         // Point 0: x_n − g = 0.2 > 0, |x_t| = 0.05 ≤ μ_f f_n = 1 (stick); point 1: f_n = 0.5,
-        // |x_t| = 1 > 0.25 (slip).
-        work.s[..4].copy_from_slice(&[0.2, 0.05, 0.1, 1.0]);
-        let (mut lambda, mut slides) = ([0.0; 4], [false; 2]);
-        evaluate(
-            &ops,
-            law,
-            &w,
-            0.7,
-            &x0,
-            &sc,
-            &mut lambda,
-            &mut slides,
-            &mut work,
-        );
-        assert_eq!(slides, [false, true]);
-        newton_step(&ops, &w, 0.7, &mut work).unwrap();
-        let dense = [work.step[0], work.step[1], work.step[2], work.step[3]];
-        work.sparse = Some(SparseNewton::new(&ops, &a).unwrap());
-        sparse_step(&ops, 0.7, &mut work).unwrap();
-        let size = dense.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        for j in 0..4 {
-            assert!(
-                (work.step[j] - dense[j]).abs() <= 1e-12 * size,
-                "{j}: sparse {:?} dense {dense:?}",
-                &work.step[..4]
+        // |x_t| = 1 > 0.25 (slip). Then both sliding (point 0: |x_t| = 1.6 > μ_f f_n = 1.5; point
+        // 1: 0.8 > 0.375).
+        for (iterate, states) in [
+            ([0.2, 0.05, 0.1, 1.0], [false, true]),
+            ([0.3, -1.6, 0.15, -0.8], [true, true]),
+        ] {
+            work.s[..4].copy_from_slice(&iterate);
+            let (mut lambda, mut slides) = ([0.0; 4], [false; 2]);
+            evaluate(
+                &ops,
+                law,
+                &w,
+                0.7,
+                &x0,
+                &sc,
+                &mut lambda,
+                &mut slides,
+                &mut work,
             );
+            assert_eq!(slides, states);
+            newton_step(&ops, &w, 0.7, &mut work).unwrap();
+            let dense = [work.step[0], work.step[1], work.step[2], work.step[3]];
+            let r = [-work.g[0], -work.g[1], -work.g[2], -work.g[3]];
+            let sn = work.schur.as_mut().unwrap();
+            let mut step = [0.0; 4];
+            sn.step(&work.point_active, &work.blocks, &r, 0.7, &mut step)
+                .unwrap();
+            let size = dense.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for j in 0..4 {
+                assert!(
+                    (step[j] - dense[j]).abs() <= 1e-10 * size,
+                    "{j}: schur {step:?} dense {dense:?}"
+                );
+            }
         }
+        let (refactors, krylov) = work.schur_counts().unwrap();
+        assert_eq!(refactors, 1);
+        assert!((1..=4).contains(&krylov), "{krylov}");
     }
 
     #[test]

@@ -193,8 +193,8 @@ impl<'a> MethodRun<'a> {
         let lcp_pred = minv
             .as_ref()
             .map(|mi| Lcp::new(g.contact.len(), mi.wm.clone()));
-        let a_friction = fac.as_ref().and_then(|f| f.a_friction.as_ref());
-        let newton_work = match NewtonWork::for_run(nit, a_friction) {
+        let schur = fac.as_ref().and_then(|f| f.schur.as_ref());
+        let newton_work = match NewtonWork::for_run(nit, schur) {
             Ok(w) => w,
             Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
         };
