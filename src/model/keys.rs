@@ -80,6 +80,20 @@ pub enum Key {
     /// The plane's tilt α in degrees (mesh2d/mesh3d, contract §1.8): the volume load becomes
     /// ρ·gravity·(sin α e_1 − cos α e_d). Default 0, so every existing run keeps its id.
     Incline,
+    /// Two bodies (contract §1.10, §2.6; issue 44): B's height H_b, the blocks' width W, B's
+    /// elements across per A's (`mesh_ratio`, 1: a matching interface), the traction −p e_d on
+    /// A's top (`pressure`), B's material and e_d velocity, B's base (`far_end`: free or
+    /// clamped) and which body's mass variant applies (`mass_side`: both, a or b).
+    HeightB,
+    Width,
+    MeshRatio,
+    Pressure,
+    LameLambdaB,
+    LameMuB,
+    DensityB,
+    VelocityB,
+    FarEnd,
+    MassSide,
 }
 
 /// What a key's value must look like.
@@ -165,7 +179,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 46] = [
+    pub const ALL: [Key; 56] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -212,6 +226,16 @@ impl Key {
         Key::VelocityTangential,
         Key::FrictionForce,
         Key::Incline,
+        Key::HeightB,
+        Key::Width,
+        Key::MeshRatio,
+        Key::Pressure,
+        Key::LameLambdaB,
+        Key::LameMuB,
+        Key::DensityB,
+        Key::VelocityB,
+        Key::FarEnd,
+        Key::MassSide,
     ];
 
     pub fn name(self) -> &'static str {
@@ -262,6 +286,16 @@ impl Key {
             Key::VelocityTangential => "velocity_tangential",
             Key::FrictionForce => "friction_force",
             Key::Incline => "incline",
+            Key::HeightB => "height_b",
+            Key::Width => "width",
+            Key::MeshRatio => "mesh_ratio",
+            Key::Pressure => "pressure",
+            Key::LameLambdaB => "lame_lambda_b",
+            Key::LameMuB => "lame_mu_b",
+            Key::DensityB => "density_b",
+            Key::VelocityB => "velocity_b",
+            Key::FarEnd => "far_end",
+            Key::MassSide => "mass_side",
         }
     }
 
@@ -289,6 +323,16 @@ impl Key {
                 | Key::VelocityTangential
                 | Key::FrictionForce
                 | Key::Incline
+                | Key::HeightB
+                | Key::Width
+                | Key::MeshRatio
+                | Key::Pressure
+                | Key::LameLambdaB
+                | Key::LameMuB
+                | Key::DensityB
+                | Key::VelocityB
+                | Key::FarEnd
+                | Key::MassSide
         )
     }
 
@@ -299,6 +343,8 @@ impl Key {
         match self {
             Key::RightEnd => Some(&["clamped", "free"]),
             Key::Load => Some(&["body", "inertial"]),
+            Key::FarEnd => Some(&["free", "clamped"]),
+            Key::MassSide => Some(&["both", "a", "b"]),
             _ => None,
         }
     }
@@ -318,7 +364,9 @@ impl Key {
             | Key::Load
             | Key::Solver
             | Key::Mesh
-            | Key::Friction => ValueType::Str,
+            | Key::Friction
+            | Key::FarEnd
+            | Key::MassSide => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -409,6 +457,18 @@ impl Key {
                     ))
                 }
             }
+            Key::FarEnd => match s {
+                "free" | "clamped" => Ok(()),
+                _ => Err(format!(
+                    "unknown far_end `{s}` (expected free or clamped: body B's base x_d = 0 traction-free or held at u = 0)"
+                )),
+            },
+            Key::MassSide => match s {
+                "both" | "a" | "b" => Ok(()),
+                _ => Err(format!(
+                    "unknown mass_side `{s}` (expected both, a or b: the body whose contact layers the mass variant changes)"
+                )),
+            },
             Key::Mesh => {
                 if s.trim().is_empty() {
                     Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())
@@ -435,11 +495,15 @@ impl Key {
             Key::T | Key::H | Key::Dt | Key::Courant => positive(x),
             Key::NitscheGamma0 | Key::PenaltyGamma0 => positive(x),
             Key::Length | Key::Young | Key::Density | Key::Height => positive(x),
+            Key::HeightB | Key::Width | Key::MeshRatio | Key::DensityB | Key::LameMuB => {
+                positive(x)
+            }
+            Key::VelocityB | Key::Pressure => finite(x).map(|_| ()),
             Key::VelocityTangential => finite(x).map(|_| ()),
             // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
             // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the
             // rigid motions.
-            Key::LameLambda => {
+            Key::LameLambda | Key::LameLambdaB => {
                 finite(x)?;
                 if x >= 0.0 {
                     Ok(())

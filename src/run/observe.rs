@@ -112,6 +112,14 @@ pub struct Metrics {
     /// energy_scale (FE scenes with friction, [`super::friction_tally`]; ≥ 0 for the
     /// position-level methods, contract §2.5). Not a column of the runs table: for the tests.
     pub tangential_work_min: Option<f64>,
+    /// Two bodies (contract §5): max_n |P^n − P⁰|/Σ_i m_i|V_i| (null with a clamp, a load or
+    /// every V_i = 0), and each body's mean e_d velocity 1ᵀM_i v/m_i at T.
+    pub momentum_drift: Option<f64>,
+    pub velocity_a_final: Option<f64>,
+    pub velocity_b_final: Option<f64>,
+    /// The contact patch test's errors (contract §1.10, with `pressure`).
+    pub patch_stress_error: Option<f64>,
+    pub patch_pressure_error: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].

@@ -237,6 +237,21 @@ schema! {
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (contract §1.5; 0: frictionless)";
         stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
+        height_b: Option<f64> => "m", "two bodies: body B's height H_b (contract §1.10)";
+        width: Option<f64> => "m", "blocks2d, blocks3d: the blocks' width W";
+        mesh_ratio: Option<f64> => "", "blocks2d, blocks3d: B's elements across per A's (1: a matching interface)";
+        pressure: Option<f64> => "Pa", "blocks2d, blocks3d: the traction −p e_d on A's top face (the patch test's p)";
+        lame_lambda_b: Option<f64> => "Pa", "two bodies: body B's λ (null: A's)";
+        lame_mu_b: Option<f64> => "Pa", "two bodies: body B's μ (null: A's)";
+        density_b: Option<f64> => "kg/m^d", "two bodies: body B's density (null: A's)";
+        velocity_b: Option<f64> => "m/s", "two bodies: body B's initial velocity along e_d (e_x in 1D)";
+        far_end: Option<String> => "", "two bodies: B's far end (base): free or clamped";
+        mass_side: Option<String> => "", "two bodies: the body whose contact layers the mass variant changes: both, a or b";
+        momentum_drift: Option<f64> => "", "two bodies: max_n |P^n − P⁰| / Σ_i m_i|V_i|, P = Σ_i 1ᵀM_i v along e_d (e_x in 1D), m_i = 1ᵀM_i1 the run's masses (contract §5; null with a clamp, an obstacle or a load, or every initial velocity 0)";
+        velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_a v/m_a at T along e_d (e_x in 1D)";
+        velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_b v/m_b at T along e_d (e_x in 1D)";
+        patch_stress_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the 2^d Gauss points of every cell of both bodies of the largest entry of |σ_h + p e_d⊗e_d|/p";
+        patch_pressure_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the interface rows of |p_h − p|/p (a node's multiplier over its weight ∫φ_i; the penalty's κ[δ_i − g_i]_+)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -484,6 +499,21 @@ impl RunRecord {
             friction_force: f(Key::FrictionForce),
             stop_time: m.stop_time,
             stop_time_exact: m.stop_time_exact,
+            height_b: f(Key::HeightB),
+            width: f(Key::Width),
+            mesh_ratio: f(Key::MeshRatio),
+            pressure: f(Key::Pressure),
+            lame_lambda_b: f(Key::LameLambdaB).filter(|x| !x.is_nan()),
+            lame_mu_b: f(Key::LameMuB).filter(|x| !x.is_nan()),
+            density_b: f(Key::DensityB).filter(|x| !x.is_nan()),
+            velocity_b: f(Key::VelocityB),
+            far_end: p.get(&Key::FarEnd).map(|v| v.to_string()),
+            mass_side: p.get(&Key::MassSide).map(|v| v.to_string()),
+            momentum_drift: m.momentum_drift,
+            velocity_a_final: m.velocity_a_final,
+            velocity_b_final: m.velocity_b_final,
+            patch_stress_error: m.patch_stress_error,
+            patch_pressure_error: m.patch_pressure_error,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

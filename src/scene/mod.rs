@@ -15,6 +15,7 @@
 pub mod ball;
 pub mod bar;
 pub mod bar1d;
+pub mod blocks;
 pub mod layer1d;
 pub mod mesh;
 pub mod oscillator;
@@ -22,6 +23,7 @@ pub mod oscillator;
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup, LoadModel};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
+pub use blocks::{Blocks, BlocksScene, MassSide};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
@@ -322,6 +324,10 @@ pub enum SceneKind {
     Mesh3d,
     /// The frictional layer with its exact solution (contract §1.7).
     Layer1d,
+    /// Two blocks, a matching interface, plane strain (contract §1.10).
+    Blocks2d,
+    /// Two blocks, a matching interface, 3D (contract §1.10).
+    Blocks3d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -333,10 +339,12 @@ static OSCILLATOR: OscillatorScene = OscillatorScene;
 static MESH2D: MeshScene = MeshScene { dim: 2 };
 static MESH3D: MeshScene = MeshScene { dim: 3 };
 static LAYER1D: Layer1dScene = Layer1dScene;
+static BLOCKS2D: BlocksScene = BlocksScene { dim: 2 };
+static BLOCKS3D: BlocksScene = BlocksScene { dim: 3 };
 
 impl SceneKind {
     /// Every scene name of contract §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 9] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 11] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
@@ -346,6 +354,8 @@ impl SceneKind {
         ("mesh2d", Some(SceneKind::Mesh2d)),
         ("mesh3d", Some(SceneKind::Mesh3d)),
         ("layer1d", Some(SceneKind::Layer1d)),
+        ("blocks2d", Some(SceneKind::Blocks2d)),
+        ("blocks3d", Some(SceneKind::Blocks3d)),
     ];
 
     /// The scene behind this name.
@@ -360,6 +370,8 @@ impl SceneKind {
             SceneKind::Mesh2d => &MESH2D,
             SceneKind::Mesh3d => &MESH3D,
             SceneKind::Layer1d => &LAYER1D,
+            SceneKind::Blocks2d => &BLOCKS2D,
+            SceneKind::Blocks3d => &BLOCKS3D,
         }
     }
 
