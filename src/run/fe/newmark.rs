@@ -313,8 +313,13 @@ impl<'a> Stepper<'a> {
         }
         let lowest = lowest_contact(g);
         let momentum = momentum_tally(g, cfg, &fac.m);
-        let refine = (g.bodies.is_some() && nit.is_none() && fac.friction.is_none())
-            .then(|| Box::new(Refinement::new(n, nc)));
+        // Two bodies: mixed, and the penalty's rows outside the hybrid scheme (its kinks move
+        // the law; nitsche.rs header).
+        let refinable = match nit {
+            None => fac.friction.is_none(),
+            Some(o) => o.penalty && o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+        };
+        let refine = (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)));
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some();
         let obs = observer(cfg, opts, energy_scale);
@@ -581,8 +586,11 @@ impl<'a> Stepper<'a> {
         if let Some(rf) = self.refine.as_mut() {
             let (g, fac) = (&*self.geo, &*self.fac);
             let lambda = &mut self.lambda;
-            rf.refine(g, fac, self.c_tau2, &self.gaps, lambda, y, &mut self.work)
-                .map_err(|e| Stop::Solver(step, e))?;
+            match fac.nitsche.as_ref() {
+                Some(ops) => rf.refine_penalty(g, fac, ops, self.c_tau2, lambda, y, &mut self.work),
+                None => rf.refine(g, fac, self.c_tau2, &self.gaps, lambda, y, &mut self.work),
+            }
+            .map_err(|e| Stop::Solver(step, e))?;
         }
         Ok(())
     }

@@ -13,10 +13,14 @@
 
 use super::factor::Factored;
 use super::geometry::Geometry;
+use super::nitsche::NitscheOps;
 use crate::space::step_solver::StepWork;
 
 /// At most this many correction sweeps per step (the contract's 2–3, with one to spare).
 const SWEEPS: usize = 4;
+/// The penalty's sweeps: each contracts the error by about 1e-2 on the patch test (its
+/// condensed Jacobian carries the same lost digits as W), so more of them.
+const PENALTY_SWEEPS: usize = 12;
 /// The relative residual ‖r‖∞ ≤ TOL·(‖b‖∞ + ‖Au‖∞ + cτ²‖Bᵀλ‖∞) that ends the sweeps.
 const TOL: f64 = 1e-14;
 
@@ -35,6 +39,7 @@ pub(super) struct Refinement {
 }
 
 impl Refinement {
+    /// For n dofs and nc contact rows (or penalty points).
     pub(super) fn new(n: usize, nc: usize) -> Refinement {
         Refinement {
             rhs: vec![0.0; n],
@@ -163,6 +168,84 @@ impl Refinement {
                     *ui += c_tau2 * delta * zv;
                 }
             }
+        }
+        Ok(())
+    }
+}
+
+impl Refinement {
+    /// The penalty's rows (contract §2.6, `penalty` node-to-node; the engine's Nitsche form
+    /// with Θ = 0, nitsche.rs header): A u + cτ² Σ_q φ_q(p_q·u) t_q = b, φ_q(s) =
+    /// w_q κ_q [s − g_q]_+, t_q = p_q. On the active points I (s_q > g_q) the correction δu
+    /// of the residual r solves (A + cτ² Σ_I w κ t tᵀ) δu = r: with s = A⁻¹r and Z_q =
+    /// A⁻¹(−t_q), δu = s + cτ² Z_I D e with (I − cτ² W_II D) e = P_I s, D = diag(w κ) — the
+    /// Newton's own Jacobian — then the points change sides and the sweeps resume. λ = φ(P u)
+    /// at the end (the forces the energy and the next Newton start from).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn refine_penalty(
+        &mut self,
+        g: &Geometry,
+        fac: &Factored,
+        ops: &NitscheOps,
+        c_tau2: f64,
+        lambda: &mut [f64],
+        u: &mut [f64],
+        work: &mut StepWork,
+    ) -> Result<(), String> {
+        let (n, nq, k) = (u.len(), ops.len(), ops.k);
+        let phi = |q: usize, u: &[f64]| {
+            ops.w[q] / ops.gamma[q] * (ops.apply(&ops.p, q, u) - ops.gap[q]).max(0.0)
+        };
+        for _ in 0..PENALTY_SWEEPS {
+            fac.m.matvec_into(u, &mut self.r);
+            g.k.matvec_into(u, &mut self.mk);
+            let mut scale = 0.0f64;
+            for i in 0..n {
+                let au = self.r[i] + c_tau2 * self.mk[i];
+                scale = scale.max(self.rhs[i].abs()).max(au.abs());
+                self.r[i] = self.rhs[i] - au;
+            }
+            self.active.clear();
+            for q in 0..nq {
+                let f = phi(q, u);
+                if f > 0.0 {
+                    self.active.push(q);
+                    let (coef, dofs) = (&ops.p[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                    for (c, &d) in coef.iter().zip(dofs) {
+                        self.r[d] -= c_tau2 * f * c;
+                    }
+                    scale = scale.max((c_tau2 * f).abs());
+                }
+            }
+            let res = self.r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if res <= TOL * scale || self.active.is_empty() {
+                break;
+            }
+            self.sweeps += 1;
+            fac.chol.solve_in_place(&mut self.r, work);
+            work.check().map_err(|e| e.to_string())?;
+            let m = self.active.len();
+            for (a, &q) in self.active.iter().enumerate() {
+                self.d[a] = ops.apply(&ops.p, q, &self.r);
+                let dq = |j: usize| ops.w[j] / ops.gamma[j];
+                for (b, &j) in self.active.iter().enumerate() {
+                    let id = if a == b { 1.0 } else { 0.0 };
+                    self.h[a * m + b] = id - c_tau2 * fac.h[q * nq + j] * dq(j);
+                }
+            }
+            solve_dense(&mut self.h[..m * m], &mut self.d[..m], m)?;
+            for (ui, si) in u.iter_mut().zip(&self.r) {
+                *ui += si;
+            }
+            for (a, &q) in self.active.iter().enumerate() {
+                let f = c_tau2 * ops.w[q] / ops.gamma[q] * self.d[a];
+                for (ui, zv) in u.iter_mut().zip(&fac.z[q * n..(q + 1) * n]) {
+                    *ui += f * zv;
+                }
+            }
+        }
+        for (q, l) in lambda.iter_mut().enumerate().take(nq) {
+            *l = phi(q, u);
         }
         Ok(())
     }
