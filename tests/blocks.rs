@@ -230,6 +230,27 @@ fn patch_test_on_matching_blocks() {
     }
 }
 
+/// The column limit of contract §1.10 (W = h: one element across, λ = λ_b = 0) runs — the
+/// geometry issue 44's done-when 4 compares with `bars1d` (E = 2μ) — and keeps its momentum
+/// (bound as above). The comparison with `bars1d` itself is the lead's (after merging it).
+#[test]
+fn the_column_runs_with_one_element_across() {
+    let text = "name = \"c\"\nscene = \"blocks2d\"\n[fixed]\nT = 2.0\nwidth = 0.125\nh = 0.125\ndt = 0.0625\nlame_lambda = 0.0\nlame_lambda_b = 0.0\n[grid]\nscheme = [\"crank-nicolson\", \"kane\"]\nmass = [\"consistent\", \"zero-contact\"]\n";
+    let runs = run_all(text);
+    for (label, o) in &runs {
+        assert_eq!(
+            o.metrics.dofs,
+            2 * 2 * 18,
+            "{label}: two columns of 9 + 9 nodes"
+        );
+    }
+    let worst = assert_momentum(&runs, 1e-12);
+    eprintln!(
+        "column: {} runs, worst momentum_drift {worst:e}",
+        runs.len()
+    );
+}
+
 /// Bad input is refused at plan time naming the key: a non-matching interface (issue 45), a
 /// clamped base that moves, a two-body key on a one-body scene.
 #[test]

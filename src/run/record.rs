@@ -373,25 +373,12 @@ impl RunRecord {
             message: out.message.clone(),
             T: f(Key::T).unwrap_or(f64::NAN),
             h: f(Key::H).unwrap_or(f64::NAN),
-            elements: p
-                .get(&Key::Elements)
-                .and_then(|v| match v {
-                    Value::Int(i) => Some(*i),
-                    _ => None,
-                })
-                .unwrap_or(0),
+            elements: elements_of(p),
             dt: f(Key::Dt).unwrap_or(f64::NAN),
             courant: f(Key::Courant).unwrap_or(f64::NAN),
             space: s(Key::Space),
             mass: s(Key::Mass),
-            mass_weights: p.get(&Key::MassWeights).map(|v| match v {
-                Value::List(w) => w
-                    .iter()
-                    .map(|x| x.to_string())
-                    .collect::<Vec<_>>()
-                    .join(","),
-                other => other.to_string(),
-            }),
+            mass_weights: p.get(&Key::MassWeights).map(weights_text),
             contact_init: p.get(&Key::ContactInit).map(|v| v.to_string()),
             scheme: s(Key::Scheme),
             scheme_label: spec.scheme_label.clone(),
@@ -516,6 +503,28 @@ impl RunRecord {
             patch_pressure_error: m.patch_pressure_error,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
+    }
+}
+
+/// The `elements` column: the run's element count (0 where the scene has none).
+fn elements_of(p: &BTreeMap<Key, Value>) -> i64 {
+    p.get(&Key::Elements)
+        .and_then(|v| match v {
+            Value::Int(i) => Some(*i),
+            _ => None,
+        })
+        .unwrap_or(0)
+}
+
+/// The `mass_weights` column: the weights joined by commas.
+fn weights_text(v: &Value) -> String {
+    match v {
+        Value::List(w) => w
+            .iter()
+            .map(|x| x.to_string())
+            .collect::<Vec<_>>()
+            .join(","),
+        other => other.to_string(),
     }
 }
 

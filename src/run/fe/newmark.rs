@@ -13,7 +13,7 @@ use super::load::gravity_load;
 use super::nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
 use super::products::dot;
 use super::reference::{RefMap, reference_record};
-use super::refine::Refinement;
+use super::refine::{Refinement, refinement};
 use super::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity,
     momentum_tally, observer, reference_map, shared_factor,
@@ -244,7 +244,6 @@ impl<'a> Stepper<'a> {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(m) => m,
         };
-
         let g = &*geo;
         let n = g.dofs.n_free();
         let nit = fac.nitsche.as_ref();
@@ -252,7 +251,6 @@ impl<'a> Stepper<'a> {
         let nc = nit.map_or(g.contact.len(), NitscheOps::unknowns);
         metrics.contact_dofs = Some(nc as i64);
         let gaps = contact_gaps(g, cfg);
-
         // Workspace: every vector of the time loop, allocated once. M u, M v and M a are
         // carried along the recursions of u, v, a, so a step costs one product with M (M a^{n+1})
         // besides the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at
@@ -311,18 +309,8 @@ impl<'a> Stepper<'a> {
         if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
             return Err(fail(status, msg, metrics));
         }
-        let lowest = lowest_contact(g);
-        let momentum = momentum_tally(g, cfg, &fac.m);
-        // Two bodies: mixed, and the penalty's rows outside the hybrid scheme (its kinks move
-        // the law; nitsche.rs header).
-        let refinable = match nit {
-            None => fac.friction.is_none(),
-            Some(o) => o.penalty && o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
-        };
-        let refine = (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)));
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some();
-        let obs = observer(cfg, opts, energy_scale);
         metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
         Ok(Stepper {
             cfg,
@@ -341,7 +329,7 @@ impl<'a> Stepper<'a> {
             vertical_mass,
             energy_scale,
             gaps,
-            lowest,
+            lowest: lowest_contact(g),
             u,
             v,
             a,
@@ -363,14 +351,14 @@ impl<'a> Stepper<'a> {
             iterations: 0,
             work,
             record,
-            obs,
+            obs: observer(cfg, opts, energy_scale),
             observe_timer: SampledTimer::default(),
             fall_error: 0.0,
             touched: false,
             done: 0,
             fric,
-            momentum,
-            refine,
+            momentum: momentum_tally(g, cfg, &fac.m),
+            refine: refinement(g, cfg, &fac, n, nc),
             geo,
             fac,
         })

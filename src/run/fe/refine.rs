@@ -11,10 +11,12 @@
 //! two products and a dense solve on the active rows. A step whose residual already meets the
 //! tolerance (every ordinary dynamic step) costs the two products only.
 
+use super::config::FeConfig;
 use super::factor::Factored;
 use super::geometry::Geometry;
 use super::nitsche::NitscheOps;
 use crate::space::step_solver::StepWork;
+use crate::time::Scheme;
 
 /// At most this many correction sweeps per step (the contract's 2–3, with one to spare).
 const SWEEPS: usize = 4;
@@ -23,6 +25,23 @@ const SWEEPS: usize = 4;
 const PENALTY_SWEEPS: usize = 12;
 /// The relative residual ‖r‖∞ ≤ TOL·(‖b‖∞ + ‖Au‖∞ + cτ²‖Bᵀλ‖∞) that ends the sweeps.
 const TOL: f64 = 1e-14;
+
+/// The refinement of a Newmark/θ run (None: not refined): two bodies with `mixed`, or with
+/// the penalty's rows outside the hybrid scheme (whose kinks move the law, nitsche.rs header);
+/// one body against the obstacle keeps its numbers.
+pub(super) fn refinement(
+    g: &Geometry,
+    cfg: &FeConfig,
+    fac: &Factored,
+    n: usize,
+    nc: usize,
+) -> Option<Box<Refinement>> {
+    let refinable = match fac.nitsche.as_ref() {
+        None => fac.friction.is_none(),
+        Some(o) => o.penalty && o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+    };
+    (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)))
+}
 
 /// A run's refinement workspace (allocated once).
 #[derive(Debug)]
