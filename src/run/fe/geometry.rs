@@ -165,6 +165,20 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
     }
 }
 
+/// AMD ordering, simplicial in 2D and supernodal in 3D: the meshes without a lattice to
+/// dissect (the mapped disc/ball, Gmsh files, the blocks; the bars' measurements,
+/// [`cholesky_options`]).
+fn amd_options(d: usize) -> CholeskyOptions {
+    CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if d == 2 {
+            FACTOR_KIND_2D
+        } else {
+            FactorKind::Supernodal
+        },
+    }
+}
+
 pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     match &s.geometry {
         FeGeometry::Box { extent, cells } => build_box(s, extent, cells),
@@ -205,14 +219,7 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
 pub(super) fn build_blocks(s: &FeSetup, b: &crate::scene::Blocks) -> Result<Geometry, String> {
     let p = blocks_parts(s, b)?;
     let d = s.dim;
-    let opts = CholeskyOptions {
-        ordering: Ordering::Amd,
-        kind: if d == 2 {
-            FACTOR_KIND_2D
-        } else {
-            FactorKind::Supernodal
-        },
-    };
+    let opts = amd_options(d);
     let one = |_: usize| 1.0;
     let gram = assemble(
         &p.mesh,
@@ -272,14 +279,7 @@ pub(super) fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, S
     let pattern = fe_pattern(&*mesh, &dofs);
     // AMD: an unstructured mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D
     // (the bars' measurements, `cholesky_options`).
-    let opts = CholeskyOptions {
-        ordering: Ordering::Amd,
-        kind: if d == 2 {
-            FACTOR_KIND_2D
-        } else {
-            FactorKind::Supernodal
-        },
-    };
+    let opts = amd_options(d);
     let (k, gram, grad) = operators(s, &*mesh, &dofs, &pattern);
     let group = mesh
         .group("contact")
@@ -416,14 +416,7 @@ pub(super) fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String
     let pattern = fe_pattern(&mesh, &dofs);
     // AMD: the mapped mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D (the
     // bars' measurements, `cholesky_options`).
-    let opts = CholeskyOptions {
-        ordering: Ordering::Amd,
-        kind: if d == 2 {
-            FACTOR_KIND_2D
-        } else {
-            FactorKind::Supernodal
-        },
-    };
+    let opts = amd_options(d);
     let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let contact: Vec<usize> = mesh.contact_nodes.iter().map(|&n| n * d + d - 1).collect();
     let contact_height = mesh
