@@ -247,11 +247,11 @@ schema! {
         velocity_b: Option<f64> => "m/s", "two bodies: body B's initial velocity along e_d (e_x in 1D)";
         far_end: Option<String> => "", "two bodies: B's far end (base): free or clamped";
         mass_side: Option<String> => "", "two bodies: the body whose contact layers the mass variant changes: both, a or b";
-        momentum_drift: Option<f64> => "", "two bodies: max_n |P^n − P⁰| / Σ_i m_i|V_i|, P = Σ_i 1ᵀM_i v along e_d (e_x in 1D), m_i = 1ᵀM_i1 the run's masses (contract §5; null with a clamp, an obstacle or a load, or every initial velocity 0)";
+        momentum_drift: Option<f64> => "", "two bodies: max_n abs(P^n − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_i v along e_d (e_x in 1D), m_i = 1ᵀM_i1 the run's masses (contract §5; null with a clamp, an obstacle or a load, or every initial velocity 0)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_a v/m_a at T along e_d (e_x in 1D)";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_b v/m_b at T along e_d (e_x in 1D)";
-        patch_stress_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the 2^d Gauss points of every cell of both bodies of the largest entry of |σ_h + p e_d⊗e_d|/p";
-        patch_pressure_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the interface rows of |p_h − p|/p (a node's multiplier over its weight ∫φ_i; the penalty's κ[δ_i − g_i]_+)";
+        patch_stress_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the 2^d Gauss points of every cell of both bodies of the largest entry of abs(σ_h + p e_d⊗e_d)/p";
+        patch_pressure_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the interface rows of abs(p_h − p)/p (a node's multiplier over its weight ∫φ_i; the penalty's κ[δ_i − g_i]_+)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
