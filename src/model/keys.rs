@@ -91,6 +91,16 @@ pub enum Key {
     MassSide,
     /// The weights of the two sides' Nitsche terms (contract §2.6): `unbiased` (default) or `a`.
     NitscheSides,
+    /// Two blocks (contract §1.10, §2.6; issue 44): B's height H_b, the blocks' width W, B's
+    /// elements across per A's (`mesh_ratio`, 1: a matching interface), the traction −p e_d on
+    /// A's top (`pressure`) and B's Lamé constants. (`density_b`, `velocity_b`, `far_end` and
+    /// `mass_side` above serve both two-body scenes.)
+    HeightB,
+    Width,
+    MeshRatio,
+    Pressure,
+    LameLambdaB,
+    LameMuB,
 }
 
 /// What a key's value must look like.
@@ -176,7 +186,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 53] = [
+    pub const ALL: [Key; 59] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -230,6 +240,12 @@ impl Key {
         Key::FarEnd,
         Key::MassSide,
         Key::NitscheSides,
+        Key::HeightB,
+        Key::Width,
+        Key::MeshRatio,
+        Key::Pressure,
+        Key::LameLambdaB,
+        Key::LameMuB,
     ];
 
     pub fn name(self) -> &'static str {
@@ -287,6 +303,12 @@ impl Key {
             Key::FarEnd => "far_end",
             Key::MassSide => "mass_side",
             Key::NitscheSides => "nitsche_sides",
+            Key::HeightB => "height_b",
+            Key::Width => "width",
+            Key::MeshRatio => "mesh_ratio",
+            Key::Pressure => "pressure",
+            Key::LameLambdaB => "lame_lambda_b",
+            Key::LameMuB => "lame_mu_b",
         }
     }
 
@@ -316,6 +338,12 @@ impl Key {
                 | Key::Incline
                 | Key::LengthB
                 | Key::YoungB
+                | Key::HeightB
+                | Key::Width
+                | Key::MeshRatio
+                | Key::Pressure
+                | Key::LameLambdaB
+                | Key::LameMuB
                 | Key::DensityB
                 | Key::VelocityB
                 | Key::FarEnd
@@ -447,6 +475,18 @@ impl Key {
                     ))
                 }
             }
+            Key::FarEnd => match s {
+                "free" | "clamped" => Ok(()),
+                _ => Err(format!(
+                    "unknown far_end `{s}` (expected free or clamped: body B's base x_d = 0 traction-free or held at u = 0)"
+                )),
+            },
+            Key::MassSide => match s {
+                "both" | "a" | "b" => Ok(()),
+                _ => Err(format!(
+                    "unknown mass_side `{s}` (expected both, a or b: the body whose contact layers the mass variant changes)"
+                )),
+            },
             Key::Mesh => {
                 if s.trim().is_empty() {
                     Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())
@@ -486,12 +526,13 @@ impl Key {
             Key::NitscheGamma0 | Key::PenaltyGamma0 => positive(x),
             Key::Length | Key::Young | Key::Density | Key::Height => positive(x),
             Key::LengthB | Key::YoungB | Key::DensityB => positive(x),
-            Key::VelocityB => finite(x).map(|_| ()),
+            Key::HeightB | Key::Width | Key::MeshRatio | Key::LameMuB => positive(x),
+            Key::VelocityB | Key::Pressure => finite(x).map(|_| ()),
             Key::VelocityTangential => finite(x).map(|_| ()),
             // λ = 0 is Poisson's ν = 0 (no lateral strain under a uniaxial load), a material
             // the tests use to keep a body's motion in a plane; μ > 0 keeps K's null space the
             // rigid motions.
-            Key::LameLambda => {
+            Key::LameLambda | Key::LameLambdaB => {
                 finite(x)?;
                 if x >= 0.0 {
                     Ok(())

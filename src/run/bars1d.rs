@@ -299,10 +299,7 @@ fn contact_rows(
             )]
         }
         ContactMethod::Nitsche { theta, gamma0 } => {
-            let weights = match b.nitsche_sides {
-                NitscheSides::Unbiased => [0.5, 0.5],
-                NitscheSides::A => [1.0, 0.0],
-            };
+            let weights = b.nitsche_sides.weights();
             let mut rows = Vec::new();
             for (i, &w) in weights.iter().enumerate() {
                 if w == 0.0 {

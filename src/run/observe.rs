@@ -104,8 +104,9 @@ pub struct Metrics {
     /// l2(τ) error of σ_t at the base and |v̄_t(T) − exact| (layer1d, contract §1.7).
     pub err_sigma_t_l2: Option<f64>,
     pub err_vt_final: Option<f64>,
-    /// Two bodies (contract §5): max_n |Pⁿ − P⁰|/Σ m_i|V_i| (null with a clamp or at rest),
-    /// each body's mean velocity 1ᵀM_iv/m_i at T and its error against the exact one (bars1d).
+    /// Two bodies (contract §5): max_n |Pⁿ − P⁰|/Σ m_i|V_i| (null with a clamp, a load or at
+    /// rest), each body's mean velocity 1ᵀM_iv/m_i at T along e_x (1D) or e_d, and its error
+    /// against the exact one (bars1d).
     pub momentum_drift: Option<f64>,
     pub velocity_a_final: Option<f64>,
     pub velocity_b_final: Option<f64>,
@@ -119,6 +120,9 @@ pub struct Metrics {
     /// energy_scale (FE scenes with friction, [`super::friction_tally`]; ≥ 0 for the
     /// position-level methods, contract §2.5). Not a column of the runs table: for the tests.
     pub tangential_work_min: Option<f64>,
+    /// The contact patch test's errors (contract §1.10, with `pressure`).
+    pub patch_stress_error: Option<f64>,
+    pub patch_pressure_error: Option<f64>,
 }
 
 /// One step in this many is timed by a [`SampledTimer`].

@@ -239,16 +239,24 @@ schema! {
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
         length_b: Option<f64> => "m", "bars1d: bar B's length L_b (contract §1.9)";
         young_b: Option<f64> => "Pa", "bars1d: bar B's Young modulus E_b";
-        density_b: Option<f64> => "kg/m", "bars1d: bar B's density ρ_b";
-        velocity_b: Option<f64> => "m/s", "bars1d: bar B's initial velocity V_b along x (A's is `velocity`, towards B)";
-        far_end: Option<String> => "", "bars1d: B's far end, free or clamped (contract §1.9)";
-        mass_side: Option<String> => "", "two bodies: the bodies the mass variant modifies: both, a or b (contract §2.6)";
+        density_b: Option<f64> => "kg/m^d", "two bodies: body B's density ρ_b (kg/m in 1D; blocks: null when it is A's)";
+        velocity_b: Option<f64> => "m/s", "two bodies: body B's initial velocity V_b along e_x (1D; A's is `velocity`, towards B) or e_d";
+        far_end: Option<String> => "", "two bodies: B's far end (its base in 2D/3D), free or clamped (contract §1.9, §1.10)";
+        mass_side: Option<String> => "", "two bodies: the bodies whose contact layers the mass variant modifies: both, a or b (contract §2.6)";
         nitsche_sides: Option<String> => "", "two bodies: the Nitsche sides' weights, unbiased (w_a = w_b = ½) or a (A the slave) (contract §2.6)";
-        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along x (1D) or e_d; null when a clamp acts or every initial velocity is 0 (contract §5)";
-        velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T";
-        velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T";
+        height_b: Option<f64> => "m", "blocks2d, blocks3d: body B's height H_b (contract §1.10)";
+        width: Option<f64> => "m", "blocks2d, blocks3d: the blocks' width W";
+        mesh_ratio: Option<f64> => "", "blocks2d, blocks3d: B's elements across per A's (1: a matching interface)";
+        pressure: Option<f64> => "Pa", "blocks2d, blocks3d: the traction −p e_d on A's top face (the patch test's p)";
+        lame_lambda_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's λ (null: A's)";
+        lame_mu_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's μ (null: A's)";
+        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d, m_i = 1ᵀM_i1 the run's masses (contract §5; null when a clamp, an obstacle or a load acts, or every initial velocity is 0)";
+        velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T along e_x (1D) or e_d";
+        velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T along e_x (1D) or e_d";
         err_velocity_a_final: Option<f64> => "m/s", "bars1d: abs(velocity_a_final − the exact mean velocity of A at T) (contract §1.9)";
         err_velocity_b_final: Option<f64> => "m/s", "bars1d: abs(velocity_b_final − the exact mean velocity of B at T)";
+        patch_stress_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the 2^d Gauss points of every cell of both bodies of the largest entry of abs(σ_h + p e_d⊗e_d)/p";
+        patch_pressure_error: Option<f64> => "", "two bodies with pressure (contract §1.10): max over the interface rows of abs(p_h − p)/p (a node's multiplier over its weight ∫φ_i; the penalty's κ[δ_i − g_i]_+)";
         tool_version: String => "", "contact-sweep version that computed the row";
     }
 }
@@ -497,16 +505,24 @@ impl RunRecord {
             stop_time_exact: m.stop_time_exact,
             length_b: f(Key::LengthB),
             young_b: f(Key::YoungB),
-            density_b: f(Key::DensityB),
+            density_b: f(Key::DensityB).filter(|x| !x.is_nan()),
             velocity_b: f(Key::VelocityB),
             far_end: p.get(&Key::FarEnd).map(|v| v.to_string()),
             mass_side: p.get(&Key::MassSide).map(|v| v.to_string()),
             nitsche_sides: p.get(&Key::NitscheSides).map(|v| v.to_string()),
+            height_b: f(Key::HeightB),
+            width: f(Key::Width),
+            mesh_ratio: f(Key::MeshRatio),
+            pressure: f(Key::Pressure),
+            lame_lambda_b: f(Key::LameLambdaB).filter(|x| !x.is_nan()),
+            lame_mu_b: f(Key::LameMuB).filter(|x| !x.is_nan()),
             momentum_drift: m.momentum_drift,
             velocity_a_final: m.velocity_a_final,
             velocity_b_final: m.velocity_b_final,
             err_velocity_a_final: m.err_velocity_a_final,
             err_velocity_b_final: m.err_velocity_b_final,
+            patch_stress_error: m.patch_stress_error,
+            patch_pressure_error: m.patch_pressure_error,
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }

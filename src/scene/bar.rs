@@ -49,6 +49,9 @@ pub enum FeGeometry {
         /// The body's vertical extent (max − min of x_d over the nodes).
         height: f64,
     },
+    /// Two boxes, A above B (contract §1.10, [`super::blocks`]): node-to-node contact rows
+    /// between A's bottom and B's top face, no obstacle.
+    Blocks(super::blocks::Blocks),
 }
 
 impl FeGeometry {
@@ -59,6 +62,7 @@ impl FeGeometry {
             FeGeometry::Box { extent, .. } => extent.last().copied().unwrap_or(1.0),
             FeGeometry::Ball { radius, .. } => 2.0 * radius,
             FeGeometry::Mesh { height, .. } => *height,
+            FeGeometry::Blocks(b) => b.height_a + b.height_b,
         }
     }
 }
@@ -108,7 +112,7 @@ impl FeSetup {
             out.push_str("revision=body-load\n");
         }
         let curved_cells = match &self.geometry {
-            FeGeometry::Box { .. } => false,
+            FeGeometry::Box { .. } | FeGeometry::Blocks(_) => false,
             FeGeometry::Ball { dim, degree, .. } => *degree == 2 || *dim == 3,
             FeGeometry::Mesh {
                 dim,

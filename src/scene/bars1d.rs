@@ -13,24 +13,9 @@
 //! ([`super::bars1d_exact`]); this file states the keys, the mesh and what the scene refuses.
 
 use super::{
-    ErrorSource, MeshChoice, MethodNames, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+    ErrorSource, MassSide, MeshChoice, MethodNames, NitscheSides, Physics, PhysicsKey, Scene,
+    SceneFacts, SceneSetup,
 };
-
-/// Which bodies a mass variant modifies (contract §2.6 `mass_side`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MassSide {
-    Both,
-    A,
-    B,
-}
-
-/// The weights of the two sides' Nitsche terms (contract §2.6 `nitsche_sides`): unbiased
-/// (w_a = w_b = ½) or A the slave (w_a = 1, w_b = 0).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum NitscheSides {
-    Unbiased,
-    A,
-}
 
 /// One bar of the pair: its length, modulus, density and initial velocity (along +x).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -151,16 +136,8 @@ impl Bars1dScene {
             b: bar("_b"),
             gap: physics.get("gap"),
             clamped: physics.get("far_end") == 1.0,
-            mass_side: match physics.get("mass_side") as usize {
-                1 => MassSide::A,
-                2 => MassSide::B,
-                _ => MassSide::Both,
-            },
-            nitsche_sides: if physics.get("nitsche_sides") == 1.0 {
-                NitscheSides::A
-            } else {
-                NitscheSides::Unbiased
-            },
+            mass_side: MassSide::from_index(physics.get("mass_side")),
+            nitsche_sides: NitscheSides::from_index(physics.get("nitsche_sides")),
         }
     }
 

@@ -17,17 +17,21 @@ pub mod bar;
 pub mod bar1d;
 pub mod bars1d;
 pub mod bars1d_exact;
+pub mod blocks;
 pub mod layer1d;
 pub mod mesh;
 pub mod oscillator;
+pub mod two_body;
 
 pub use ball::BallScene;
 pub use bar::{BarScene, FeGeometry, FeSetup, LoadModel};
 pub use bar1d::{Bar1dScene, BarExact, BarParams};
-pub use bars1d::{BarMaterial, Bars1dParams, Bars1dScene, MassSide, NitscheSides};
+pub use bars1d::{BarMaterial, Bars1dParams, Bars1dScene};
+pub use blocks::{Blocks, BlocksScene};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::MeshScene;
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
+pub use two_body::{MassSide, NitscheSides};
 
 /// A physics parameter of a scene: its key name (contract §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -330,6 +334,10 @@ pub enum SceneKind {
     Layer1d,
     /// Two bars colliding, with their exact solution (contract §1.9).
     Bars1d,
+    /// Two blocks, a matching interface, plane strain (contract §1.10).
+    Blocks2d,
+    /// Two blocks, a matching interface, 3D (contract §1.10).
+    Blocks3d,
 }
 
 static BAR1D: Bar1dScene = Bar1dScene;
@@ -342,10 +350,12 @@ static MESH2D: MeshScene = MeshScene { dim: 2 };
 static MESH3D: MeshScene = MeshScene { dim: 3 };
 static LAYER1D: Layer1dScene = Layer1dScene;
 static BARS1D: Bars1dScene = Bars1dScene;
+static BLOCKS2D: BlocksScene = BlocksScene { dim: 2 };
+static BLOCKS3D: BlocksScene = BlocksScene { dim: 3 };
 
 impl SceneKind {
     /// Every scene name of contract §1, with whether this build implements it.
-    pub const NAMES: [(&'static str, Option<SceneKind>); 10] = [
+    pub const NAMES: [(&'static str, Option<SceneKind>); 12] = [
         ("bar1d", Some(SceneKind::Bar1d)),
         ("bar2d", Some(SceneKind::Bar2d)),
         ("bar3d", Some(SceneKind::Bar3d)),
@@ -356,6 +366,8 @@ impl SceneKind {
         ("mesh3d", Some(SceneKind::Mesh3d)),
         ("layer1d", Some(SceneKind::Layer1d)),
         ("bars1d", Some(SceneKind::Bars1d)),
+        ("blocks2d", Some(SceneKind::Blocks2d)),
+        ("blocks3d", Some(SceneKind::Blocks3d)),
     ];
 
     /// The scene behind this name.
@@ -371,6 +383,8 @@ impl SceneKind {
             SceneKind::Mesh3d => &MESH3D,
             SceneKind::Layer1d => &LAYER1D,
             SceneKind::Bars1d => &BARS1D,
+            SceneKind::Blocks2d => &BLOCKS2D,
+            SceneKind::Blocks3d => &BLOCKS3D,
         }
     }
 

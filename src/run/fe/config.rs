@@ -53,6 +53,13 @@ impl FeConfig {
                 clamped_nodes,
                 ..
             } => nodes.saturating_sub(*clamped_nodes).saturating_mul(*dim),
+            // Two blocks (contract §1.10): every node of both, B's base less when clamped.
+            FeGeometry::Blocks(b) => {
+                let d = self.setup.dim;
+                let face = (b.across + 1).saturating_pow(d as u32 - 1);
+                let layers = b.cells_a + b.cells_b + 2 - usize::from(b.base_clamped);
+                face.saturating_mul(layers).saturating_mul(d)
+            }
             FeGeometry::Ball {
                 dim,
                 degree,

@@ -120,11 +120,23 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
         }
     };
     let mut ops = match cfg.method {
+        // Two bodies' points are the penalty's node rows (σ_n = 0): no Nitsche there yet.
+        ContactMethod::Nitsche { .. } if g.bodies.is_some() => {
+            return Err(format!(
+                "space = nitsche is not available for scene {} yet (two bodies: issue 44)",
+                cfg.setup.scene
+            ));
+        }
         ContactMethod::Nitsche { theta, gamma0 } => NitscheOps::new(points()?, theta, gamma0),
         ContactMethod::Penalty { gamma0 } => {
-            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (contract §2.4).
+            // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (contract §2.4); two
+            // bodies: E_a = λ_a + 2μ_a and h A's mesh size (contract §2.6).
             let (l, m) = (cfg.setup.lame_lambda, cfg.setup.lame_mu);
-            let young = m * (3.0 * l + 2.0 * m) / (l + m);
+            let young = if g.bodies.is_some() {
+                l + 2.0 * m
+            } else {
+                m * (3.0 * l + 2.0 * m) / (l + m)
+            };
             NitscheOps::penalty(points()?, young, gamma0)
         }
         ContactMethod::Mixed => return factor_mixed(g, cfg, c_tau2),
@@ -148,7 +160,7 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
     let a = SymMatrix::lin_comb(1.0, &m, c_tau2, &g.k);
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| e.to_string())?;
     let n = g.dofs.n_free();
-    let nc = g.contact.len();
+    let nc = g.rows.len();
     let tangential = if frictional(cfg) {
         tangential_dofs(g)?
     } else {
@@ -156,16 +168,19 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
     };
     let nz = nc + tangential.len();
     let mut z = vec![0.0; n * nz];
-    for (j, &c) in g.contact.iter().chain(&tangential).enumerate() {
-        z[j * n + c] = 1.0;
+    for j in 0..nc {
+        g.rows.add(j, 1.0, &mut z[j * n..(j + 1) * n]);
+    }
+    for (j, &c) in tangential.iter().enumerate() {
+        z[(nc + j) * n + c] = 1.0;
     }
     let mut work = chol.work_for(nz);
     chol.try_solve_many_in_place(&mut z, nz, &mut work)
         .map_err(|e| format!("the condensation columns A⁻¹Bᵀ: {e}"))?;
     let mut h = vec![0.0; nc * nc];
-    for (i, &ci) in g.contact.iter().enumerate() {
+    for i in 0..nc {
         for j in 0..nc {
-            h[i * nc + j] = c_tau2 * z[j * n + ci];
+            h[i * nc + j] = c_tau2 * g.rows.dot(i, &z[j * n..(j + 1) * n]);
         }
     }
     // W is symmetric in exact arithmetic; symmetrise the round-off.
@@ -173,14 +188,14 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
     let friction = (!tangential.is_empty()).then(|| {
         let d = g.mesh.dim();
         let dm = nc * d;
-        // Row/column (i, a) of W: node i's normal (a = 0) or tangential a − 1; its dof and
+        // Row/column (i, a) of W: node i's normal row (a = 0) or tangential dof a − 1, and
         // its column of Z.
-        let dof = |k: usize| {
+        let row_dot = |k: usize, x: &[f64]| {
             let (i, a) = (k / d, k % d);
             if a == 0 {
-                g.contact[i]
+                g.rows.dot(i, x)
             } else {
-                tangential[i * (d - 1) + a - 1]
+                x[tangential[i * (d - 1) + a - 1]]
             }
         };
         let col = |k: usize| {
@@ -189,9 +204,8 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
         };
         let mut w = vec![0.0; dm * dm];
         for r in 0..dm {
-            let dr = dof(r);
             for c in 0..dm {
-                w[r * dm + c] = c_tau2 * z[col(c) * n + dr];
+                w[r * dm + c] = c_tau2 * row_dot(r, &z[col(c) * n..(col(c) + 1) * n]);
             }
         }
         symmetrise(&mut w, dm);

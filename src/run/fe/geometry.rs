@@ -4,7 +4,9 @@
 
 use std::sync::{Arc, OnceLock};
 
+use super::bodies::{TwoBodies, blocks_parts};
 use super::cache::Cache;
+use super::rows::Rows;
 use crate::run::friction_tally::MeanVelocity;
 use crate::scene::{FeGeometry, FeSetup};
 use crate::space::fe::mesh::mesh_layers;
@@ -12,7 +14,8 @@ use crate::space::fe::nitsche::{
     ContactPoint, box_contact_faces, contact_points, face_contact_points, gmsh_contact_faces,
 };
 use crate::space::fe::{
-    BallMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+    BallMesh, BodiesMesh, BoxMesh, DofMap, ElementOp, GmshMesh, Mesh, Pattern, SymMatrix, assemble,
+    fe_pattern,
 };
 use crate::space::linalg::{CholeskyOptions, FactorKind, LinalgError, Ordering, SymbolicCholesky};
 
@@ -26,6 +29,11 @@ pub(super) enum FeMesh {
         mesh: Arc<GmshMesh>,
         layers: Vec<usize>,
     },
+    /// Several bodies in one numbering (contract §1.10), each element's layer within its body.
+    Bodies {
+        mesh: BodiesMesh,
+        layers: Vec<usize>,
+    },
 }
 
 impl FeMesh {
@@ -34,6 +42,7 @@ impl FeMesh {
             FeMesh::Box(m) => m,
             FeMesh::Ball(m) => m,
             FeMesh::Gmsh { mesh, .. } => &**mesh,
+            FeMesh::Bodies { mesh, .. } => mesh,
         }
     }
     pub(super) fn dim(&self) -> usize {
@@ -44,21 +53,23 @@ impl FeMesh {
         match self {
             FeMesh::Box(m) => m.element_layer(e),
             FeMesh::Ball(m) => m.layers[e],
-            FeMesh::Gmsh { layers, .. } => layers[e],
+            FeMesh::Gmsh { layers, .. } | FeMesh::Bodies { layers, .. } => layers[e],
         }
     }
     pub(super) fn num_layers(&self) -> usize {
         match self {
             FeMesh::Box(m) => m.num_layers(),
             FeMesh::Ball(m) => m.layers.iter().max().map_or(0, |l| l + 1),
-            FeMesh::Gmsh { layers, .. } => layers.iter().max().map_or(0, |l| l + 1),
+            FeMesh::Gmsh { layers, .. } | FeMesh::Bodies { layers, .. } => {
+                layers.iter().max().map_or(0, |l| l + 1)
+            }
         }
     }
     /// The bars' box (reference lattices are defined on it only).
     pub(super) fn as_box(&self) -> Option<&BoxMesh> {
         match self {
             FeMesh::Box(m) => Some(m),
-            FeMesh::Ball(_) | FeMesh::Gmsh { .. } => None,
+            FeMesh::Ball(_) | FeMesh::Gmsh { .. } | FeMesh::Bodies { .. } => None,
         }
     }
 }
@@ -77,8 +88,12 @@ pub(super) struct Geometry {
     /// Unweighted Gram matrix (ρ = 1) and ∫∇u:∇v, for the error norms.
     pub(super) gram: SymMatrix,
     pub(super) grad: SymMatrix,
-    /// Reduced index of the vertical dof of each Γ_C node, and the node.
+    /// Reduced index of the vertical dof of each Γ_C node (two bodies: of A's Γ^a node of each
+    /// row), the dof the observables read (u_contact is their mean).
     pub(super) contact: Vec<usize>,
+    /// The contact rows B_i (one per Γ_C node, [`Rows`]): what the condensed solve, the
+    /// energies and the methods take. One body: e_c for c in `contact`.
+    pub(super) rows: Rows,
     /// Height x_d of each Γ_C node in the reference configuration, measured from the bottom
     /// face (box: 0, the run's `gap` is added) or from the rigid plane (ball: the gap is in it).
     pub(super) contact_height: Vec<f64>,
@@ -101,6 +116,8 @@ pub(super) struct Geometry {
     /// Reduced indices of the e_1 component (the tangential direction of `velocity_tangential`,
     /// contract §1.8).
     pub(super) tangential: Vec<usize>,
+    /// The second body and the pair's data (contract §1.10); None for one body.
+    pub(super) bodies: Option<TwoBodies>,
 }
 
 impl Geometry {
@@ -148,6 +165,20 @@ pub fn cholesky_options(mesh: &BoxMesh, dofs: &DofMap) -> CholeskyOptions {
     }
 }
 
+/// AMD ordering, simplicial in 2D and supernodal in 3D: the meshes without a lattice to
+/// dissect (the mapped disc/ball, Gmsh files, the blocks; the bars' measurements,
+/// [`cholesky_options`]).
+fn amd_options(d: usize) -> CholeskyOptions {
+    CholeskyOptions {
+        ordering: Ordering::Amd,
+        kind: if d == 2 {
+            FACTOR_KIND_2D
+        } else {
+            FactorKind::Supernodal
+        },
+    }
+}
+
 pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
     match &s.geometry {
         FeGeometry::Box { extent, cells } => build_box(s, extent, cells),
@@ -179,7 +210,56 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
             }
             build_gmsh(s, mesh)
         }
+        FeGeometry::Blocks(b) => build_blocks(s, b),
     }
+}
+
+/// Two blocks (contract §1.10, [`super::bodies`]): A's Γ^a rows paired node to node with B's
+/// Γ^b, the run's gap in the rows, no Nitsche points yet.
+pub(super) fn build_blocks(s: &FeSetup, b: &crate::scene::Blocks) -> Result<Geometry, String> {
+    let p = blocks_parts(s, b)?;
+    let d = s.dim;
+    let opts = amd_options(d);
+    let one = |_: usize| 1.0;
+    let gram = assemble(
+        &p.mesh,
+        &p.dofs,
+        &p.pattern,
+        ElementOp::Mass { rho: 1.0 },
+        &one,
+    );
+    let grad = assemble(&p.mesh, &p.dofs, &p.pattern, ElementOp::GradGrad, &one);
+    let n = p.dofs.n_free();
+    let on_contact_node = (0..n).map(|r| p.contact_node[p.dofs.free[r] / d]).collect();
+    let vertical = (0..n).filter(|&r| p.dofs.free[r] % d == d - 1).collect();
+    let tangential = (0..n)
+        .filter(|&r| p.dofs.free[r].is_multiple_of(d))
+        .collect();
+    Ok(Geometry {
+        mesh: FeMesh::Bodies {
+            mesh: p.mesh,
+            layers: p.layers,
+        },
+        dofs: p.dofs,
+        pattern: p.pattern,
+        cholesky: opts,
+        symbolic: OnceLock::new(),
+        k: p.k,
+        gram,
+        grad,
+        contact_height: vec![0.0; p.contact.len()],
+        contact: p.contact,
+        rows: p.rows,
+        gap_in_geometry: false,
+        contact_node: p.contact_node,
+        points: Ok(p.points),
+        contact_weight: p.contact_weight,
+        contact_measure: p.contact_measure,
+        on_contact_node,
+        vertical,
+        tangential,
+        bodies: Some(p.two),
+    })
 }
 
 /// A Gmsh mesh (contract §1.6): the `clamped` group's nodes fixed (every component), contact on the
@@ -199,14 +279,7 @@ pub(super) fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, S
     let pattern = fe_pattern(&*mesh, &dofs);
     // AMD: an unstructured mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D
     // (the bars' measurements, `cholesky_options`).
-    let opts = CholeskyOptions {
-        ordering: Ordering::Amd,
-        kind: if d == 2 {
-            FACTOR_KIND_2D
-        } else {
-            FactorKind::Supernodal
-        },
-    };
+    let opts = amd_options(d);
     let (k, gram, grad) = operators(s, &*mesh, &dofs, &pattern);
     let group = mesh
         .group("contact")
@@ -297,6 +370,7 @@ pub(super) fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, S
         k,
         gram,
         grad,
+        rows: Rows::unit(&contact),
         contact,
         contact_height,
         gap_in_geometry: false,
@@ -307,6 +381,7 @@ pub(super) fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, S
         on_contact_node,
         vertical,
         tangential,
+        bodies: None,
     })
 }
 
@@ -341,14 +416,7 @@ pub(super) fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String
     let pattern = fe_pattern(&mesh, &dofs);
     // AMD: the mapped mesh has no lattice to dissect; simplicial in 2D, supernodal in 3D (the
     // bars' measurements, `cholesky_options`).
-    let opts = CholeskyOptions {
-        ordering: Ordering::Amd,
-        kind: if d == 2 {
-            FACTOR_KIND_2D
-        } else {
-            FactorKind::Supernodal
-        },
-    };
+    let opts = amd_options(d);
     let (k, gram, grad) = operators(s, &mesh, &dofs, &pattern);
     let contact: Vec<usize> = mesh.contact_nodes.iter().map(|&n| n * d + d - 1).collect();
     let contact_height = mesh
@@ -387,6 +455,7 @@ pub(super) fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String
         k,
         gram,
         grad,
+        rows: Rows::unit(&contact),
         contact,
         contact_height,
         gap_in_geometry: true,
@@ -397,6 +466,7 @@ pub(super) fn build_ball(s: &FeSetup, mesh: BallMesh) -> Result<Geometry, String
         on_contact_node,
         vertical,
         tangential,
+        bodies: None,
     })
 }
 
@@ -470,6 +540,7 @@ pub(super) fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<
         k,
         gram,
         grad,
+        rows: Rows::unit(&contact),
         contact,
         contact_height,
         gap_in_geometry: false,
@@ -480,6 +551,7 @@ pub(super) fn build_box(s: &FeSetup, extent: &[f64], cells: &[usize]) -> Result<
         on_contact_node,
         vertical,
         tangential,
+        bodies: None,
     })
 }
 

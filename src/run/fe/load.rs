@@ -45,7 +45,7 @@ pub(super) fn gravity_load(
     let s = &cfg.setup;
     let fall = -s.gravity;
     if fall == 0.0 {
-        return Ok(None);
+        return pressure_load(g, cfg, m);
     }
     if g.mesh.as_box().is_some() {
         return Err(format!(
@@ -127,6 +127,51 @@ pub(super) fn gravity_load(
         a0,
         m_ed,
         vertical_mass,
+        energy_scale,
+    }))
+}
+
+/// The traction −p e_d on the upper block's top face (contract §1.10 `pressure`; None without
+/// one): F, a⁰ with M a⁰ = F on the dofs with inertia (u⁰ = 0), and the energy unit
+/// p²|Γ|(H_a/(λ_a + 2μ_a) + H_b/(λ_b + 2μ_b)) + ½Σ_i m_i V_i² — the static column's strain
+/// energy scale plus the bodies' kinetic energy — since the patch test starts at rest (E⁰ = 0).
+fn pressure_load(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+) -> Result<Option<GravityLoad>, String> {
+    let (Some(two), crate::scene::FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
+        return Ok(None);
+    };
+    let Some(force) = &two.pressure else {
+        return Ok(None);
+    };
+    let s = &cfg.setup;
+    let a0 = inertial_solve(m, force, vec![0.0; force.len()])?;
+    let mut ones = vec![0.0; force.len()];
+    for &r in &g.vertical {
+        ones[r] = 1.0;
+    }
+    let mut m1 = vec![0.0; force.len()];
+    m.matvec_into(&ones, &mut m1);
+    let (mut ma, mut mb) = (0.0, 0.0);
+    for &r in &g.vertical {
+        if two.body[r] == 0 {
+            ma += m1[r];
+        } else {
+            mb += m1[r];
+        }
+    }
+    let compliance = b.height_a / (s.lame_lambda + 2.0 * s.lame_mu)
+        + b.height_b / (b.lame_lambda_b + 2.0 * b.lame_mu_b);
+    let energy_scale = b.pressure * b.pressure * g.contact_measure * compliance
+        + 0.5 * ma * (s.v0 * s.v0 + s.v0_tangential * s.v0_tangential)
+        + 0.5 * mb * b.velocity_b * b.velocity_b;
+    Ok(Some(GravityLoad {
+        force: force.clone(),
+        a0,
+        m_ed: m1,
+        vertical_mass: ma + mb,
         energy_scale,
     }))
 }

@@ -160,6 +160,16 @@ pub(super) fn step_together(mut active: Vec<(usize, Stepper)>) -> Vec<(usize, Ou
             }
         }
         add_contact(&fac, c_tau2, nz, &mut active, &mut block);
+        let mut j = 0;
+        while j < active.len() {
+            match active[j].1.refine(step, &mut block[j * n..(j + 1) * n]) {
+                Ok(()) => j += 1,
+                Err(stop) => {
+                    leave(&mut active, &mut finished, j, Err(stop));
+                    block.copy_within((j + 1) * n..(active.len() + 1) * n, j * n);
+                }
+            }
+        }
         for ((_, s), y) in active.iter_mut().zip(block.chunks_exact(n)) {
             s.accelerate(y);
         }

@@ -1,6 +1,7 @@
 //! The mass variants of contract §2.2 on the FE meshes: the consistent and lumped matrices and the
 //! redistributions that move the contact layer's mass inward (massless contact dofs).
 
+use super::bodies::body_weight;
 use super::geometry::{FeMesh, Geometry};
 use crate::scene::FeSetup;
 use crate::space::MassVariant;
@@ -78,7 +79,12 @@ pub(super) fn mass_matrix(
     mass: &MassVariant,
 ) -> Result<(SymMatrix, f64), String> {
     let layers = g.mesh.num_layers();
-    if layers < 2 && mass.massless_contact() {
+    // Two bodies: each body the variant acts on needs its two layers (contract §2.6).
+    let too_thin = match &g.bodies {
+        Some(two) => (0..2).any(|b| two.mass_side.includes(b) && two.layer_counts[b] < 2),
+        None => layers < 2,
+    };
+    if too_thin && mass.massless_contact() {
         return Err(format!(
             "mass = {} needs at least two element layers",
             mass.name()
@@ -100,8 +106,24 @@ pub(super) fn mass_matrix(
         }
         _ => Redistribution::equal_layers(layers),
     };
-    let weight = |e: usize| layer_weight(mass, fm.element_layer(e), redistribution);
-    let rho = ElementOp::Mass { rho: s.density };
+    // Two bodies: the densities in the weights (ρ = 1 in the element), each body with its own
+    // equal layers ([`body_weight`]).
+    let (weight, density): (Box<dyn Fn(usize) -> f64 + '_>, f64) = match (&g.bodies, fm) {
+        (Some(two), FeMesh::Bodies { mesh: bm, .. }) => (
+            Box::new(move |e: usize| {
+                let lw = |l: usize, count: usize| {
+                    layer_weight(mass, l, Redistribution::equal_layers(count))
+                };
+                body_weight(two, bm.element_body(e), lw, fm.element_layer(e))
+            }),
+            1.0,
+        ),
+        _ => (
+            Box::new(|e: usize| layer_weight(mass, fm.element_layer(e), redistribution)),
+            s.density,
+        ),
+    };
+    let rho = ElementOp::Mass { rho: density };
     let mut m = assemble(mesh, &g.dofs, &g.pattern, rho, &weight);
     match mass {
         MassVariant::Lumped => {
@@ -135,6 +157,6 @@ pub(super) fn mass_matrix(
     let zeroed = |i: usize, j: usize| {
         matches!(mass, MassVariant::ZeroContact) && (bottom_node(i) || bottom_node(j))
     };
-    let total = component_total(mesh, s.density, &weight, &zeroed);
+    let total = component_total(mesh, density, &weight, &zeroed);
     Ok((m, total))
 }

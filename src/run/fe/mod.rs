@@ -36,6 +36,7 @@
 //! nodes (the run's `max_penetration` is its maximum over the steps; Nitsche and the penalty
 //! are measured at the same nodes). Nothing is allocated in the time loop.
 
+mod bodies;
 mod cache;
 mod cfl;
 mod config;
@@ -49,6 +50,8 @@ mod newmark;
 pub mod nitsche;
 mod products;
 mod reference;
+mod refine;
+mod rows;
 mod schur;
 mod setup;
 mod simulate;

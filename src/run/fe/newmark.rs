@@ -17,16 +17,18 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::bodies::{MomentumTally, patch_stress_error};
 use super::config::{CLOCK_EVERY, FeConfig, LCP_MAX_ITER, LCP_TOL};
 use super::factor::{Factored, FrictionFactor, factor_failure};
-use super::geometry::{Geometry, lowest_contact, mean_velocity};
+use super::geometry::{FeMesh, Geometry, lowest_contact, mean_velocity};
 use super::load::gravity_load;
 use super::nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
 use super::products::dot;
 use super::reference::{RefMap, reference_record};
+use super::refine::{Refinement, refinement};
 use super::setup::{
-    checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity, observer,
-    reference_map, shared_factor,
+    checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity,
+    momentum_tally, observer, reference_map, shared_factor,
 };
 use super::start::start_state;
 use crate::contact::friction::FrictionLaw;
@@ -111,6 +113,10 @@ pub(super) struct Stepper<'a> {
     /// Whether the step solves for the increment u^{n+1} − u^n (module header): the mixed runs
     /// that start quasi-static.
     pub(super) incr: bool,
+    /// Two bodies: the momentum and the bodies' mean velocities (contract §5).
+    pub(super) momentum: Option<MomentumTally>,
+    /// Two bodies with `mixed`: the refinement of the condensed step ([`Refinement`]).
+    pub(super) refine: Option<Box<Refinement>>,
 }
 
 /// A frictional mixed run's contact workspace and tally (contract §2.5, §1.8).
@@ -253,7 +259,6 @@ impl<'a> Stepper<'a> {
             Err(e) => return Err(fail(Status::Invalid, e, metrics)),
             Ok(m) => m,
         };
-
         let g = &*geo;
         let n = g.dofs.n_free();
         let nit = fac.nitsche.as_ref();
@@ -261,7 +266,6 @@ impl<'a> Stepper<'a> {
         let nc = nit.map_or(g.contact.len(), NitscheOps::unknowns);
         metrics.contact_dofs = Some(nc as i64);
         let gaps = contact_gaps(g, cfg);
-
         // Workspace: every vector of the time loop, allocated once. M u, M v and M a are
         // carried along the recursions of u, v, a, so a step costs one product with M (M a^{n+1})
         // besides the solve: M p^n = Mu + τ Mv + c₁τ² Ma, and the energy needs no product at
@@ -319,7 +323,6 @@ impl<'a> Stepper<'a> {
         if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
             return Err(fail(status, msg, metrics));
         }
-        let lowest = lowest_contact(g);
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some() || incr;
         let obs = observer(cfg, opts, energy_scale);
@@ -341,7 +344,7 @@ impl<'a> Stepper<'a> {
             vertical_mass,
             energy_scale,
             gaps,
-            lowest,
+            lowest: lowest_contact(g),
             u,
             v,
             a,
@@ -369,6 +372,8 @@ impl<'a> Stepper<'a> {
             touched: false,
             done: 0,
             fric,
+            momentum: momentum_tally(g, cfg, &fac.m),
+            refine: refinement(g, cfg, &fac, n, nc),
             geo,
             fac,
             incr,
@@ -402,6 +407,7 @@ impl<'a> Stepper<'a> {
             fall_error,
             touched,
             fric,
+            momentum,
             ..
         } = self;
         let (g, nit, tau, fall) = (&**geo, fac.nitsche.as_ref(), *tau, *fall);
@@ -411,15 +417,15 @@ impl<'a> Stepper<'a> {
         // is 0 and not summed.
         let carried = sums.take();
         let kinetic: f64 = carried.map_or_else(|| dot(v, mv), |c| c.0);
-        let fu: f64 = if fall != 0.0 { dot(u, force_vec) } else { 0.0 };
+        // A load: gravity, or the two blocks' pressure (contract §1.10).
+        let loaded = fall != 0.0 || g.bodies.as_ref().is_some_and(|b| b.pressure.is_some());
+        let fu: f64 = if loaded { dot(u, force_vec) } else { 0.0 };
         let uku = if nit.is_some() {
             dot(u, ku)
         } else {
-            let contact: f64 = g
-                .contact
-                .iter()
+            let contact: f64 = (0..g.rows.len())
                 .zip(lambda.iter())
-                .map(|(&c, l)| l * u[c])
+                .map(|(i, l)| l * g.rows.dot(i, u))
                 .sum();
             let uma: f64 = carried.map_or_else(|| dot(u, ma), |c| c.1);
             match (fric.as_ref(), fac.friction.as_ref()) {
@@ -442,11 +448,7 @@ impl<'a> Stepper<'a> {
         // Penetration at the Γ_C nodes, (u_n − g)_+ with u_n = −u_d (contract §1.3 decisions): the
         // points where the mixed method enforces the constraint, and where Nitsche/penalty
         // are measured too (their quadrature points carry only a weak constraint).
-        let penetration = g
-            .contact
-            .iter()
-            .zip(gaps.iter())
-            .fold(0.0f64, |m, (&c, gap)| m.max(-u[c] - gap));
+        let penetration = g.rows.penetration(gaps, u);
         // Nitsche: E_Θ and the total force from u itself (contract §2.3); mixed: Σ λ.
         // Penalty: its potential is part of E^h (contract §2.4), and there is no E_Θ.
         let (e, theta_term, force) = match nit {
@@ -465,6 +467,9 @@ impl<'a> Stepper<'a> {
                 .sum()
         };
         let uc = mean(u);
+        if let (Some(mt), Some(two)) = (momentum.as_mut(), g.bodies.as_ref()) {
+            mt.observe(two, &g.vertical, mv);
+        }
         if let (Some(fr), Some(ff)) = (fric.as_mut(), fac.friction.as_ref()) {
             // The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v; the stop
             // time and E + W_f in the tally; the series' Σf_t along e_1, the Γ_C mean of v_1
@@ -575,12 +580,63 @@ impl<'a> Stepper<'a> {
                 y[i] = mp;
                 mu[i] = mp;
             }
-            if self.fall != 0.0 {
+            // The load: gravity, or the two blocks' pressure (contract §1.10).
+            let pressed = self
+                .geo
+                .bodies
+                .as_ref()
+                .is_some_and(|b| b.pressure.is_some());
+            if self.fall != 0.0 || pressed {
                 for (yi, fi) in y.iter_mut().zip(&self.force_vec) {
                     *yi += c_tau2 * fi;
                 }
             }
         }
+        if let Some(rf) = self.refine.as_mut() {
+            rf.keep_rhs(y);
+        }
+    }
+
+    /// Two bodies with `mixed`: refine u^{n+1} = `y` and λ on the full residual
+    /// ([`Refinement`]); nothing for the other runs.
+    pub(super) fn refine(&mut self, step: usize, y: &mut [f64]) -> Result<(), Stop<String>> {
+        if let Some(rf) = self.refine.as_mut() {
+            let (g, fac) = (&*self.geo, &*self.fac);
+            let lambda = &mut self.lambda;
+            match fac.nitsche.as_ref() {
+                Some(ops) => rf.refine_penalty(g, fac, ops, self.c_tau2, lambda, y, &mut self.work),
+                None => rf.refine(g, fac, self.c_tau2, &self.gaps, lambda, y, &mut self.work),
+            }
+            .map_err(|e| Stop::Solver(step, e))?;
+        }
+        Ok(())
+    }
+
+    /// The patch test's errors (contract §1.10), with `pressure`: the largest relative stress
+    /// error over the Gauss points and the largest relative contact pressure error over the
+    /// rows (a multiplier over its node's weight ∫φ_i; the penalty's κ[δ_i − g_i]_+).
+    fn patch_errors(&self) -> Option<(f64, f64)> {
+        let (Some(two), crate::scene::FeGeometry::Blocks(b), FeMesh::Bodies { mesh, .. }) =
+            (&self.geo.bodies, &self.cfg.setup.geometry, &self.geo.mesh)
+        else {
+            return None;
+        };
+        two.pressure.as_ref()?;
+        let (g, p, u) = (&*self.geo, b.pressure, &self.u);
+        let stress = patch_stress_error(mesh, &g.dofs, two, u, p);
+        let worst =
+            |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, |m, ph| m.max((ph - p).abs() / p));
+        let pressure = match self.fac.nitsche.as_ref() {
+            Some(ops) => worst(
+                &mut (0..ops.len())
+                    .map(|q| (ops.apply(&ops.p, q, u) - ops.gap[q]).max(0.0) / ops.gamma[q]),
+            ),
+            None => worst(
+                &mut (0..g.rows.len())
+                    .map(|i| self.lambda[i] / (g.contact_weight[i] * g.contact_measure)),
+            ),
+        };
+        Some((stress, pressure))
     }
 
     /// Step n's contact problem once `y` = A⁻¹(right-hand side): the forces λ (upward) from
@@ -642,9 +698,12 @@ impl<'a> Stepper<'a> {
             // Stepping in increments, y is y − uⁿ: q_n = (uⁿ_d + y_d) + gap, q_t = y_t.
             let g = &*self.geo;
             let (incr, u) = (self.incr, &self.u);
-            let total = |i: usize| if incr { u[i] + y[i] } else { y[i] };
-            for ((qi, &ci), gi) in fr.q_n.iter_mut().zip(&g.contact).zip(&self.gaps) {
-                *qi = total(ci) + gi;
+            for (j, (qi, gi)) in fr.q_n.iter_mut().zip(&self.gaps).enumerate() {
+                *qi = if incr {
+                    g.rows.dot_sum(j, u, y)
+                } else {
+                    g.rows.dot(j, y)
+                } + gi;
             }
             for ((qt, up), &ct) in fr.q_t.iter_mut().zip(&mut fr.ut_prev).zip(&ff.tangential) {
                 *up = u[ct];
@@ -675,9 +734,12 @@ impl<'a> Stepper<'a> {
         } else {
             let g = &*self.geo;
             let (incr, u) = (self.incr, &self.u);
-            let total = |i: usize| if incr { u[i] + y[i] } else { y[i] };
-            for ((qi, &ci), gi) in self.q.iter_mut().zip(&g.contact).zip(&self.gaps) {
-                *qi = total(ci) + gi;
+            for (j, (qi, gi)) in self.q.iter_mut().zip(&self.gaps).enumerate() {
+                *qi = if incr {
+                    g.rows.dot_sum(j, u, y)
+                } else {
+                    g.rows.dot(j, y)
+                } + gi;
             }
             let it = self
                 .lcp
@@ -788,6 +850,7 @@ impl<'a> Stepper<'a> {
     /// The outcome of the run, however its loop ended.
     pub(super) fn finish(mut self, stop: Result<(), Stop<String>>) -> Outcome {
         let cfg = self.cfg;
+        let patch = self.patch_errors();
         let metrics = &mut self.metrics;
         metrics.steps = self.done as i64;
         metrics.iterations = self.iterations;
@@ -807,6 +870,13 @@ impl<'a> Stepper<'a> {
         metrics.err_sigma_mid_l2 = None;
         metrics.contact_toggles = Some(metrics.contact_switches);
         metrics.energy_scale = self.energy_scale.or(metrics.energy_initial);
+        if let Some(mt) = &self.momentum {
+            mt.finish(metrics);
+        }
+        if let Some((s, p)) = patch {
+            metrics.patch_stress_error = Some(s);
+            metrics.patch_pressure_error = Some(p);
+        }
         if let Some(fr) = self.fric.as_ref() {
             // contract §5: the e_1 component in 2D, the tangential norm in 3D.
             let vt = fr.mean.tangential(&fr.mean_v);

@@ -7,6 +7,7 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use super::bodies::MomentumTally;
 use super::cache::geometry_key;
 use super::config::FeConfig;
 use super::factor::{FACTORS, Factored, factor, factor_key};
@@ -14,6 +15,7 @@ use super::geometry::{GEOMETRIES, Geometry, build_geometry};
 use super::reference::{RefMap, ref_map};
 use crate::run::observe::Observer;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Series, Status};
+use crate::space::fe::SymMatrix;
 
 /// The metrics known before anything can fail: a failed row still gets its size and its energy
 /// tolerance's length scale.
@@ -98,8 +100,8 @@ pub(super) fn contact_gaps(g: &Geometry, cfg: &FeConfig) -> Vec<f64> {
     g.contact_height.iter().map(|h| h + base_gap).collect()
 }
 
-/// v⁰: the scene's vertical and tangential velocities, times the ensemble member's
-/// perturbation 1 + δ(2r − 1) per dof.
+/// v⁰: the scene's vertical and tangential velocities (two bodies: A's, and B's `velocity_b`
+/// along e_d), times the ensemble member's perturbation 1 + δ(2r − 1) per dof.
 pub(super) fn initial_velocity(g: &Geometry, cfg: &FeConfig, v: &mut [f64]) {
     for &r in &g.vertical {
         v[r] = cfg.setup.v0;
@@ -107,12 +109,33 @@ pub(super) fn initial_velocity(g: &Geometry, cfg: &FeConfig, v: &mut [f64]) {
     for &r in &g.tangential {
         v[r] = cfg.setup.v0_tangential;
     }
+    if let Some(two) = &g.bodies {
+        for &r in g.vertical.iter().chain(&g.tangential) {
+            if two.body[r] == 1 {
+                v[r] = 0.0;
+            }
+        }
+        for &r in &g.vertical {
+            if two.body[r] == 1 {
+                v[r] = two.velocity_b;
+            }
+        }
+    }
     if let Some((delta, seed)) = cfg.perturbation {
         let mut rng = fastrand::Rng::with_seed(seed);
         for x in v.iter_mut() {
             *x *= 1.0 + delta * (2.0 * rng.f64() - 1.0);
         }
     }
+}
+
+/// Two bodies' momentum tally with the run's mass (contract §5), None for one body. A load
+/// (gravity, pressure) or a clamp leaves the drift undefined.
+pub(super) fn momentum_tally(g: &Geometry, cfg: &FeConfig, m: &SymMatrix) -> Option<MomentumTally> {
+    let two = g.bodies.as_ref()?;
+    let loaded = cfg.setup.gravity != 0.0 || two.pressure.is_some();
+    let v = (cfg.setup.v0, two.velocity_b);
+    Some(MomentumTally::new(two, &g.vertical, m, v, loaded))
 }
 
 /// The fall along e_d: on an incline (contract §1.8) the load's e_d part is −g cos α (cos 0 = 1:

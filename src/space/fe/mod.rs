@@ -30,6 +30,7 @@
 //! builds on this folder, not the other way round).
 
 pub mod ball;
+pub mod bodies;
 mod check;
 pub mod element;
 mod element_kind;
@@ -45,6 +46,7 @@ pub mod simplex;
 pub mod sparse;
 
 pub use ball::{BallMesh, BoundaryFace, FacePoint};
+pub use bodies::BodiesMesh;
 pub use element::{ElementOp, Q1Mat2, Q1Mat3, Q2Mat2, Q2Mat3};
 pub use gmsh::{ElementKind, GmshError, GmshMesh, PhysicalGroup};
 pub use mesh::{BoxMesh, Mesh};

@@ -49,8 +49,8 @@ impl MethodRun<'_> {
         for i in 0..n {
             pred[i] = u[i] + tau * v[i];
         }
-        for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(gaps) {
-            *qi = pred[ci] + gi;
+        for (j, (qi, gi)) in q.iter_mut().zip(gaps).enumerate() {
+            *qi = g.rows.dot(j, pred) + gi;
         }
         let it = lp
             .solve(q, nu, LCP_MAX_ITER, LCP_TOL)
@@ -74,7 +74,7 @@ impl MethodRun<'_> {
             fric.as_mut(),
             lcp,
             f,
-            &g.contact,
+            &g.rows,
             gaps,
             pred,
             |r| pred[r] - u[r],

@@ -7,6 +7,7 @@ use crate::contact::Lcp;
 use crate::run::fe::config::{LCP_MAX_ITER, LCP_TOL};
 use crate::run::fe::factor::Factored;
 use crate::run::fe::nitsche::NitscheOps;
+use crate::run::fe::rows::Rows;
 
 /// y += s Σ_j μ_j Z_j over the columns with μ_j ≠ 0 (Z column-major, n rows).
 /// The contact correction `kane` and `contact-stabilized-newmark` share (one step matrix
@@ -21,7 +22,7 @@ pub(super) fn implicit_contact_correction(
     fric: Option<&mut Friction>,
     lcp: &mut Lcp,
     f: &Factored,
-    contact: &[usize],
+    contact: &Rows,
     gaps: &[f64],
     base: &[f64],
     off: impl Fn(usize) -> f64,
@@ -31,13 +32,15 @@ pub(super) fn implicit_contact_correction(
     sd: &mut [f64],
 ) -> Result<usize, String> {
     if let Some(fr) = fric {
-        fr.set_free(y, off, |j| base[contact[j]] + y[contact[j]] + gaps[j]);
+        fr.set_free(y, off, |j| {
+            contact.dot(j, base) + contact.dot(j, y) + gaps[j]
+        });
         let it = fr.solve(c, false, y, sd, lambda)?;
         fr.take_forces(0.5);
         Ok(it)
     } else {
-        for ((qi, &ci), gi) in q.iter_mut().zip(contact).zip(gaps) {
-            *qi = base[ci] + y[ci] + gi;
+        for (j, (qi, gi)) in q.iter_mut().zip(gaps).enumerate() {
+            *qi = contact.dot(j, base) + contact.dot(j, y) + gi;
         }
         let it = lcp
             .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
@@ -62,9 +65,9 @@ pub(super) fn add_columns(z: &[f64], mu: &[f64], s: f64, y: &mut [f64]) {
 }
 
 /// y_{c_j} += s μ_j: s Bᵀμ on the contact rows.
-pub(super) fn add_rows(contact: &[usize], mu: &[f64], s: f64, y: &mut [f64]) {
-    for (&c, l) in contact.iter().zip(mu) {
-        y[c] += s * l;
+pub(super) fn add_rows(rows: &Rows, mu: &[f64], s: f64, y: &mut [f64]) {
+    for (j, l) in mu.iter().enumerate() {
+        rows.add(j, s * l, y);
     }
 }
 

@@ -154,7 +154,7 @@ impl MethodRun<'_> {
             pred[i] = u[i] + tau * v[i] + kp * a[i];
             y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
         }
-        add_rows(&g.contact, lambda_prev, kf, y);
+        add_rows(&g.rows, lambda_prev, kf, y);
         if let Some(fr) = fric.as_ref() {
             fr.add_previous_tangential(kf, y);
         }
@@ -164,21 +164,21 @@ impl MethodRun<'_> {
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         let it = if let Some(fr) = fric.as_mut() {
             // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
-            fr.set_free(y, |r| -u[r], |j| y[g.contact[j]] + gaps[j]);
+            fr.set_free(y, |r| -u[r], |j| g.rows.dot(j, y) + gaps[j]);
             let it = fr
                 .solve(c, false, y, sd, lambda)
                 .map_err(|e| Stop::Solver(step, e))?;
             fr.take_forces(1.0);
             it
         } else {
-            for ((qi, &ci), gi) in q.iter_mut().zip(&g.contact).zip(gaps) {
-                *qi = y[ci] + gi;
+            for (j, (qi, gi)) in q.iter_mut().zip(gaps).enumerate() {
+                *qi = g.rows.dot(j, y) + gi;
             }
             let it = lcp
                 .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
             add_columns(&f.z, lambda, c, y);
-            add_rows(&g.contact, lambda, c, sd);
+            add_rows(&g.rows, lambda, c, sd);
             it
         };
         *newton_max = (*newton_max).max(it);

@@ -52,7 +52,7 @@ impl MethodRun<'_> {
             fric.as_mut(),
             lcp,
             f,
-            &g.contact,
+            &g.rows,
             gaps,
             u,
             |_| 0.0,

@@ -23,17 +23,17 @@ pub(super) fn mass_inverse(g: &Geometry, m: &SymMatrix) -> Result<MassInverse, S
     let symbolic = g.symbolic().map_err(|e| e.to_string())?;
     let chol = Cholesky::new(&symbolic, m)
         .map_err(|e| format!("the mass matrix is not positive definite: {e}"))?;
-    let (n, nc) = (g.dofs.n_free(), g.contact.len());
+    let (n, nc) = (g.dofs.n_free(), g.rows.len());
     let mut zm = vec![0.0; n * nc];
-    for (j, &c) in g.contact.iter().enumerate() {
-        zm[j * n + c] = 1.0;
+    for j in 0..nc {
+        g.rows.add(j, 1.0, &mut zm[j * n..(j + 1) * n]);
     }
     let mut work = chol.work_for(nc);
     chol.solve_many_in_place(&mut zm, nc, &mut work);
     let mut wm = vec![0.0; nc * nc];
-    for (i, &ci) in g.contact.iter().enumerate() {
+    for i in 0..nc {
         for j in 0..nc {
-            wm[i * nc + j] = zm[j * n + ci];
+            wm[i * nc + j] = g.rows.dot(i, &zm[j * n..(j + 1) * n]);
         }
     }
     for i in 0..nc {

@@ -54,12 +54,13 @@ impl MethodRun<'_> {
         work.check()
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         let mut any = false;
-        for (j, (&ci, gi)) in g.contact.iter().zip(gaps).enumerate() {
-            let active = u[ci] + gi + 0.5 * tau * v[ci] <= 0.0;
+        for (j, gi) in gaps.iter().enumerate() {
+            let vj = g.rows.dot(j, v);
+            let active = g.rows.dot(j, u) + gi + 0.5 * tau * vj <= 0.0;
             rows[j] = active;
             any |= active;
             q[j] = if active {
-                (1.0 + mj.restitution) * v[ci] + y[ci]
+                (1.0 + mj.restitution) * vj + g.rows.dot(j, y)
             } else {
                 0.0
             };
@@ -92,7 +93,7 @@ impl MethodRun<'_> {
             *newton_max = (*newton_max).max(it);
             *iterations += it as i64;
             add_columns(&f.z, lambda, c, y);
-            add_rows(&g.contact, lambda, c, sd);
+            add_rows(&g.rows, lambda, c, sd);
         } else {
             lambda.iter_mut().for_each(|l| *l = 0.0);
         }

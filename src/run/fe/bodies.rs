@@ -1,0 +1,360 @@
+//! Two bodies as engine data (contract §1.10, §2.6; issue 44): the blocks' meshes joined into one
+//! numbering ([`BodiesMesh`]: A's nodes, then B's), each body's material in its block of K,
+//! and the contact pair A–B as node-to-node rows B_i = e_{a,i,d} − e_{b,π(i),d} ([`Rows`]).
+//!
+//! A body is (mesh, material, density, mass layers, initial velocity); a pair is the list of
+//! (Γ^a node, Γ^b node) it matches; the rows are what the condensed solve takes. Nothing here
+//! is a time loop: every scheme and §3.2 method runs two bodies through the rows, the one-body
+//! scenes being the case of unit rows against the obstacle.
+
+use std::sync::Arc;
+
+use super::rows::Rows;
+use crate::run::Metrics;
+use crate::scene::{Blocks, FeSetup, MassSide};
+use crate::space::fe::element::q1_gradient_at;
+use crate::space::fe::nitsche::ContactPoint;
+use crate::space::fe::{
+    BodiesMesh, BoxMesh, DofMap, ElementOp, Mesh, Pattern, SymMatrix, assemble, fe_pattern,
+};
+
+/// What a second body adds to a geometry.
+#[derive(Debug)]
+pub(super) struct TwoBodies {
+    /// The body (0 = A, 1 = B) of each reduced dof.
+    pub(super) body: Vec<u8>,
+    /// Element layers of each body (layer 0 touches the body's own contact face).
+    pub(super) layer_counts: [usize; 2],
+    /// Each body's density and Lamé coefficients (λ, μ).
+    pub(super) density: [f64; 2],
+    pub(super) lame: [(f64, f64); 2],
+    /// B's initial e_d velocity (A's is the run's `velocity`).
+    pub(super) velocity_b: f64,
+    /// B's base clamped (`far_end = "clamped"`): no momentum invariant.
+    pub(super) base_clamped: bool,
+    pub(super) mass_side: MassSide,
+    /// The traction −p e_d on A's top face as forces on the reduced dofs (None: p = 0).
+    pub(super) pressure: Option<Vec<f64>>,
+}
+
+/// The parts of a two-block geometry ([`super::geometry::build_blocks`] makes the
+/// [`super::geometry::Geometry`]).
+pub(super) struct BlocksParts {
+    pub(super) mesh: BodiesMesh,
+    /// Mass layer of each element within its body.
+    pub(super) layers: Vec<usize>,
+    pub(super) dofs: DofMap,
+    pub(super) pattern: Arc<Pattern>,
+    pub(super) k: SymMatrix,
+    /// A's Γ^a vertical dofs (reduced) in row order, and the rows.
+    pub(super) contact: Vec<usize>,
+    pub(super) rows: Rows,
+    /// Trapezoidal weights of the Γ^a nodes (sum 1) and |Γ^a|.
+    pub(super) contact_weight: Vec<f64>,
+    pub(super) contact_measure: f64,
+    /// Global nodes whose mass a massless variant removes (both faces, per `mass_side`).
+    pub(super) contact_node: Vec<bool>,
+    /// The penalty's node-to-node rows as contact points ([`node_rows_as_points`]).
+    pub(super) points: Vec<ContactPoint>,
+    pub(super) two: TwoBodies,
+}
+
+/// Trapezoidal weight of a face node of a box with `cells` across: ½ per end of each axis.
+fn face_weight(idx: [usize; 3], cells: &[usize], d: usize) -> f64 {
+    (0..d - 1)
+        .map(|a| {
+            if idx[a] == 0 || idx[a] == cells[a] {
+                0.5
+            } else {
+                1.0
+            }
+        })
+        .product()
+}
+
+/// The two blocks of `s` (contract §1.10): B = [0, W]^{d−1} × [0, H_b] (body 1), A the box of
+/// height H_a placed on B's top (body 0; the gap is the run's, in the rows, so every gap shares
+/// the geometry), Q1, the same elements across so every Γ^a node lies above a Γ^b node.
+pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, String> {
+    let d = s.dim;
+    let mut ext = vec![b.width; d];
+    let mut cells = vec![b.across; d];
+    ext[d - 1] = b.height_a;
+    cells[d - 1] = b.cells_a;
+    let mut mesh_a = BoxMesh::try_new(&ext, &cells).map_err(|e| e.to_string())?;
+    mesh_a
+        .coords
+        .iter_mut()
+        .for_each(|c| c[d - 1] += b.height_b);
+    let cells_a = cells.clone();
+    ext[d - 1] = b.height_b;
+    cells[d - 1] = b.cells_b;
+    let mesh_b = BoxMesh::try_new(&ext, &cells).map_err(|e| e.to_string())?;
+    let mesh = BodiesMesh::new(&[&mesh_a, &mesh_b]);
+    let nn = mesh.num_nodes();
+    let b_node = |n: usize| mesh.node_body(n) == 1;
+    let clamped = |n: usize| {
+        b.base_clamped && b_node(n) && mesh_b.node_index(n - mesh.node(1, 0))[d - 1] == 0
+    };
+    let dofs = DofMap::new(nn * d, |g| clamped(g / d));
+    let pattern = fe_pattern(&mesh, &dofs);
+    let body_of = |e: usize| mesh.element_body(e);
+    // Each body's material in its own block (the blocks do not couple).
+    let stiffness = |lambda: f64, mu: f64, body: usize| {
+        let w = move |e: usize| f64::from(u8::from(body_of(e) == body));
+        assemble(
+            &mesh,
+            &dofs,
+            &pattern,
+            ElementOp::Stiffness { lambda, mu },
+            &w,
+        )
+    };
+    let k = SymMatrix::lin_comb(
+        1.0,
+        &stiffness(s.lame_lambda, s.lame_mu, 0),
+        1.0,
+        &stiffness(b.lame_lambda_b, b.lame_mu_b, 1),
+    );
+    // Layers from each body's contact face: A's bottom rows upward, B's top rows downward.
+    let (ea, eb) = (mesh_a.num_elements(), mesh_b.num_elements());
+    let layers: Vec<usize> = (0..ea)
+        .map(|e| mesh_a.element_layer(e))
+        .chain((0..eb).map(|e| b.cells_b - 1 - mesh_b.element_layer(e)))
+        .collect();
+    let free = |n: usize| dofs.free_index(n * d + d - 1).expect("Γ nodes are free");
+    let a_face = mesh_a.nodes_on_plane(d - 1, 0);
+    // π(i): the node of B's top face with the same horizontal index.
+    let partner = |n: usize| {
+        let mut idx = mesh_a.node_index(n);
+        idx[d - 1] = b.cells_b;
+        mesh.node(1, mesh_b.node_id(idx))
+    };
+    let contact: Vec<usize> = a_face.iter().map(|&n| free(n)).collect();
+    let contact_b: Vec<usize> = a_face.iter().map(|&n| free(partner(n))).collect();
+    let pairs: Vec<(usize, usize)> = contact.iter().copied().zip(contact_b).collect();
+    let mut contact_weight: Vec<f64> = a_face
+        .iter()
+        .map(|&n| face_weight(mesh_a.node_index(n), &cells_a, d))
+        .collect();
+    let total: f64 = contact_weight.iter().sum();
+    contact_weight.iter_mut().for_each(|w| *w /= total);
+    let contact_measure: f64 = b.width.powi(d as i32 - 1);
+    let mut contact_node = vec![false; nn];
+    for &n in &a_face {
+        if b.mass_side.includes(0) {
+            contact_node[n] = true;
+        }
+        if b.mass_side.includes(1) {
+            contact_node[partner(n)] = true;
+        }
+    }
+    let body = dofs.free.iter().map(|&g| u8::from(b_node(g / d))).collect();
+    // −p ∫φ_i on A's top nodes: the trapezoidal weights times |Γ^a|.
+    let pressure = (b.pressure != 0.0).then(|| {
+        let mut f = vec![0.0; dofs.n_free()];
+        for n in mesh_a.nodes_on_plane(d - 1, b.cells_a) {
+            let w = face_weight(mesh_a.node_index(n), &cells_a, d) / total;
+            f[free(n)] = -b.pressure * w * contact_measure;
+        }
+        f
+    });
+    let h = b.width / b.across as f64;
+    let points = node_rows_as_points(&pairs, &contact_weight, contact_measure, h);
+    Ok(BlocksParts {
+        points,
+        layers,
+        dofs,
+        pattern,
+        k,
+        rows: Rows::pairs(&pairs),
+        contact,
+        contact_weight,
+        contact_measure,
+        contact_node,
+        two: TwoBodies {
+            body,
+            layer_counts: [b.cells_a, b.cells_b],
+            density: [s.density, b.density_b],
+            lame: [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)],
+            velocity_b: b.velocity_b,
+            base_clamped: b.base_clamped,
+            mass_side: b.mass_side,
+            pressure,
+        },
+        mesh,
+    })
+}
+
+/// The node-to-node rows of `penalty` (contract §2.6) in the form the engine's Nitsche/penalty
+/// operators take ([`super::nitsche::NitscheOps::penalty`]): one "point" per pair with dofs
+/// (a, b), u_n = δ_i = (u^a_i − u^b_{π(i)})·n = −u^a_d + u^b_d (n = −e_d), σ_n = 0 (no Nitsche
+/// term: `nitsche` is refused on these rows), weight w_i = ∫_Γa φ_i and γ = h, A's mesh size,
+/// so κ_i = E_a γ0/h and the row force is w_i κ [δ_i − g_i]_+ — the weighted rows that pass the
+/// patch test (an unweighted force gives the end nodes twice their share). Gap 0: the run's
+/// gap is added where the operators are made, as for the one-body box.
+fn node_rows_as_points(
+    pairs: &[(usize, usize)],
+    weight: &[f64],
+    measure: f64,
+    h: f64,
+) -> Vec<ContactPoint> {
+    pairs
+        .iter()
+        .zip(weight)
+        .map(|(&(a, b), w)| ContactPoint {
+            weight: w * measure,
+            gamma: h,
+            gap: 0.0,
+            dofs: vec![a, b],
+            un: vec![-1.0, 1.0],
+            sn: vec![0.0, 0.0],
+            ut: Vec::new(),
+            st: Vec::new(),
+        })
+        .collect()
+}
+
+/// The element weights of a mass variant on two bodies: each body's density times its layer
+/// weight where `mass_side` puts the variant, 1 elsewhere (contract §2.6), with each body's
+/// own equal-layer redistribution.
+pub(super) fn body_weight(
+    two: &TwoBodies,
+    element_body: usize,
+    weight: impl Fn(usize, usize) -> f64,
+    layer: usize,
+) -> f64 {
+    let w = if two.mass_side.includes(element_body) {
+        weight(layer, two.layer_counts[element_body])
+    } else {
+        1.0
+    };
+    two.density[element_body] * w
+}
+
+/// The total momentum along e_d, P = Σ over the vertical dofs of (M v) (contract §2.6), and
+/// each body's share: (P, P_a, P_b).
+pub(super) fn momentum(two: &TwoBodies, vertical: &[usize], mv: &[f64]) -> (f64, f64, f64) {
+    let (mut pa, mut pb) = (0.0, 0.0);
+    for &r in vertical {
+        if two.body[r] == 0 {
+            pa += mv[r];
+        } else {
+            pb += mv[r];
+        }
+    }
+    (pa + pb, pa, pb)
+}
+
+/// The two-body columns of a run (contract §5): P^n along e_d at every observed step, its largest
+/// deviation from P⁰ over Σ_i m_i|V_i| (null with a clamp, a load, or every V_i = 0) and each
+/// body's final mean velocity 1ᵀM_i v/m_i.
+#[derive(Debug, Clone)]
+pub(super) struct MomentumTally {
+    /// m_a, m_b: 1ᵀM_i1 over the e_d component, the run's masses.
+    masses: [f64; 2],
+    /// Σ_i m_i|V_i|, or None where the drift is not defined.
+    scale: Option<f64>,
+    p0: Option<f64>,
+    max_dev: f64,
+    last: [f64; 2],
+}
+
+impl MomentumTally {
+    /// With the run's mass matrix `m`, A's and B's initial e_d velocities and whether a load
+    /// acts (gravity, pressure).
+    pub(super) fn new(
+        two: &TwoBodies,
+        vertical: &[usize],
+        m: &SymMatrix,
+        (v_a, v_b): (f64, f64),
+        loaded: bool,
+    ) -> MomentumTally {
+        let mut ones = vec![0.0; m.n()];
+        for &r in vertical {
+            ones[r] = 1.0;
+        }
+        let mut m1 = vec![0.0; m.n()];
+        m.matvec_into(&ones, &mut m1);
+        let (_, ma, mb) = momentum(two, vertical, &m1);
+        let scale = ma * v_a.abs() + mb * v_b.abs();
+        let defined = !two.base_clamped && !loaded && scale > 0.0;
+        MomentumTally {
+            masses: [ma, mb],
+            scale: defined.then_some(scale),
+            p0: None,
+            max_dev: 0.0,
+            last: [0.0; 2],
+        }
+    }
+
+    /// Step n's momentum from the run's M v; returns P^n.
+    pub(super) fn observe(&mut self, two: &TwoBodies, vertical: &[usize], mv: &[f64]) -> f64 {
+        let (p, pa, pb) = momentum(two, vertical, mv);
+        let p0 = *self.p0.get_or_insert(p);
+        self.max_dev = self.max_dev.max((p - p0).abs());
+        self.last = [pa, pb];
+        p
+    }
+
+    /// `momentum_drift`, `velocity_a_final`, `velocity_b_final` into the run's metrics.
+    pub(super) fn finish(&self, metrics: &mut Metrics) {
+        metrics.momentum_drift = self.scale.map(|s| self.max_dev / s);
+        metrics.velocity_a_final = Some(self.last[0] / self.masses[0]);
+        metrics.velocity_b_final = Some(self.last[1] / self.masses[1]);
+    }
+}
+
+/// The patch test's stress error (contract §1.10): the largest entry of |σ_h + p e_d⊗e_d|/p
+/// over the 2^d Gauss points of every cell of both bodies, σ = λ tr(ε) I + 2με per body.
+pub(super) fn patch_stress_error(
+    mesh: &BodiesMesh,
+    dofs: &DofMap,
+    two: &TwoBodies,
+    u: &[f64],
+    p: f64,
+) -> f64 {
+    match mesh.dim() {
+        2 => stress_error::<2, 4>(mesh, dofs, two, u, p),
+        _ => stress_error::<3, 8>(mesh, dofs, two, u, p),
+    }
+}
+
+fn stress_error<const D: usize, const NN: usize>(
+    mesh: &BodiesMesh,
+    dofs: &DofMap,
+    two: &TwoBodies,
+    u: &[f64],
+    p: f64,
+) -> f64 {
+    let g = 1.0 / 3f64.sqrt();
+    let mut worst = 0.0f64;
+    for e in 0..mesh.num_elements() {
+        let (lambda, mu) = two.lame[mesh.element_body(e)];
+        let mut x = [[0.0; D]; NN];
+        let mut ue = [[0.0; D]; NN];
+        for (a, &n) in mesh.element_nodes(e).iter().enumerate() {
+            let c = mesh.coord(n);
+            for k in 0..D {
+                x[a][k] = c[k];
+                ue[a][k] = dofs.free_index(n * D + k).map_or(0.0, |r| u[r]);
+            }
+        }
+        for corner in 0..1usize << D {
+            let xi: [f64; D] = std::array::from_fn(|k| if (corner >> k) & 1 == 1 { g } else { -g });
+            let grad = q1_gradient_at::<D, NN>(&x, &ue, xi);
+            let tr: f64 = (0..D).map(|k| grad[k][k]).sum();
+            for i in 0..D {
+                for j in 0..D {
+                    let eps = 0.5 * (grad[i][j] + grad[j][i]);
+                    let mut s = 2.0 * mu * eps + if i == j { lambda * tr } else { 0.0 };
+                    if i == D - 1 && j == D - 1 {
+                        s += p;
+                    }
+                    worst = worst.max((s / p).abs());
+                }
+            }
+        }
+    }
+    worst
+}

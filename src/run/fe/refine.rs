@@ -1,0 +1,302 @@
+//! Iterative refinement of the condensed `mixed` step on the full residual (contract §4, §1.10).
+//!
+//! The condensed step u = y + cτ²Zλ, y = A⁻¹b, solves A u = b + cτ²Bᵀλ with the LCP on the rows.
+//! A body held by contact alone at a step τ far above its periods (the patch test: one
+//! backward-Euler step, τ = 1e6) makes A = M + cτ²K nearly singular along its rigid modes
+//! (M/τ² ≈ 1e-12 of K), W = B A⁻¹ Bᵀ is dominated by them and the condensed solve loses about
+//! 12 digits. With the LCP's active set I fixed, the step is the linear system
+//! A u = b + cτ²B_Iᵀλ_I, B_I u + g_I = 0, and its residual (r, d) can be corrected:
+//! s = A⁻¹r, H_II δ = −(B_I(u + s) + g_I) with H = cτ²BZ, u ← u + s + cτ²Z_I δ, λ_I ← λ_I + δ,
+//! a few times until r meets the tolerance — the classic refinement, each sweep a step solve,
+//! two products and a dense solve on the active rows. A step whose residual already meets the
+//! tolerance (every ordinary dynamic step) costs the two products only.
+
+use super::config::FeConfig;
+use super::factor::Factored;
+use super::geometry::Geometry;
+use super::nitsche::NitscheOps;
+use crate::space::step_solver::StepWork;
+use crate::time::Scheme;
+
+/// At most this many correction sweeps per step (the contract's 2–3, with one to spare).
+const SWEEPS: usize = 4;
+/// The penalty's sweeps: each contracts the error by about 1e-2 on the patch test (its
+/// condensed Jacobian carries the same lost digits as W), so more of them.
+const PENALTY_SWEEPS: usize = 12;
+/// The relative residual ‖r‖∞ ≤ TOL·(‖b‖∞ + ‖Au‖∞ + cτ²‖Bᵀλ‖∞) that ends the sweeps.
+const TOL: f64 = 1e-14;
+
+/// The refinement of a Newmark/θ run (None: not refined): two bodies with `mixed`, or with
+/// the penalty's rows outside the hybrid scheme (whose kinks move the law, nitsche.rs header);
+/// one body against the obstacle keeps its numbers.
+pub(super) fn refinement(
+    g: &Geometry,
+    cfg: &FeConfig,
+    fac: &Factored,
+    n: usize,
+    nc: usize,
+) -> Option<Box<Refinement>> {
+    let refinable = match fac.nitsche.as_ref() {
+        None => fac.friction.is_none(),
+        Some(o) => o.penalty && o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+    };
+    (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)))
+}
+
+/// A run's refinement workspace (allocated once).
+#[derive(Debug)]
+pub(super) struct Refinement {
+    /// The step's right-hand side b (kept before the solve overwrites it).
+    rhs: Vec<f64>,
+    r: Vec<f64>,
+    mk: Vec<f64>,
+    active: Vec<usize>,
+    h: Vec<f64>,
+    d: Vec<f64>,
+    /// Correction sweeps made over the run.
+    pub(super) sweeps: usize,
+}
+
+impl Refinement {
+    /// For n dofs and nc contact rows (or penalty points).
+    pub(super) fn new(n: usize, nc: usize) -> Refinement {
+        Refinement {
+            rhs: vec![0.0; n],
+            r: vec![0.0; n],
+            mk: vec![0.0; n],
+            active: Vec::with_capacity(nc),
+            h: vec![0.0; nc * nc],
+            d: vec![0.0; nc],
+            sweeps: 0,
+        }
+    }
+
+    /// Keep the step's right-hand side b.
+    pub(super) fn keep_rhs(&mut self, b: &[f64]) {
+        self.rhs.copy_from_slice(b);
+    }
+
+    /// Refine u (= y + cτ²Zλ on entry) and λ: sweeps on the active rows of λ, then the rows
+    /// that violate the contact conditions at the refined state (an inactive row penetrating,
+    /// an active one pulling) change sides and the sweeps resume — an active-set method on the
+    /// exact step problem started from the LCP's answer, which the ill-conditioned W can get
+    /// wrong (the patch test: 2 of 5 rows). Returns the sweeps made.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn refine(
+        &mut self,
+        g: &Geometry,
+        fac: &Factored,
+        c_tau2: f64,
+        gaps: &[f64],
+        lambda: &mut [f64],
+        u: &mut [f64],
+        work: &mut StepWork,
+    ) -> Result<(), String> {
+        let nc = g.rows.len();
+        if lambda.iter().all(|&l| l == 0.0) {
+            return Ok(());
+        }
+        for _ in 0..(10 + 2 * nc) {
+            self.active.clear();
+            self.active.extend((0..nc).filter(|&i| lambda[i] != 0.0));
+            if !self.active.is_empty() {
+                self.sweeps(g, fac, c_tau2, gaps, lambda, u, work)?;
+            }
+            // The sides: 1e-10 of the state's scale, far above the sweeps' round-off and far
+            // below any physical penetration or pull.
+            let scale = gaps
+                .iter()
+                .chain(u.iter())
+                .fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+            let fscale = lambda.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+            let mut changed = false;
+            for i in 0..nc {
+                if lambda[i] == 0.0 && g.rows.dot(i, u) + gaps[i] < -1e-10 * scale {
+                    // A tiny seed: the sweeps then find its force.
+                    lambda[i] = f64::MIN_POSITIVE;
+                    changed = true;
+                } else if lambda[i] < -1e-10 * fscale {
+                    // Drop the row: its force leaves the residual, the sweeps correct u.
+                    lambda[i] = 0.0;
+                    changed = true;
+                }
+            }
+            if !changed {
+                return Ok(());
+            }
+        }
+        Err("iterative refinement: the contact set did not settle".into())
+    }
+
+    /// Correction sweeps on the rows `active` until the residual meets the tolerance.
+    #[allow(clippy::too_many_arguments)]
+    fn sweeps(
+        &mut self,
+        g: &Geometry,
+        fac: &Factored,
+        c_tau2: f64,
+        gaps: &[f64],
+        lambda: &mut [f64],
+        u: &mut [f64],
+        work: &mut StepWork,
+    ) -> Result<(), String> {
+        let (n, nc) = (u.len(), g.rows.len());
+        for _ in 0..SWEEPS {
+            // r = b + cτ²Bᵀλ − (M + cτ²K)u.
+            fac.m.matvec_into(u, &mut self.r);
+            g.k.matvec_into(u, &mut self.mk);
+            let mut scale = 0.0f64;
+            for i in 0..n {
+                let au = self.r[i] + c_tau2 * self.mk[i];
+                scale = scale.max(self.rhs[i].abs()).max(au.abs());
+                self.r[i] = self.rhs[i] - au;
+            }
+            for &i in &self.active {
+                g.rows.add(i, c_tau2 * lambda[i], &mut self.r);
+                scale = scale.max((c_tau2 * lambda[i]).abs());
+            }
+            let res = self.r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let defect = self
+                .active
+                .iter()
+                .fold(0.0f64, |m, &i| m.max((g.rows.dot(i, u) + gaps[i]).abs()));
+            let uscale = u.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+            if res <= TOL * scale && defect <= TOL * uscale {
+                break;
+            }
+            self.sweeps += 1;
+            fac.chol.solve_in_place(&mut self.r, work);
+            work.check().map_err(|e| e.to_string())?;
+            // u + s, and the active rows' defects −(B_I(u + s) + g_I).
+            for (ui, si) in u.iter_mut().zip(&self.r) {
+                *ui += si;
+            }
+            let k = self.active.len();
+            for (a, &i) in self.active.iter().enumerate() {
+                self.d[a] = -(g.rows.dot(i, u) + gaps[i]);
+                for (b, &j) in self.active.iter().enumerate() {
+                    self.h[a * k + b] = fac.h[i * nc + j];
+                }
+            }
+            solve_dense(&mut self.h[..k * k], &mut self.d[..k], k)?;
+            for (a, &i) in self.active.iter().enumerate() {
+                let delta = self.d[a];
+                lambda[i] += delta;
+                let zi = &fac.z[i * n..(i + 1) * n];
+                for (ui, zv) in u.iter_mut().zip(zi) {
+                    *ui += c_tau2 * delta * zv;
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Refinement {
+    /// The penalty's rows (contract §2.6, `penalty` node-to-node; the engine's Nitsche form
+    /// with Θ = 0, nitsche.rs header): A u + cτ² Σ_q φ_q(p_q·u) t_q = b, φ_q(s) =
+    /// w_q κ_q [s − g_q]_+, t_q = p_q. On the active points I (s_q > g_q) the correction δu
+    /// of the residual r solves (A + cτ² Σ_I w κ t tᵀ) δu = r: with s = A⁻¹r and Z_q =
+    /// A⁻¹(−t_q), δu = s + cτ² Z_I D e with (I − cτ² W_II D) e = P_I s, D = diag(w κ) — the
+    /// Newton's own Jacobian — then the points change sides and the sweeps resume. λ = φ(P u)
+    /// at the end (the forces the energy and the next Newton start from).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn refine_penalty(
+        &mut self,
+        g: &Geometry,
+        fac: &Factored,
+        ops: &NitscheOps,
+        c_tau2: f64,
+        lambda: &mut [f64],
+        u: &mut [f64],
+        work: &mut StepWork,
+    ) -> Result<(), String> {
+        let (n, nq, k) = (u.len(), ops.len(), ops.k);
+        let phi = |q: usize, u: &[f64]| {
+            ops.w[q] / ops.gamma[q] * (ops.apply(&ops.p, q, u) - ops.gap[q]).max(0.0)
+        };
+        for _ in 0..PENALTY_SWEEPS {
+            fac.m.matvec_into(u, &mut self.r);
+            g.k.matvec_into(u, &mut self.mk);
+            let mut scale = 0.0f64;
+            for i in 0..n {
+                let au = self.r[i] + c_tau2 * self.mk[i];
+                scale = scale.max(self.rhs[i].abs()).max(au.abs());
+                self.r[i] = self.rhs[i] - au;
+            }
+            self.active.clear();
+            for q in 0..nq {
+                let f = phi(q, u);
+                if f > 0.0 {
+                    self.active.push(q);
+                    let (coef, dofs) = (&ops.p[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                    for (c, &d) in coef.iter().zip(dofs) {
+                        self.r[d] -= c_tau2 * f * c;
+                    }
+                    scale = scale.max((c_tau2 * f).abs());
+                }
+            }
+            let res = self.r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            if res <= TOL * scale || self.active.is_empty() {
+                break;
+            }
+            self.sweeps += 1;
+            fac.chol.solve_in_place(&mut self.r, work);
+            work.check().map_err(|e| e.to_string())?;
+            let m = self.active.len();
+            for (a, &q) in self.active.iter().enumerate() {
+                self.d[a] = ops.apply(&ops.p, q, &self.r);
+                let dq = |j: usize| ops.w[j] / ops.gamma[j];
+                for (b, &j) in self.active.iter().enumerate() {
+                    let id = if a == b { 1.0 } else { 0.0 };
+                    self.h[a * m + b] = id - c_tau2 * fac.h[q * nq + j] * dq(j);
+                }
+            }
+            solve_dense(&mut self.h[..m * m], &mut self.d[..m], m)?;
+            for (ui, si) in u.iter_mut().zip(&self.r) {
+                *ui += si;
+            }
+            for (a, &q) in self.active.iter().enumerate() {
+                let f = c_tau2 * ops.w[q] / ops.gamma[q] * self.d[a];
+                for (ui, zv) in u.iter_mut().zip(&fac.z[q * n..(q + 1) * n]) {
+                    *ui += f * zv;
+                }
+            }
+        }
+        for (q, l) in lambda.iter_mut().enumerate().take(nq) {
+            *l = phi(q, u);
+        }
+        Ok(())
+    }
+}
+
+/// x with H x = d in place of d (H row-major k × k, destroyed): Gaussian elimination with
+/// partial pivoting.
+fn solve_dense(h: &mut [f64], d: &mut [f64], k: usize) -> Result<(), String> {
+    for c in 0..k {
+        let p = (c..k)
+            .max_by(|&a, &b| h[a * k + c].abs().total_cmp(&h[b * k + c].abs()))
+            .expect("a pivot row");
+        if h[p * k + c] == 0.0 {
+            return Err("iterative refinement: the active rows' W is singular".into());
+        }
+        if p != c {
+            for j in 0..k {
+                h.swap(p * k + j, c * k + j);
+            }
+            d.swap(p, c);
+        }
+        for r in c + 1..k {
+            let f = h[r * k + c] / h[c * k + c];
+            for j in c..k {
+                h[r * k + j] -= f * h[c * k + j];
+            }
+            d[r] -= f * d[c];
+        }
+    }
+    for c in (0..k).rev() {
+        let s: f64 = (c + 1..k).map(|j| h[c * k + j] * d[j]).sum();
+        d[c] = (d[c] - s) / h[c * k + c];
+    }
+    Ok(())
+}

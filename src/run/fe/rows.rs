@@ -1,0 +1,124 @@
+//! Contact rows: the constraints every contact pair hands to the condensed solve (contract §2.1,
+//! §2.6, §4).
+//!
+//! A row i is a sparse vector B_i over the reduced dofs and a gap g_i, the constraint being
+//! B_i·u + g_i ≥ 0 with the force λ_i ≥ 0 acting as B_iᵀλ_i. A body against the obstacle gives
+//! B_i = e_{node,d} (u_d + g ≥ 0, an upward force); a node-to-node pair of two bodies, A above
+//! B, gives B_i = e_{a,i,d} − e_{b,π(i),d} (the relative normal displacement
+//! δ_i = (u^a_i − u^b_{π(i)})·n with n = −e_d, so δ_i ≤ g_i reads B_i·u + g_i ≥ 0), whose force
+//! pushes A up and B down by the same amount — action = reaction, so Σ_j (B_iᵀ)_j over a
+//! component vanishes and the total momentum is an exact invariant (contract §2.6).
+//!
+//! Why one type for both: the condensation Z = A⁻¹Bᵀ, W = BZ, the LCP, the energies and the
+//! §3.2 methods only ever take B·x and Bᵀλ, so a second body is data (rows with two entries),
+//! not a branch. A one-entry row with coefficient 1 computes exactly what the obstacle engine
+//! computed before rows existed (1·x = x, and a sum is started from its first term, never from
+//! 0.0, which would turn −0 into +0), so the one-body runs keep their numbers bit for bit.
+
+/// The rows of one run's contact set, in compressed sparse row form.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(super) struct Rows {
+    start: Vec<usize>,
+    dof: Vec<usize>,
+    coef: Vec<f64>,
+}
+
+impl Rows {
+    /// One row e_c per dof c (a body against the obstacle).
+    pub(super) fn unit(dofs: &[usize]) -> Rows {
+        Rows {
+            start: (0..=dofs.len()).collect(),
+            dof: dofs.to_vec(),
+            coef: vec![1.0; dofs.len()],
+        }
+    }
+
+    /// One row e_a − e_b per pair (a, b) (node-to-node between two bodies, A above B).
+    pub(super) fn pairs(pairs: &[(usize, usize)]) -> Rows {
+        let mut r = Rows {
+            start: vec![0],
+            ..Rows::default()
+        };
+        for &(a, b) in pairs {
+            r.dof.extend([a, b]);
+            r.coef.extend([1.0, -1.0]);
+            r.start.push(r.dof.len());
+        }
+        r
+    }
+
+    /// The number of rows.
+    pub(super) fn len(&self) -> usize {
+        self.start.len() - 1
+    }
+
+    /// Whether every row is a single unit entry (a body against the obstacle): the methods
+    /// that act node by node (the kinematic impulse of central difference, the quasi-static
+    /// start's friction) take only those.
+    pub(super) fn is_unit(&self) -> bool {
+        self.len() == self.dof.len() && self.coef.iter().all(|&c| c == 1.0)
+    }
+
+    /// B_i·x, summed from the first entry on (a one-entry row gives x_c itself, bit for bit).
+    #[inline]
+    pub(super) fn dot(&self, i: usize, x: &[f64]) -> f64 {
+        let (s, e) = (self.start[i], self.start[i + 1]);
+        let mut acc = self.coef[s] * x[self.dof[s]];
+        for k in s + 1..e {
+            acc += self.coef[k] * x[self.dof[k]];
+        }
+        acc
+    }
+
+    /// B_i·(x + y), each entry's sum formed first (a one-entry row gives x_c + y_c, bit for bit:
+    /// the increment form of a step, `run::fe::newmark`).
+    #[inline]
+    pub(super) fn dot_sum(&self, i: usize, x: &[f64], y: &[f64]) -> f64 {
+        let (s, e) = (self.start[i], self.start[i + 1]);
+        let mut acc = self.coef[s] * (x[self.dof[s]] + y[self.dof[s]]);
+        for k in s + 1..e {
+            acc += self.coef[k] * (x[self.dof[k]] + y[self.dof[k]]);
+        }
+        acc
+    }
+
+    /// The largest penetration max_i (−B_i·u − g_i)_+ (contract §1.3: (u_n − g)_+ at the nodes).
+    pub(super) fn penetration(&self, gaps: &[f64], u: &[f64]) -> f64 {
+        gaps.iter()
+            .enumerate()
+            .fold(0.0f64, |m, (i, gap)| m.max(-self.dot(i, u) - gap))
+    }
+
+    /// y += s B_iᵀ.
+    #[inline]
+    pub(super) fn add(&self, i: usize, s: f64, y: &mut [f64]) {
+        for k in self.start[i]..self.start[i + 1] {
+            y[self.dof[k]] += s * self.coef[k];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Unit rows reproduce the indexed reads and writes exactly, −0 included; pair rows act
+    /// equally and oppositely (exact binary fractions).
+    #[test]
+    fn unit_rows_are_indexing_and_pairs_balance() {
+        let x = [-0.0, 0.5, -0.25, 3.0];
+        let u = Rows::unit(&[0, 2]);
+        assert_eq!(u.len(), 2);
+        assert!(u.is_unit());
+        assert_eq!(u.dot(0, &x).to_bits(), (-0.0f64).to_bits());
+        assert_eq!(u.dot(1, &x), -0.25);
+        let p = Rows::pairs(&[(1, 3), (2, 0)]);
+        assert!(!p.is_unit());
+        assert_eq!(p.dot(0, &x), 0.5 - 3.0);
+        let mut y = [0.0; 4];
+        p.add(0, 2.0, &mut y);
+        assert_eq!(y, [0.0, 2.0, 0.0, -2.0]);
+        assert_eq!(y.iter().sum::<f64>(), 0.0);
+        assert_eq!(p.dot(1, &x), -0.25 - -0.0);
+    }
+}

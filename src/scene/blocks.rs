@@ -1,0 +1,236 @@
+//! Two elastic blocks, one falling on the other: `blocks2d` (plane strain) and `blocks3d`
+//! (contract §1.10, §2.6; issue 44).
+//!
+//! B = [0, W]^{d−1} × [0, H_b] below A = [0, W]^{d−1} × [H_b + g, H_b + g + H_a], Q1 squares or
+//! cubes of side h; A has W/h elements across and H_a/h up, B the same across (`mesh_ratio` = 1:
+//! a matching interface, every node of A's bottom face above a node of B's top face) and
+//! round(H_b/h) up. A moves with `velocity` e_d (+ `velocity_tangential` e_1), B with
+//! `velocity_b` e_d; B's base is free or clamped (`far_end`); a traction −p e_d acts on A's top
+//! (`pressure`). There is no obstacle: the contact rows are node-to-node between the two faces,
+//! δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with n = −e_d ([`crate::run::fe`]'s rows). With no clamp and
+//! no load the total momentum is an exact invariant of every scheme (contract §2.6).
+//!
+//! Why a scene of its own rather than a mesh file: the matching interface, the per-body
+//! materials and the patch test's exact static solution are known by construction; the
+//! two-body Gmsh meshes reuse the same engine data (bodies and rows).
+
+use super::{
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, Physics,
+    PhysicsKey, Scene, SceneFacts, SceneSetup,
+};
+
+/// The two blocks as the engine meshes them (A's material, gap and velocities are the
+/// [`FeSetup`]'s own fields).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Blocks {
+    pub width: f64,
+    pub height_a: f64,
+    pub height_b: f64,
+    /// Elements across (each horizontal axis), up A and up B.
+    pub across: usize,
+    pub cells_a: usize,
+    pub cells_b: usize,
+    /// B's base x_d = 0 held at u = 0 (`far_end = "clamped"`).
+    pub base_clamped: bool,
+    pub density_b: f64,
+    pub lame_lambda_b: f64,
+    pub lame_mu_b: f64,
+    /// B's initial e_d velocity.
+    pub velocity_b: f64,
+    /// The traction −p e_d on A's top face.
+    pub pressure: f64,
+    pub mass_side: MassSide,
+}
+
+/// The scenes `blocks2d` (dim 2) and `blocks3d` (dim 3).
+#[derive(Debug, Clone, Copy)]
+pub struct BlocksScene {
+    pub dim: usize,
+}
+
+const fn key(name: &'static str, default: f64) -> PhysicsKey {
+    PhysicsKey { name, default }
+}
+
+/// contract §1.10's keys and defaults; B's material keys default to A's (NaN here, resolved in
+/// [`BlocksScene::setup`]), `far_end` and `mass_side` are indices into their words.
+const BLOCKS_PHYSICS: [PhysicsKey; 18] = [
+    key("width", 1.0),
+    key("height", 1.0),
+    key("height_b", 1.0),
+    key("density", 1.0),
+    key("lame_lambda", 1.0),
+    key("lame_mu", 1.0),
+    key("density_b", f64::NAN),
+    key("lame_lambda_b", f64::NAN),
+    key("lame_mu_b", f64::NAN),
+    key("gap", 0.1),
+    key("velocity", -1.0),
+    key("velocity_tangential", 0.0),
+    key("velocity_b", 0.0),
+    key("far_end", 0.0),
+    key("gravity", 0.0),
+    key("pressure", 0.0),
+    key("mass_side", 0.0),
+    key("mesh_ratio", 1.0),
+];
+
+/// B's value of a material key: its own, or A's where the sweep gives none.
+fn b_value(p: &Physics, name: &str) -> f64 {
+    let own = p.get(&format!("{name}_b"));
+    if own.is_nan() { p.get(name) } else { own }
+}
+
+impl BlocksScene {
+    /// Elements across W for a size h (a whole number), or why not.
+    fn across(p: &Physics, h: f64) -> Result<usize, String> {
+        let w = p.get("width");
+        let r = w / h;
+        let n = r.round();
+        if n < 1.0 || (r - n).abs() > 1e-9 * n.max(1.0) {
+            return Err(format!(
+                "h = {h} does not divide the blocks' width {w} into a whole number of square elements (width/h = {r}); use h = width/k"
+            ));
+        }
+        Ok(n as usize)
+    }
+}
+
+impl Scene for BlocksScene {
+    fn fe_dim(&self) -> Option<usize> {
+        Some(self.dim)
+    }
+    fn facts(&self) -> SceneFacts {
+        SceneFacts {
+            name: if self.dim == 2 {
+                "blocks2d"
+            } else {
+                "blocks3d"
+            },
+            physics: &BLOCKS_PHYSICS,
+            default_t: 4.0,
+        }
+    }
+    /// The larger P-wave speed of the two bodies.
+    fn wave_speed(&self, p: &Physics) -> f64 {
+        let c = |l: f64, m: f64, r: f64| ((l + 2.0 * m) / r).sqrt();
+        let a = c(p.get("lame_lambda"), p.get("lame_mu"), p.get("density"));
+        let b = c(
+            b_value(p, "lame_lambda"),
+            b_value(p, "lame_mu"),
+            b_value(p, "density"),
+        );
+        a.max(b)
+    }
+    fn mesh_from_h(&self, p: &Physics, h: f64) -> Result<MeshChoice, String> {
+        let n = Self::across(p, h)?;
+        let h = p.get("width") / n as f64;
+        let up = (p.get("height") / h).round().max(1.0);
+        Ok(MeshChoice {
+            elements: up as usize,
+            h,
+        })
+    }
+    fn mesh_from_elements(&self, p: &Physics, elements: usize) -> Result<MeshChoice, String> {
+        let h = p.get("height") / elements as f64;
+        self.mesh_from_h(p, h)
+            .map_err(|e| format!("elements = {elements} (h = height/{elements}): {e}"))
+    }
+    fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
+        super::fe_supports(self.name(), m)?;
+        super::require("space", m.space, &["mixed", "penalty"], || {
+            format!(
+                "space = {} is not available for scene {} yet (mixed and penalty node-to-node; nitsche between two bodies: issue 44, not yet)",
+                m.space,
+                self.name()
+            )
+        })
+    }
+    fn supports_friction(&self) -> Result<(), String> {
+        Err(format!(
+            "scene {}: friction between two bodies (the relative slip's rows) is not implemented yet (issue 44)",
+            self.name()
+        ))
+    }
+    fn supports_physics(
+        &self,
+        p: &Physics,
+        scheme: &crate::time::Scheme,
+    ) -> Result<(), (&'static str, String)> {
+        if p.get("mesh_ratio") != 1.0 {
+            return Err((
+                "mesh_ratio",
+                format!(
+                    "mesh_ratio = {}: non-matching interfaces: issue 45 (only mesh_ratio = 1, a matching interface, is implemented)",
+                    p.get("mesh_ratio")
+                ),
+            ));
+        }
+        if p.get("far_end") == 1.0 && p.get("velocity_b") != 0.0 {
+            return Err((
+                "velocity_b",
+                format!(
+                    "velocity_b = {} with far_end = \"clamped\": a clamped body B cannot move rigidly",
+                    p.get("velocity_b")
+                ),
+            ));
+        }
+        if p.get("gravity") != 0.0 {
+            return Err((
+                "gravity",
+                format!(
+                    "gravity = {} on scene {}: the two bodies' volume load is not implemented yet (issue 44)",
+                    p.get("gravity"),
+                    self.name()
+                ),
+            ));
+        }
+        if *scheme == crate::time::Scheme::Newmark(crate::time::NewmarkParams::central_difference())
+        {
+            return Err((
+                "scheme",
+                format!(
+                    "scheme = central-difference on scene {}: its kinematic impulse acts on obstacle rows only (two bodies: not yet, issue 44)",
+                    self.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+    fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
+        None
+    }
+    fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
+        let across = (p.get("width") / mesh.h).round() as usize;
+        let blocks = Blocks {
+            width: p.get("width"),
+            height_a: p.get("height"),
+            height_b: p.get("height_b"),
+            across,
+            cells_a: mesh.elements,
+            cells_b: (p.get("height_b") / mesh.h).round().max(1.0) as usize,
+            base_clamped: p.get("far_end") == 1.0,
+            density_b: b_value(p, "density"),
+            lame_lambda_b: b_value(p, "lame_lambda"),
+            lame_mu_b: b_value(p, "lame_mu"),
+            velocity_b: p.get("velocity_b"),
+            pressure: p.get("pressure"),
+            mass_side: MassSide::from_index(p.get("mass_side")),
+        };
+        SceneSetup::Fe(FeSetup {
+            scene: self.name(),
+            dim: self.dim,
+            geometry: FeGeometry::Blocks(blocks),
+            h: mesh.h,
+            density: p.get("density"),
+            lame_lambda: p.get("lame_lambda"),
+            lame_mu: p.get("lame_mu"),
+            gap: p.get("gap"),
+            gravity: p.get("gravity"),
+            load: LoadModel::Body,
+            v0: p.get("velocity"),
+            v0_tangential: p.get("velocity_tangential"),
+            incline: 0.0,
+        })
+    }
+}
