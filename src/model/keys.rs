@@ -475,18 +475,6 @@ impl Key {
                     ))
                 }
             }
-            Key::FarEnd => match s {
-                "free" | "clamped" => Ok(()),
-                _ => Err(format!(
-                    "unknown far_end `{s}` (expected free or clamped: body B's base x_d = 0 traction-free or held at u = 0)"
-                )),
-            },
-            Key::MassSide => match s {
-                "both" | "a" | "b" => Ok(()),
-                _ => Err(format!(
-                    "unknown mass_side `{s}` (expected both, a or b: the body whose contact layers the mass variant changes)"
-                )),
-            },
             Key::Mesh => {
                 if s.trim().is_empty() {
                     Err("must name a Gmsh .msh file (a path relative to the sweep file)".into())

@@ -38,7 +38,7 @@ use super::stepping::{failed, finished, time_loop};
 use super::{Metrics, Outcome, RunOptions, Status, Stop};
 use crate::contact::{self, ContactLaw, ContactSolveError};
 use crate::scene::bars1d_exact::{Body as Side, TwoBarsExact};
-use crate::scene::{BarParams, Bars1dParams, MassSide, NitscheSides};
+use crate::scene::{BarParams, Bars1dParams, MassSide};
 use crate::space::{Bar1dSpace, ContactMethod, MassVariant, Tridiag, TridiagLu};
 use crate::time::{GeneralizedAlphaParams, MoreauJeanParams, NewmarkParams, Scheme, ThetaParams};
 
@@ -879,7 +879,7 @@ pub fn simulate(cfg: &Bars1dConfig, opts: &RunOptions) -> Outcome {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::BarMaterial;
+    use crate::scene::{BarMaterial, NitscheSides};
 
     /// Two massless contact ends (`zero-contact` on both bars) are quasi-static: in contact the
     /// multiplier is the two end elements' springs in series, contract §2.6's closed form

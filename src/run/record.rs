@@ -376,10 +376,9 @@ pub struct Timing {
 impl RunRecord {
     /// Assemble the row of a run.
     pub fn new(sweep: &str, spec: &RunSpec, out: &Outcome, timing: Timing) -> RunRecord {
-        let p: &BTreeMap<Key, Value> = &spec.params;
+        let (p, m) = (&spec.params, &out.metrics);
         let f = |k: Key| p.get(&k).and_then(Value::as_f64);
         let s = |k: Key| p.get(&k).map(|v| v.to_string()).unwrap_or_default();
-        let m = &out.metrics;
         let scene = spec.scene.name();
         RunRecord {
             run_id: spec.run_id.clone(),
