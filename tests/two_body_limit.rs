@@ -22,7 +22,7 @@
 //! - the differences then grow like n² (5e-15 at step 10, 5e-14..3e-13 at 30, 2e-13..4e-12 at
 //!   60, 3e-12..2.3e-11 at 150) while bars1d nudged by one round-off (V·(1 + 1e-15)) moves by
 //!   ≤ 4e-14: the gap is not the problem's conditioning but each engine's own round-off per
-//!   step. The FE engine steps these runs in totals (`run::fe::newmark` header: its round-off
+//!   step. Its likely sources (not isolated one by one): the FE engine steps these runs in totals (`run::fe::newmark` header: its round-off
 //!   is relative to |uⁿ|, not to the step's Δu as bars1d's increments are), and Q1's K applied
 //!   to a uniform motion cancels only to round-off where P1's rows cancel exactly; both feed a
 //!   velocity error ~ε|u|/τ per step, integrated twice. The bound is therefore
@@ -295,6 +295,7 @@ fn blocks2d_column_is_bars1d() {
             // One-sided: bars1d leaves energy_scale null (its energy unit is E⁰), the FE
             // engine writes the scene's scale (FeSetup::energy_scale).
             assert!(mb.energy_scale.is_none() && mk.energy_scale.is_some());
+            assert!(mb.err_velocity_a_final.is_some() && mk.err_velocity_a_final.is_none());
             let steps = mb.steps as usize;
             let pairs = pairs(b, k, true);
             // bars1d's own sensitivity to one round-off: V·(1 + 1e-15).
