@@ -37,24 +37,10 @@
 //! `energy_kinetic`, `energy_elastic`, `u_lowest` and `energy_scale`. `length_scale` differs by
 //! definition (bars1d: A's length; blocks: H_a + H_b).
 
-use std::path::Path;
+mod common;
 
-use contact_sweep::run::{Outcome, RunOptions, Status, simulate};
-use contact_sweep::sweep::{SweepFile, expand};
-
-/// Every run of a sweep text, in the planner's order.
-fn run_all(text: &str) -> Vec<(String, Outcome)> {
-    let plan =
-        expand(&SweepFile::parse(Path::new("two_body_limit.toml"), text).expect("valid sweep"))
-            .expect("plan");
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let label = format!("{:?}", spec.params);
-            (label, simulate(&spec.config, &RunOptions::default()))
-        })
-        .collect()
-}
+use common::outcomes;
+use contact_sweep::run::{Outcome, Status};
 
 const H: f64 = 0.25;
 
@@ -276,10 +262,10 @@ fn round_off(n: usize) -> f64 {
 #[test]
 fn blocks2d_column_is_bars1d() {
     for vb in [-1.0, -0.5] {
-        let bars = run_all(&bars_text(vb));
+        let bars = outcomes(&bars_text(vb));
         let nudged =
-            run_all(&bars_text(vb).replace("velocity = 1.0", "velocity = 1.000000000000001"));
-        let blocks = run_all(&blocks_text(vb));
+            outcomes(&bars_text(vb).replace("velocity = 1.0", "velocity = 1.000000000000001"));
+        let blocks = outcomes(&blocks_text(vb));
         assert_eq!((bars.len(), blocks.len()), (3, 3));
         for (m, (((lb, b), (lk, k)), (_, n))) in bars.iter().zip(&blocks).zip(&nudged).enumerate() {
             assert_eq!(b.status, Status::Ok, "{lb}: {:?}", b.message);
