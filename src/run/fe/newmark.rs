@@ -468,7 +468,9 @@ impl<'a> Stepper<'a> {
         };
         let uc = mean(u);
         if let (Some(mt), Some(two)) = (momentum.as_mut(), g.bodies.as_ref()) {
-            mt.observe(two, &g.vertical, mv);
+            // The series' Pⁿ and Γ^b's mean e_d displacement (u_contact's convention).
+            let p = mt.observe(two, &g.vertical, mv);
+            obs.set_two_body(g.rows.second_mean(&g.contact_weight, u), p);
         }
         if let (Some(fr), Some(ff)) = (fric.as_mut(), fac.friction.as_ref()) {
             // The body's mean velocities 1ᵀMv/1ᵀM1 per axis from the carried M v; the stop

@@ -59,6 +59,17 @@ impl Rows {
         self.len() == self.dof.len() && self.coef.iter().all(|&c| c == 1.0)
     }
 
+    /// Σ_i w_i x at row i's second entry (a node-to-node row's Γ^b dof; unit rows add nothing):
+    /// Γ^b's mean displacement with Γ^a's weights, the `u_contact_b` series of a matching
+    /// interface (contract §5).
+    pub(super) fn second_mean(&self, w: &[f64], x: &[f64]) -> f64 {
+        (0..self.len())
+            .zip(w)
+            .filter(|&(i, _)| self.start[i + 1] - self.start[i] > 1)
+            .map(|(i, w)| w * x[self.dof[self.start[i] + 1]])
+            .sum()
+    }
+
     /// B_i·x, summed from the first entry on (a one-entry row gives x_c itself, bit for bit).
     #[inline]
     pub(super) fn dot(&self, i: usize, x: &[f64]) -> f64 {
