@@ -50,7 +50,11 @@
 //!   76.8 ms frictionless, 73.7 ms Coulomb (57 Newton iterations over the 10 steps, at most 11):
 //!   0.96×; penalty 70.3 ms, 87.96 ms (75 iterations, at most 16): 1.25× — both met (session 28,
 //!   with a full-space sparse LU per Newton iteration: 25×). Mixed 6.68 ms, 13.57 ms (the
-//!   Alart–Curnier Newton on 273 unknowns, 20 iterations): 2.03×, not met.
+//!   Alart–Curnier Newton on 273 unknowns, 20 iterations, a dense LU each): 2.03×, not met.
+//!   With chord steps on the kept LU while the node kinds repeat (`contact::coulomb`'s
+//!   header; session 29, before/after binaries run alternately, load ~1.3): before 3.85 ms,
+//!   9.35 ms (2.43×); after 3.89 ms, 6.86 ms (1.77×; 31 iterations, at most 4) — better, still
+//!   not met: the rest is the fresh factors the chord steps do not avoid and Z's 273 columns.
 //!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).

@@ -33,7 +33,14 @@
 //! in buffers allocated once by [`FrictionalContact::new`]; no allocation per solve. A 2D
 //! system, or a 3D one without a slipping node, depends only on the node states (and μ_f), so
 //! its LU is kept and reused while the states repeat — from one time step to the next during a
-//! steady contact phase a step then costs two triangular solves. Convergence: the natural
+//! steady contact phase a step then costs two triangular solves. A 3D system with slipping
+//! nodes changes with their directions t and ratios α at every iterate, but slowly: while the
+//! node kinds (open, stick, slip) are those of the kept LU, the step is first a chord step on
+//! it, f ← f − J_old⁻¹ (J f − rhs) with the current rows (the exact Newton residual, so its
+//! fixed points are the law's solutions), kept where it divides ‖Φ‖ by at least 10 (else a
+//! Newton step on a fresh factor follows, with the line search below) — on the 3D block of
+//! issue 43, 273 unknowns all sliding, a dense LU (k³/3 flops) per iteration had been most of
+//! the frictional step; a chord step costs a few k² products. Convergence: the natural
 //! residual ‖Φ‖_∞ below `tol` relative to the problem's force scale max(|f|, r|q|) (contract §4:
 //! 1e-12); not converged within `max_iter` steps is an error ([`FrictionalContactError`]), which
 //! an engine reports as a `solver-failed` run. Warm-started from the caller's forces (the
@@ -142,6 +149,11 @@ pub struct FrictionalContact {
     lu_slope: f64,
     lu_k: usize,
     lu_valid: bool,
+    /// `mat` holds an LU of a 3D system with `lu_state`'s node kinds: a chord step may use it
+    /// (module header, the chord steps).
+    lu_chord: bool,
+    /// The rows being reduced are the residual of the Newton equation at `trial` (a chord step).
+    residual_form: bool,
     /// Tresca's closure (the fallback, module header) in force.
     closure: bool,
     /// The caller's warm start, kept for the fallback.
@@ -226,6 +238,8 @@ impl FrictionalContact {
             lu_slope: 0.0,
             lu_k: 0,
             lu_valid: false,
+            lu_chord: false,
+            residual_form: false,
             k: 0,
             closure: false,
             warm: vec![0.0; n],
@@ -392,7 +406,21 @@ impl FrictionalContact {
             // α = 1, ½, ¼, … that decreases ‖Φ‖² (a plain active-set iteration can cycle on a
             // coupled Coulomb problem); if none does, the full step.
             self.trial.copy_from_slice(forces);
-            self.newton_step(law, weights, q_n, q_t)?;
+            if self.newton_step(law, weights, q_n, q_t, true)? {
+                // A chord step (module header): taken whole where it contracts ‖Φ‖ at least
+                // 1/CHORD_RATE-fold, else replaced by a Newton step on a fresh factor.
+                let trial = std::mem::take(&mut self.trial);
+                let (r, mr) = self.states_and_residual(law, weights, q_n, q_t, kept, &trial);
+                self.trial = trial;
+                if mr <= CHORD_RATE * CHORD_RATE * merit {
+                    forces.copy_from_slice(&self.trial);
+                    (residual, merit) = (r, mr);
+                    continue;
+                }
+                self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+                self.trial.copy_from_slice(forces);
+                self.newton_step(law, weights, q_n, q_t, false)?;
+            }
             self.start.copy_from_slice(forces);
             let mut alpha = 1.0;
             loop {
@@ -533,14 +561,17 @@ impl FrictionalContact {
     }
 
     /// One Newton (active-set) step from the states of [`Self::states_and_residual`]: the
-    /// linear system on the closed nodes' unknowns, solved into `trial`.
+    /// linear system on the closed nodes' unknowns, solved into `trial` (the iterate on entry).
+    /// With `chord_ok`, a 3D step whose node kinds are those of the kept LU is a chord step on
+    /// it (returns true).
     fn newton_step(
         &mut self,
         law: &FrictionLaw,
         weights: &[f64],
         q_n: &[f64],
         q_t: &[f64],
-    ) -> Result<(), FrictionalContactError> {
+        chord_ok: bool,
+    ) -> Result<bool, FrictionalContactError> {
         let slope = match *law {
             FrictionLaw::Coulomb { coefficient } => coefficient,
             _ => 0.0,
@@ -558,18 +589,43 @@ impl FrictionalContact {
             && self.lu_k == k
             && self.lu_state == self.state
             && self.lu_extra == self.extra;
-        self.assemble_rows(law, weights, q_n, q_t, slope, reuse);
-        if !reuse {
+        let chord = !reuse
+            && chord_ok
+            && self.lu_chord
+            && !has_graze
+            && self.lu_slope == slope
+            && self.lu_k == k
+            && self.lu_extra == self.extra
+            && self
+                .state
+                .iter()
+                .zip(&self.lu_state)
+                .all(|(a, b)| std::mem::discriminant(a) == std::mem::discriminant(b));
+        self.residual_form = chord;
+        self.assemble_rows(law, weights, q_n, q_t, slope, reuse || chord);
+        self.residual_form = false;
+        if !reuse && !chord {
+            self.lu_valid = false;
+            self.lu_chord = false;
             lu_factor(&mut self.mat[..k * k], k, &mut self.piv[..k])?;
             self.lu_state.copy_from_slice(&self.state);
             self.lu_slope = slope;
             self.lu_k = k;
             self.lu_extra.copy_from_slice(&self.extra);
             self.lu_valid = !has_slip3 && !has_graze;
+            self.lu_chord = self.d == 3 && !has_graze;
         }
         lu_solve(&self.mat[..k * k], k, &self.piv[..k], &mut self.rhs[..k]);
+        if chord {
+            // The correction δ = −J_old⁻¹ (J f − rhs) onto the iterate's unknowns.
+            for (j, &c) in self.col.iter().enumerate() {
+                if c != NONE {
+                    self.rhs[c] += self.trial[j];
+                }
+            }
+        }
         self.write_trial(law, weights, slope);
-        Ok(())
+        Ok(chord)
     }
 
     /// Unknowns: f_n of every closed node, f_t unless eliminated (2D slip); their indices into
@@ -756,12 +812,21 @@ impl FrictionalContact {
                             self.mat[e * k + self.col[i * d + c]] += self.row[i * d + c];
                         }
                     }
+                    if self.residual_form {
+                        for c in 0..d {
+                            rhs -= self.row[i * d + c] * self.trial[i * d + c];
+                        }
+                    }
                 }
             }
         }
         self.rhs[e] = rhs;
     }
 }
+
+/// A chord step (module header) is kept where it divides ‖Φ‖ by at least 1/CHORD_RATE: a
+/// digit per step, so that a slowly contracting chord does not outlast the Newton steps.
+const CHORD_RATE: f64 = 0.1;
 
 /// The continuation's first step in the bound's factor θ (then doubled after each success,
 /// halved after each failure) and its smallest step before it gives up.

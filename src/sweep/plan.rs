@@ -382,6 +382,7 @@ fn resolve_given(
     if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
         revision.push_str("revision=friction-balance-step-1\n");
     }
+    chord_revision(scene, &m, &mut revision);
     if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
@@ -719,13 +720,26 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 5] = [
+const THIS_VERSION: [&str; 6] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
     "revision=quasi-static-start",
     "revision=increment-step",
+    "revision=mixed-friction-chord",
 ];
+
+/// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
+/// (`contact::coulomb`'s header): the same solution to the same tolerance, not the same
+/// round-off, so such a run gets a revision line.
+fn chord_revision(scene: &dyn Scene, m: &Method, revision: &mut String) {
+    if scene.fe_dim() == Some(3)
+        && m.friction_kind != FrictionKind::None
+        && m.contact == ContactMethod::Mixed
+    {
+        revision.push_str("revision=mixed-friction-chord\n");
+    }
+}
 
 /// The revision lines of a run's id in the previous version: its lines without this version's
 /// when it carries one of them; else empty — the ids of before issue 34, which a folder of any
