@@ -122,6 +122,21 @@ enum NodeState {
     },
 }
 
+/// One step's problem as every stage of the solve sees it (the primary Newton, Tresca's
+/// closure, the continuation, Gauss–Seidel and its polish): the free gaps and slips, Tresca's
+/// node weights, the nodes allowed to carry force, the iteration budget and the tolerance
+/// relative to max(`scale`, |f|).
+#[derive(Clone, Copy)]
+struct Problem<'a> {
+    weights: &'a [f64],
+    q_n: &'a [f64],
+    q_t: &'a [f64],
+    kept: &'a dyn Fn(usize) -> bool,
+    max_iter: usize,
+    tol: f64,
+    scale: f64,
+}
+
 /// The frictional contact problem of m nodes in dimension d, with its workspace.
 #[derive(Debug, Clone)]
 pub struct FrictionalContact {
@@ -326,11 +341,20 @@ impl FrictionalContact {
         for i in (0..m).filter(|&i| !kept(i)) {
             forces[i * d..(i + 1) * d].iter_mut().for_each(|x| *x = 0.0);
         }
+        let p = Problem {
+            weights,
+            q_n,
+            q_t,
+            kept: &kept,
+            max_iter,
+            tol,
+            scale,
+        };
         let tresca = matches!(*law, FrictionLaw::Tresca { threshold } if threshold > 0.0);
         self.closure = false;
         self.stages = Stages::default();
         self.warm.copy_from_slice(forces);
-        let e = match self.newton(law, weights, q_n, q_t, &kept, forces, max_iter, tol, scale) {
+        let e = match self.newton(law, &p, forces) {
             Ok(it) => {
                 self.stages.newton = it;
                 return Ok(it);
@@ -351,7 +375,7 @@ impl FrictionalContact {
                 } else {
                     forces.copy_from_slice(&self.warm);
                 }
-                match self.newton(law, weights, q_n, q_t, &kept, forces, max_iter, tol, scale) {
+                match self.newton(law, &p, forces) {
                     Ok(it) => {
                         self.closure = false;
                         self.stages.closure = it + max_iter * usize::from(cold);
@@ -369,29 +393,22 @@ impl FrictionalContact {
             }
         }
         // The rescue (module header): continuation in the bound, then block Gauss–Seidel.
-        let r = self.rescue(law, weights, q_n, q_t, &kept, forces, max_iter, tol, scale);
+        let r = self.rescue(law, &p, forces);
         self.closure = false;
         r.map(|_| self.stages.total())
     }
 
     /// The damped semismooth Newton iteration from `forces` (the law's form as `closure`
     /// says), to `tol` relative to max(`scale`, |f|).
-    #[allow(clippy::too_many_arguments)]
     fn newton(
         &mut self,
         law: &FrictionLaw,
-        weights: &[f64],
-        q_n: &[f64],
-        q_t: &[f64],
-        kept: &dyn Fn(usize) -> bool,
+        p: &Problem,
         forces: &mut [f64],
-        max_iter: usize,
-        tol: f64,
-        scale: f64,
     ) -> Result<usize, FrictionalContactError> {
+        let (max_iter, tol, scale) = (p.max_iter, p.tol, p.scale);
         let eps_scale = |f: &[f64]| f.iter().fold(scale, |s, x| s.max(x.abs()));
-        let (mut residual, mut merit) =
-            self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+        let (mut residual, mut merit) = self.states_and_residual(law, p, forces);
         for it in 0..=max_iter {
             if !residual.is_finite() {
                 return Err(FrictionalContactError::NonFinite);
@@ -406,20 +423,20 @@ impl FrictionalContact {
             // α = 1, ½, ¼, … that decreases ‖Φ‖² (a plain active-set iteration can cycle on a
             // coupled Coulomb problem); if none does, the full step.
             self.trial.copy_from_slice(forces);
-            if self.newton_step(law, weights, q_n, q_t, true)? {
+            if self.newton_step(law, p.weights, p.q_n, p.q_t, true)? {
                 // A chord step (module header): taken whole where it contracts ‖Φ‖ at least
                 // 1/CHORD_RATE-fold, else replaced by a Newton step on a fresh factor.
                 let trial = std::mem::take(&mut self.trial);
-                let (r, mr) = self.states_and_residual(law, weights, q_n, q_t, kept, &trial);
+                let (r, mr) = self.states_and_residual(law, p, &trial);
                 self.trial = trial;
                 if mr <= CHORD_RATE * CHORD_RATE * merit {
                     forces.copy_from_slice(&self.trial);
                     (residual, merit) = (r, mr);
                     continue;
                 }
-                self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+                self.states_and_residual(law, p, forces);
                 self.trial.copy_from_slice(forces);
-                self.newton_step(law, weights, q_n, q_t, false)?;
+                self.newton_step(law, p.weights, p.q_n, p.q_t, false)?;
             }
             self.start.copy_from_slice(forces);
             let mut alpha = 1.0;
@@ -427,12 +444,11 @@ impl FrictionalContact {
                 for ((f, s), t) in forces.iter_mut().zip(&self.start).zip(&self.trial) {
                     *f = s + alpha * (t - s);
                 }
-                let (r, mr) = self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+                let (r, mr) = self.states_and_residual(law, p, forces);
                 if mr <= (1.0 - 1e-4 * alpha) * merit || alpha < 1e-3 {
                     if alpha < 1e-3 && mr > merit {
                         forces.copy_from_slice(&self.trial);
-                        (residual, merit) =
-                            self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+                        (residual, merit) = self.states_and_residual(law, p, forces);
                     } else {
                         (residual, merit) = (r, mr);
                     }
@@ -449,15 +465,14 @@ impl FrictionalContact {
 
     /// gap and slip of `f` into `y`, each node's state for the next Newton step, and the
     /// natural residual ‖Φ(f)‖_∞.
-    fn states_and_residual(
-        &mut self,
-        law: &FrictionLaw,
-        weights: &[f64],
-        q_n: &[f64],
-        q_t: &[f64],
-        kept: &dyn Fn(usize) -> bool,
-        f: &[f64],
-    ) -> (f64, f64) {
+    fn states_and_residual(&mut self, law: &FrictionLaw, p: &Problem, f: &[f64]) -> (f64, f64) {
+        let Problem {
+            weights,
+            q_n,
+            q_t,
+            kept,
+            ..
+        } = *p;
         let (m, d) = (self.m, self.d);
         let n = m * d;
         for (k, yk) in self.y.iter_mut().enumerate() {
@@ -845,30 +860,22 @@ impl FrictionalContact {
     /// to the law (θ = 1), with an adaptive step; then projected block Gauss–Seidel on the law
     /// itself from the last point solved, polished by Newton. Each stage stops at the same
     /// natural residual `tol` as the primary Newton.
-    #[allow(clippy::too_many_arguments)]
     fn rescue(
         &mut self,
         law: &FrictionLaw,
-        weights: &[f64],
-        q_n: &[f64],
-        q_t: &[f64],
-        kept: &dyn Fn(usize) -> bool,
+        p: &Problem,
         forces: &mut [f64],
-        max_iter: usize,
-        tol: f64,
-        scale: f64,
     ) -> Result<(), FrictionalContactError> {
         // Tresca is continued and relaxed in its closure (the literal law's solutions are the
         // closure's too; the closure has one where the law has none).
         self.closure = matches!(*law, FrictionLaw::Tresca { threshold } if threshold > 0.0);
         forces.iter_mut().for_each(|x| *x = 0.0);
+        let max_iter = p.max_iter;
         let (mut solved, mut step) = (None::<f64>, CONTINUATION_STEP);
         loop {
             let theta = solved.map_or(0.0, |t| (t + step).min(1.0));
             let scaled = scaled_law(law, theta);
-            match self.newton(
-                &scaled, weights, q_n, q_t, kept, forces, max_iter, tol, scale,
-            ) {
+            match self.newton(&scaled, p, forces) {
                 Ok(it) => {
                     self.stages.continuation += it;
                     if theta == 1.0 {
@@ -896,31 +903,32 @@ impl FrictionalContact {
         } else {
             forces.copy_from_slice(&self.warm);
         }
-        self.gauss_seidel(law, weights, q_n, q_t, kept, forces, max_iter, tol, scale)
+        self.gauss_seidel(law, p, forces)
     }
 
     /// Projected block Gauss–Seidel on the law (module header): node by node, the others held,
     /// [`GS_LOCAL`] projections f_n ← [f_n − r y_n]₊, f_t ← proj_B(b)(f_t − r_t y_t) with y the
     /// node's gap and slip kept current; every [`GS_POLISH_EVERY`] sweeps a Newton polish from
     /// a copy. Converged when the natural residual meets `tol` (as Newton's).
-    #[allow(clippy::too_many_arguments)]
     fn gauss_seidel(
         &mut self,
         law: &FrictionLaw,
-        weights: &[f64],
-        q_n: &[f64],
-        q_t: &[f64],
-        kept: &dyn Fn(usize) -> bool,
+        p: &Problem,
         forces: &mut [f64],
-        max_iter: usize,
-        tol: f64,
-        scale: f64,
     ) -> Result<(), FrictionalContactError> {
+        let Problem {
+            weights,
+            kept,
+            max_iter,
+            tol,
+            scale,
+            ..
+        } = *p;
         let eps_scale = |f: &[f64]| f.iter().fold(scale, |s, x| s.max(x.abs()));
         let mut residual = f64::INFINITY;
         for sweep in 1..=GS_SWEEPS_PER_STEP * max_iter {
             // y = q + W f afresh each sweep (no drift of the incremental updates).
-            self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+            self.states_and_residual(law, p, forces);
             for i in (0..self.m).filter(|&i| kept(i)) {
                 for _ in 0..GS_LOCAL {
                     if !self.relax_node(law, weights, i, forces) {
@@ -929,7 +937,7 @@ impl FrictionalContact {
                 }
             }
             self.stages.gauss_seidel = sweep;
-            (residual, _) = self.states_and_residual(law, weights, q_n, q_t, kept, forces);
+            (residual, _) = self.states_and_residual(law, p, forces);
             if !residual.is_finite() {
                 return Err(FrictionalContactError::NonFinite);
             }
@@ -938,7 +946,7 @@ impl FrictionalContact {
             }
             if sweep % GS_POLISH_EVERY == 0 {
                 self.best.copy_from_slice(forces);
-                match self.newton(law, weights, q_n, q_t, kept, forces, max_iter, tol, scale) {
+                match self.newton(law, p, forces) {
                     Ok(it) => {
                         self.stages.polish += it;
                         return Ok(());
