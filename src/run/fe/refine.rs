@@ -128,6 +128,20 @@ impl Refinement {
         Err("iterative refinement: the contact set did not settle".into())
     }
 
+    /// The bodies' part of the residual, r = b − (M + cτ²K)u, into `r`; returns the scale
+    /// max(‖b‖∞, ‖(M + cτ²K)u‖∞) the tolerance is relative to.
+    fn body_residual(&mut self, g: &Geometry, fac: &Factored, c_tau2: f64, u: &[f64]) -> f64 {
+        fac.m.matvec_into(u, &mut self.r);
+        g.k.matvec_into(u, &mut self.mk);
+        let mut scale = 0.0f64;
+        for ((r, mk), b) in self.r.iter_mut().zip(&self.mk).zip(&self.rhs) {
+            let au = *r + c_tau2 * mk;
+            scale = scale.max(b.abs()).max(au.abs());
+            *r = b - au;
+        }
+        scale
+    }
+
     /// Correction sweeps on the rows `active` until the residual meets the tolerance.
     #[allow(clippy::too_many_arguments)]
     fn sweeps(
@@ -143,14 +157,7 @@ impl Refinement {
         let (n, nc) = (u.len(), g.rows.len());
         for _ in 0..SWEEPS {
             // r = b + cτ²Bᵀλ − (M + cτ²K)u.
-            fac.m.matvec_into(u, &mut self.r);
-            g.k.matvec_into(u, &mut self.mk);
-            let mut scale = 0.0f64;
-            for i in 0..n {
-                let au = self.r[i] + c_tau2 * self.mk[i];
-                scale = scale.max(self.rhs[i].abs()).max(au.abs());
-                self.r[i] = self.rhs[i] - au;
-            }
+            let mut scale = self.body_residual(g, fac, c_tau2, u);
             for &i in &self.active {
                 g.rows.add(i, c_tau2 * lambda[i], &mut self.r);
                 scale = scale.max((c_tau2 * lambda[i]).abs());
@@ -216,14 +223,7 @@ impl Refinement {
             ops.w[q] / ops.gamma[q] * (ops.apply(&ops.p, q, u) - ops.gap[q]).max(0.0)
         };
         for _ in 0..PENALTY_SWEEPS {
-            fac.m.matvec_into(u, &mut self.r);
-            g.k.matvec_into(u, &mut self.mk);
-            let mut scale = 0.0f64;
-            for i in 0..n {
-                let au = self.r[i] + c_tau2 * self.mk[i];
-                scale = scale.max(self.rhs[i].abs()).max(au.abs());
-                self.r[i] = self.rhs[i] - au;
-            }
+            let mut scale = self.body_residual(g, fac, c_tau2, u);
             self.active.clear();
             for q in 0..nq {
                 let f = phi(q, u);
