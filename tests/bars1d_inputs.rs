@@ -160,7 +160,8 @@ fn a_bars1d_run_fills_the_two_body_columns() {
     assert_eq!(free.status, "ok");
     assert_eq!(free.far_end.as_deref(), Some("free"));
     assert_eq!(free.mass_side.as_deref(), Some("both"));
-    assert_eq!(free.length_b, Some(1.0));
+    // B's length defaults to A's (contract §1.9): not given, so its column is null.
+    assert_eq!(free.length_b, None);
     assert!(free.momentum_drift.unwrap() <= 1e-12);
     assert!(free.velocity_a_final.is_some() && free.velocity_b_final.is_some());
     for r in series.rows() {
@@ -170,4 +171,50 @@ fn a_bars1d_run_fills_the_two_body_columns() {
     let (clamped, _) = &rows[1];
     assert_eq!(clamped.far_end.as_deref(), Some("clamped"));
     assert_eq!(clamped.momentum_drift, None);
+}
+
+/// B's material keys default to A's values (contract §1.9): A of length 2, modulus 4 and
+/// density 3 with B's keys omitted is the run with B's keys written equal to A's — the same
+/// numbers bit for bit (the same parameters reach the engine), under different ids (the
+/// written keys enter the id), and the omitted ones leave B's columns null. Equal bars leave
+/// A at rest and B at A's speed (contract §1.9's first row), so v̄_b is near V = 1 (within
+/// 2e-2 at 20 elements: the two-bar test's errors are 1e-2 at that level).
+#[test]
+fn b_material_defaults_to_a() {
+    use contact_sweep::run::{RunOptions, RunRecord, record::Timing, simulate};
+    use contact_sweep::sweep::{SweepFile, expand};
+    let text = "name = \"t\"\nscene = \"bars1d\"\n[fixed]\nT = 6.0\nelements = 20\ncourant = 1.0\nmass = \"zero-contact\"\nscheme = \"crank-nicolson\"\nlength = 2.0\nyoung = 4.0\ndensity = 3.0\n[grid]\ncase = [{}, { length_b = 2.0, young_b = 4.0, density_b = 3.0 }]\n";
+    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
+    assert_eq!(plan.runs.len(), 2);
+    let timing = Timing {
+        median_s: 0.0,
+        min_s: 0.0,
+        max_s: 0.0,
+        repeats: 1,
+    };
+    let rec: Vec<RunRecord> = plan
+        .runs
+        .iter()
+        .map(|spec| {
+            let out = simulate(&spec.config, &RunOptions::default());
+            RunRecord::new("t", spec, &out, timing)
+        })
+        .collect();
+    let (omitted, written) = (&rec[0], &rec[1]);
+    assert_eq!(omitted.status, "ok");
+    assert_ne!(omitted.run_id, written.run_id);
+    assert_eq!(
+        (omitted.length_b, omitted.young_b, omitted.density_b),
+        (None, None, None)
+    );
+    assert_eq!(written.length_b, Some(2.0));
+    for (a, b) in [
+        (omitted.velocity_a_final, written.velocity_a_final),
+        (omitted.velocity_b_final, written.velocity_b_final),
+        (omitted.energy_final, written.energy_final),
+        (omitted.momentum_drift, written.momentum_drift),
+    ] {
+        assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+    }
+    assert!((omitted.velocity_b_final.unwrap() - 1.0).abs() < 2e-2);
 }

@@ -164,3 +164,79 @@ fn twelve_method_groups_are_drawn_apart_in_every_figure() {
         assert_eq!(looks.len(), GROUPS, "{id} legend looks");
     }
 }
+
+/// The SVG figures of a `<h3 id=…>` subsection (up to the next heading).
+fn subsection_figures<'a>(html: &'a str, id: &str) -> Vec<&'a str> {
+    let start = html
+        .find(&format!("<h3 id=\"{id}\">"))
+        .unwrap_or_else(|| panic!("no subsection {id}"));
+    let rest = &html[start + 4..];
+    let end = [rest.find("<h2"), rest.find("<h3")]
+        .into_iter()
+        .flatten()
+        .min()
+        .unwrap_or(rest.len());
+    rest[..end]
+        .split("<svg")
+        .skip(1)
+        .map(|s| &s[..s.find("</svg>").unwrap()])
+        .collect()
+}
+
+#[test]
+fn two_body_runs_draw_both_contact_faces_and_the_momentum() {
+    // Two bars (contract §1.9) in three method groups: both faces and the momentum are drawn
+    // for each, in its group's colour; a one-body report has no such subsection (the test
+    // above's bar1d report is checked for its absence).
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(
+        tmp.path(),
+        "bars.toml",
+        "name = \"bars\"\nscene = \"bars1d\"\n\n[fixed]\nT = 3.0\ncourant = 1.0\nscheme = \"crank-nicolson\"\nmass = \"zero-contact\"\n\n[grid]\nelements = [10, 20]\ncase = [{ space = \"mixed\" }, { space = \"penalty\", penalty_gamma0 = 10.0 }, { space = \"nitsche\", nitsche_gamma0 = 0.1 }]\n",
+    );
+    let o = cli(
+        tmp.path(),
+        &[
+            "run",
+            sweep.to_str().unwrap(),
+            "--out",
+            "out",
+            "--threads",
+            "2",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(tmp.path().join("out/report.html")).unwrap();
+    let figs = subsection_figures(&html, "two-body");
+    assert_eq!(figs.len(), 2, "u_C^a/u_C^b and the momentum");
+    for svg in &figs {
+        assert_eq!(curve_colours(svg).len(), 3, "one colour per method group");
+    }
+    assert!(figs[0].contains("u_C^a, u_C^b"), "{}", figs[0]);
+    assert!(figs[1].contains("momentum"), "{}", figs[1]);
+}
+
+#[test]
+fn a_one_body_report_has_no_two_body_figures() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(
+        tmp.path(),
+        "one.toml",
+        "name = \"one\"\nscene = \"bar1d\"\n\n[fixed]\nT = 2.0\ncourant = 1.0\nscheme = \"crank-nicolson\"\n\n[grid]\nh = [0.125, 0.0625]\n",
+    );
+    let o = cli(
+        tmp.path(),
+        &[
+            "run",
+            sweep.to_str().unwrap(),
+            "--out",
+            "out",
+            "--threads",
+            "2",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let html = std::fs::read_to_string(tmp.path().join("out/report.html")).unwrap();
+    assert!(html.contains("<h2 id=\"series\">"));
+    assert!(!html.contains("id=\"two-body\""));
+}

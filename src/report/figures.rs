@@ -17,6 +17,9 @@
 //! - Frictional runs: the energy balance (E, W_f and E + W_f against t in one panel: a scheme
 //!   whose E + W_f stays flat while E falls lost only the friction's work) and the slip velocity
 //!   v_t of the contact node.
+//! - Two-body runs: both bodies' contact displacements u_C^a, u_C^b in one panel (A solid, B
+//!   faded), and the total momentum's departure Pⁿ − P⁰, which is round-off for an exact
+//!   scheme with free bodies (contract §2.6).
 //!
 //! Every curve carries its group's colour and marker ([`super::style`]: distinct for up to 60
 //! groups); the time-series curves, too dense for a marker per point, carry a dozen markers
@@ -451,24 +454,47 @@ pub fn balance(
     work: &[Curve],
     total: &[Curve],
 ) -> Result<String, FigureError> {
-    let Some((t, y)) = time_axes(energy.iter().chain(work).chain(total)) else {
+    layered(
+        title,
+        "energy / energy_scale",
+        &[(work, 1, true), (energy, 1, false), (total, 3, false)],
+    )
+}
+
+/// Several quantities of the same runs in one time panel, told apart by line style rather than
+/// by a legend per curve: each layer is (curves, stroke width, faded), drawn in that order, a
+/// curve in its group's colour.
+pub fn layered(
+    title: &str,
+    y_name: &str,
+    layers: &[(&[Curve], u32, bool)],
+) -> Result<String, FigureError> {
+    let all = layers.iter().flat_map(|(c, _, _)| c.iter());
+    let Some((t, y)) = time_axes(all) else {
         return Err(err(title)("no values to plot".into()));
     };
-    let names = ("t", "energy / energy_scale");
-    panel(title, &TIME, names, t.0..t.1, y.0..y.1, None, |chart| {
-        for (curves, width, faded) in [(work, 1, true), (energy, 1, false), (total, 3, false)] {
-            for c in curves {
-                let col = style::color(c.group);
-                let style = if faded {
-                    col.mix(0.45).stroke_width(width)
-                } else {
-                    col.stroke_width(width)
-                };
-                time_curve(chart, c, style)?;
+    panel(
+        title,
+        &TIME,
+        ("t", y_name),
+        t.0..t.1,
+        y.0..y.1,
+        None,
+        |chart| {
+            for &(curves, width, faded) in layers {
+                for c in curves {
+                    let col = style::color(c.group);
+                    let style = if faded {
+                        col.mix(0.45).stroke_width(width)
+                    } else {
+                        col.stroke_width(width)
+                    };
+                    time_curve(chart, c, style)?;
+                }
             }
-        }
-        Ok(())
-    })
+            Ok(())
+        },
+    )
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
-//! The report's figure sections: convergence, work-precision, time series and the frictional
-//! runs' energy balance and slip velocity — what each figure shows of the summary's
-//! computations (the same groups, main refinement paths, least-squares slopes and Pareto
+//! The report's figure sections: convergence, work-precision, time series, the frictional
+//! runs' energy balance and slip velocity, and the two-body runs' contact faces and momentum —
+//! what each figure shows of the summary's computations (the same groups, main refinement paths, least-squares slopes and Pareto
 //! fronts as `DIR/summary/`), the caption above it and the legend of its method groups.
 //! [`super::figures`] draws them.
 //!
@@ -311,7 +311,69 @@ pub(super) fn time_series(page: &mut Page, dir: &Path, s: &Sections) -> anyhow::
     }
     page.body.push_str("</div>\n");
     frictional_figures(page, runs, &chosen, &series);
+    two_body_figures(page, runs, &chosen, &series);
     Ok(())
+}
+
+/// The two-body runs' figures (only when some chosen run recorded B's contact displacement or
+/// the momentum): u_C^a and u_C^b against t in one panel — the bodies' faces move together
+/// while in contact and part at release — and the total momentum's departure Pⁿ − P⁰, the
+/// invariant every scheme keeps with free bodies (contract §2.6), so a curve off round-off is a
+/// force that is not action = reaction (or a load or clamp, which `momentum_drift` marks null).
+fn two_body_figures(
+    page: &mut Page,
+    runs: &Runs,
+    chosen: &[(usize, usize)],
+    series: &HashMap<String, RunSeries>,
+) {
+    let (mut ua, mut ub, mut p) = (Vec::new(), Vec::new(), Vec::new());
+    let mut groups = Vec::new();
+    for &(g, i) in chosen {
+        let r = &runs.runs[i];
+        let Some(rs) = series.get(&r.run_id) else {
+            continue;
+        };
+        if rs.u_b.is_empty() && rs.momentum.is_empty() {
+            continue;
+        }
+        let curve = |points: &[(f64, f64)]| Curve {
+            name: runs.groups[g].title.clone(),
+            points: figures::decimate(points, 1500),
+            group: g,
+        };
+        if !rs.u_b.is_empty() {
+            ua.push(curve(&rs.u));
+            ub.push(curve(&rs.u_b));
+        }
+        if let Some(&(_, p0)) = rs.momentum.first() {
+            let dev: Vec<(f64, f64)> = rs.momentum.iter().map(|&(t, x)| (t, x - p0)).collect();
+            p.push(curve(&dev));
+        }
+        groups.push(g);
+    }
+    if groups.is_empty() {
+        return;
+    }
+    let body = &mut page.body;
+    body.push_str("<h3 id=\"two-body\">Two bodies: both contact faces and the momentum</h3>\n");
+    body.push_str("<p class=\"note\">Same runs as above, those with two bodies. Contact displacements: solid u_C^a (A's contact end or face node), faded u_C^b (B's) — equal while the faces touch (with the gap subtracted), apart after release. Momentum: Pⁿ − P⁰ of the whole system, round-off for free bodies with no load (contract §2.6); a load adds its impulse.</p>\n");
+    body.push_str(&legend(runs, &groups, "solid A, faded B"));
+    body.push_str("<div class=\"figs\">\n");
+    let mut drawn = Vec::new();
+    if !ub.is_empty() {
+        drawn.push(figures::layered(
+            "contact displacements u_C^a, u_C^b (t)",
+            "u_C",
+            &[(&ub, 3, true), (&ua, 1, false)],
+        ));
+    }
+    if !p.is_empty() {
+        drawn.push(figures::series("total momentum Pⁿ − P⁰", "ΔP", &p, None));
+    }
+    for fig in drawn {
+        page.figure(fig);
+    }
+    page.body.push_str("</div>\n");
 }
 
 /// The frictional runs' figures (only when some chosen run has a friction law and recorded its

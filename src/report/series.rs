@@ -1,6 +1,7 @@
 //! The time series the report draws, read from `DIR/series`: for one run per method group,
-//! the contact displacement and pressure, the energy, their exact values, and for frictional
-//! runs the frictional work and the slip velocity — only those runs' rows and those columns.
+//! the contact displacement and pressure, the energy, their exact values, for frictional
+//! runs the frictional work and the slip velocity, and for two-body runs B's contact
+//! displacement and the total momentum — only those runs' rows and those columns.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -19,6 +20,10 @@ pub(super) struct RunSeries {
     /// (t, v_t) the contact node's slip velocity.
     pub balance: Vec<(f64, f64, f64)>,
     pub v_t: Vec<(f64, f64)>,
+    /// Two-body runs (null columns otherwise): (t, u_C^b) B's contact displacement and
+    /// (t, P) the total momentum.
+    pub u_b: Vec<(f64, f64)>,
+    pub momentum: Vec<(f64, f64)>,
 }
 
 /// The series of the runs `chosen`, in time order. Only the series parts that hold them are
@@ -39,8 +44,9 @@ pub(super) fn read_series(
     // A run without its part's name (not known to the loader) means: read every part.
     let parts: Option<HashSet<String>> = chosen.iter().map(|r| r.part.clone()).collect();
     let wanted: HashSet<&str> = chosen.iter().map(|r| r.run_id.as_str()).collect();
-    // The friction columns are absent from frictionless parts: read as nulls, nothing drawn.
-    const DRAWN: [&str; 8] = [
+    // The friction and two-body columns are absent from the parts of runs without them: read
+    // as nulls, nothing drawn.
+    const DRAWN: [&str; 10] = [
         "t",
         "u_contact",
         "sigma_contact",
@@ -49,6 +55,8 @@ pub(super) fn read_series(
         "sigma_contact_exact",
         "friction_work",
         "v_t_contact",
+        "u_contact_b",
+        "momentum",
     ];
     for part in crate::sink::parquet_parts(&folder)? {
         let name = part
@@ -69,7 +77,7 @@ pub(super) fn read_series(
         let Ok(cols) = pq::read_rows_f64(&part, &rows, &DRAWN) else {
             continue;
         };
-        let [t, u, s, en, ue, se, wf, vt] = &cols[..] else {
+        let [t, u, s, en, ue, se, wf, vt, ub, p] = &cols[..] else {
             unreachable!("one vector per drawn column")
         };
         let mut k = 0;
@@ -88,6 +96,8 @@ pub(super) fn read_series(
                     push(&mut rs.u_exact, ue[k]);
                     push(&mut rs.sigma_exact, se[k]);
                     push(&mut rs.v_t, vt[k]);
+                    push(&mut rs.u_b, ub[k]);
+                    push(&mut rs.momentum, p[k]);
                     if let (Some(e), Some(w)) = (en[k], wf[k])
                         && e.is_finite()
                         && w.is_finite()
@@ -109,6 +119,8 @@ pub(super) fn read_series(
             &mut rs.u_exact,
             &mut rs.sigma_exact,
             &mut rs.v_t,
+            &mut rs.u_b,
+            &mut rs.momentum,
         ] {
             if !v.is_sorted_by(|a, b| a.0 <= b.0) {
                 v.sort_by(|a, b| a.0.total_cmp(&b.0));

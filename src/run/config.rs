@@ -62,10 +62,12 @@ impl RunConfig {
                     Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
                 ))
             }
-            SceneSetup::Bars1d { bars, elements } => RunConfig::Bars1d(bars1d::Bars1dConfig::new(
-                bars,
-                Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
-            )),
+            SceneSetup::Bars1d { bars, elements, .. } => {
+                RunConfig::Bars1d(bars1d::Bars1dConfig::new(
+                    bars,
+                    Grid1d::with_steps(elements, dt, steps, method, mass, scheme),
+                ))
+            }
         }
     }
 

@@ -237,9 +237,9 @@ schema! {
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (contract §1.5; 0: frictionless)";
         stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
-        length_b: Option<f64> => "m", "bars1d: bar B's length L_b (contract §1.9)";
-        young_b: Option<f64> => "Pa", "bars1d: bar B's Young modulus E_b";
-        density_b: Option<f64> => "kg/m^d", "two bodies: body B's density ρ_b (kg/m in 1D; blocks: null when it is A's)";
+        length_b: Option<f64> => "m", "bars1d: bar B's length L_b (contract §1.9; null when it is A's)";
+        young_b: Option<f64> => "Pa", "bars1d: bar B's Young modulus E_b (null when it is A's)";
+        density_b: Option<f64> => "kg/m^d", "two bodies: body B's density ρ_b (kg/m in 1D; null when it is A's)";
         velocity_b: Option<f64> => "m/s", "two bodies: body B's initial velocity V_b along e_x (1D; A's is `velocity`, towards B) or e_d";
         far_end: Option<String> => "", "two bodies: B's far end (its base in 2D/3D), free or clamped (contract §1.9, §1.10)";
         mass_side: Option<String> => "", "two bodies: the bodies whose contact layers the mass variant modifies: both, a or b (contract §2.6)";
@@ -502,8 +502,8 @@ impl RunRecord {
             friction_force: f(Key::FrictionForce),
             stop_time: m.stop_time,
             stop_time_exact: m.stop_time_exact,
-            length_b: f(Key::LengthB),
-            young_b: f(Key::YoungB),
+            length_b: f(Key::LengthB).filter(|x| !x.is_nan()),
+            young_b: f(Key::YoungB).filter(|x| !x.is_nan()),
             density_b: f(Key::DensityB).filter(|x| !x.is_nan()),
             velocity_b: f(Key::VelocityB),
             far_end: p.get(&Key::FarEnd).map(|v| v.to_string()),

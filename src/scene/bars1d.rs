@@ -87,17 +87,17 @@ const fn key(name: &'static str, default: f64) -> PhysicsKey {
 }
 
 /// The physics keys (contract §7). The choice keys hold indices into `Key::choices()`:
-/// `far_end` 0 = free, `mass_side` 0 = both, `nitsche_sides` 0 = unbiased. B's material
-/// defaults to A's defaults (L = E = ρ = 1).
+/// `far_end` 0 = free, `mass_side` 0 = both, `nitsche_sides` 0 = unbiased. B's material keys
+/// default to A's values (NaN here, resolved by [`super::two_body::b_value`]).
 const BARS1D_PHYSICS: [PhysicsKey; 12] = [
     key("length", 1.0),
     key("young", 1.0),
     key("density", 1.0),
     key("velocity", 1.0),
     key("gap", 0.0),
-    key("length_b", 1.0),
-    key("young_b", 1.0),
-    key("density_b", 1.0),
+    key("length_b", f64::NAN),
+    key("young_b", f64::NAN),
+    key("density_b", f64::NAN),
     key("velocity_b", 0.0),
     key("far_end", 0.0),
     key("mass_side", 0.0),
@@ -125,15 +125,22 @@ const SCHEMES: [&str; 8] = [
 impl Bars1dScene {
     /// The run's physics as the engine takes them.
     pub fn params(physics: &Physics) -> Bars1dParams {
-        let bar = |suffix: &str| BarMaterial {
-            length: physics.get(&format!("length{suffix}")),
-            young: physics.get(&format!("young{suffix}")),
-            density: physics.get(&format!("density{suffix}")),
-            velocity: physics.get(&format!("velocity{suffix}")),
+        let value = |name: &str, b: bool| {
+            if b {
+                super::two_body::b_value(physics, name)
+            } else {
+                physics.get(name)
+            }
+        };
+        let bar = |b: bool| BarMaterial {
+            length: value("length", b),
+            young: value("young", b),
+            density: value("density", b),
+            velocity: physics.get(if b { "velocity_b" } else { "velocity" }),
         };
         Bars1dParams {
-            a: bar(""),
-            b: bar("_b"),
+            a: bar(false),
+            b: bar(true),
             gap: physics.get("gap"),
             clamped: physics.get("far_end") == 1.0,
             mass_side: MassSide::from_index(physics.get("mass_side")),
@@ -211,6 +218,10 @@ impl Scene for Bars1dScene {
         SceneSetup::Bars1d {
             bars: Self::params(physics),
             elements: mesh.elements,
+            b_follows_a: super::two_body::b_follows_a_off_one(
+                physics,
+                &["length", "young", "density"],
+            ),
         }
     }
 }

@@ -75,12 +75,6 @@ const BLOCKS_PHYSICS: [PhysicsKey; 18] = [
     key("mesh_ratio", 1.0),
 ];
 
-/// B's value of a material key: its own, or A's where the sweep gives none.
-fn b_value(p: &Physics, name: &str) -> f64 {
-    let own = p.get(&format!("{name}_b"));
-    if own.is_nan() { p.get(name) } else { own }
-}
-
 impl BlocksScene {
     /// Elements across W for a size h (a whole number), or why not.
     fn across(p: &Physics, h: f64) -> Result<usize, String> {
@@ -116,9 +110,9 @@ impl Scene for BlocksScene {
         let c = |l: f64, m: f64, r: f64| ((l + 2.0 * m) / r).sqrt();
         let a = c(p.get("lame_lambda"), p.get("lame_mu"), p.get("density"));
         let b = c(
-            b_value(p, "lame_lambda"),
-            b_value(p, "lame_mu"),
-            b_value(p, "density"),
+            super::two_body::b_value(p, "lame_lambda"),
+            super::two_body::b_value(p, "lame_mu"),
+            super::two_body::b_value(p, "density"),
         );
         a.max(b)
     }
@@ -210,9 +204,9 @@ impl Scene for BlocksScene {
             cells_a: mesh.elements,
             cells_b: (p.get("height_b") / mesh.h).round().max(1.0) as usize,
             base_clamped: p.get("far_end") == 1.0,
-            density_b: b_value(p, "density"),
-            lame_lambda_b: b_value(p, "lame_lambda"),
-            lame_mu_b: b_value(p, "lame_mu"),
+            density_b: super::two_body::b_value(p, "density"),
+            lame_lambda_b: super::two_body::b_value(p, "lame_lambda"),
+            lame_mu_b: super::two_body::b_value(p, "lame_mu"),
             velocity_b: p.get("velocity_b"),
             pressure: p.get("pressure"),
             mass_side: MassSide::from_index(p.get("mass_side")),

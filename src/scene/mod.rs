@@ -96,7 +96,12 @@ pub enum SceneSetup {
     /// The frictional layer: two P1 chains on the same nodes (contract §1.7).
     Layer1d { layer: LayerParams, elements: usize },
     /// Two bars colliding (contract §1.9): A's element count (B's follows from one h).
-    Bars1d { bars: Bars1dParams, elements: usize },
+    Bars1d {
+        bars: Bars1dParams,
+        elements: usize,
+        /// B takes a material value of A's other than 1 (`revision=bars1d-b-follows-a`).
+        b_follows_a: bool,
+    },
 }
 
 /// What [`Scene::setup_from_file`] gives for a mesh file: the mesh choice and the run's setup
@@ -118,6 +123,11 @@ impl SceneSetup {
             SceneSetup::Oscillator(p) if p.friction > 0.0 => {
                 "revision=dry-friction-stick-slip\n".into()
             }
+            // B's material keys defaulted to 1, now to A's values: the runs where the two
+            // differ changed (issue 44).
+            SceneSetup::Bars1d {
+                b_follows_a: true, ..
+            } => "revision=bars1d-b-follows-a\n".into(),
             SceneSetup::Bar1d { .. }
             | SceneSetup::Layer1d { .. }
             | SceneSetup::Bars1d { .. }

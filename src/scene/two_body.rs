@@ -1,6 +1,24 @@
 //! The choices both two-body scenes share (contract §2.6): which bodies a mass variant modifies
-//! (`mass_side`) and how the unbiased Nitsche method weights its two sides (`nitsche_sides`).
-//! One definition, so `bars1d` and `blocks2d`/`blocks3d` read the keys the same way.
+//! (`mass_side`), how the unbiased Nitsche method weights its two sides (`nitsche_sides`), and
+//! B's material keys, which default to A's values (contract §1.9, §1.10). One definition, so
+//! `bars1d` and `blocks2d`/`blocks3d` read the keys the same way.
+
+use super::Physics;
+
+/// B's value of a material key `name` (`name_b`): its own, or A's where the sweep gives none
+/// (the key's default is NaN, which no given value can be).
+pub(super) fn b_value(p: &Physics, name: &str) -> f64 {
+    let own = p.get(&format!("{name}_b"));
+    if own.is_nan() { p.get(name) } else { own }
+}
+
+/// Whether B takes A's value of a key that A sets away from 1 — the keys' default before B's
+/// keys defaulted to A's, so such a run's numbers changed with that default.
+pub(super) fn b_follows_a_off_one(p: &Physics, names: &[&str]) -> bool {
+    names
+        .iter()
+        .any(|n| p.get(&format!("{n}_b")).is_nan() && p.get(n) != 1.0)
+}
 
 /// Which bodies a mass variant modifies (contract §2.6 `mass_side`): layer 0 of body i is its
 /// elements touching its own contact face.

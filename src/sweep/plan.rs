@@ -720,13 +720,14 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 6] = [
+const THIS_VERSION: [&str; 7] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
     "revision=quasi-static-start",
     "revision=increment-step",
     "revision=mixed-friction-chord",
+    "revision=bars1d-b-follows-a",
 ];
 
 /// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
