@@ -53,6 +53,8 @@ import sys
 import getfem as gf
 import numpy as np
 
+from common import stiffness
+
 BETA = 0.25
 # GetFEM's Newton stops when min(‖residual‖₁/‖load‖₁, ‖Δx‖₁/‖x‖₁) ≤ TOL
 # (getfem_model_solvers.h): once its active set is right one Newton step solves the step's
@@ -85,14 +87,7 @@ class Body:
         u0 = np.zeros(self.n)
         self.M = rho * gf.asm('generic', self.mim, 2, 'Test_u.Test2_u', -1, 'u', 1, self.mf,
                               u0).full()
-        md = gf.Model('real')
-        md.add_fem_variable('u', self.mf)
-        md.add_initialized_data('lambda', [lam])
-        md.add_initialized_data('mu', [mu])
-        md.add_isotropic_linearized_elasticity_brick(self.mim, 'u', 'lambda', 'mu')
-        md.assembly('build_matrix')
-        K = md.tangent_matrix().full()
-        self.K = 0.5 * (K + K.T)
+        self.K = stiffness(self.mf, self.mim, lam, mu)
         faces = self.m.outer_faces_with_direction(face_normal, 0.01)
         self.m.set_region(region, faces)
         self.region = region
