@@ -28,7 +28,7 @@ Newmark β = ¼, γ = ½ in numpy around GetFEM's solve: predictor p = u + τv +
 step's model is (M/(βτ²) + K) u = M p/(βτ²) + B_Nᵀλ_N (explicit matrices and right-hand sides
 per body, so λ_N is a force, not a force times βτ²) with the brick, solved by GetFEM's Newton
 from the previous step's (u, λ_N) to a residual of `TOL`; then a = (u − p)/(βτ²),
-v ← v + τ(½a_old + ½a). v⁰ = (0, V) on A, (0, V_b) on B, u⁰ = 0 (the massless dofs' quasi-static
+v ← v + τ(½a_old + ½a). v⁰ = (V_t, V) on A, (0, V_b) on B, u⁰ = 0 (the massless dofs' quasi-static
 start K_cc u_c = −K_cf u_f = 0: nothing loads them), a⁰ = 0 (M_ff a⁰_f = −(K u⁰)_f = 0).
 Energy E = ½vᵀMv + ½uᵀKu (both bodies), momentum P = Σ (M v)_y over the free e_y dofs, each
 body's mass 1ᵀM_i1 (e_y component) and mass_total = Σ_i 1ᵀM_i1 (e_x component, clamped nodes
@@ -39,7 +39,8 @@ rows and columns of both components of every Γ^a node and every Γ^b node zeroe
 dofs become quasi-static: the step's rows read K u = B_Nᵀλ_N there).
 
 Usage: blocks.py OUT.json PARAMS_JSON VARIANTS
-  PARAMS_JSON: {"width", "height", "height_b", "h", "gap", "velocity", "velocity_b",
+  PARAMS_JSON: {"width", "height", "height_b", "h", "gap", "velocity", "velocity_tangential",
+                "velocity_b",
                 "density", "lame_lambda", "lame_mu", "density_b", "lame_lambda_b", "lame_mu_b",
                 "far_end" ("free" | "clamped"), "T", "dt"}
   VARIANTS: comma-separated masses.
@@ -177,9 +178,10 @@ def run(name):
     bodies = (A, B)
     u = [np.zeros(b.n) for b in bodies]
     v = [np.zeros(b.n) for b in bodies]
-    for b, vb, V in zip(bodies, v, (params['velocity'], params['velocity_b'])):
+    for vb, V in zip(v, (params['velocity'], params['velocity_b'])):
         vb[1::2] = V
-        vb[b.clamped] = 0.0
+    v[0][0::2] = params['velocity_tangential']
+    v[1][B.clamped] = 0.0
     a = [np.zeros(b.n) for b in bodies]
     lam = np.zeros(len(md.variable('lam_n')))
     series = {k: [] for k in ('force', 'energy', 'kinetic', 'elastic', 'momentum', 'iterations')}
