@@ -1,8 +1,8 @@
-//! The GetFEM checks' shared set-up (tests/getfem_disc.rs, tests/friction_nitsche.rs): the
-//! 003 disc as P2 triangles (`sweeps/meshes/disc_p2.msh`), its sweep text for the engine, and
-//! the scripts of tests/getfem/ run by Debian's python3-getfem — installed, when missing, by
-//! tests/install_getfem.sh (a failed install fails the test: nothing is skipped) — with their
-//! JSON read back.
+//! The GetFEM checks' shared set-up (tests/getfem_disc.rs, tests/friction_nitsche.rs,
+//! tests/getfem_blocks.rs): the 003 disc as P2 triangles (`sweeps/meshes/disc_p2.msh`), its
+//! sweep text for the engine, and the scripts of tests/getfem/ run by Debian's python3-getfem —
+//! installed, when missing, by tests/install_getfem.sh (a failed install fails the test: nothing
+//! is skipped) — with their JSON read back.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -49,6 +49,17 @@ method = [{methods}]
 /// Run `tests/getfem/SCRIPT MESH OUT.json ARGS…` on the disc with Debian's python3 (installing
 /// python3-getfem first if needed) and return the JSON it wrote.
 pub fn run_script(script: &str, args: &[String]) -> serde_json::Value {
+    run_script_on(script, Some(&disc_mesh()), args)
+}
+
+/// Run `tests/getfem/SCRIPT [MESH] OUT.json ARGS…` with Debian's python3 (installing
+/// python3-getfem first if needed) and return the JSON it wrote; a script that builds its own
+/// meshes (tests/getfem/blocks.py) takes no MESH.
+pub fn run_script_on(
+    script: &str,
+    mesh: Option<&std::path::Path>,
+    args: &[String],
+) -> serde_json::Value {
     let install = Command::new("bash")
         .arg(root().join("tests/install_getfem.sh"))
         .status()
@@ -58,7 +69,7 @@ pub fn run_script(script: &str, args: &[String]) -> serde_json::Value {
     let out = dir.path().join("getfem.json");
     let o = Command::new("/usr/bin/python3")
         .arg(root().join("tests/getfem").join(script))
-        .arg(disc_mesh())
+        .args(mesh)
         .arg(&out)
         .args(args)
         .output()

@@ -15,7 +15,8 @@ Crank–Nicolson as Newmark β = ¼, γ = ½: predictor p = u + τv + τ²(½ �
 (M + βτ²K) u^{n+1} (+ βτ² R_c) = M p + βτ² F, then a^{n+1} = (u^{n+1} − p)/(βτ²) and
 v^{n+1} = v + τ(½a + ½a^{n+1}). Energy ½vᵀMv + ½uᵀKu − Fᵀu.
 
-Imported by the scripts beside it (Python puts a script's folder first on sys.path).
+`stiffness` is shared with tests/getfem/blocks.py. Imported by the scripts beside it (Python
+puts a script's folder first on sys.path).
 """
 import getfem as gf
 import numpy as np
@@ -23,6 +24,19 @@ import numpy as np
 RHO, LAM, MU, GRAV = 1.0, 20.0, 20.0, 0.1
 BETA = 0.25
 CONTACT_REGION = 101
+
+
+def stiffness(mf, mim, lam, mu):
+    """K of isotropic linearized elasticity (plane strain in 2D) on the vector space mf with the
+    rule mim, GetFEM's brick, symmetrised (dense)."""
+    md = gf.Model('real')
+    md.add_fem_variable('u', mf)
+    md.add_initialized_data('lambda', [lam])
+    md.add_initialized_data('mu', [mu])
+    md.add_isotropic_linearized_elasticity_brick(mim, 'u', 'lambda', 'mu')
+    md.assembly('build_matrix')
+    K = md.tangent_matrix().full()
+    return 0.5 * (K + K.T)
 
 
 class Disc:
@@ -41,14 +55,7 @@ class Disc:
         ycentre = 0.5 * (self.ymin + self.ymax)
         self.U0 = np.zeros(self.n)
 
-        md = gf.Model('real')
-        md.add_fem_variable('u', self.mfu)
-        md.add_initialized_data('lambda', [LAM])
-        md.add_initialized_data('mu', [MU])
-        md.add_isotropic_linearized_elasticity_brick(self.mim, 'u', 'lambda', 'mu')
-        md.assembly('build_matrix')
-        K = md.tangent_matrix().full()
-        self.K = 0.5 * (K + K.T)
+        self.K = stiffness(self.mfu, self.mim, LAM, MU)
         F = gf.asm('generic', self.mim, 1, f'{RHO}*[0,{-GRAV}].Test_u', -1, 'u', 1, self.mfu,
                    self.U0)
         self.F = np.asarray(F).ravel()
