@@ -19,22 +19,17 @@
 //!   v̄_1(T) = V − μ_f p W T/m_A − μ_f v̄_d(T):
 //! the rigid body's deceleration μ_f p W/m_A, up to A's vertical vibration under the step load.
 
-use std::path::Path;
+mod common;
 
-use contact_sweep::run::{Outcome, RunOptions, Status, simulate};
-use contact_sweep::sweep::{SweepFile, expand};
+use common::run_sweep_text;
+use contact_sweep::run::RunRecord;
 
-/// Every run of a sweep text, with its label (the run's parameters as the planner lists them).
-fn run_all(text: &str) -> Vec<(String, Outcome)> {
-    let plan = expand(&SweepFile::parse(Path::new("blocks_friction.toml"), text).expect("valid"))
-        .expect("plan");
-    assert!(!plan.runs.is_empty(), "{text}");
-    plan.runs
-        .iter()
-        .map(|spec| {
-            let label = format!("{:?}", spec.params);
-            (label, simulate(&spec.config, &RunOptions::default()))
-        })
+/// Every run of a sweep text through the executor (lockstep groups included), with its label
+/// (run id and the method's label).
+fn run_all(text: &str) -> Vec<(String, RunRecord)> {
+    run_sweep_text(text)
+        .into_iter()
+        .map(|r| (format!("{} {}", r.run_id, r.label), r))
         .collect()
 }
 
@@ -61,11 +56,11 @@ space = ["mixed", { space = "penalty", penalty_gamma0 = 10.0 }]
 
 /// Asserts every run ended ok, touched, carried friction (some point-step in stick or slip),
 /// and kept its momentum to `tol`; returns the worst drift and the number of runs.
-fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> (f64, usize) {
+fn assert_momentum(runs: &[(String, RunRecord)], tol: f64) -> (f64, usize) {
     let mut worst = 0.0f64;
     for (label, o) in runs {
-        assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
-        let m = &o.metrics;
+        assert_eq!(o.status, "ok", "{label}: {:?}", o.message);
+        let m = &o;
         assert!(
             m.contact_phases.unwrap_or(0) >= 1,
             "{label}: the blocks never touched"
@@ -127,7 +122,14 @@ fn momentum_is_an_invariant_with_friction() {
 
 /// A pressed on a clamped B (far_end = "clamped", gap 0, at rest vertically), thrown along e_1
 /// at V: blocks2d, W = H_a = H_b = 1, ρ = 1, λ = 0, μ = 1 (c_p = √2), p on A's top, Coulomb μ_f.
-fn pressed(space: &str, scheme: &str, v: f64, p: f64, mu_f: f64, t: f64) -> Vec<(String, Outcome)> {
+fn pressed(
+    space: &str,
+    scheme: &str,
+    v: f64,
+    p: f64,
+    mu_f: f64,
+    t: f64,
+) -> Vec<(String, RunRecord)> {
     let text = format!(
         "name = \"pr\"\nscene = \"blocks2d\"\n[fixed]\nT = {t}\nh = 0.25\ndt = 0.05\nfar_end = \"clamped\"\ngap = 0.0\nvelocity = 0.0\nvelocity_tangential = {v}\npressure = {p}\nlame_lambda = 0.0\nlame_mu = 1.0\nfriction = \"coulomb\"\nfriction_coefficient = {mu_f}\nmass = \"consistent\"\n{space}\n{scheme}\n"
     );
@@ -174,8 +176,8 @@ fn a_sliding_on_a_clamped_b_decelerates_at_mu_p_w_over_m() {
     let c_p = 2f64.sqrt();
     for (space, scheme) in PRESSED {
         for (label, o) in pressed(space, scheme, v, p, mu_f, t) {
-            assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
-            let m = &o.metrics;
+            assert_eq!(o.status, "ok", "{label}: {:?}", o.message);
+            let m = &o;
             let (stick, slip) = (m.stick_steps.unwrap(), m.slip_steps.unwrap());
             assert!(
                 slip > 0 && stick == 0,
@@ -212,8 +214,8 @@ fn a_pressed_hard_on_a_clamped_b_sticks() {
     let (v, p, mu_f, t) = (0.1, 0.5, 2.0, 6.0);
     for (space, scheme) in PRESSED {
         for (label, o) in pressed(space, scheme, v, p, mu_f, t) {
-            assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
-            let m = &o.metrics;
+            assert_eq!(o.status, "ok", "{label}: {:?}", o.message);
+            let m = &o;
             let (stick, slip) = (m.stick_steps.unwrap(), m.slip_steps.unwrap());
             eprintln!(
                 "{space} {scheme}: stick {stick}, slip {slip}, v̄_1(T) {:.3e}, W_f {:?}",
@@ -245,7 +247,7 @@ fn throwing_a_the_other_way_mirrors_the_run() {
             run_all(&text).remove(0).1
         };
         let (a, b) = (run(0.7), run(-0.7));
-        let (ma, mb) = (&a.metrics, &b.metrics);
+        let (ma, mb) = (&a, &b);
         let pairs = [
             (
                 ma.tangential_velocity_final.unwrap(),

@@ -192,4 +192,29 @@ mod tests {
         assert_eq!(y.iter().sum::<f64>(), 0.0);
         assert_eq!(p.dot(1, &x), -0.25 - -0.0);
     }
+
+    /// The tangential rows copy each row's coefficients onto the mapped dofs (node-major), and
+    /// `gather` interleaves rows of two sets in the order asked: a unit row stays a unit row,
+    /// a pair row's tangential rows balance (e_{a,c} − e_{b,c}).
+    #[test]
+    fn tangential_rows_follow_their_normal_rows() {
+        // Vertical dofs 2 and 5 (d = 2: the tangential dof is one below).
+        let below = |dof: usize, c: usize| Ok(dof - 1 + c);
+        let u = Rows::unit(&[2, 5]).tangential(1, below).unwrap();
+        assert!(u.is_unit());
+        assert_eq!(u.all(), (&[1usize, 4][..], &[1.0, 1.0][..]));
+        let p = Rows::pairs(&[(2, 5)]).tangential(1, below).unwrap();
+        assert_eq!(p.entries(0), (&[1usize, 4][..], &[1.0, -1.0][..]));
+        let x = [0.0, 0.75, 0.0, 0.0, 0.5, 0.0];
+        assert_eq!(p.dot(0, &x), 0.25);
+        let mut y = [0.0; 6];
+        p.add(0, 3.0, &mut y);
+        assert_eq!(y.iter().sum::<f64>(), 0.0);
+        let n = Rows::pairs(&[(2, 5)]);
+        let g = Rows::gather(2, |k| if k == 0 { (&n, 0) } else { (&p, 0) });
+        assert_eq!(g.len(), 2);
+        assert_eq!(g.entries(1), p.entries(0));
+        assert_eq!(g.entries(0), n.entries(0));
+        assert!(Rows::unit(&[]).is_empty());
+    }
 }
