@@ -230,12 +230,12 @@ schema! {
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
         slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
         friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |Σf_t|/Σf_n (sums over the contact points, 3D: the norm of Σf_t), the apparent friction coefficient";
-        tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D)";
-        normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
+        tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D; two bodies: A's)";
+        normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes; two bodies: A's)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
         err_vt_final: Option<f64> => "m/s", "layer1d: |mean tangential velocity at T − exact| (the exact one after the impact is V_t − 2σ_t*/Z_p)";
         friction_force: Option<f64> => "N", "oscillator: the dry (Coulomb) friction force F on the mass (contract §1.5; 0: frictionless)";
-        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 reaches 0, interpolated between the two steps where it changes sign; null if it never does";
+        stop_time: Option<f64> => "s", "oscillator with friction_force > 0: the time of the first step after which the mass never moves again (every later step moves it by at most 1e-12·max(abs(x0), gap)); FE scenes with friction (contract §1.8): the first time the mean tangential velocity 1ᵀMv_1/1ᵀM1 (two bodies: A's) reaches 0, interpolated between the two steps where it changes sign; null if it never does";
         stop_time_exact: Option<f64> => "s", "oscillator with friction_force > 0: the exact rest time, the first turning point where the friction holds the mass, abs(k x − f) ≤ F (null if after T)";
         length_b: Option<f64> => "m", "bars1d: bar B's length L_b (contract §1.9; null when it is A's)";
         young_b: Option<f64> => "Pa", "bars1d: bar B's Young modulus E_b (null when it is A's)";
@@ -250,7 +250,7 @@ schema! {
         pressure: Option<f64> => "Pa", "blocks2d, blocks3d: the traction −p e_d on A's top face (the patch test's p)";
         lame_lambda_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's λ (null: A's)";
         lame_mu_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's μ (null: A's)";
-        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d, m_i = 1ᵀM_i1 the run's masses (contract §5; null when a clamp, an obstacle or a load acts, or every initial velocity is 0)";
+        momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰) / Σ_i m_i·abs(V_i), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d (with friction: the largest over every axis, V_i the full velocity), m_i = 1ᵀM_i1 the run's masses (contract §5; null when a clamp, an obstacle or a load acts, or every initial velocity is 0)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T along e_x (1D) or e_d";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T along e_x (1D) or e_d";
         err_velocity_a_final: Option<f64> => "m/s", "bars1d: abs(velocity_a_final − the exact mean velocity of A at T) (contract §1.9)";

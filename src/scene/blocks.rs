@@ -140,11 +140,10 @@ impl Scene for BlocksScene {
             )
         })
     }
+    /// Friction (contract §2.5) acts on the relative slip (u^a − u^b∘π)_t through the
+    /// tangential rows e_{a,i,t} − e_{b,π(i),t} (`run::fe`), for `mixed` and `penalty`.
     fn supports_friction(&self) -> Result<(), String> {
-        Err(format!(
-            "scene {}: friction between two bodies (the relative slip's rows) is not implemented yet (issue 44)",
-            self.name()
-        ))
+        Ok(())
     }
     fn supports_physics(
         &self,

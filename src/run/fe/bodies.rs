@@ -215,6 +215,43 @@ fn node_rows_as_points(
         .collect()
 }
 
+/// The penalty's node-to-node points with the relative slip's rows for friction (contract
+/// §2.5, §2.6): point q (row q) gains the dofs of its tangential rows q·nt … q·nt + nt − 1
+/// ([`super::geometry::tangential_rows`]: e_{a,q,c} − e_{b,π(q),c}) after its two vertical
+/// ones, u_n and σ_n zero there, and u_t's row c holds row q·nt + c's coefficients on them, so
+/// the penalty's f_t = proj(−κ Δ(u^a − u^b)_t) acts on A and, opposite, on B. Only frictional
+/// runs take these: the frictionless points keep their two dofs, and their numbers.
+pub(super) fn frictional_points(
+    points: &[ContactPoint],
+    tangential: &Rows,
+    nt: usize,
+) -> Vec<ContactPoint> {
+    points
+        .iter()
+        .enumerate()
+        .map(|(q, p)| {
+            let mut p = p.clone();
+            let base = p.dofs.len();
+            for c in 0..nt {
+                p.dofs.extend_from_slice(tangential.entries(q * nt + c).0);
+            }
+            let k = p.dofs.len();
+            p.un.resize(k, 0.0);
+            p.sn.resize(k, 0.0);
+            p.ut = vec![0.0; nt * k];
+            p.st = vec![0.0; nt * k];
+            let mut slot = base;
+            for c in 0..nt {
+                for &coef in tangential.entries(q * nt + c).1 {
+                    p.ut[c * k + slot] = coef;
+                    slot += 1;
+                }
+            }
+            p
+        })
+        .collect()
+}
+
 /// The element weights of a mass variant on two bodies: each body's density times its layer
 /// weight where `mass_side` puts the variant, 1 elsewhere (contract §2.6), with each body's
 /// own equal-layer redistribution.
@@ -258,17 +295,24 @@ pub(super) struct MomentumTally {
     p0: Option<f64>,
     max_dev: f64,
     last: [f64; 2],
+    /// Frictional runs (contract §2.5): the reduced dofs of each tangential axis, whose momenta
+    /// the drift measures too (the friction rows act along them), and their P⁰; empty without
+    /// friction, so the frictionless runs keep their figures.
+    tangential: Vec<Vec<usize>>,
+    p0_t: Vec<f64>,
 }
 
 impl MomentumTally {
-    /// With the run's mass matrix `m`, A's and B's initial e_d velocities and whether a load
-    /// acts (gravity, pressure).
+    /// With the run's mass matrix `m`, A's and B's initial e_d velocities, whether a load
+    /// acts (gravity, pressure) and, with friction, the tangential axes' dofs and A's e_1
+    /// velocity (the scale then takes A's speed |V_a|).
     pub(super) fn new(
         two: &TwoBodies,
         vertical: &[usize],
         m: &SymMatrix,
         (v_a, v_b): (f64, f64),
         loaded: bool,
+        tangential: Option<(Vec<Vec<usize>>, f64)>,
     ) -> MomentumTally {
         let mut ones = vec![0.0; m.n()];
         for &r in vertical {
@@ -277,7 +321,11 @@ impl MomentumTally {
         let mut m1 = vec![0.0; m.n()];
         m.matvec_into(&ones, &mut m1);
         let (_, ma, mb) = momentum(two, vertical, &m1);
-        let scale = ma * v_a.abs() + mb * v_b.abs();
+        let (tangential, speed_a) = match tangential {
+            Some((axes, v_t)) => (axes, v_a.hypot(v_t)),
+            None => (Vec::new(), v_a.abs()),
+        };
+        let scale = ma * speed_a + mb * v_b.abs();
         let defined = !two.base_clamped && !loaded && scale > 0.0;
         MomentumTally {
             masses: [ma, mb],
@@ -285,14 +333,24 @@ impl MomentumTally {
             p0: None,
             max_dev: 0.0,
             last: [0.0; 2],
+            p0_t: vec![f64::NAN; tangential.len()],
+            tangential,
         }
     }
 
     /// Step n's momentum from the run's M v; returns P^n.
     pub(super) fn observe(&mut self, two: &TwoBodies, vertical: &[usize], mv: &[f64]) -> f64 {
         let (p, pa, pb) = momentum(two, vertical, mv);
+        let first = self.p0.is_none();
         let p0 = *self.p0.get_or_insert(p);
         self.max_dev = self.max_dev.max((p - p0).abs());
+        for (axis, p0) in self.tangential.iter().zip(&mut self.p0_t) {
+            let pt: f64 = axis.iter().map(|&r| mv[r]).sum();
+            if first {
+                *p0 = pt;
+            }
+            self.max_dev = self.max_dev.max((pt - *p0).abs());
+        }
         self.last = [pa, pb];
         p
     }

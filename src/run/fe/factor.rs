@@ -2,11 +2,13 @@
 //! Nitsche/penalty form, its factor (or A itself for CG), and the condensation Z = A⁻¹Cᵀ,
 //! W = cτ²CZ onto the contact rows. Made once per key and shared through [`FACTORS`].
 
+use super::bodies::frictional_points;
 use super::cache::{Cache, geometry_key};
 use super::config::{FeConfig, frictional};
-use super::geometry::{Geometry, tangential_dofs};
+use super::geometry::{Geometry, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
+use super::rows::Rows;
 use super::schur::ContactSchur;
 use crate::run::Status;
 use crate::space::ContactMethod;
@@ -52,9 +54,10 @@ pub(super) struct Factored {
 /// The mixed method's condensation over the normal and tangential rows C of Γ_C.
 #[derive(Debug)]
 pub(super) struct FrictionFactor {
-    /// Reduced index of each Γ_C node's tangential dofs, node-major (d − 1 per node, e_1 then
-    /// e_2): Z's column nc + i(d − 1) + c is A⁻¹ of the unit vector there.
-    pub(super) tangential: Vec<usize>,
+    /// The tangential rows of the Γ_C nodes, node-major (d − 1 per node, e_1 then e_2;
+    /// [`tangential_rows`]: one body's unit dofs, two bodies' relative slips): Z's column
+    /// nc + i(d − 1) + c is A⁻¹ of row i(d − 1) + c.
+    pub(super) tangential: Rows,
     /// W = cτ² C Z (dm × dm, row-major), rows and columns node-major [normal, tangential…].
     pub(super) w: Vec<f64>,
 }
@@ -119,6 +122,20 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
             )),
         }
     };
+    // Two bodies with friction: the penalty's points carry the relative slip's rows too.
+    let penalty = matches!(cfg.method, ContactMethod::Penalty { .. });
+    let slip_points = if penalty && frictional(cfg) && g.bodies.is_some() {
+        let nt = g.mesh.dim() - 1;
+        Some(frictional_points(points()?, &tangential_rows(g)?, nt))
+    } else {
+        None
+    };
+    let points = || -> Result<&[ContactPoint], String> {
+        match &slip_points {
+            Some(p) => Ok(p),
+            None => points(),
+        }
+    };
     let mut ops = match cfg.method {
         // Two bodies' points are the penalty's node rows (σ_n = 0): no Nitsche there yet.
         ContactMethod::Nitsche { .. } if g.bodies.is_some() => {
@@ -162,17 +179,17 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
     let n = g.dofs.n_free();
     let nc = g.rows.len();
     let tangential = if frictional(cfg) {
-        tangential_dofs(g)?
+        tangential_rows(g)?
     } else {
-        Vec::new()
+        Rows::unit(&[])
     };
     let nz = nc + tangential.len();
     let mut z = vec![0.0; n * nz];
     for j in 0..nc {
         g.rows.add(j, 1.0, &mut z[j * n..(j + 1) * n]);
     }
-    for (j, &c) in tangential.iter().enumerate() {
-        z[(nc + j) * n + c] = 1.0;
+    for j in 0..tangential.len() {
+        tangential.add(j, 1.0, &mut z[(nc + j) * n..(nc + j + 1) * n]);
     }
     let mut work = chol.work_for(nz);
     chol.try_solve_many_in_place(&mut z, nz, &mut work)
@@ -195,7 +212,7 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
             if a == 0 {
                 g.rows.dot(i, x)
             } else {
-                x[tangential[i * (d - 1) + a - 1]]
+                tangential.dot(i * (d - 1) + a - 1, x)
             }
         };
         let col = |k: usize| {

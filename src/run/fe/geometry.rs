@@ -601,9 +601,20 @@ pub(super) fn lowest_contact(g: &Geometry) -> Option<usize> {
 
 /// The body's mean velocities per axis (contract §5; [`MeanVelocity`]) with the run's mass matrix:
 /// a reduced dof's axis is its global dof's component.
+/// Two bodies: A's (the sliding body of contract §1.8's stop time), B's dofs counted on no axis
+/// (axis d is none of e_1, e_2, e_d) — with B clamped or at rest, A's mean is the slip's.
 pub(super) fn mean_velocity(g: &Geometry, m: &SymMatrix) -> MeanVelocity {
     let d = g.mesh.dim();
-    MeanVelocity::new(d, m, |r| g.dofs.free[r] % d)
+    match &g.bodies {
+        None => MeanVelocity::new(d, m, |r| g.dofs.free[r] % d),
+        Some(two) => MeanVelocity::new(d, m, |r| {
+            if two.body[r] == 0 {
+                g.dofs.free[r] % d
+            } else {
+                d
+            }
+        }),
+    }
 }
 
 /// The reduced indices of the Γ_C nodes' tangential dofs, node-major (e_1, then e_2 in 3D).
@@ -613,18 +624,30 @@ pub(super) fn tangential_dofs(g: &Geometry) -> Result<Vec<usize>, String> {
     let d = g.mesh.dim();
     let mut out = Vec::with_capacity(g.contact.len() * (d - 1));
     for &cv in &g.contact {
-        let global = g.dofs.free[cv];
         for c in 0..d - 1 {
-            let want = global - (d - 1 - c);
-            match (cv.checked_sub(d - 1 - c), g.dofs.free_index(want)) {
-                (Some(r), Some(f)) if r == f => out.push(r),
-                _ => {
-                    return Err(format!(
-                        "friction: the tangential dof {c} of the Γ_C node with global vertical dof {global} is not free"
-                    ));
-                }
-            }
+            out.push(tangential_of(g, cv, c)?);
         }
     }
     Ok(out)
+}
+
+/// The reduced index of component c of the node whose vertical dof is `cv` (reduced).
+fn tangential_of(g: &Geometry, cv: usize, c: usize) -> Result<usize, String> {
+    let d = g.mesh.dim();
+    let global = g.dofs.free[cv];
+    let want = global - (d - 1 - c);
+    match (cv.checked_sub(d - 1 - c), g.dofs.free_index(want)) {
+        (Some(r), Some(f)) if r == f => Ok(r),
+        _ => Err(format!(
+            "friction: the tangential dof {c} of the Γ_C node with global vertical dof {global} is not free"
+        )),
+    }
+}
+
+/// The tangential rows of the contact rows, node-major (contract §2.5, §2.6; [`Rows::tangential`]):
+/// one body's unit rows e_{i,c} (the dofs of [`tangential_dofs`], coefficient 1), two bodies'
+/// e_{a,i,c} − e_{b,π(i),c} on the relative slip.
+pub(super) fn tangential_rows(g: &Geometry) -> Result<Rows, String> {
+    g.rows
+        .tangential(g.mesh.dim() - 1, |cv, c| tangential_of(g, cv, c))
 }

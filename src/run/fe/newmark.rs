@@ -432,11 +432,9 @@ impl<'a> Stepper<'a> {
                 // With friction Cᵀf has tangential rows too: uᵀKu = uᵀ(F + Cᵀf − Ma).
                 (Some(_), Some(ff)) => {
                     let nc = g.contact.len();
-                    let tangential: f64 = ff
-                        .tangential
-                        .iter()
+                    let tangential: f64 = (0..ff.tangential.len())
                         .zip(&lambda[nc..])
-                        .map(|(&c, l)| l * u[c])
+                        .map(|(j, l)| l * ff.tangential.dot(j, u))
                         .sum();
                     fu + (contact + tangential) - uma
                 }
@@ -484,7 +482,7 @@ impl<'a> Stepper<'a> {
                 .contact_weight
                 .iter()
                 .enumerate()
-                .map(|(i, w)| w * v[ff.tangential[i * t]])
+                .map(|(i, w)| w * ff.tangential.dot(i * t, v))
                 .sum();
             obs.set_friction(fr.tally.total_tangential()[0], v1, fr.tally.work());
         }
@@ -707,9 +705,14 @@ impl<'a> Stepper<'a> {
                     g.rows.dot(j, y)
                 } + gi;
             }
-            for ((qt, up), &ct) in fr.q_t.iter_mut().zip(&mut fr.ut_prev).zip(&ff.tangential) {
-                *up = u[ct];
-                *qt = if incr { y[ct] } else { y[ct] - *up };
+            // Two bodies: the relative slip's rows ([`FrictionFactor::tangential`]).
+            for (j, (qt, up)) in fr.q_t.iter_mut().zip(&mut fr.ut_prev).enumerate() {
+                *up = ff.tangential.dot(j, u);
+                *qt = if incr {
+                    ff.tangential.dot(j, y)
+                } else {
+                    ff.tangential.dot(j, y) - *up
+                };
             }
             let it = fr
                 .solver
@@ -827,8 +830,8 @@ impl<'a> Stepper<'a> {
             std::mem::swap(&mut self.ma, &mut self.pred);
         }
         if let (Some(fr), Some(ff)) = (self.fric.as_mut(), self.fac.friction.as_ref()) {
-            for ((du, up), &ct) in fr.du_t.iter_mut().zip(&fr.ut_prev).zip(&ff.tangential) {
-                *du = self.u[ct] - up;
+            for (j, (du, up)) in fr.du_t.iter_mut().zip(&fr.ut_prev).enumerate() {
+                *du = ff.tangential.dot(j, &self.u) - up;
             }
             fr.tally.step(&fr.forces, &fr.du_t);
         }

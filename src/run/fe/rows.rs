@@ -47,9 +47,69 @@ impl Rows {
         r
     }
 
+    /// The tangential rows of these normal rows (contract §2.5, §2.6): for each row i and each
+    /// tangential direction c < `nt`, row i·nt + c has row i's coefficients on the dofs
+    /// `dof(k, c)` of its entries k (the same node's e_c component). A unit row e_{node,d} gives
+    /// the unit tangential row e_{node,c} (one body's u_t), a pair e_{a,d} − e_{b,d} gives
+    /// e_{a,c} − e_{b,c}: the relative slip (u^a − u^b∘π)_c, whose force acts equally and
+    /// oppositely on the two bodies.
+    pub(super) fn tangential(
+        &self,
+        nt: usize,
+        dof: impl Fn(usize, usize) -> Result<usize, String>,
+    ) -> Result<Rows, String> {
+        let mut r = Rows {
+            start: vec![0],
+            ..Rows::default()
+        };
+        for i in 0..self.len() {
+            for c in 0..nt {
+                for k in self.start[i]..self.start[i + 1] {
+                    r.dof.push(dof(self.dof[k], c)?);
+                    r.coef.push(self.coef[k]);
+                }
+                r.start.push(r.dof.len());
+            }
+        }
+        Ok(r)
+    }
+
+    /// Rows taken in turn from `from`: row k of the result is row `pick(k).1` of the rows
+    /// `pick(k).0` (the node-major [normal, tangential…] order of a frictional solve's unknowns).
+    pub(super) fn gather<'a>(count: usize, pick: impl Fn(usize) -> (&'a Rows, usize)) -> Rows {
+        let mut r = Rows {
+            start: vec![0],
+            ..Rows::default()
+        };
+        for k in 0..count {
+            let (from, i) = pick(k);
+            let (s, e) = (from.start[i], from.start[i + 1]);
+            r.dof.extend_from_slice(&from.dof[s..e]);
+            r.coef.extend_from_slice(&from.coef[s..e]);
+            r.start.push(r.dof.len());
+        }
+        r
+    }
+
+    /// Every row's dofs and coefficients, flat (one per row for unit rows).
+    pub(super) fn all(&self) -> (&[usize], &[f64]) {
+        (&self.dof, &self.coef)
+    }
+
+    /// Row i's dofs and coefficients.
+    pub(super) fn entries(&self, i: usize) -> (&[usize], &[f64]) {
+        let (s, e) = (self.start[i], self.start[i + 1]);
+        (&self.dof[s..e], &self.coef[s..e])
+    }
+
     /// The number of rows.
     pub(super) fn len(&self) -> usize {
         self.start.len() - 1
+    }
+
+    /// Whether there is no row.
+    pub(super) fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 
     /// Whether every row is a single unit entry (a body against the obstacle): the methods
@@ -131,5 +191,30 @@ mod tests {
         assert_eq!(y, [0.0, 2.0, 0.0, -2.0]);
         assert_eq!(y.iter().sum::<f64>(), 0.0);
         assert_eq!(p.dot(1, &x), -0.25 - -0.0);
+    }
+
+    /// The tangential rows copy each row's coefficients onto the mapped dofs (node-major), and
+    /// `gather` interleaves rows of two sets in the order asked: a unit row stays a unit row,
+    /// a pair row's tangential rows balance (e_{a,c} − e_{b,c}).
+    #[test]
+    fn tangential_rows_follow_their_normal_rows() {
+        // Vertical dofs 2 and 5 (d = 2: the tangential dof is one below).
+        let below = |dof: usize, c: usize| Ok(dof - 1 + c);
+        let u = Rows::unit(&[2, 5]).tangential(1, below).unwrap();
+        assert!(u.is_unit());
+        assert_eq!(u.all(), (&[1usize, 4][..], &[1.0, 1.0][..]));
+        let p = Rows::pairs(&[(2, 5)]).tangential(1, below).unwrap();
+        assert_eq!(p.entries(0), (&[1usize, 4][..], &[1.0, -1.0][..]));
+        let x = [0.0, 0.75, 0.0, 0.0, 0.5, 0.0];
+        assert_eq!(p.dot(0, &x), 0.25);
+        let mut y = [0.0; 6];
+        p.add(0, 3.0, &mut y);
+        assert_eq!(y.iter().sum::<f64>(), 0.0);
+        let n = Rows::pairs(&[(2, 5)]);
+        let g = Rows::gather(2, |k| if k == 0 { (&n, 0) } else { (&p, 0) });
+        assert_eq!(g.len(), 2);
+        assert_eq!(g.entries(1), p.entries(0));
+        assert_eq!(g.entries(0), n.entries(0));
+        assert!(Rows::unit(&[]).is_empty());
     }
 }

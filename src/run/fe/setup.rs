@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use super::bodies::MomentumTally;
 use super::cache::geometry_key;
-use super::config::FeConfig;
+use super::config::{FeConfig, frictional};
 use super::factor::{FACTORS, Factored, factor, factor_key};
 use super::geometry::{GEOMETRIES, Geometry, build_geometry};
 use super::reference::{RefMap, ref_map};
@@ -135,7 +135,23 @@ pub(super) fn momentum_tally(g: &Geometry, cfg: &FeConfig, m: &SymMatrix) -> Opt
     let two = g.bodies.as_ref()?;
     let loaded = cfg.setup.gravity != 0.0 || two.pressure.is_some();
     let v = (cfg.setup.v0, two.velocity_b);
-    Some(MomentumTally::new(two, &g.vertical, m, v, loaded))
+    // Friction acts along the tangential axes: their momenta enter the drift (contract §2.6).
+    let tangential = frictional(cfg).then(|| {
+        let d = g.mesh.dim();
+        let axis = |c: usize| (0..g.dofs.n_free()).filter(move |&r| g.dofs.free[r] % d == c);
+        (
+            (0..d - 1).map(|c| axis(c).collect()).collect(),
+            cfg.setup.v0_tangential,
+        )
+    });
+    Some(MomentumTally::new(
+        two,
+        &g.vertical,
+        m,
+        v,
+        loaded,
+        tangential,
+    ))
 }
 
 /// The fall along e_d: on an incline (contract §1.8) the load's e_d part is −g cos α (cos 0 = 1:

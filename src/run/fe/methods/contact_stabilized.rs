@@ -77,7 +77,7 @@ impl MethodRun<'_> {
             &g.rows,
             gaps,
             pred,
-            |r| pred[r] - u[r],
+            |t, j| t.dot(j, pred) - t.dot(j, u),
             c,
             (q, lambda),
             y,

@@ -25,7 +25,7 @@ pub(super) fn implicit_contact_correction(
     contact: &Rows,
     gaps: &[f64],
     base: &[f64],
-    off: impl Fn(usize) -> f64,
+    off: impl Fn(&Rows, usize) -> f64,
     c: f64,
     (q, lambda): (&mut [f64], &mut [f64]),
     y: &mut [f64],

@@ -1,6 +1,7 @@
 //! Friction with the nodal multiplier in the contract §3.2 methods (module header of
-//! [`super`]): the tangential dofs of each Γ_C node, the step's forces, the condensed
-//! Coulomb/Tresca problem and the run's [`FrictionTally`].
+//! [`super`]): the tangential rows of each Γ_C node (one body: its unit tangential dofs; two
+//! bodies: the relative slip e_{a,i,t} − e_{b,π(i),t}, contract §2.6), the step's forces, the
+//! condensed Coulomb/Tresca problem and the run's [`FrictionTally`].
 
 use std::sync::Arc;
 
@@ -9,7 +10,8 @@ use crate::contact::friction::FrictionLaw;
 use crate::run::Metrics;
 use crate::run::fe::config::{FeConfig, LCP_MAX_ITER, LCP_TOL};
 use crate::run::fe::factor::Factored;
-use crate::run::fe::geometry::{Geometry, mean_velocity, tangential_dofs};
+use crate::run::fe::geometry::{Geometry, mean_velocity, tangential_rows};
+use crate::run::fe::rows::Rows;
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
 use crate::space::fe::SymMatrix;
 
@@ -19,8 +21,8 @@ pub(super) struct Friction {
     pub(super) law: FrictionLaw,
     /// Tangential directions per node (d − 1).
     pub(super) nt: usize,
-    /// Reduced index of direction k of contact node j: `tdofs[j·nt + k]`.
-    pub(super) tdofs: Vec<usize>,
+    /// Direction k of contact node j's tangential row: row j·nt + k (a unit row on one body).
+    pub(super) trows: Rows,
     /// The nodes' trapezoidal weights (sum 1): Γ_C means.
     pub(super) mean_weight: Vec<f64>,
     /// Tresca's weights w_j = ∫_ΓC φ_j of the nodes.
@@ -44,8 +46,8 @@ pub(super) struct Friction {
 /// the rows C node-major, normal then e_1 (, e_2) per node).
 pub(super) struct Implicit {
     pub(super) fac: Arc<Factored>,
-    /// C's rows (dofs) and Z's columns in the node-major order of μ.
-    pub(super) rows: Vec<usize>,
+    /// C's rows and Z's columns in the node-major order of μ.
+    pub(super) rows: Rows,
     pub(super) cols: Vec<usize>,
     pub(super) solver: FrictionalContact,
     /// The free gaps and slips of the step, the active mask (Moreau–Jean), the unknowns μ
@@ -68,7 +70,7 @@ impl Friction {
         let d = cfg.setup.dim;
         let nt = d - 1;
         let nc = g.contact.len();
-        let tdofs = tangential_dofs(g)?;
+        let trows = tangential_rows(g)?;
         let weight = g
             .contact_weight
             .iter()
@@ -77,7 +79,7 @@ impl Friction {
         Ok(Friction {
             law: cfg.friction,
             nt,
-            tdofs,
+            trows,
             mean_weight: g.contact_weight.clone(),
             weight,
             forces: vec![0.0; nc * d],
@@ -104,15 +106,21 @@ impl Friction {
             .ok_or("the step factor has no frictional columns")?;
         let (nt, nc) = (self.nt, g.contact.len());
         let d = nt + 1;
-        let (mut rows, mut cols) = (Vec::with_capacity(nc * d), Vec::with_capacity(nc * d));
-        for (j, &ci) in g.contact.iter().enumerate() {
-            rows.push(ci);
-            cols.push(j);
-            for k in 0..nt {
-                rows.push(ff.tangential[j * nt + k]);
-                cols.push(nc + j * nt + k);
+        // μ's unknown j·d + a: node j's normal row (a = 0) or its tangential row a − 1.
+        let rows = Rows::gather(nc * d, |k| {
+            let (j, a) = (k / d, k % d);
+            if a == 0 {
+                (&g.rows, j)
+            } else {
+                (&ff.tangential, j * nt + a - 1)
             }
-        }
+        });
+        let cols = (0..nc * d)
+            .map(|k| {
+                let (j, a) = (k / d, k % d);
+                if a == 0 { j } else { nc + j * nt + a - 1 }
+            })
+            .collect();
         self.implicit = Some(Implicit {
             fac: Arc::clone(fac),
             rows,
@@ -129,25 +137,25 @@ impl Friction {
 
     /// Keep u_tⁿ before a step.
     pub(super) fn begin(&mut self, u: &[f64]) {
-        for (p, &r) in self.u_t_prev.iter_mut().zip(&self.tdofs) {
-            *p = u[r];
+        for (j, p) in self.u_t_prev.iter_mut().enumerate() {
+            *p = self.trows.dot(j, u);
         }
     }
 
-    /// The free gaps q_n and slips q_t = Ty + `off` (T the tangential rows; `off` the method's
-    /// slip reference at those rows, module header) into the problem; `gap(j)` is node j's.
+    /// The free gaps q_n and slips q_t = Ty + `off` (T the tangential rows; `off(T, j)` the
+    /// method's slip reference at row j, module header) into the problem; `gap(j)` is node j's.
     pub(super) fn set_free(
         &mut self,
         y: &[f64],
-        off: impl Fn(usize) -> f64,
+        off: impl Fn(&Rows, usize) -> f64,
         gap: impl Fn(usize) -> f64,
     ) {
         let im = self.implicit.as_mut().expect("an implicit method");
         for (j, q) in im.q_n.iter_mut().enumerate() {
             *q = gap(j);
         }
-        for (q, &r) in im.q_t.iter_mut().zip(&self.tdofs) {
-            *q = y[r] + off(r);
+        for (j, q) in im.q_t.iter_mut().enumerate() {
+            *q = self.trows.dot(j, y) + off(&self.trows, j);
         }
     }
 
@@ -178,13 +186,13 @@ impl Friction {
             )
             .map_err(|e| e.to_string())?;
         let n = y.len();
-        for ((&mk, &col), &row) in im.mu.iter().zip(&im.cols).zip(&im.rows) {
+        for (k, (&mk, &col)) in im.mu.iter().zip(&im.cols).enumerate() {
             if mk != 0.0 {
                 let f = c * mk;
                 for (yi, zi) in y.iter_mut().zip(&im.fac.z[col * n..(col + 1) * n]) {
                     *yi += f * zi;
                 }
-                sd[row] += f;
+                im.rows.add(k, f, sd);
             }
         }
         for (l, m) in normal.iter_mut().zip(im.mu.iter().step_by(d)) {
@@ -207,19 +215,23 @@ impl Friction {
         let d = self.nt + 1;
         for (j, f) in self.forces.chunks_exact(d).enumerate() {
             for (k, fk) in f[1..].iter().enumerate() {
-                y[self.tdofs[j * self.nt + k]] += s * fk;
+                self.trows.add(j * self.nt + k, s * fk, y);
             }
         }
     }
 
     /// Kinematic friction (module header): with the normal impulses' forces in `forces`, the
     /// tangential force of each node that stops its slip increment, projected onto the disc
-    /// of radius b, applied to u_t and v_t^{n+½}. `diag` is the lumped mass.
+    /// of radius b, applied to u_t and v_t^{n+½}. `diag` is the lumped mass. One body's unit
+    /// rows only (central difference is refused between two bodies at plan time): each row's
+    /// dof is its tangential dof.
     pub(super) fn kinematic(&mut self, u: &mut [f64], v: &mut [f64], diag: &[f64], tau: f64) {
         let (nt, d) = (self.nt, self.nt + 1);
         let t2 = tau * tau;
+        debug_assert!(self.trows.is_unit());
+        let (tdofs, _) = self.trows.all();
         for (j, f) in self.forces.chunks_exact_mut(d).enumerate() {
-            let ts = &self.tdofs[j * nt..(j + 1) * nt];
+            let ts = &tdofs[j * nt..(j + 1) * nt];
             let prev = &self.u_t_prev[j * nt..(j + 1) * nt];
             let (fn_j, ft) = f.split_first_mut().expect("d ≥ 2");
             if *fn_j <= 0.0 {
@@ -251,8 +263,8 @@ impl Friction {
     /// The step's bookkeeping once u^{n+1} and the forces are known (the tally: W_f, stick
     /// and slip, the apparent friction coefficient, the step's tangential work).
     pub(super) fn end(&mut self, u: &[f64]) {
-        for ((du, p), &r) in self.du_t.iter_mut().zip(&self.u_t_prev).zip(&self.tdofs) {
-            *du = u[r] - p;
+        for (j, (du, p)) in self.du_t.iter_mut().zip(&self.u_t_prev).enumerate() {
+            *du = self.trows.dot(j, u) - p;
         }
         self.tally.step(&self.forces, &self.du_t);
     }
@@ -260,12 +272,10 @@ impl Friction {
     /// The series' friction values: the total e_1 contact force, the Γ_C mean of v_1 (the
     /// nodes' trapezoidal weights), W_f.
     pub(super) fn series(&self, v: &[f64]) -> [f64; 3] {
-        let v_t = self
-            .tdofs
-            .iter()
+        let v_t = (0..self.trows.len())
             .step_by(self.nt)
             .zip(&self.mean_weight)
-            .map(|(&r, w)| w * v[r])
+            .map(|(j, w)| w * self.trows.dot(j, v))
             .sum();
         [self.tally.total_tangential()[0], v_t, self.tally.work()]
     }

@@ -164,7 +164,7 @@ impl MethodRun<'_> {
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         let it = if let Some(fr) = fric.as_mut() {
             // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
-            fr.set_free(y, |r| -u[r], |j| g.rows.dot(j, y) + gaps[j]);
+            fr.set_free(y, |t, j| -t.dot(j, u), |j| g.rows.dot(j, y) + gaps[j]);
             let it = fr
                 .solve(c, false, y, sd, lambda)
                 .map_err(|e| Stop::Solver(step, e))?;

@@ -55,7 +55,7 @@ impl MethodRun<'_> {
             &g.rows,
             gaps,
             u,
-            |_| 0.0,
+            |_, _| 0.0,
             c,
             (q, lambda),
             y,

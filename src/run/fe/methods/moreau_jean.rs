@@ -69,7 +69,7 @@ impl MethodRun<'_> {
             // De Saxcé on velocities over the active nodes: "gap" =
             // Bv^{n+1} + eBvⁿ (q as above), slip = v_t^{n+1} = T(vⁿ + Δv).
             if any {
-                fr.set_free(y, |r| v[r], |j| q[j]);
+                fr.set_free(y, |t, j| t.dot(j, v), |j| q[j]);
                 fr.implicit
                     .as_mut()
                     .expect("attached")
