@@ -55,6 +55,13 @@
 //!   header; session 29, before/after binaries run alternately, load ~1.3): before 3.85 ms,
 //!   9.35 ms (2.43×); after 3.89 ms, 6.86 ms (1.77×; 31 iterations, at most 4) — better, still
 //!   not met: the rest is the fresh factors the chord steps do not avoid and Z's 273 columns.
+//!   Session 30: a slipping node's two Newton rows in the frame (t, s), one tangential force
+//!   eliminated (182 unknowns, not 273), on faer's blocked LU (`contact::coulomb`'s header):
+//!   12.62 ms frictionless, 19.06 ms Coulomb (33 iterations, at most 4): 1.51× by the clock
+//!   at load ~11; by perf's CPU samples in the stepping loop (150 steps each, same load) 647
+//!   against 700, 1.08×: the frictional contact solve now costs what the LCP does (89 and 92
+//!   samples), the rest is Z's 273 columns against 91 (72 and 178 samples), streamed from
+//!   memory, which the load slows most. The clock's ratio wants a quiet machine.
 //!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).

@@ -720,7 +720,7 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 7] = [
+const THIS_VERSION: [&str; 8] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
@@ -728,17 +728,20 @@ const THIS_VERSION: [&str; 7] = [
     "revision=increment-step",
     "revision=mixed-friction-chord",
     "revision=bars1d-b-follows-a",
+    "revision=mixed-friction-slip-elimination",
 ];
 
 /// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
-/// (`contact::coulomb`'s header): the same solution to the same tolerance, not the same
-/// round-off, so such a run gets a revision line.
+/// (`contact::coulomb`'s header), and its Newton steps eliminate a slipping node's tangential
+/// component along the slip on faer's blocked LU: the same solution to the same tolerance, not
+/// the same round-off, so such a run gets a revision line for each.
 fn chord_revision(scene: &dyn Scene, m: &Method, revision: &mut String) {
     if scene.fe_dim() == Some(3)
         && m.friction_kind != FrictionKind::None
         && m.contact == ContactMethod::Mixed
     {
         revision.push_str("revision=mixed-friction-chord\n");
+        revision.push_str("revision=mixed-friction-slip-elimination\n");
     }
 }
 
