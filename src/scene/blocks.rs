@@ -157,6 +157,17 @@ impl Scene for BlocksScene {
             self.name()
         ))
     }
+    /// Friction between two bodies acts on the relative slip's rows of `mixed` and `penalty`;
+    /// the relative slip's Nitsche term is not implemented (contract §2.6).
+    fn supports_friction_with(&self, space: &str) -> Result<(), String> {
+        if space == "nitsche" {
+            return Err(format!(
+                "friction with space = nitsche on scene {}: the Nitsche term of the relative slip between two bodies is not implemented (mixed and penalty take friction on the relative slip)",
+                self.name()
+            ));
+        }
+        Ok(())
+    }
     fn supports_physics(
         &self,
         p: &Physics,
