@@ -11,23 +11,7 @@
 
 mod common;
 
-use common::outcomes;
-use contact_sweep::run::Outcome;
-
-/// Every run's momentum_drift (asserted ≤ `tol`) after a contact phase; the worst.
-fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> f64 {
-    let mut worst = 0.0f64;
-    for (label, o) in runs {
-        assert!(
-            o.metrics.contact_phases.unwrap_or(0) >= 1,
-            "{label}: the blocks never touched"
-        );
-        let drift = o.metrics.momentum_drift.expect("free blocks have a drift");
-        assert!(drift <= tol, "{label}: momentum_drift {drift:e}");
-        worst = worst.max(drift);
-    }
-    worst
-}
+use common::{assert_momentum, outcomes};
 
 /// The contact patch test (contract §1.10) for `nitsche`: B's base clamped, gap 0, at rest,
 /// λ = λ_b = 0, μ = 1, μ_b = 2, p = 1e-2, one backward-Euler step of τ = 1e6, unbiased and
@@ -38,22 +22,10 @@ fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> f64 {
 #[test]
 fn nitsche_passes_the_patch_test() {
     for (scene, h) in [("blocks2d", 0.25), ("blocks3d", 0.5)] {
-        let text = format!(
-            "name = \"patch\"\nscene = \"{scene}\"\n[fixed]\nT = 1e6\nh = {h}\ndt = 1e6\nscheme = \"backward-euler\"\nspace = \"nitsche\"\nnitsche_gamma0 = 0.05\nfar_end = \"clamped\"\ngap = 0.0\nvelocity = 0.0\nlame_lambda = 0.0\nlame_lambda_b = 0.0\nlame_mu = 1.0\nlame_mu_b = 2.0\npressure = 1e-2\n[grid]\nnitsche_theta = [-1.0, 0.0, 1.0]\nnitsche_sides = [\"unbiased\", \"a\"]\n"
-        );
-        let runs = outcomes(&text);
+        let method = "space = \"nitsche\"\nnitsche_gamma0 = 0.05\n[grid]\nnitsche_theta = [-1.0, 0.0, 1.0]\nnitsche_sides = [\"unbiased\", \"a\"]";
+        let runs = outcomes(&common::patch_sweep(scene, h, method));
         assert_eq!(runs.len(), 6);
-        for (label, o) in runs {
-            let (s, p) = (
-                o.metrics.patch_stress_error.expect("a pressure run"),
-                o.metrics.patch_pressure_error.expect("a pressure run"),
-            );
-            eprintln!("patch {scene} {label}: stress {s:e}, pressure {p:e}");
-            assert!(
-                s <= 1e-8 && p <= 1e-8,
-                "{label}: stress {s:e}, pressure {p:e}"
-            );
-        }
+        common::assert_patch(scene, &runs);
     }
 }
 
