@@ -18,7 +18,8 @@ use common::{assert_momentum, outcomes};
 /// one-sided, Θ = −1, 0, 1, γ0 = 0.05, 2D and 3D. One step is the static solution up to
 /// O(ρH²/(μτ²)) = 1e-12, and the refined step (`run::fe::refine`, the penalty's sweeps with
 /// Nitsche's Θ-term in the residual) resolves it to round-off: the bound is issue 44's 1e-8
-/// (done-when 5).
+/// (done-when 5). Measured 5.0e-13 to 6.3e-13 (stress and pressure, every case); without the
+/// refinement 3.5e-3 (stress) and 3.3e-2 (pressure) on blocks2d, Θ = −1, unbiased.
 #[test]
 fn nitsche_passes_the_patch_test() {
     for (scene, h) in [("blocks2d", 0.25), ("blocks3d", 0.5)] {
