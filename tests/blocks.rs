@@ -7,7 +7,11 @@
 //! gives 1_dᵀM v^{n+1} = 1_dᵀM v^n: P is constant up to the round-off of the step's solve and of
 //! the carried products, whatever the mass variant and the side it acts on.
 
+mod common;
+
 use std::path::Path;
+
+use common::assert_momentum;
 
 use contact_sweep::run::{Outcome, RunOptions, Status, simulate};
 use contact_sweep::sweep::{SweepFile, expand};
@@ -53,22 +57,6 @@ const METHODS: &str = r#"method = [
 mass = ["consistent", "lumped", "mod1", "mod2", "mod3", { mass = "weights", mass_weights = [0.5, 1.5] }, "zero-contact"]
 mass_side = ["both", "a", "b"]
 "#;
-
-/// Asserts every run ended ok, touched (a contact phase), and kept its momentum to `tol`.
-fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> f64 {
-    let mut worst = 0.0f64;
-    for (label, o) in runs {
-        assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
-        assert!(
-            o.metrics.contact_phases.unwrap_or(0) >= 1,
-            "{label}: the blocks never touched"
-        );
-        let drift = o.metrics.momentum_drift.expect("free blocks have a drift");
-        assert!(drift <= tol, "{label}: momentum_drift {drift:e}");
-        worst = worst.max(drift);
-    }
-    worst
-}
 
 /// contract §2.6's invariant on blocks2d: every scheme × mass variant × mass_side, A thrown down
 /// at 1 onto B thrown up at ½, 4 × 4 squares per block. Tolerance 1e-12 (issue 44 done-when
@@ -212,21 +200,8 @@ fn patch_test_on_matching_blocks() {
             "space = \"penalty\"\npenalty_gamma0 = 10.0",
         ),
     ] {
-        let text = format!(
-            "name = \"patch\"\nscene = \"{scene}\"\n[fixed]\nT = 1e6\nh = {h}\ndt = 1e6\nscheme = \"backward-euler\"\n{space}\nfar_end = \"clamped\"\ngap = 0.0\nvelocity = 0.0\nlame_lambda = 0.0\nlame_lambda_b = 0.0\nlame_mu = 1.0\nlame_mu_b = 2.0\npressure = 1e-2\n"
-        );
-        for (label, o) in run_all(&text) {
-            assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
-            let (s, p) = (
-                o.metrics.patch_stress_error.expect("a pressure run"),
-                o.metrics.patch_pressure_error.expect("a pressure run"),
-            );
-            eprintln!("patch {scene} {space}: stress {s:e}, pressure {p:e}");
-            assert!(
-                s <= 1e-8 && p <= 1e-8,
-                "{label}: stress {s:e}, pressure {p:e}"
-            );
-        }
+        let runs = run_all(&common::patch_sweep(scene, h, space));
+        common::assert_patch(&format!("{scene} {space}"), &runs);
     }
 }
 

@@ -7,7 +7,8 @@
 //! round(H_b/h) up. A moves with `velocity` e_d (+ `velocity_tangential` e_1), B with
 //! `velocity_b` e_d; B's base is free or clamped (`far_end`); a traction −p e_d acts on A's top
 //! (`pressure`). There is no obstacle: the contact rows are node-to-node between the two faces,
-//! δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with n = −e_d ([`crate::run::fe`]'s rows). With no clamp and
+//! δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with n = −e_d ([`crate::run::fe`]'s rows), or Nitsche's
+//! points of both faces (`nitsche_sides` unbiased or one-sided). With no clamp and
 //! no load the total momentum is an exact invariant of every scheme (contract §2.6).
 //!
 //! Why a scene of its own rather than a mesh file: the matching interface, the per-body
@@ -15,8 +16,8 @@
 //! two-body Gmsh meshes reuse the same engine data (bodies and rows).
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, Physics,
-    PhysicsKey, Scene, SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, NitscheSides,
+    Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
 };
 
 /// The two blocks as the engine meshes them (A's material, gap and velocities are the
@@ -40,6 +41,8 @@ pub struct Blocks {
     /// The traction −p e_d on A's top face.
     pub pressure: f64,
     pub mass_side: MassSide,
+    /// The weights of Nitsche's two sides (contract §2.6 `nitsche_sides`).
+    pub nitsche_sides: NitscheSides,
 }
 
 /// The scenes `blocks2d` (dim 2) and `blocks3d` (dim 3).
@@ -53,8 +56,9 @@ const fn key(name: &'static str, default: f64) -> PhysicsKey {
 }
 
 /// contract §1.10's keys and defaults; B's material keys default to A's (NaN here, resolved in
-/// [`BlocksScene::setup`]), `far_end` and `mass_side` are indices into their words.
-const BLOCKS_PHYSICS: [PhysicsKey; 18] = [
+/// [`BlocksScene::setup`]), `far_end`, `mass_side` and `nitsche_sides` are indices into their
+/// words.
+const BLOCKS_PHYSICS: [PhysicsKey; 19] = [
     key("width", 1.0),
     key("height", 1.0),
     key("height_b", 1.0),
@@ -73,6 +77,7 @@ const BLOCKS_PHYSICS: [PhysicsKey; 18] = [
     key("pressure", 0.0),
     key("mass_side", 0.0),
     key("mesh_ratio", 1.0),
+    key("nitsche_sides", 0.0),
 ];
 
 impl BlocksScene {
@@ -132,9 +137,9 @@ impl Scene for BlocksScene {
     }
     fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
         super::fe_supports(self.name(), m)?;
-        super::require("space", m.space, &["mixed", "penalty"], || {
+        super::require("space", m.space, &["mixed", "penalty", "nitsche"], || {
             format!(
-                "space = {} is not available for scene {} yet (mixed and penalty node-to-node; nitsche between two bodies: issue 44, not yet)",
+                "space = {} is not available for scene {} (mixed and penalty node-to-node, nitsche unbiased or one-sided)",
                 m.space,
                 self.name()
             )
@@ -143,6 +148,17 @@ impl Scene for BlocksScene {
     /// Friction (contract §2.5) acts on the relative slip (u^a − u^b∘π)_t through the
     /// tangential rows e_{a,i,t} − e_{b,π(i),t} (`run::fe`), for `mixed` and `penalty`.
     fn supports_friction(&self) -> Result<(), String> {
+        Ok(())
+    }
+    /// Friction between two bodies acts on the relative slip's rows of `mixed` and `penalty`;
+    /// the relative slip's Nitsche term is not implemented (contract §2.6).
+    fn supports_friction_with(&self, space: &str) -> Result<(), String> {
+        if space == "nitsche" {
+            return Err(format!(
+                "friction with space = nitsche on scene {}: the Nitsche term of the relative slip between two bodies is not implemented (mixed and penalty take friction on the relative slip)",
+                self.name()
+            ));
+        }
         Ok(())
     }
     fn supports_physics(
@@ -209,6 +225,7 @@ impl Scene for BlocksScene {
             velocity_b: p.get("velocity_b"),
             pressure: p.get("pressure"),
             mass_side: MassSide::from_index(p.get("mass_side")),
+            nitsche_sides: NitscheSides::from_index(p.get("nitsche_sides")),
         };
         SceneSetup::Fe(FeSetup {
             scene: self.name(),

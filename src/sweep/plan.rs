@@ -695,6 +695,13 @@ fn friction_of(
     if friction_kind != FrictionKind::None {
         if let Err(why) = given.scene.supports_friction() {
             issues.push(Issue::at(&given.origin(Key::Friction), why));
+        } else if let Err(why) = given.scene.supports_friction_with(&given.word(Key::Space)) {
+            // A combination of two axes is left out; fixed together, it is the input's fault.
+            if friction_fixed && !given.on_axis(Key::Space) {
+                issues.push(Issue::at(&given.origin(Key::Friction), why));
+            } else {
+                return Err(Outcome::Inapplicable(why));
+            }
         }
         // Where the literature defines no frictional version (contract §2.5).
         let undefined = match scheme {

@@ -225,3 +225,47 @@ pub fn outcomes_edited(
 pub fn outcomes(text: &str) -> Vec<(String, Outcome)> {
     outcomes_at(Path::new("t.toml"), text)
 }
+
+/// The contact patch test's sweep (contract §1.10) on `scene` with mesh size `h`: B's base
+/// clamped, gap 0, at rest, λ = λ_b = 0, μ = 1, μ_b = 2, p = 1e-2, one backward-Euler step of
+/// τ = 1e6; `method` is the contact treatment's lines (keys of [fixed], then optionally a
+/// [grid] table).
+pub fn patch_sweep(scene: &str, h: f64, method: &str) -> String {
+    format!(
+        "name = \"patch\"\nscene = \"{scene}\"\n[fixed]\nT = 1e6\nh = {h}\ndt = 1e6\nscheme = \"backward-euler\"\nfar_end = \"clamped\"\ngap = 0.0\nvelocity = 0.0\nlame_lambda = 0.0\nlame_lambda_b = 0.0\nlame_mu = 1.0\nlame_mu_b = 2.0\npressure = 1e-2\n{method}\n"
+    )
+}
+
+/// Asserts every patch-test run ended ok with `patch_stress_error` and `patch_pressure_error`
+/// ≤ 1e-8 (issue 44 done-when 5), printing them.
+pub fn assert_patch(what: &str, runs: &[(String, Outcome)]) {
+    for (label, o) in runs {
+        assert_eq!(o.status.as_str(), "ok", "{label}: {:?}", o.message);
+        let (s, p) = (
+            o.metrics.patch_stress_error.expect("a pressure run"),
+            o.metrics.patch_pressure_error.expect("a pressure run"),
+        );
+        eprintln!("patch {what} {label}: stress {s:e}, pressure {p:e}");
+        assert!(
+            s <= 1e-8 && p <= 1e-8,
+            "{label}: stress {s:e}, pressure {p:e}"
+        );
+    }
+}
+
+/// Asserts every two-body run ended ok, touched (a contact phase), and kept its momentum to
+/// `tol` (contract §2.6's invariant, `momentum_drift`); returns the worst drift.
+pub fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for (label, o) in runs {
+        assert_eq!(o.status, Status::Ok, "{label}: {:?}", o.message);
+        assert!(
+            o.metrics.contact_phases.unwrap_or(0) >= 1,
+            "{label}: the blocks never touched"
+        );
+        let drift = o.metrics.momentum_drift.expect("free blocks have a drift");
+        assert!(drift <= tol, "{label}: momentum_drift {drift:e}");
+        worst = worst.max(drift);
+    }
+    worst
+}

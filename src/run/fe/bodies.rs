@@ -9,6 +9,7 @@
 
 use std::sync::Arc;
 
+use super::nitsche_pair::pair_points;
 use super::rows::Rows;
 use crate::run::Metrics;
 use crate::scene::{Blocks, FeSetup, MassSide};
@@ -35,6 +36,9 @@ pub(super) struct TwoBodies {
     pub(super) mass_side: MassSide,
     /// The traction −p e_d on A's top face as forces on the reduced dofs (None: p = 0).
     pub(super) pressure: Option<Vec<f64>>,
+    /// Nitsche's points of Γ^a and Γ^b, each with both bodies' traces and unit side weight
+    /// ([`super::nitsche_pair`]; dofs reduced by the geometry).
+    pub(super) nitsche_points: [Vec<ContactPoint>; 2],
 }
 
 /// The parts of a two-block geometry ([`super::geometry::build_blocks`] makes the
@@ -161,6 +165,8 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
     });
     let h = b.width / b.across as f64;
     let points = node_rows_as_points(&pairs, &contact_weight, contact_measure, h);
+    let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
+    let nitsche_points = pair_points(&mesh_a, &mesh_b, mesh.node(1, 0), lame);
     Ok(BlocksParts {
         points,
         layers,
@@ -181,6 +187,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
             base_clamped: b.base_clamped,
             mass_side: b.mass_side,
             pressure,
+            nitsche_points,
         },
         mesh,
     })
@@ -189,7 +196,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
 /// The node-to-node rows of `penalty` (contract §2.6) in the form the engine's Nitsche/penalty
 /// operators take ([`super::nitsche::NitscheOps::penalty`]): one "point" per pair with dofs
 /// (a, b), u_n = δ_i = (u^a_i − u^b_{π(i)})·n = −u^a_d + u^b_d (n = −e_d), σ_n = 0 (no Nitsche
-/// term: `nitsche` is refused on these rows), weight w_i = ∫_Γa φ_i and γ = h, A's mesh size,
+/// term: `nitsche` takes its own points, [`super::nitsche_pair`]), weight w_i = ∫_Γa φ_i and γ = h, A's mesh size,
 /// so κ_i = E_a γ0/h and the row force is w_i κ [δ_i − g_i]_+ — the weighted rows that pass the
 /// patch test (an unweighted force gives the end nodes twice their share). Gap 0: the run's
 /// gap is added where the operators are made, as for the one-body box.

@@ -8,9 +8,11 @@ use super::config::{FeConfig, frictional};
 use super::geometry::{Geometry, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
+use super::nitsche_pair::sided_points;
 use super::rows::Rows;
 use super::schur::ContactSchur;
 use crate::run::Status;
+use crate::scene::FeGeometry;
 use crate::space::ContactMethod;
 use crate::space::fe::SymMatrix;
 use crate::space::fe::nitsche::ContactPoint;
@@ -137,12 +139,10 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
         }
     };
     let mut ops = match cfg.method {
-        // Two bodies' points are the penalty's node rows (σ_n = 0): no Nitsche there yet.
-        ContactMethod::Nitsche { .. } if g.bodies.is_some() => {
-            return Err(format!(
-                "space = nitsche is not available for scene {} yet (two bodies: issue 44)",
-                cfg.setup.scene
-            ));
+        // Two bodies: Nitsche's points of both faces, weighted per `nitsche_sides`
+        // ([`super::nitsche_pair`]); `g.points` are the penalty's node rows there.
+        ContactMethod::Nitsche { theta, gamma0 } if g.bodies.is_some() => {
+            pair_ops(g, cfg, theta, gamma0)?
         }
         ContactMethod::Nitsche { theta, gamma0 } => NitscheOps::new(points()?, theta, gamma0),
         ContactMethod::Penalty { gamma0 } => {
@@ -167,6 +167,23 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
         ops = ops.with_friction(points()?, cfg.dt);
     }
     factor_nitsche(g, cfg, c_tau2, ops)
+}
+
+/// Nitsche's operators between two bodies (contract §2.6): both faces' points with the side
+/// weights of the run's `nitsche_sides`. Friction is refused: the relative slip's Nitsche term
+/// is not implemented (the planner refuses it first).
+fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<NitscheOps, String> {
+    let (Some(two), FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
+        unreachable!("two bodies are the blocks' geometry")
+    };
+    if frictional(cfg) {
+        return Err(format!(
+            "space = nitsche with friction is not available for scene {} (two bodies: the relative slip's Nitsche term is not implemented; mixed and penalty take friction)",
+            cfg.setup.scene
+        ));
+    }
+    let points = sided_points(&two.nitsche_points, b.nitsche_sides);
+    Ok(NitscheOps::new(&points, theta, gamma0))
 }
 
 /// The mixed method's factor: A = M + cτ²K, Z = A⁻¹Bᵀ, H = cτ² B Z. With friction Z also holds
@@ -283,8 +300,17 @@ pub(super) fn factor_nitsche(
                     (r, Some(fr)) => &fr.st[(q * td + r - 1) * k..(q * td + r) * k],
                     (_, None) => unreachable!("no tangential rows without friction"),
                 };
+                // Zero entries skipped (subtracting 0 changes no value): two bodies' points
+                // span both bodies, whose cross entries are not in the pattern, and σ_n^i is
+                // zero on the other body's dofs.
                 for (i, &gi) in d.iter().enumerate() {
+                    if sq[i] == 0.0 {
+                        continue;
+                    }
                     for (j, &gj) in d.iter().enumerate() {
+                        if sq[j] == 0.0 {
+                            continue;
+                        }
                         let pos = a
                             .pattern
                             .position(red(gi), red(gj))

@@ -215,9 +215,11 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
 }
 
 /// Two blocks (contract §1.10, [`super::bodies`]): A's Γ^a rows paired node to node with B's
-/// Γ^b, the run's gap in the rows, no Nitsche points yet.
+/// Γ^b, the run's gap in the rows; Nitsche's points of both sides in the pair's data.
 pub(super) fn build_blocks(s: &FeSetup, b: &crate::scene::Blocks) -> Result<Geometry, String> {
-    let p = blocks_parts(s, b)?;
+    let mut p = blocks_parts(s, b)?;
+    let sides = std::mem::take(&mut p.two.nitsche_points);
+    p.two.nitsche_points = sides.map(|x| reduce_points(x, &p.dofs));
     let d = s.dim;
     let opts = amd_options(d);
     let one = |_: usize| 1.0;

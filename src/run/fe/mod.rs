@@ -48,6 +48,7 @@ mod mass;
 mod methods;
 mod newmark;
 pub mod nitsche;
+mod nitsche_pair;
 mod products;
 mod reference;
 mod refine;

@@ -614,7 +614,8 @@ impl<'a> Stepper<'a> {
 
     /// The patch test's errors (contract §1.10), with `pressure`: the largest relative stress
     /// error over the Gauss points and the largest relative contact pressure error over the
-    /// rows (a multiplier over its node's weight ∫φ_i; the penalty's κ[δ_i − g_i]_+).
+    /// rows (a multiplier over its node's weight ∫φ_i; the penalty's κ[δ_i − g_i]_+; Nitsche's
+    /// (1/γ^i)[P^i_γ − g]_+ at the points of every side with w_i > 0).
     fn patch_errors(&self) -> Option<(f64, f64)> {
         let (Some(two), crate::scene::FeGeometry::Blocks(b), FeMesh::Bodies { mesh, .. }) =
             (&self.geo.bodies, &self.cfg.setup.geometry, &self.geo.mesh)

@@ -27,8 +27,8 @@ const PENALTY_SWEEPS: usize = 12;
 const TOL: f64 = 1e-14;
 
 /// The refinement of a Newmark/θ run (None: not refined): two bodies with `mixed`, or with
-/// the penalty's rows outside the hybrid scheme (whose kinks move the law, nitsche.rs header);
-/// one body against the obstacle keeps its numbers.
+/// the penalty's rows or Nitsche's points outside the hybrid scheme (whose kinks move the law,
+/// nitsche.rs header), frictionless; one body against the obstacle keeps its numbers.
 pub(super) fn refinement(
     g: &Geometry,
     cfg: &FeConfig,
@@ -38,7 +38,7 @@ pub(super) fn refinement(
 ) -> Option<Box<Refinement>> {
     let refinable = match fac.nitsche.as_ref() {
         None => fac.friction.is_none(),
-        Some(o) => o.penalty && o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+        Some(o) => o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
     };
     (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)))
 }
@@ -200,13 +200,15 @@ impl Refinement {
 }
 
 impl Refinement {
-    /// The penalty's rows (contract §2.6, `penalty` node-to-node; the engine's Nitsche form
-    /// with Θ = 0, nitsche.rs header): A u + cτ² Σ_q φ_q(p_q·u) t_q = b, φ_q(s) =
-    /// w_q κ_q [s − g_q]_+, t_q = p_q. On the active points I (s_q > g_q) the correction δu
-    /// of the residual r solves (A + cτ² Σ_I w κ t tᵀ) δu = r: with s = A⁻¹r and Z_q =
-    /// A⁻¹(−t_q), δu = s + cτ² Z_I D e with (I − cτ² W_II D) e = P_I s, D = diag(w κ) — the
-    /// Newton's own Jacobian — then the points change sides and the sweeps resume. λ = φ(P u)
-    /// at the end (the forces the energy and the next Newton start from).
+    /// The penalty's rows and Nitsche's points (contract §2.6; nitsche.rs header):
+    /// A u + cτ² Σ_q φ_q(p_q·u) t_q = b, A = M + cτ²(K − Θ Σ_q w_q γ_q s_q s_qᵀ), φ_q(s) =
+    /// (w_q/γ_q)[s − g_q]_+, t_q = −c_q (the penalty: Θ = 0, t_q = p_q, 1/γ_q = κ_q). On the
+    /// active points I (s_q > g_q) the correction δu of the residual r solves
+    /// (A + cτ² Σ_I (w/γ) t pᵀ) δu = r: with s = A⁻¹r and Z_q = A⁻¹c_q, δu = s + cτ² Z_I D e
+    /// with (I − cτ² W_II D) e = P_I s, D = diag(w/γ) — the Newton's own Jacobian — then the
+    /// points change sides and the sweeps resume. λ = φ(P u) at the end (the forces the energy
+    /// and the next Newton start from). The penalty's numbers are those of its own form
+    /// (c_q = −p_q exactly, and no Θ-term).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn refine_penalty(
         &mut self,
@@ -224,14 +226,24 @@ impl Refinement {
         };
         for _ in 0..PENALTY_SWEEPS {
             let mut scale = self.body_residual(g, fac, c_tau2, u);
+            if ops.theta != 0.0 {
+                // A's Θ-term: r += cτ²Θ Σ_q w_q γ_q s_q (s_q·u).
+                for q in 0..nq {
+                    let f = c_tau2 * ops.theta * ops.w[q] * ops.gamma[q] * ops.apply(&ops.s, q, u);
+                    let (coef, dofs) = (&ops.s[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                    for (c, &d) in coef.iter().zip(dofs) {
+                        self.r[d] += f * c;
+                    }
+                }
+            }
             self.active.clear();
             for q in 0..nq {
                 let f = phi(q, u);
                 if f > 0.0 {
                     self.active.push(q);
-                    let (coef, dofs) = (&ops.p[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                    let (coef, dofs) = (&ops.c[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
                     for (c, &d) in coef.iter().zip(dofs) {
-                        self.r[d] -= c_tau2 * f * c;
+                        self.r[d] += c_tau2 * f * c;
                     }
                     scale = scale.max((c_tau2 * f).abs());
                 }
