@@ -13,8 +13,16 @@
 //! Criterion's medians are wall clock; the machine running it may be shared, so the set-up also
 //! times each size in the process's CPU time (median of 5) and prints the ratios per doubling.
 //!
-//! Measured once at issue 45 (`cargo bench --bench interface`, 2 cores shared with other builds):
-//! see the report of the branch and docs/performance.md (the lead adds the table).
+//! Measured once at issue 45 (`cargo bench --bench interface`, 2 cores shared with ~8 builds,
+//! load average 11–16): linear, ≤ 2.11× the CPU time per doubling of the faces (the wall-clock
+//! medians move with the load of the moment).
+//!
+//! | Γ^a on Γ^b | pieces | CPU median of 5 | ratio | criterion median (wall) |
+//! | --- | --- | --- | --- | --- |
+//! | 20² on 27² | 2 116 | 4.83 ms | | 15.0 ms |
+//! | 28² on 37² | 4 096 | 9.30 ms | 1.93 (faces × 1.96) | 25.8 ms |
+//! | 40² on 53² | 8 464 | 19.65 ms | 2.11 (faces × 2.04) | 54.6 ms |
+//! | 56² on 75² | 16 900 | 40.56 ms | 2.06 (faces × 1.96) | 146.4 ms |
 
 use std::time::Duration;
 

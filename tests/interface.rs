@@ -329,12 +329,12 @@ fn compare(mortar: &Mortar, r: &Reference) -> f64 {
 /// Largest |Σ_i D_ki − Σ_j M_kj| and |Σ_i D_ki − ∫ψ_k| over the rows.
 fn partition_of_unity(mortar: &Mortar, full: &[f64]) -> (f64, f64) {
     let (mut dm, mut dpsi): (f64, f64) = (0.0, 0.0);
-    for k in 0..full.len() {
+    for (k, &fk) in full.iter().enumerate() {
         let sd = mortar.d.row_sum(k);
         dm = dm.max((sd - mortar.m.row_sum(k)).abs());
         dpsi = dpsi
-            .max((sd - full[k]).abs())
-            .max((mortar.psi_integral[k] - full[k]).abs());
+            .max((sd - fk).abs())
+            .max((mortar.psi_integral[k] - fk).abs());
     }
     (dm, dpsi)
 }
