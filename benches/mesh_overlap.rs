@@ -32,6 +32,10 @@ use std::time::Duration;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
+#[path = "common/cpu_time.rs"]
+mod cpu_time;
+use cpu_time::cpu_seconds;
+
 use contact_sweep::space::fe::GmshMesh;
 
 #[path = "common/square_msh.rs"]
@@ -40,18 +44,6 @@ use square_msh::square_msh;
 
 /// Pairs of interleaved reads timed in CPU time (each pair both variants, the order alternating).
 const PAIRS: usize = 4;
-
-/// The process's CPU time in seconds (every thread; the read runs on one).
-fn cpu_seconds() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant of the platform.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    assert_eq!(rc, 0, "clock_gettime(CLOCK_PROCESS_CPUTIME_ID)");
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
 
 /// The CPU seconds of one read of `bytes`, with or without the overlap check.
 fn timed_read(bytes: &[u8], overlap: bool) -> f64 {

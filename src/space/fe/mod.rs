@@ -20,6 +20,10 @@
 //! - [`simplex`]: vector P1/P2 triangle and tetrahedron mass, elasticity stiffness, grad-grad
 //!   and load (isoparametric; degree-4 rule on triangles, degree-5 on tetrahedra), the simplices
 //!   of Gmsh meshes, assembled by [`sparse`] like the Q1/Q2 cells;
+//! - [`interface`]: the geometry of a non-matching two-body interface (contract §2.6, issue 45):
+//!   the projection Π on Γ^b through a bin grid, the segmentation of Γ^a by Γ^b's projected
+//!   faces, and the mortar matrices D, M with the `standard` and `dual` bases — a library the
+//!   engine does not use yet;
 //! - [`sparse`]: the CSC pattern of the full symmetric matrix on the free dofs, assembly with
 //!   element weights (the layer-weighted masses of contract §2.2) and the matrix operations of a
 //!   time loop (`matvec_into` allocates nothing).
@@ -36,6 +40,7 @@ pub mod element;
 mod element_kind;
 pub mod gmsh;
 mod gmsh_error;
+pub mod interface;
 pub mod locate;
 pub mod mesh;
 pub mod msh;

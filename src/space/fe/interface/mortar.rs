@@ -1,0 +1,237 @@
+//! The mortar matrices of contract §2.6 on the segmentation (`segment.rs`):
+//!
+//!   D_ki = ∫_Γa ψ_k φ^a_i,   M_kj = ∫_Γa ψ_k (φ^b_j∘Π),   g̃⁰_k = ∫_Γa ψ_k g,
+//!
+//! g(x) = (Π(x) − x)·n_a the reference gap, each integral summed piece by piece with the piece's
+//! rule (exact on affine faces). Rows k and columns i are Γ^a's nodes, columns j Γ^b's.
+//!
+//! The multiplier basis ψ (`mortar_basis`):
+//! - `standard`: ψ_k = φ^a_k;
+//! - `dual` (Wohlmuth 2000): on each face e of Γ^a, ψ_k = Σ_l A_kl φ_l with A_e = D_e M_e⁻¹,
+//!   D_e = diag(∫_e φ_k), (M_e)_kl = ∫_e φ_k φ_l — so ∫_e ψ_k φ_i = δ_ki ∫_e φ_i and D is
+//!   diagonal with D_kk = ∫φ_k wherever the segmentation covers Γ^a. ψ_k is discontinuous
+//!   across faces, which the mortar rows do not mind (they are integrals).
+//!
+//! Why integrate D on the pieces too (not on Γ^a's faces): then Σ_i D_ki = Σ_j M_kj = ∫ψ_k
+//! over the covered part exactly (Σ_i φ^a_i = Σ_j φ^b_j = 1 at every point), so a rigid
+//! translation makes no weighted gap and every row acts equally and oppositely on the two
+//! bodies (the momentum invariant of §2.6), even where Γ^a reaches beyond Γ^b.
+
+use nalgebra::DMatrix;
+
+use super::super::quadrature::{collapsed_simplex_rule, gauss_legendre_any};
+use super::segment::{PiecePoint, Segmentation};
+use super::surface::{FaceKind, InterfaceError, Surface, dot, sub};
+
+/// The multiplier basis of the mortar rows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Basis {
+    Standard,
+    Dual,
+}
+
+/// A sparse matrix by rows (CSR), columns sorted within a row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SparseRows {
+    pub n_rows: usize,
+    pub n_cols: usize,
+    pub start: Vec<usize>,
+    pub col: Vec<usize>,
+    pub val: Vec<f64>,
+}
+
+impl SparseRows {
+    /// Σ of the triplets (r, c, v) per entry.
+    pub fn from_triplets(
+        n_rows: usize,
+        n_cols: usize,
+        mut t: Vec<(usize, usize, f64)>,
+    ) -> SparseRows {
+        t.sort_unstable_by_key(|&(r, c, _)| (r, c));
+        let mut start = vec![0; n_rows + 1];
+        let (mut col, mut val): (Vec<usize>, Vec<f64>) = (Vec::new(), Vec::new());
+        let mut last = None;
+        for (r, c, v) in t {
+            if last == Some((r, c)) {
+                *val.last_mut().expect("an entry") += v;
+            } else {
+                start[r + 1] += 1;
+                col.push(c);
+                val.push(v);
+                last = Some((r, c));
+            }
+        }
+        for r in 0..n_rows {
+            start[r + 1] += start[r];
+        }
+        SparseRows {
+            n_rows,
+            n_cols,
+            start,
+            col,
+            val,
+        }
+    }
+
+    /// The stored entries of row r: (column, value).
+    pub fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        (self.start[r]..self.start[r + 1]).map(|k| (self.col[k], self.val[k]))
+    }
+
+    /// Entry (r, c), 0 when not stored.
+    pub fn get(&self, r: usize, c: usize) -> f64 {
+        let cols = &self.col[self.start[r]..self.start[r + 1]];
+        cols.binary_search(&c)
+            .map_or(0.0, |k| self.val[self.start[r] + k])
+    }
+
+    pub fn row_sum(&self, r: usize) -> f64 {
+        self.row(r).map(|(_, v)| v).sum()
+    }
+}
+
+/// D, M, the weighted reference gaps g̃⁰_k = ∫ψ_k g and ∫ψ_k, all on the segmentation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mortar {
+    pub basis: Basis,
+    pub d: SparseRows,
+    pub m: SparseRows,
+    pub weighted_gap: Vec<f64>,
+    pub psi_integral: Vec<f64>,
+}
+
+/// Gauss points of a whole face of `kind` (exact for φ_k φ_l J on an affine face).
+fn face_rule(kind: FaceKind) -> Vec<([f64; 2], f64)> {
+    let g = |n| -> Vec<(f64, f64)> {
+        gauss_legendre_any(n)
+            .into_iter()
+            .map(|(t, w)| (0.5 * (t + 1.0), 0.5 * w))
+            .collect()
+    };
+    match kind {
+        FaceKind::Seg2 => g(2).into_iter().map(|(t, w)| ([t, 0.0], w)).collect(),
+        FaceKind::Tri3 => collapsed_simplex_rule(2, 2)
+            .into_iter()
+            .map(|(p, w)| ([p[0], p[1]], w))
+            .collect(),
+        FaceKind::Quad4 => {
+            let g3 = g(3);
+            g3.iter()
+                .flat_map(|&(s, ws)| g3.iter().map(move |&(t, wt)| ([s, t], ws * wt)))
+                .collect()
+        }
+    }
+}
+
+/// ∫_Γa φ_k for every node of `a` (each face with its own rule): the lumped weights, and
+/// ∫ψ_k for both bases on a fully covered Γ^a.
+pub fn face_integrals(a: &Surface) -> Vec<f64> {
+    let rule = face_rule(a.kind);
+    let mut out = vec![0.0; a.num_nodes()];
+    for f in 0..a.num_faces() {
+        for &(xi, w) in &rule {
+            let n = a.kind.shape(xi);
+            let jw = w * a.jacobian(f, xi);
+            for (k, &node) in a.face(f).iter().enumerate() {
+                out[node] += jw * n[k];
+            }
+        }
+    }
+    out
+}
+
+/// The coefficients ψ_k = Σ_l A_kl φ_l of `basis` on face `f` of Γ^a (the module header's
+/// A_e = D_e M_e⁻¹ for `dual`, the identity for `standard`).
+pub fn basis_coefficients(a: &Surface, f: usize, basis: Basis) -> [[f64; 4]; 4] {
+    let p = a.kind.nodes();
+    let mut coef = [[0.0; 4]; 4];
+    if basis == Basis::Standard {
+        for (k, row) in coef.iter_mut().enumerate().take(p) {
+            row[k] = 1.0;
+        }
+        return coef;
+    }
+    let mut mass = DMatrix::<f64>::zeros(p, p);
+    let mut lumped = DMatrix::<f64>::zeros(p, p);
+    for &(xi, w) in &face_rule(a.kind) {
+        let n = a.kind.shape(xi);
+        let jw = w * a.jacobian(f, xi);
+        for k in 0..p {
+            lumped[(k, k)] += jw * n[k];
+            for l in 0..p {
+                mass[(k, l)] += jw * n[k] * n[l];
+            }
+        }
+    }
+    // A = D M⁻¹ ⇔ Aᵀ = M⁻¹ D (M symmetric): one LU solve. The face mass of a non-degenerate
+    // face (checked by `Surface::new`) is SPD.
+    let at = mass.lu().solve(&lumped).expect("an SPD face mass");
+    for k in 0..p {
+        for l in 0..p {
+            coef[k][l] = at[(l, k)];
+        }
+    }
+    coef
+}
+
+/// The mortar matrices of Γ^a (rows) against Γ^b on the segmentation `seg` (module header).
+pub fn mortar_matrices(
+    a: &Surface,
+    b: &Surface,
+    seg: &Segmentation,
+    basis: Basis,
+) -> Result<Mortar, InterfaceError> {
+    let (pa, pb) = (a.kind.nodes(), b.kind.nodes());
+    let mut d = Vec::new();
+    let mut m = Vec::new();
+    let mut weighted_gap = vec![0.0; a.num_nodes()];
+    let mut psi_integral = vec![0.0; a.num_nodes()];
+    let mut points: Vec<PiecePoint> = Vec::new();
+    let mut coef_face = usize::MAX;
+    let mut coef = [[0.0; 4]; 4];
+    for piece in &seg.pieces {
+        if piece.face_a != coef_face {
+            coef = basis_coefficients(a, piece.face_a, basis);
+            coef_face = piece.face_a;
+        }
+        points.clear();
+        seg.points(a, b, piece, &mut points)?;
+        let (mut dl, mut ml) = ([[0.0; 4]; 4], [[0.0; 4]; 4]);
+        let (mut gl, mut sl) = ([0.0; 4], [0.0; 4]);
+        for q in &points {
+            let na = a.kind.shape(q.xi_a);
+            let nb = b.kind.shape(q.xi_b);
+            let g = dot(sub(q.pi, q.x), q.normal);
+            for k in 0..pa {
+                let psi: f64 = (0..pa).map(|l| coef[k][l] * na[l]).sum();
+                let wk = q.weight * psi;
+                for i in 0..pa {
+                    dl[k][i] += wk * na[i];
+                }
+                for j in 0..pb {
+                    ml[k][j] += wk * nb[j];
+                }
+                gl[k] += wk * g;
+                sl[k] += wk;
+            }
+        }
+        let (fa, fb) = (a.face(piece.face_a), b.face(piece.face_b));
+        for k in 0..pa {
+            for i in 0..pa {
+                d.push((fa[k], fa[i], dl[k][i]));
+            }
+            for j in 0..pb {
+                m.push((fa[k], fb[j], ml[k][j]));
+            }
+            weighted_gap[fa[k]] += gl[k];
+            psi_integral[fa[k]] += sl[k];
+        }
+    }
+    Ok(Mortar {
+        basis,
+        d: SparseRows::from_triplets(a.num_nodes(), a.num_nodes(), d),
+        m: SparseRows::from_triplets(a.num_nodes(), b.num_nodes(), m),
+        weighted_gap,
+        psi_integral,
+    })
+}
