@@ -193,6 +193,15 @@ fn gap_from_obstacle(
         return Ok(None);
     };
     let obstacle = v.as_f64().expect("obstacle is a checked number");
+    if mesh.bodies.is_some() {
+        return Err(Issue::at(
+            o,
+            format!(
+                "{} holds two bodies (contract §1.10): there is no obstacle; `gap` is the initial distance between them",
+                mesh.file
+            ),
+        ));
+    }
     if let Some((_, g)) = user.get(&Key::Gap) {
         return Err(Issue::at(
             o,
@@ -1396,6 +1405,11 @@ impl Columns {
         let weightless = physics.0.iter().any(|(n, g)| *n == "gravity" && *g == 0.0);
         for (name, value) in &physics.0 {
             let key = Key::from_name(name).unwrap();
+            // A key whose default is "not given" (NaN: B's material on the blocks, the
+            // two-body keys of a mesh file) has no column and no part in the id.
+            if value.is_nan() {
+                continue;
+            }
             if key == Key::Load && weightless {
                 if given.has(Key::Load) {
                     dropped.push("load applies only with gravity ≠ 0".into());
