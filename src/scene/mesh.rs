@@ -295,9 +295,13 @@ impl Scene for MeshScene {
             clamped_nodes: clamped.len(),
             contact_nodes: contact,
             nodes_per_element: mesh.nodes_per_element(),
-            height: {
-                let z = mesh.coords.iter().map(|c| c[self.dim - 1]);
-                z.clone().fold(f64::NEG_INFINITY, f64::max) - z.fold(f64::INFINITY, f64::min)
+            // Two bodies: H_a + H_b, each body's own extent (the blocks' length scale),
+            // whatever the file's distance between them.
+            height: match &mesh.bodies {
+                None => mesh.extent(|_| true),
+                Some(b) => (0..2u8)
+                    .map(|body| mesh.extent(|n| b.node_body[n] == body))
+                    .sum(),
             },
             bodies,
         };

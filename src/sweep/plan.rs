@@ -153,10 +153,11 @@ fn default_of(scene: &dyn Scene, key: Key) -> Option<Value> {
 
 /// A scene's physics value as a parameter: a number, or the word a choice key's index names
 /// (`right_end`: 0 → clamped).
+/// A NaN default ("not given": the two-body keys of a mesh file) stays NaN, a choice key's too.
 fn physics_value(key: Key, x: f64) -> Value {
     match key.choices() {
-        Some(words) => Value::Str(words[x as usize].into()),
-        None => Value::Num(x),
+        Some(words) if !x.is_nan() => Value::Str(words[x as usize].into()),
+        _ => Value::Num(x),
     }
 }
 

@@ -40,6 +40,9 @@ pub(super) struct TwoBodies {
     pub(super) pressure_value: f64,
     /// Each body's extent along e_d (H_a, H_b): the pressure's energy unit (contract §1.10).
     pub(super) heights: [f64; 2],
+    /// `mod2`/`mod3` put layer 0's mass back by the layers' measured masses (a file's unequal
+    /// layers), not by equal layers (the blocks' lattice).
+    pub(super) measured_layers: bool,
 }
 
 /// The parts of a two-body geometry ([`super::geometry::build_bodies`] makes the
@@ -88,6 +91,7 @@ pub(super) struct BodiesSpec {
     pub(super) loaded: Vec<(usize, f64)>,
     pub(super) loaded_measure: f64,
     pub(super) heights: [f64; 2],
+    pub(super) measured_layers: bool,
     /// B's material and velocity, which side the mass variant acts on, p.
     pub(super) density_b: f64,
     pub(super) lame_b: (f64, f64),
@@ -173,6 +177,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
             loaded,
             loaded_measure: measure,
             heights: [b.height_a, b.height_b],
+            measured_layers: false,
             density_b: b.density_b,
             lame_b: (b.lame_lambda_b, b.lame_mu_b),
             velocity_b: b.velocity_b,
@@ -269,6 +274,7 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
             pressure,
             pressure_value: spec.pressure,
             heights: spec.heights,
+            measured_layers: spec.measured_layers,
         },
         mesh,
     })
@@ -308,8 +314,8 @@ fn node_rows_as_points(
 }
 
 /// The element weights of a mass variant on two bodies: each body's density times its layer
-/// weight where `mass_side` puts the variant, 1 elsewhere (contract §2.6), with each body's
-/// own equal-layer redistribution.
+/// weight `weight(layer, body)` where `mass_side` puts the variant, 1 elsewhere (contract
+/// §2.6), with each body's own redistribution.
 pub(super) fn body_weight(
     two: &TwoBodies,
     element_body: usize,
@@ -317,7 +323,7 @@ pub(super) fn body_weight(
     layer: usize,
 ) -> f64 {
     let w = if two.mass_side.includes(element_body) {
-        weight(layer, two.layer_counts[element_body])
+        weight(layer, element_body)
     } else {
         1.0
     };

@@ -130,12 +130,7 @@ pub(super) fn mesh_bodies_parts(
         }
         None => (Vec::new(), 0.0),
     };
-    let extent = |body: u8| {
-        let z = (0..mesh.coords.len())
-            .filter(|&n| gb.node_body[n] == body)
-            .map(|n| mesh.coords[n][d - 1]);
-        z.clone().fold(f64::NEG_INFINITY, f64::max) - z.fold(f64::INFINITY, f64::min)
-    };
+    let extent = |body: u8| mesh.extent(|n| gb.node_body[n] == body);
     bodies_parts(
         s,
         BodiesSpec {
@@ -150,6 +145,7 @@ pub(super) fn mesh_bodies_parts(
             loaded,
             loaded_measure,
             heights: [extent(0), extent(1)],
+            measured_layers: true,
             density_b: keys.density_b,
             lame_b: (keys.lame_lambda_b, keys.lame_mu_b),
             velocity_b: keys.velocity_b,

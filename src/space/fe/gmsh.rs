@@ -319,6 +319,16 @@ impl GmshMesh {
             .reduce(f64::min)
     }
 
+    /// The extent along e_d (max − min of x_d) of the nodes `which` takes: the body's height,
+    /// or one body's of two.
+    pub fn extent(&self, which: impl Fn(usize) -> bool) -> f64 {
+        let d = self.dim;
+        let z = (0..self.coords.len())
+            .filter(|&n| which(n))
+            .map(|n| self.coords[n][d - 1]);
+        z.clone().fold(f64::NEG_INFINITY, f64::max) - z.fold(f64::INFINITY, f64::min)
+    }
+
     /// |Ω_h| = Σ_K ∫_K̂ det J by [`ElementKind::quadrature`] (exact for affine cells).
     pub fn measure(&self) -> f64 {
         let q = self.kind.quadrature();
