@@ -250,14 +250,12 @@ const METHODS: &str = r#"method = [
 /// run's.
 const PHYSICS: &str = "T = 1.2\ndt = 0.02\npenalty_gamma0 = 10.0\ndensity = 1.0\nlame_lambda = 0.5\nlame_mu = 1.0\ndensity_b = 2.0\nlame_lambda_b = 0.25\nlame_mu_b = 0.5\nvelocity = -1.0\nvelocity_b = 0.5\ngap = 0.1\n";
 
-/// The blocks sweep and its Gmsh copy's, and the copy's file, in a fresh folder.
-/// With `clamped`, B's base is clamped (blocks: `far_end`; the file: its `clamped` group).
-fn both(
-    b: Blocks,
-    clamped: bool,
-    physics: &str,
-    methods: &str,
-) -> (Vec<(String, Outcome)>, Vec<(String, Outcome)>) {
+/// A sweep's runs with their labels.
+type Runs = Vec<(String, Outcome)>;
+
+/// The blocks sweep and its Gmsh copy's, and the copy's file, in a fresh folder. With
+/// `clamped`, B's base is clamped (blocks: `far_end`; the file: its `clamped` group).
+fn both(b: Blocks, clamped: bool, physics: &str, methods: &str) -> (Runs, Runs) {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("blocks.msh"), blocks_msh(b, clamped)).unwrap();
     let h = b.width / b.across as f64;
