@@ -63,6 +63,14 @@
 //!   samples), the rest is Z's 273 columns against 91 (72 and 178 samples), streamed from
 //!   memory, which the load slows most. The clock's ratio wants a quiet machine.
 //!
+//! - `two-bodies-cost/…` (issue 44, done-when 7): one step of mixed + Crank–Nicolson, consistent
+//!   mass, on two bodies against one body of the same size: `blocks2d` with W = 0.1 and
+//!   H_a = H_b = ½ (the bar cut in two, 17 × 81 nodes each at h = 0.1/16: 5 508 dofs, 17
+//!   node-to-node rows) against `bar2d` (0.1 × 1, 17 × 161 nodes less its clamped top: 5 440
+//!   dofs, 17 obstacle rows), both falling at ½ over a gap of 0.2 (the impact at t = 0.4), T =
+//!   0.6, τ = h/2: the engine's stepping time per step, factor cached. The target: two bodies ÷
+//!   one ≤ 1.2.
+//!
 //! `cargo bench --bench fe`; compare medians within one run (`cargo bench --bench fe -- disc2d`
 //! for one group).
 
@@ -388,6 +396,39 @@ fn bench_friction(c: &mut Criterion) {
     g.finish();
 }
 
+/// Issue 44's cost of a second body per step (module header, `two-bodies-cost`).
+fn bench_two_bodies(c: &mut Criterion) {
+    let mut g = c.benchmark_group("two-bodies-cost");
+    g.sample_size(10)
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2));
+    let h = 0.1 / 16.0;
+    let common = format!(
+        "[fixed]\nT = 0.6\nh = {h:?}\ndt = {:?}\nspace = \"mixed\"\nmass = \"consistent\"\nscheme = \"crank-nicolson\"\ngap = 0.2\n",
+        h / 2.0
+    );
+    for (what, scene, extra) in [
+        ("one-body-bar2d", "bar2d", ""),
+        (
+            "two-bodies-blocks2d",
+            "blocks2d",
+            "width = 0.1\nheight = 0.5\nheight_b = 0.5\nlame_lambda = 0.25\nlame_mu = 0.5\nvelocity = -0.5\n",
+        ),
+    ] {
+        let text = format!("name = \"{what}\"\nscene = \"{scene}\"\n{common}{extra}");
+        let sweep =
+            contact_sweep::sweep::SweepFile::parse(std::path::Path::new("cost.toml"), &text)
+                .expect("valid sweep");
+        let plan = contact_sweep::sweep::expand(&sweep).expect("plan");
+        let contact_sweep::run::RunConfig::Fe(cfg) = &plan.runs[0].config else {
+            unreachable!("an FE scene")
+        };
+        eprintln!("{what}: {} dofs", cfg.unknowns());
+        bench_steps(&mut g, what, cfg);
+    }
+    g.finish();
+}
+
 /// Issue 43's cost of Nitsche/penalty friction per step in 3D (module header, `block3d-friction`).
 fn bench_friction_3d(c: &mut Criterion) {
     let mut g = c.benchmark_group("block3d-friction");
@@ -440,6 +481,7 @@ friction = [
 }
 
 fn fe(c: &mut Criterion) {
+    bench_two_bodies(c);
     bench_friction_3d(c);
     bench_friction(c);
     bench_methods(c);

@@ -256,6 +256,27 @@ fn disc2d_time_loops_allocate_nothing() {
     assert_loop_allocates_nothing_with(&fe_sweep("alloc-disc", "disc2d", DISC, &methods), 15.0, 1);
 }
 
+/// Two bodies (contract §1.10, issue 44): blocks2d and blocks3d with node-to-node rows —
+/// mixed and penalty + Crank–Nicolson, mixed + backward Euler with a massless contact on B
+/// alone (the quasi-static dofs), kane — and the two-body Gmsh file's copy of blocks2d's mesh
+/// through the same engine data: the momentum tally, the rows' products and the refinement
+/// allocate nothing per step.
+#[test]
+fn two_body_time_loops_allocate_nothing() {
+    let methods = [
+        r#"{ space = "mixed", scheme = "crank-nicolson" }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 10.0, scheme = "crank-nicolson" }"#,
+        r#"{ space = "mixed", mass = "zero-contact", mass_side = "b", scheme = "backward-euler" }"#,
+        r#"{ space = "mixed", scheme = "kane" }"#,
+    ];
+    let fixed = "h = 0.25\ndt = 0.01\nvelocity = -1.0\nvelocity_b = 0.5\ngap = 0.05";
+    // Backward Euler's impact is plastic: the blocks touch and stay (one switch).
+    for scene in ["blocks2d", "blocks3d"] {
+        let text = fe_sweep("alloc-blocks", scene, fixed, &methods);
+        assert_loop_allocates_nothing_with(&text, 1.0, 1);
+    }
+}
+
 /// The FE engine's contract §3.2 methods (run::fe's methods module) on bar2d: kane with the
 /// consistent and a massless contact mass, contact-stabilized Newmark's two LCPs (M⁻¹Bᵀ built
 /// at setup), generalized-α/hht, Moreau–Jean's masked LCP, kinematic central difference.

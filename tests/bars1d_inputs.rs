@@ -18,7 +18,7 @@ const CASES: &[(&str, &str, &str)] = &[
     (
         "name = \"x\"\nscene = \"layer1d\"\n[fixed]\nh = 0.1\ndt = 0.1\nvelocity_b = 1.0\n",
         "fixed.velocity_b",
-        "`velocity_b` is not a parameter of scene layer1d (scenes that take it: bars1d, blocks2d, blocks3d)",
+        "`velocity_b` is not a parameter of scene layer1d (scenes that take it: mesh2d, mesh3d, bars1d, blocks2d, blocks3d)",
     ),
     (
         "name = \"x\"\nscene = \"bar2d\"\n[fixed]\nh = 0.1\ndt = 0.1\n[grid]\nmass_side = [\"a\"]\n",

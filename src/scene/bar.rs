@@ -48,6 +48,8 @@ pub enum FeGeometry {
         nodes_per_element: usize,
         /// The body's vertical extent (max − min of x_d over the nodes).
         height: f64,
+        /// Two bodies in the file (groups `body_a`, `body_b`; contract §1.10): B's keys.
+        bodies: Option<super::mesh::MeshBodies>,
     },
     /// Two boxes, A above B (contract §1.10, [`super::blocks`]): node-to-node contact rows
     /// between A's bottom and B's top face, no obstacle.

@@ -41,8 +41,8 @@
 use std::path::Path;
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MeshChoice, MethodNames, Physics, PhysicsKey,
-    Scene, SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, Physics,
+    PhysicsKey, Scene, SceneFacts, SceneSetup,
 };
 use crate::space::fe::{GmshMesh, Mesh};
 
@@ -52,7 +52,31 @@ pub struct MeshScene {
     pub dim: usize,
 }
 
-const MESH_PHYSICS: [PhysicsKey; 9] = [
+/// B's keys of a two-body file (contract §1.10), as the blocks': its material (default A's), its
+/// initial e_d velocity, the traction on A's `loaded` face and the side of the mass variant.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshBodies {
+    pub density_b: f64,
+    pub lame_lambda_b: f64,
+    pub lame_mu_b: f64,
+    pub velocity_b: f64,
+    pub pressure: f64,
+    pub mass_side: MassSide,
+}
+
+/// The two-body keys (contract §1.10), all NaN by default — "not given": the column is null
+/// and the id unchanged, so the one-body files' runs keep their ids and columns, and a
+/// one-body file refuses any of them ([`two_body_keys_on_one_body`]).
+const TWO_BODY_KEYS: [&str; 6] = [
+    "density_b",
+    "lame_lambda_b",
+    "lame_mu_b",
+    "velocity_b",
+    "pressure",
+    "mass_side",
+];
+
+const MESH_PHYSICS: [PhysicsKey; 15] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -94,7 +118,73 @@ const MESH_PHYSICS: [PhysicsKey; 9] = [
         name: "incline",
         default: 0.0,
     },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[0],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[1],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[2],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[3],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[4],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[5],
+        default: f64::NAN,
+    },
 ];
+
+/// A key's value, `or` where the sweep gives none (NaN).
+fn given_or(p: &Physics, name: &str, or: f64) -> f64 {
+    let v = p.get(name);
+    if v.is_nan() { or } else { v }
+}
+
+/// The first two-body key a sweep gives for a one-body file, with its value.
+fn two_body_keys_on_one_body(p: &Physics) -> Option<(&'static str, f64)> {
+    TWO_BODY_KEYS
+        .iter()
+        .map(|&k| (k, p.get(k)))
+        .find(|(_, v)| !v.is_nan())
+}
+
+/// B's keys of a two-body run, A's material where B's is not given; `gravity` (not yet) and
+/// `incline` (no plane) are refused.
+fn mesh_bodies(p: &Physics, path: &Path) -> Result<MeshBodies, String> {
+    for (key, why) in [
+        (
+            "gravity",
+            "the two bodies' volume load is not implemented yet (issue 44)",
+        ),
+        ("incline", "there is no plane to tilt between two bodies"),
+    ] {
+        if p.get(key) != 0.0 {
+            return Err(format!(
+                "{}: {key} = {} on a two-body mesh: {why}",
+                path.display(),
+                p.get(key)
+            ));
+        }
+    }
+    Ok(MeshBodies {
+        density_b: given_or(p, "density_b", p.get("density")),
+        lame_lambda_b: given_or(p, "lame_lambda_b", p.get("lame_lambda")),
+        lame_mu_b: given_or(p, "lame_mu_b", p.get("lame_mu")),
+        velocity_b: given_or(p, "velocity_b", 0.0),
+        pressure: given_or(p, "pressure", 0.0),
+        mass_side: MassSide::from_index(given_or(p, "mass_side", 0.0)),
+    })
+}
 
 impl MeshScene {
     fn file_only(&self, what: &str) -> String {
@@ -120,8 +210,17 @@ impl Scene for MeshScene {
             default_t: 2.0,
         }
     }
+    /// The P-wave speed; of two bodies, the larger (B's keys default to A's, NaN when not
+    /// given: the one-body speed).
     fn wave_speed(&self, p: &Physics) -> f64 {
-        ((p.get("lame_lambda") + 2.0 * p.get("lame_mu")) / p.get("density")).sqrt()
+        let c = |l: f64, m: f64, r: f64| ((l + 2.0 * m) / r).sqrt();
+        let a = c(p.get("lame_lambda"), p.get("lame_mu"), p.get("density"));
+        let b = c(
+            given_or(p, "lame_lambda_b", p.get("lame_lambda")),
+            given_or(p, "lame_mu_b", p.get("lame_mu")),
+            given_or(p, "density_b", p.get("density")),
+        );
+        a.max(b)
     }
     fn mesh_from_h(&self, _p: &Physics, _h: f64) -> Result<MeshChoice, String> {
         Err(self.file_only("h"))
@@ -162,7 +261,22 @@ impl Scene for MeshScene {
             ));
         }
         let clamped = mesh.group("clamped").map_or(&[][..], |g| &g.nodes[..]);
-        let contact = mesh.contact_nodes().len();
+        let bodies = match &mesh.bodies {
+            Some(_) => Some(mesh_bodies(p, path)?),
+            None => {
+                if let Some((key, v)) = two_body_keys_on_one_body(p) {
+                    return Err(format!(
+                        "{}: {key} = {v} applies to a two-body mesh (physical groups \"body_a\" and \"body_b\", contract §1.10); this file holds one body",
+                        path.display()
+                    ));
+                }
+                None
+            }
+        };
+        let contact = match &mesh.bodies {
+            Some(b) => b.pairs.len(),
+            None => mesh.contact_nodes().len(),
+        };
         if contact == 0 {
             return Err(format!(
                 "{}: every node of the group \"contact\" is in \"clamped\": no contact dof is left",
@@ -181,10 +295,15 @@ impl Scene for MeshScene {
             clamped_nodes: clamped.len(),
             contact_nodes: contact,
             nodes_per_element: mesh.nodes_per_element(),
-            height: {
-                let z = mesh.coords.iter().map(|c| c[self.dim - 1]);
-                z.clone().fold(f64::NEG_INFINITY, f64::max) - z.fold(f64::INFINITY, f64::min)
+            // Two bodies: H_a + H_b, each body's own extent (the blocks' length scale),
+            // whatever the file's distance between them.
+            height: match &mesh.bodies {
+                None => mesh.extent(|_| true),
+                Some(b) => (0..2u8)
+                    .map(|body| mesh.extent(|n| b.node_body[n] == body))
+                    .sum(),
             },
+            bodies,
         };
         Ok((
             choice,

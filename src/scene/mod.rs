@@ -29,7 +29,7 @@ pub use bar1d::{Bar1dScene, BarExact, BarParams};
 pub use bars1d::{BarMaterial, Bars1dParams, Bars1dScene};
 pub use blocks::{Blocks, BlocksScene};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
-pub use mesh::MeshScene;
+pub use mesh::{MeshBodies, MeshScene};
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
 pub use two_body::{MassSide, NitscheSides};
 

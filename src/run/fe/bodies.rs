@@ -31,17 +31,26 @@ pub(super) struct TwoBodies {
     pub(super) lame: [(f64, f64); 2],
     /// B's initial e_d velocity (A's is the run's `velocity`).
     pub(super) velocity_b: f64,
-    /// B's base clamped (`far_end = "clamped"`): no momentum invariant.
+    /// A node clamped (B's base, `far_end = "clamped"`, or a mesh's `clamped` group): no
+    /// momentum invariant.
     pub(super) base_clamped: bool,
     pub(super) mass_side: MassSide,
-    /// The traction −p e_d on A's top face as forces on the reduced dofs (None: p = 0).
+    /// The traction −p e_d on A's top face (its loaded face) as forces on the reduced dofs
+    /// (None: p = 0), and p.
     pub(super) pressure: Option<Vec<f64>>,
+    pub(super) pressure_value: f64,
+    /// Each body's extent along e_d (H_a, H_b): the pressure's energy unit (contract §1.10).
+    pub(super) heights: [f64; 2],
+    /// `mod2`/`mod3` put layer 0's mass back by the layers' measured masses (a file's unequal
+    /// layers), not by equal layers (the blocks' lattice).
+    pub(super) measured_layers: bool,
     /// Nitsche's points of Γ^a and Γ^b, each with both bodies' traces and unit side weight
-    /// ([`super::nitsche_pair`]; dofs reduced by the geometry).
+    /// ([`super::nitsche_pair`]; dofs reduced by the geometry). Built for the blocks' boxes;
+    /// empty for a two-body file, which refuses `nitsche` at plan time.
     pub(super) nitsche_points: [Vec<ContactPoint>; 2],
 }
 
-/// The parts of a two-block geometry ([`super::geometry::build_blocks`] makes the
+/// The parts of a two-body geometry ([`super::geometry::build_bodies`] makes the
 /// [`super::geometry::Geometry`]).
 pub(super) struct BlocksParts {
     pub(super) mesh: BodiesMesh,
@@ -53,7 +62,10 @@ pub(super) struct BlocksParts {
     /// A's Γ^a vertical dofs (reduced) in row order, and the rows.
     pub(super) contact: Vec<usize>,
     pub(super) rows: Rows,
-    /// Trapezoidal weights of the Γ^a nodes (sum 1) and |Γ^a|.
+    /// Each row's initial gap beyond the run's `gap` (the file's shape of the interface; 0 for
+    /// the blocks).
+    pub(super) contact_height: Vec<f64>,
+    /// Weights of the Γ^a nodes (sum 1, ∫_Γa φ_i/|Γ^a|) and |Γ^a|.
     pub(super) contact_weight: Vec<f64>,
     pub(super) contact_measure: f64,
     /// Global nodes whose mass a massless variant removes (both faces, per `mass_side`).
@@ -61,6 +73,36 @@ pub(super) struct BlocksParts {
     /// The penalty's node-to-node rows as contact points ([`node_rows_as_points`]).
     pub(super) points: Vec<ContactPoint>,
     pub(super) two: TwoBodies,
+}
+
+/// Two bodies as data (issue 44's design): the joined mesh, what is clamped, the matched
+/// pairs with their weights, and each body's material — whatever made them (the blocks'
+/// boxes, a Gmsh file). [`bodies_parts`] turns it into the engine's parts.
+pub(super) struct BodiesSpec {
+    pub(super) mesh: BodiesMesh,
+    /// Each element's mass layer within its body, and each body's layer count.
+    pub(super) layers: Vec<usize>,
+    pub(super) layer_counts: [usize; 2],
+    /// Per global node: every component fixed.
+    pub(super) clamped: Vec<bool>,
+    /// (Γ^a node, Γ^b node), global ids, one per row; each row's gap beyond the run's, its
+    /// weight (sum 1) and its γ = h (the penalty's size), and |Γ^a|.
+    pub(super) pairs: Vec<(usize, usize)>,
+    pub(super) height: Vec<f64>,
+    pub(super) weight: Vec<f64>,
+    pub(super) row_h: Vec<f64>,
+    pub(super) measure: f64,
+    /// A's loaded face: (node, weight, sum 1) and its measure, where `pressure` acts.
+    pub(super) loaded: Vec<(usize, f64)>,
+    pub(super) loaded_measure: f64,
+    pub(super) heights: [f64; 2],
+    pub(super) measured_layers: bool,
+    /// B's material and velocity, which side the mass variant acts on, p.
+    pub(super) density_b: f64,
+    pub(super) lame_b: (f64, f64),
+    pub(super) velocity_b: f64,
+    pub(super) mass_side: MassSide,
+    pub(super) pressure: f64,
 }
 
 /// Trapezoidal weight of a face node of a box with `cells` across: ½ per end of each axis.
@@ -95,12 +137,76 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
     cells[d - 1] = b.cells_b;
     let mesh_b = BoxMesh::try_new(&ext, &cells).map_err(|e| e.to_string())?;
     let mesh = BodiesMesh::new(&[&mesh_a, &mesh_b]);
+    let b0 = mesh.node(1, 0);
+    let clamped = (0..mesh.num_nodes())
+        .map(|n| b.base_clamped && n >= b0 && mesh_b.node_index(n - b0)[d - 1] == 0)
+        .collect();
+    // Layers from each body's contact face: A's bottom rows upward, B's top rows downward.
+    let (ea, eb) = (mesh_a.num_elements(), mesh_b.num_elements());
+    let layers: Vec<usize> = (0..ea)
+        .map(|e| mesh_a.element_layer(e))
+        .chain((0..eb).map(|e| b.cells_b - 1 - mesh_b.element_layer(e)))
+        .collect();
+    let a_face = mesh_a.nodes_on_plane(d - 1, 0);
+    // π(i): the node of B's top face with the same horizontal index.
+    let partner = |n: usize| {
+        let mut idx = mesh_a.node_index(n);
+        idx[d - 1] = b.cells_b;
+        mesh.node(1, mesh_b.node_id(idx))
+    };
+    let pairs = a_face.iter().map(|&n| (n, partner(n))).collect();
+    let mut weight: Vec<f64> = a_face
+        .iter()
+        .map(|&n| face_weight(mesh_a.node_index(n), &cells_a, d))
+        .collect();
+    let total: f64 = weight.iter().sum();
+    weight.iter_mut().for_each(|w| *w /= total);
+    let loaded = mesh_a
+        .nodes_on_plane(d - 1, b.cells_a)
+        .into_iter()
+        .map(|n| (n, face_weight(mesh_a.node_index(n), &cells_a, d) / total))
+        .collect();
+    let measure: f64 = b.width.powi(d as i32 - 1);
+    let h = b.width / b.across as f64;
+    let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
+    let nitsche_points = pair_points(&mesh_a, &mesh_b, b0, lame);
+    let mut parts = bodies_parts(
+        s,
+        BodiesSpec {
+            layers,
+            layer_counts: [b.cells_a, b.cells_b],
+            clamped,
+            height: vec![0.0; a_face.len()],
+            row_h: vec![h; a_face.len()],
+            pairs,
+            weight,
+            measure,
+            loaded,
+            loaded_measure: measure,
+            heights: [b.height_a, b.height_b],
+            measured_layers: false,
+            density_b: b.density_b,
+            lame_b: (b.lame_lambda_b, b.lame_mu_b),
+            velocity_b: b.velocity_b,
+            mass_side: b.mass_side,
+            pressure: b.pressure,
+            mesh,
+        },
+    )?;
+    parts.two.nitsche_points = nitsche_points;
+    Ok(parts)
+}
+
+/// The engine's parts of two bodies ([`BodiesSpec`]): dofs (the clamped nodes removed), the
+/// pattern, K with each body's material in its own block, the node-to-node rows
+/// B_i = e_{a,i,d} − e_{b,π(i),d}, the massless nodes of `mass_side`, the pressure's forces
+/// and the penalty's rows as points.
+pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts, String> {
+    let d = s.dim;
+    let mesh = spec.mesh;
     let nn = mesh.num_nodes();
     let b_node = |n: usize| mesh.node_body(n) == 1;
-    let clamped = |n: usize| {
-        b.base_clamped && b_node(n) && mesh_b.node_index(n - mesh.node(1, 0))[d - 1] == 0
-    };
-    let dofs = DofMap::new(nn * d, |g| clamped(g / d));
+    let dofs = DofMap::new(nn * d, |g| spec.clamped[g / d]);
     let pattern = fe_pattern(&mesh, &dofs);
     let body_of = |e: usize| mesh.element_body(e);
     // Each body's material in its own block (the blocks do not couple).
@@ -114,80 +220,71 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
             &w,
         )
     };
+    let (lambda_b, mu_b) = spec.lame_b;
     let k = SymMatrix::lin_comb(
         1.0,
         &stiffness(s.lame_lambda, s.lame_mu, 0),
         1.0,
-        &stiffness(b.lame_lambda_b, b.lame_mu_b, 1),
+        &stiffness(lambda_b, mu_b, 1),
     );
-    // Layers from each body's contact face: A's bottom rows upward, B's top rows downward.
-    let (ea, eb) = (mesh_a.num_elements(), mesh_b.num_elements());
-    let layers: Vec<usize> = (0..ea)
-        .map(|e| mesh_a.element_layer(e))
-        .chain((0..eb).map(|e| b.cells_b - 1 - mesh_b.element_layer(e)))
-        .collect();
-    let free = |n: usize| dofs.free_index(n * d + d - 1).expect("Γ nodes are free");
-    let a_face = mesh_a.nodes_on_plane(d - 1, 0);
-    // π(i): the node of B's top face with the same horizontal index.
-    let partner = |n: usize| {
-        let mut idx = mesh_a.node_index(n);
-        idx[d - 1] = b.cells_b;
-        mesh.node(1, mesh_b.node_id(idx))
+    let free = |n: usize| {
+        dofs.free_index(n * d + d - 1)
+            .ok_or_else(|| format!("contact node {n} is clamped"))
     };
-    let contact: Vec<usize> = a_face.iter().map(|&n| free(n)).collect();
-    let contact_b: Vec<usize> = a_face.iter().map(|&n| free(partner(n))).collect();
-    let pairs: Vec<(usize, usize)> = contact.iter().copied().zip(contact_b).collect();
-    let mut contact_weight: Vec<f64> = a_face
-        .iter()
-        .map(|&n| face_weight(mesh_a.node_index(n), &cells_a, d))
-        .collect();
-    let total: f64 = contact_weight.iter().sum();
-    contact_weight.iter_mut().for_each(|w| *w /= total);
-    let contact_measure: f64 = b.width.powi(d as i32 - 1);
+    let mut pairs = Vec::with_capacity(spec.pairs.len());
+    for &(a, b) in &spec.pairs {
+        pairs.push((free(a)?, free(b)?));
+    }
+    let contact: Vec<usize> = pairs.iter().map(|p| p.0).collect();
     let mut contact_node = vec![false; nn];
-    for &n in &a_face {
-        if b.mass_side.includes(0) {
-            contact_node[n] = true;
-        }
-        if b.mass_side.includes(1) {
-            contact_node[partner(n)] = true;
-        }
+    for &(a, b) in &spec.pairs {
+        contact_node[a] |= spec.mass_side.includes(0);
+        contact_node[b] |= spec.mass_side.includes(1);
     }
     let body = dofs.free.iter().map(|&g| u8::from(b_node(g / d))).collect();
-    // −p ∫φ_i on A's top nodes: the trapezoidal weights times |Γ^a|.
-    let pressure = (b.pressure != 0.0).then(|| {
+    // −p ∫φ_i on A's loaded nodes: the weights times the face's measure.
+    let pressure = if spec.pressure != 0.0 {
         let mut f = vec![0.0; dofs.n_free()];
-        for n in mesh_a.nodes_on_plane(d - 1, b.cells_a) {
-            let w = face_weight(mesh_a.node_index(n), &cells_a, d) / total;
-            f[free(n)] = -b.pressure * w * contact_measure;
+        for &(n, w) in &spec.loaded {
+            if let Some(r) = dofs.free_index(n * d + d - 1) {
+                f[r] = -spec.pressure * w * spec.loaded_measure;
+            }
         }
-        f
-    });
-    let h = b.width / b.across as f64;
-    let points = node_rows_as_points(&pairs, &contact_weight, contact_measure, h);
-    let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
-    let nitsche_points = pair_points(&mesh_a, &mesh_b, mesh.node(1, 0), lame);
+        Some(f)
+    } else {
+        None
+    };
+    let points = node_rows_as_points(
+        &pairs,
+        (&spec.weight, &spec.height),
+        spec.measure,
+        &spec.row_h,
+    );
     Ok(BlocksParts {
         points,
-        layers,
+        layers: spec.layers,
         dofs,
         pattern,
         k,
         rows: Rows::pairs(&pairs),
         contact,
-        contact_weight,
-        contact_measure,
+        contact_height: spec.height,
+        contact_weight: spec.weight,
+        contact_measure: spec.measure,
         contact_node,
         two: TwoBodies {
             body,
-            layer_counts: [b.cells_a, b.cells_b],
-            density: [s.density, b.density_b],
-            lame: [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)],
-            velocity_b: b.velocity_b,
-            base_clamped: b.base_clamped,
-            mass_side: b.mass_side,
+            layer_counts: spec.layer_counts,
+            density: [s.density, spec.density_b],
+            lame: [(s.lame_lambda, s.lame_mu), spec.lame_b],
+            velocity_b: spec.velocity_b,
+            base_clamped: spec.clamped.iter().any(|&c| c),
+            mass_side: spec.mass_side,
             pressure,
-            nitsche_points,
+            pressure_value: spec.pressure,
+            heights: spec.heights,
+            measured_layers: spec.measured_layers,
+            nitsche_points: [Vec::new(), Vec::new()],
         },
         mesh,
     })
@@ -198,21 +295,25 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
 /// (a, b), u_n = δ_i = (u^a_i − u^b_{π(i)})·n = −u^a_d + u^b_d (n = −e_d), σ_n = 0 (no Nitsche
 /// term: `nitsche` takes its own points, [`super::nitsche_pair`]), weight w_i = ∫_Γa φ_i and γ = h, A's mesh size,
 /// so κ_i = E_a γ0/h and the row force is w_i κ [δ_i − g_i]_+ — the weighted rows that pass the
-/// patch test (an unweighted force gives the end nodes twice their share). Gap 0: the run's
-/// gap is added where the operators are made, as for the one-body box.
+/// patch test (an unweighted force gives the end nodes twice their share). Each row's gap is
+/// its height beyond the run's gap (0 for the blocks): the run's gap is added where the
+/// operators are made, as for the one-body box. `h` per row (a Gmsh interface's faces differ
+/// in size).
 fn node_rows_as_points(
     pairs: &[(usize, usize)],
-    weight: &[f64],
+    (weight, height): (&[f64], &[f64]),
     measure: f64,
-    h: f64,
+    h: &[f64],
 ) -> Vec<ContactPoint> {
     pairs
         .iter()
         .zip(weight)
-        .map(|(&(a, b), w)| ContactPoint {
+        .zip(h)
+        .zip(height)
+        .map(|(((&(a, b), w), &h), &gap)| ContactPoint {
             weight: w * measure,
             gamma: h,
-            gap: 0.0,
+            gap,
             dofs: vec![a, b],
             un: vec![-1.0, 1.0],
             sn: vec![0.0, 0.0],
@@ -260,8 +361,8 @@ pub(super) fn frictional_points(
 }
 
 /// The element weights of a mass variant on two bodies: each body's density times its layer
-/// weight where `mass_side` puts the variant, 1 elsewhere (contract §2.6), with each body's
-/// own equal-layer redistribution.
+/// weight `weight(layer, body)` where `mass_side` puts the variant, 1 elsewhere (contract
+/// §2.6), with each body's own redistribution.
 pub(super) fn body_weight(
     two: &TwoBodies,
     element_body: usize,
@@ -269,7 +370,7 @@ pub(super) fn body_weight(
     layer: usize,
 ) -> f64 {
     let w = if two.mass_side.includes(element_body) {
-        weight(layer, two.layer_counts[element_body])
+        weight(layer, element_body)
     } else {
         1.0
     };

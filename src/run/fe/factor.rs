@@ -173,8 +173,12 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
 /// weights of the run's `nitsche_sides`. Friction is refused: the relative slip's Nitsche term
 /// is not implemented (the planner refuses it first).
 fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<NitscheOps, String> {
+    // The planner refuses Nitsche on a two-body file; kept as an error, not a panic.
     let (Some(two), FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
-        unreachable!("two bodies are the blocks' geometry")
+        return Err(format!(
+            "space = nitsche between two bodies is built for blocks2d/blocks3d only (scene {})",
+            cfg.setup.scene
+        ));
     };
     if frictional(cfg) {
         return Err(format!(

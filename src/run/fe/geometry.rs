@@ -4,8 +4,9 @@
 
 use std::sync::{Arc, OnceLock};
 
-use super::bodies::{TwoBodies, blocks_parts};
+use super::bodies::{BlocksParts, TwoBodies, blocks_parts};
 use super::cache::Cache;
+use super::mesh_bodies::{face_node_weights, mesh_bodies_parts};
 use super::rows::Rows;
 use crate::run::friction_tally::MeanVelocity;
 use crate::scene::{FeGeometry, FeSetup};
@@ -197,7 +198,10 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
             build_ball(s, mesh)
         }
         FeGeometry::Mesh {
-            path, content_hash, ..
+            path,
+            content_hash,
+            bodies,
+            ..
         } => {
             let mesh = GmshMesh::read_shared(path).map_err(|e| e.to_string())?;
             if mesh.content_hash != *content_hash {
@@ -208,16 +212,19 @@ pub(super) fn build_geometry(s: &FeSetup) -> Result<Geometry, String> {
                     mesh.content_hash
                 ));
             }
-            build_gmsh(s, mesh)
+            match bodies {
+                Some(keys) => build_bodies(s, mesh_bodies_parts(s, &mesh, keys)?),
+                None => build_gmsh(s, mesh),
+            }
         }
-        FeGeometry::Blocks(b) => build_blocks(s, b),
+        FeGeometry::Blocks(b) => build_bodies(s, blocks_parts(s, b)?),
     }
 }
 
-/// Two blocks (contract §1.10, [`super::bodies`]): A's Γ^a rows paired node to node with B's
-/// Γ^b, the run's gap in the rows; Nitsche's points of both sides in the pair's data.
-pub(super) fn build_blocks(s: &FeSetup, b: &crate::scene::Blocks) -> Result<Geometry, String> {
-    let mut p = blocks_parts(s, b)?;
+/// Two bodies (contract §1.10, [`super::bodies`]; the blocks or a two-body file): A's Γ^a rows
+/// paired node to node with B's Γ^b, the run's gap in the rows; Nitsche's points of both sides
+/// (the blocks') in the pair's data, their dofs reduced here.
+pub(super) fn build_bodies(s: &FeSetup, mut p: BlocksParts) -> Result<Geometry, String> {
     let sides = std::mem::take(&mut p.two.nitsche_points);
     p.two.nitsche_points = sides.map(|x| reduce_points(x, &p.dofs));
     let d = s.dim;
@@ -249,7 +256,7 @@ pub(super) fn build_blocks(s: &FeSetup, b: &crate::scene::Blocks) -> Result<Geom
         k: p.k,
         gram,
         grad,
-        contact_height: vec![0.0; p.contact.len()],
+        contact_height: p.contact_height,
         contact: p.contact,
         rows: p.rows,
         gap_in_geometry: false,
@@ -301,34 +308,7 @@ pub(super) fn build_gmsh(s: &FeSetup, mesh: Arc<GmshMesh>) -> Result<Geometry, S
         .collect();
     // Each Γ_C face spreads its measure (of its vertices' straight line or flat polygon) evenly
     // over its nodes: the trapezoidal weights of the bars' bottom face for 2-node lines.
-    let mut node_weight = vec![0.0; nn];
-    for face in &group.elements {
-        let c = |i: usize| mesh.coords[face[i]];
-        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            let x = [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ];
-            (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]).sqrt()
-        };
-        let measure = match (d, face.len()) {
-            (2, _) => {
-                let v = sub(c(1), c(0));
-                (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-            }
-            (_, 3 | 6) => 0.5 * cross(sub(c(1), c(0)), sub(c(2), c(0))),
-            // Quadrilateral faces, Gmsh order (vertices around the face first): two triangles.
-            _ => {
-                0.5 * cross(sub(c(1), c(0)), sub(c(2), c(0)))
-                    + 0.5 * cross(sub(c(2), c(0)), sub(c(3), c(0)))
-            }
-        };
-        for &n in face {
-            node_weight[n] += measure / face.len() as f64;
-        }
-    }
+    let node_weight = face_node_weights(&mesh, &group.elements);
     let mut contact_weight: Vec<f64> = cnodes.iter().map(|&n| node_weight[n]).collect();
     let total: f64 = contact_weight.iter().sum();
     if total.is_nan() || total <= 0.0 {

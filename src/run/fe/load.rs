@@ -140,7 +140,7 @@ fn pressure_load(
     cfg: &FeConfig,
     m: &SymMatrix,
 ) -> Result<Option<GravityLoad>, String> {
-    let (Some(two), crate::scene::FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
+    let Some(two) = &g.bodies else {
         return Ok(None);
     };
     let Some(force) = &two.pressure else {
@@ -162,11 +162,11 @@ fn pressure_load(
             mb += m1[r];
         }
     }
-    let compliance = b.height_a / (s.lame_lambda + 2.0 * s.lame_mu)
-        + b.height_b / (b.lame_lambda_b + 2.0 * b.lame_mu_b);
-    let energy_scale = b.pressure * b.pressure * g.contact_measure * compliance
+    let ([h_a, h_b], (lambda_b, mu_b), p) = (two.heights, two.lame[1], two.pressure_value);
+    let compliance = h_a / (s.lame_lambda + 2.0 * s.lame_mu) + h_b / (lambda_b + 2.0 * mu_b);
+    let energy_scale = p * p * g.contact_measure * compliance
         + 0.5 * ma * (s.v0 * s.v0 + s.v0_tangential * s.v0_tangential)
-        + 0.5 * mb * b.velocity_b * b.velocity_b;
+        + 0.5 * mb * two.velocity_b * two.velocity_b;
     Ok(Some(GravityLoad {
         force: force.clone(),
         a0,

@@ -107,17 +107,33 @@ pub(super) fn mass_matrix(
         _ => Redistribution::equal_layers(layers),
     };
     // Two bodies: the densities in the weights (ρ = 1 in the element), each body with its own
-    // equal layers ([`body_weight`]).
+    // redistribution ([`body_weight`]): equal layers on the blocks' lattice, the layers'
+    // measured masses in a file (as one body's, above; the body's density cancels).
     let (weight, density): (Box<dyn Fn(usize) -> f64 + '_>, f64) = match (&g.bodies, fm) {
-        (Some(two), FeMesh::Bodies { mesh: bm, .. }) => (
-            Box::new(move |e: usize| {
-                let lw = |l: usize, count: usize| {
-                    layer_weight(mass, l, Redistribution::equal_layers(count))
+        (Some(two), FeMesh::Bodies { mesh: bm, .. }) => {
+            let redistribution: [Redistribution; 2] = std::array::from_fn(|b| {
+                let measured =
+                    two.measured_layers && matches!(mass, MassVariant::Mod2 | MassVariant::Mod3);
+                if !measured {
+                    return Redistribution::equal_layers(two.layer_counts[b]);
+                }
+                let in_body = |e: usize, l: Option<usize>| {
+                    bm.element_body(e) == b && l.is_none_or(|l| fm.element_layer(e) == l)
                 };
-                body_weight(two, bm.element_body(e), lw, fm.element_layer(e))
-            }),
-            1.0,
-        ),
+                let mass_of = |l: Option<usize>| {
+                    let w = |e: usize| f64::from(u8::from(in_body(e, l)));
+                    component_total(mesh, 1.0, &w, &never)
+                };
+                Redistribution::measured(mass_of(None), mass_of(Some(0)), mass_of(Some(1)))
+            });
+            (
+                Box::new(move |e: usize| {
+                    let lw = |l: usize, b: usize| layer_weight(mass, l, redistribution[b]);
+                    body_weight(two, bm.element_body(e), lw, fm.element_layer(e))
+                }),
+                1.0,
+            )
+        }
         _ => (
             Box::new(|e: usize| layer_weight(mass, fm.element_layer(e), redistribution)),
             s.density,

@@ -45,6 +45,7 @@ mod geometry;
 mod load;
 mod lockstep;
 mod mass;
+mod mesh_bodies;
 mod methods;
 mod newmark;
 pub mod nitsche;

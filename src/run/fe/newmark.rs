@@ -617,13 +617,11 @@ impl<'a> Stepper<'a> {
     /// rows (a multiplier over its node's weight ∫φ_i; the penalty's κ[δ_i − g_i]_+; Nitsche's
     /// (1/γ^i)[P^i_γ − g]_+ at the points of every side with w_i > 0).
     fn patch_errors(&self) -> Option<(f64, f64)> {
-        let (Some(two), crate::scene::FeGeometry::Blocks(b), FeMesh::Bodies { mesh, .. }) =
-            (&self.geo.bodies, &self.cfg.setup.geometry, &self.geo.mesh)
-        else {
+        let (Some(two), FeMesh::Bodies { mesh, .. }) = (&self.geo.bodies, &self.geo.mesh) else {
             return None;
         };
         two.pressure.as_ref()?;
-        let (g, p, u) = (&*self.geo, b.pressure, &self.u);
+        let (g, p, u) = (&*self.geo, two.pressure_value, &self.u);
         let stress = patch_stress_error(mesh, &g.dofs, two, u, p);
         let worst =
             |it: &mut dyn Iterator<Item = f64>| it.fold(0.0f64, |m, ph| m.max((ph - p).abs() / p));

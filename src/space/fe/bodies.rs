@@ -55,6 +55,45 @@ impl BodiesMesh {
         m
     }
 
+    /// The bodies of one mesh whose nodes carry their body (`node_body[n]`, 0, 1, …; no cell
+    /// spans two): body 0's nodes first, each body's in their order, then the cells likewise
+    /// (a cell's body is its nodes'). Also returns each old node's new id. A mesh whose bodies
+    /// are already in order (body 0's nodes and cells first) keeps its numbering.
+    pub fn split(mesh: &dyn Mesh, node_body: &[u8]) -> (BodiesMesh, Vec<usize>) {
+        let bodies = node_body
+            .iter()
+            .map(|&b| usize::from(b) + 1)
+            .max()
+            .unwrap_or(1);
+        let k = mesh.nodes_per_element();
+        let mut m = BodiesMesh {
+            dim: mesh.dim(),
+            nodes_per_element: k,
+            coords: Vec::with_capacity(mesh.num_nodes()),
+            elements: Vec::with_capacity(mesh.num_elements() * k),
+            node_start: vec![0],
+            element_start: vec![0],
+        };
+        let mut new_id = vec![usize::MAX; mesh.num_nodes()];
+        for body in 0..bodies {
+            for n in (0..mesh.num_nodes()).filter(|&n| usize::from(node_body[n]) == body) {
+                new_id[n] = m.coords.len();
+                m.coords.push(mesh.coord(n));
+            }
+            m.node_start.push(m.coords.len());
+        }
+        for body in 0..bodies {
+            for e in 0..mesh.num_elements() {
+                let nodes = mesh.element_nodes(e);
+                if usize::from(node_body[nodes[0]]) == body {
+                    m.elements.extend(nodes.iter().map(|&n| new_id[n]));
+                }
+            }
+            m.element_start.push(m.elements.len() / k);
+        }
+        (m, new_id)
+    }
+
     /// The global id of body `body`'s node `node`.
     pub fn node(&self, body: usize, node: usize) -> usize {
         self.node_start[body] + node
@@ -116,5 +155,16 @@ mod tests {
         assert_eq!((m.element_body(1), m.element_body(2)), (0, 1));
         assert_eq!((m.node_body(5), m.node_body(6)), (0, 1));
         assert_eq!(m.coord(9), [1.0, 1.0, 0.0]);
+        // Split again by the node bodies: the same mesh, the same numbering.
+        let nb: Vec<u8> = (0..10).map(|n| m.node_body(n) as u8).collect();
+        let (s, id) = BodiesMesh::split(&m, &nb);
+        assert_eq!(s, m);
+        assert_eq!(id, (0..10).collect::<Vec<_>>());
+        // Bodies listed out of order: B's nodes and cell move behind A's.
+        let swapped: Vec<u8> = nb.iter().map(|b| 1 - b).collect();
+        let (s, id) = BodiesMesh::split(&m, &swapped);
+        assert_eq!((id[6], id[0]), (0, 4));
+        assert_eq!(s.element_nodes(0), &[0, 1, 2, 3]);
+        assert_eq!((s.element_body(0), s.element_body(1)), (0, 1));
     }
 }

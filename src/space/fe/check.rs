@@ -539,7 +539,13 @@ pub(crate) const COINCIDENT: f64 = 1e-10;
 
 /// The first pair of distinct nodes closer than [`COINCIDENT`] × the body's size, with their
 /// distance.
-pub(crate) fn coincident_nodes(dim: usize, coords: &[[f64; 3]]) -> Result<(), (usize, usize, f64)> {
+///
+/// Pairs for which `apart` holds (nodes of two bodies, which may touch) are let through.
+pub(crate) fn coincident_nodes(
+    dim: usize,
+    coords: &[[f64; 3]],
+    apart: &dyn Fn(usize, usize) -> bool,
+) -> Result<(), (usize, usize, f64)> {
     let (lo, hi) = bounding_box(coords);
     let size = (0..dim).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
     if coords.len() < 2 || size <= 0.0 {
@@ -583,7 +589,7 @@ pub(crate) fn coincident_nodes(dim: usize, coords: &[[f64; 3]]) -> Result<(), (u
                     let c = coords[jj];
                     let r = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2))
                         .sqrt();
-                    if r <= tol {
+                    if r <= tol && !apart(i, jj) {
                         return Err((i.min(jj), i.max(jj), r));
                     }
                 }

@@ -48,6 +48,8 @@ use sha2::{Digest, Sha256};
 
 pub use super::element_kind::ElementKind;
 use super::element_kind::{det_from_gradients, jacobian_det};
+pub use super::gmsh_bodies::GmshBodies;
+use super::gmsh_bodies::{Interface, match_interface, node_bodies};
 pub use super::gmsh_error::GmshError;
 use super::mesh::Mesh;
 use super::{check, msh, overlap};
@@ -142,6 +144,9 @@ pub struct GmshMesh {
     pub content_hash: String,
     /// Whether the 2D cells were reoriented (all clockwise in the file).
     pub reoriented: bool,
+    /// Two bodies (groups `body_a`/`body_b`, contract §1.10): each node's body and the
+    /// matched interface ([`GmshBodies`]); None for one body.
+    pub bodies: Option<GmshBodies>,
 }
 
 impl GmshMesh {
@@ -203,9 +208,34 @@ impl GmshMesh {
         }
         let reoriented = dim == 2 && cells.orient_2d(&nodes.coords);
         let h = cells.check_jacobians_at_points(file, &nodes.coords)?;
-        let topo = check_topology(file, &nodes, &cells, geometric)?;
+        // Two bodies: each node's body first, since nodes of two bodies may coincide (contract
+        // §1.10: bodies touching at g = 0), where nodes of one body may not (a crack).
+        let node_body = reader.node_bodies(&names, entities.as_ref(), &nodes.tags)?;
+        let topo = check_topology(file, &nodes, &cells, geometric, node_body.as_deref())?;
         let groups = reader.groups(names, entities.as_ref(), &topo)?;
-        require_contact(file, &groups)?;
+        require_contact(file, &groups, node_body.is_some())?;
+        let bodies = match node_body {
+            None => None,
+            Some(node_body) => {
+                let nodes_of = |name: &str| {
+                    groups
+                        .iter()
+                        .find(|g| g.name == name)
+                        .map_or(&[][..], |g| &g.nodes[..])
+                };
+                Some(match_interface(Interface {
+                    file,
+                    dim,
+                    coords: &nodes.coords,
+                    node_tags: &nodes.tags,
+                    node_body,
+                    contact_a: nodes_of("contact_a"),
+                    contact_b: nodes_of("contact_b"),
+                    clamped: nodes_of("clamped"),
+                    h,
+                })?)
+            }
+        };
         let content_hash = Sha256::digest(bytes)
             .iter()
             .map(|b| format!("{b:02x}"))
@@ -222,6 +252,7 @@ impl GmshMesh {
             h,
             content_hash,
             reoriented,
+            bodies,
         })
     }
 
@@ -286,6 +317,16 @@ impl GmshMesh {
             .iter()
             .map(|&n| self.coords[n][self.dim - 1])
             .reduce(f64::min)
+    }
+
+    /// The extent along e_d (max − min of x_d) of the nodes `which` takes: the body's height,
+    /// or one body's of two.
+    pub fn extent(&self, which: impl Fn(usize) -> bool) -> f64 {
+        let d = self.dim;
+        let z = (0..self.coords.len())
+            .filter(|&n| which(n))
+            .map(|n| self.coords[n][d - 1]);
+        z.clone().fold(f64::NEG_INFINITY, f64::max) - z.fold(f64::INFINITY, f64::min)
     }
 
     /// |Ω_h| = Σ_K ∫_K̂ det J by [`ElementKind::quadrature`] (exact for affine cells).
@@ -409,6 +450,21 @@ fn cell_dimension(file: &str, blocks: &[msh::ElementBlock]) -> Result<usize, Gms
     Ok(dim)
 }
 
+/// The groups that name boundary faces (contract §1.6, §1.10): Γ_C, the clamped face, and
+/// the two bodies' contact faces and loaded face.
+const BOUNDARY_GROUPS: [&str; 5] = ["contact", "clamped", "contact_a", "contact_b", "loaded"];
+
+/// The tags of the entities of dimension `gdim` that the physical group `tag` holds.
+fn entities_of(entities: Option<&[Vec<msh::Entity>; 4]>, gdim: usize, tag: i32) -> Vec<i32> {
+    entities.map_or_else(Vec::new, |en| {
+        en[gdim.min(3)]
+            .iter()
+            .filter(|x| x.physical_tags.iter().any(|&t| t.abs() == tag))
+            .map(|x| x.tag)
+            .collect()
+    })
+}
+
 /// The element blocks of a file with what reading them needs: node tags → node ids, the
 /// dimension of the cells.
 struct BlockReader<'a> {
@@ -498,18 +554,32 @@ impl BlockReader<'_> {
     ) -> Result<Vec<PhysicalGroup>, GmshError> {
         let mut groups = Vec::new();
         for (gdim, tag, name) in names {
-            let mut ents: Vec<i32> = Vec::new();
-            if let Some(en) = entities {
-                ents.extend(
-                    en[gdim.min(3)]
-                        .iter()
-                        .filter(|x| x.physical_tags.iter().any(|&t| t.abs() == tag))
-                        .map(|x| x.tag),
-                );
-            }
-            groups.push(self.group(gdim, tag, name, ents, topo)?);
+            let ents = entities_of(entities, gdim, tag);
+            groups.push(self.group(gdim, tag, name, ents, Some(topo))?);
         }
         Ok(groups)
+    }
+
+    /// Each node's body (0 = A, 1 = B) of a two-body file (groups `body_a`, `body_b` of the
+    /// cells' dimension, contract §1.10), None for one body.
+    fn node_bodies(
+        &self,
+        names: &[(usize, i32, String)],
+        entities: Option<&[Vec<msh::Entity>; 4]>,
+        node_tags: &[u64],
+    ) -> Result<Option<Vec<u8>>, GmshError> {
+        if !names.iter().any(|n| n.2 == "body_a" || n.2 == "body_b") {
+            return Ok(None);
+        }
+        let mut body = [Vec::new(), Vec::new()];
+        for (gdim, tag, name) in names {
+            let Some(i) = ["body_a", "body_b"].iter().position(|b| b == name) else {
+                continue;
+            };
+            let ents = entities_of(entities, *gdim, *tag);
+            body[i].extend(self.group(*gdim, *tag, name.clone(), ents, None)?.nodes);
+        }
+        node_bodies(self.file, node_tags, &body[0], &body[1]).map(Some)
     }
 
     /// The group `name` of dimension `gdim` over the entities `ents`: its elements and nodes.
@@ -519,16 +589,17 @@ impl BlockReader<'_> {
         tag: i32,
         name: String,
         ents: Vec<i32>,
-        topo: &check::Topology,
+        topo: Option<&check::Topology>,
     ) -> Result<PhysicalGroup, GmshError> {
         let (file, dim) = (self.file, self.dim);
-        let boundary = name == "contact" || name == "clamped";
-        if boundary && gdim + 1 != dim {
+        let boundary = BOUNDARY_GROUPS.contains(&name.as_str());
+        let cells = name == "body_a" || name == "body_b";
+        if (boundary && gdim + 1 != dim) || (cells && gdim != dim) {
             return Err(GmshError::GroupDimension {
                 file: file.to_string(),
                 group: name,
                 found: gdim,
-                expected: dim - 1,
+                expected: if cells { dim } else { dim - 1 },
                 mesh_dim: dim,
             });
         }
@@ -548,7 +619,7 @@ impl BlockReader<'_> {
                 // `contact` and `clamped` are boundary faces of the cells' degree: Γ_C's
                 // quadrature and the clamped nodes act on them (a point or an interior face
                 // would fail or silently cut the body inside the runs).
-                if boundary {
+                if let (true, Some(topo)) = (boundary, topo) {
                     topo.boundary_face(b.element_type, &ids).map_err(|reason| {
                         GmshError::GroupElement {
                             file: file.to_string(),
@@ -714,18 +785,21 @@ fn check_topology<'a>(
     nodes: &'a Nodes,
     cells: &'a Cells,
     geometric: bool,
+    node_body: Option<&[u8]>,
 ) -> Result<check::Topology<'a>, GmshError> {
     let f = || file.to_string();
     let topo = check::Topology::new(cells.kind, &cells.elements, &nodes.tags, &cells.tags);
     topo.check(file)?;
-    check::coincident_nodes(cells.kind.dim(), &nodes.coords).map_err(|(a, b, distance)| {
-        GmshError::CoincidentNodes {
+    // Nodes of two bodies may coincide (their interface at g = 0), nodes of one may not.
+    let apart = |a: usize, b: usize| node_body.is_some_and(|nb| nb[a] != nb[b]);
+    check::coincident_nodes(cells.kind.dim(), &nodes.coords, &apart).map_err(
+        |(a, b, distance)| GmshError::CoincidentNodes {
             file: f(),
             a: nodes.tags[a],
             b: nodes.tags[b],
             distance,
-        }
-    })?;
+        },
+    )?;
     check::certify_jacobians(cells.kind, &nodes.coords, &cells.elements)
         .map_err(|e| e.into_gmsh(f(), &cells.tags))?;
     if geometric {
@@ -742,12 +816,21 @@ fn check_topology<'a>(
     Ok(topo)
 }
 
-/// The `contact` group (Γ_C) is required.
-fn require_contact(file: &str, groups: &[PhysicalGroup]) -> Result<(), GmshError> {
-    if !groups.iter().any(|g| g.name == "contact") {
+/// The `contact` group (Γ_C) is required; of two bodies (contract §1.10), both bodies and both
+/// contact faces.
+fn require_contact(file: &str, groups: &[PhysicalGroup], two: bool) -> Result<(), GmshError> {
+    let required: &[&str] = if two {
+        &["body_a", "body_b", "contact_a", "contact_b"]
+    } else {
+        &["contact"]
+    };
+    if let Some(missing) = required
+        .iter()
+        .find(|r| !groups.iter().any(|g| g.name == **r))
+    {
         return Err(GmshError::MissingGroup {
             file: file.to_string(),
-            group: "contact".into(),
+            group: (*missing).into(),
             found: if groups.is_empty() {
                 "none".into()
             } else {

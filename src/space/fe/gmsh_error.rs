@@ -166,6 +166,9 @@ pub enum GmshError {
         element: u64,
         reason: String,
     },
+    /// A two-body mesh (contract §1.10) whose bodies or interface are not what the engine takes.
+    #[error("{file}: two bodies: {reason}")]
+    TwoBodies { file: String, reason: String },
     #[error("{file}: element {element} refers to node {node}, which the file does not define")]
     UnknownNode {
         file: String,
