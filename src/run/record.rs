@@ -230,6 +230,9 @@ schema! {
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
         slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
         friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |Σf_t|/Σf_n (sums over the contact points, 3D: the norm of Σf_t), the apparent friction coefficient";
+        friction_newton_iterations: Option<i64> => "", "friction: the frictional contact solve's primary semismooth Newton iterations summed over the steps (mixed: the Alart–Curnier Newton with Tresca's closure; Nitsche, penalty: from the previous forces, then from rest); null without friction";
+        friction_continuation_iterations: Option<i64> => "", "friction: Newton iterations of the rescue's continuation in the friction bound (μ_f or s scaled from 0 to 1), summed over the steps where the primary Newton failed";
+        friction_fallback_iterations: Option<i64> => "", "friction: the last fallback's work where the continuation failed too: projected block Gauss–Seidel sweeps plus its Newton polish iterations, summed over the steps";
         tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D)";
         normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
@@ -495,6 +498,9 @@ impl RunRecord {
             stick_steps: m.stick_steps,
             slip_steps: m.slip_steps,
             friction_ratio_max: m.friction_ratio_max,
+            friction_newton_iterations: m.friction_newton_iterations,
+            friction_continuation_iterations: m.friction_continuation_iterations,
+            friction_fallback_iterations: m.friction_fallback_iterations,
             tangential_velocity_final: m.tangential_velocity_final,
             normal_velocity_final: m.normal_velocity_final,
             err_sigma_t_l2: m.err_sigma_t_l2,

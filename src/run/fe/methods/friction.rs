@@ -177,6 +177,7 @@ impl Friction {
                 LCP_TOL,
             )
             .map_err(|e| e.to_string())?;
+        self.tally.add_stages(im.solver.stages().columns());
         let n = y.len();
         for ((&mk, &col), &row) in im.mu.iter().zip(&im.cols).zip(&im.rows) {
             if mk != 0.0 {
