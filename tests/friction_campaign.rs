@@ -178,13 +178,18 @@ fn potential_methods(t: Treatment) -> Vec<String> {
     out
 }
 
-/// Whether the Nitsche and penalty cases are asserted too. Measured on this branch (mixed
-/// rescued, Nitsche/penalty's Newton as on main; campaign() prints each failure as "FAIL …"):
-/// Nitsche 30 of its 55 runs `solver-failed` (most at step 1 with μ_f ≥ 1, γ0 = 1e-4 or 1e-2),
-/// penalty 26 of 55; backward Euler's stick criterion fails on 4 Nitsche and 6 penalty runs
-/// (the penalty's friction is a spring: it never sticks exactly). None diverged. Mixed: 0 of
-/// its 77 (16 of them rescued, i.e. `solver-failed` on main). Set to true after nitsche43's
-/// merge.
+/// Whether the Nitsche and penalty cases are asserted too. Measured (campaign() prints each
+/// failure as "FAIL …"; seed 43, 55 runs each): at the start of robust43, Nitsche 11 and
+/// penalty 8 runs `solver-failed` — 15 of them in the quasi-static start of mod3's massless
+/// layer (μ_f 2.3–5), now rescued by its frictionless fallback
+/// ([`sticking_block_mod3_start_with_mu_5`]). Left: 6 steps that neither the continuation
+/// in the bound nor the block Gauss–Seidel fallback (400 sweeps, a Newton polish every 20)
+/// solve — Nitsche γ0 = 1e-4 on the 18° incline (backward Euler μ_f 4.15, generalized-α
+/// 3.42, HHT 4.18) and flat (CN mod3 4.98? see the printout), Tresca s = 0.048 with HHT, and
+/// the penalty γ0 = 1e3, backward Euler μ_f 3.9 (the continuation stalls at t = 0.5–0.9 of
+/// the bound, the polish's tangential residual stays 1e1–1e4 above its scale). Nitsche's and
+/// the penalty's stick drift is printed, not asserted (their stick is regularised). None
+/// diverged. Mixed: 0 of its 77.
 const ASSERT_POTENTIALS: bool = false;
 
 /// Whether the stick criterion is asserted for every scheme; it is for backward Euler always.
@@ -312,6 +317,8 @@ struct Report {
     drift: Option<f64>,
     iterations: i64,
     iterations_max_step: i64,
+    /// The run record's stage columns: primary Newton, continuation, fallback.
+    stages: [Option<i64>; 3],
     /// The frictionless twin's status where the run did not end ok.
     twin: Option<Status>,
 }
@@ -345,6 +352,11 @@ fn evaluate(c: &Case) -> Option<Report> {
         drift,
         iterations: o.metrics.iterations,
         iterations_max_step: o.metrics.iterations_max_step.unwrap_or(0),
+        stages: [
+            o.metrics.friction_newton_iterations,
+            o.metrics.friction_continuation_iterations,
+            o.metrics.friction_fallback_iterations,
+        ],
         twin,
     })
 }
@@ -387,12 +399,17 @@ fn campaign() {
     );
     for (c, r) in all.iter().zip(&reports) {
         let Some(r) = r else { continue };
+        check_stage_columns(c, r);
         let solver_failed = r.status == Status::SolverFailed;
         let lost = r.status != Status::Ok && !solver_failed && r.twin == Some(Status::Ok);
         // Stick: 1e-8·V (issue 43): a stuck node's slip is the solver's residual, 1e-12
         // relative, and the mean over the window averages the elastic vibration out.
         let slid = r.drift.is_some_and(|d| d > 1e-8)
             && (ASSERT_STICK || c.method.contains("backward-euler"));
+        // Nitsche's and the penalty's stick is regularised (a stuck point slips by
+        // γτ(σ_t − f_t), resp. f_t/κ, per step) and these blocks start bouncing: their drift
+        // is measured and printed, not asserted ([`ASSERT_POTENTIALS`]).
+        let slid_asserted = slid && c.treatment == Treatment::Mixed;
         let e = counts.entry(format!("{:?}", c.treatment)).or_default();
         e[0] += 1;
         e[1] += usize::from(solver_failed);
@@ -410,7 +427,9 @@ fn campaign() {
                 r.message
             );
             eprintln!("FAIL {line}");
-            if c.treatment == Treatment::Mixed || ASSERT_POTENTIALS {
+            if (c.treatment == Treatment::Mixed || ASSERT_POTENTIALS)
+                && (solver_failed || lost || slid_asserted)
+            {
                 failures.push(line);
             }
         }
@@ -428,6 +447,36 @@ fn campaign() {
         failures.len(),
         failures.join("\n")
     );
+}
+
+/// The stage columns of a frictional run (issue 43: iterations of each stage reported): set
+/// on every run that stepped, and on a run that ended ok where every contact solve is the frictional one (Nitsche, penalty: the steps' and the
+/// stages' counts are the same integers) they add up to `iterations`; a mixed run whose step
+/// needed more than the primary Newton's budget (the rescue) shows it in the rescue's columns.
+fn check_stage_columns(c: &Case, r: &Report) {
+    let [Some(newton), Some(cont), Some(fallback)] = r.stages else {
+        // A run stopped in its set-up (the quasi-static start) has no step and no tally.
+        assert_ne!(r.status, Status::Ok, "{}: no stage columns", c.label());
+        return;
+    };
+    // A failed step's stages are counted, its iterations not: ok runs only.
+    if c.treatment != Treatment::Mixed && r.status == Status::Ok {
+        assert_eq!(newton + cont + fallback, r.iterations, "{}", c.label());
+    } else if r.status == Status::Ok {
+        assert!(newton + cont + fallback <= r.iterations, "{}", c.label());
+    }
+    let limit = if matches!(c.law, Law::Tresca(_)) {
+        300
+    } else {
+        100
+    };
+    if c.treatment == Treatment::Mixed && r.iterations_max_step >= limit {
+        assert!(
+            cont + fallback > 0,
+            "{}: rescued, no rescue stage",
+            c.label()
+        );
+    }
 }
 
 /// sweeps/sliding_block.toml's text with `friction = "tresca"` and the thresholds of issue 43
@@ -550,22 +599,19 @@ fn block_with_mu_5() {
     assert_eq!(all_ok(&runs, |_| true), 34);
 }
 
+/// The scene and [fixed] keys of sweeps/sliding_block.toml's block resting on the plane, up to
+/// its throw speed.
+const BLOCK2D_KEYS: &str = "scene = \"mesh2d\"\n[fixed]\nmesh = \"meshes/block2d.msh\"\ndensity = 1.0\nlame_lambda = 10.0\nlame_mu = 10.0\ngravity = 0.1\ngap = 0.0\n";
+
 /// The block of sweeps/sliding_block.toml thrown at V = 0.5 on the flat plane with Nitsche,
 /// mod3 and backward Euler, μ_f = 0.9174 (rigid stop near t = 5.45): on main its frictional
 /// Newton fails as the block stops (measured: step 116, t = 5.8, "did not converge in 100
 /// iterations"). The mixed twin runs too.
 #[test]
 fn sliding_block_nitsche_mod3_backward_euler_at_its_stop() {
-    let text = r#"name = "stop"
-scene = "mesh2d"
-[fixed]
-mesh = "meshes/block2d.msh"
-density = 1.0
-lame_lambda = 10.0
-lame_mu = 10.0
-gravity = 0.1
-gap = 0.0
-velocity_tangential = 0.5
+    let text = format!(
+        r#"name = "stop"
+{}velocity_tangential = 0.5
 friction = "coulomb"
 friction_coefficient = 0.9174
 mass = "mod3"
@@ -573,9 +619,58 @@ scheme = "backward-euler"
 T = 8.0
 dt = 0.05
 [grid]
-space = [{ space = "mixed" }, { space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 }]
-"#;
-    assert_eq!(all_ok(&statuses(text), |_| true), 2);
+space = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-3 }}]
+"#,
+        BLOCK2D_KEYS
+    );
+    assert_eq!(all_ok(&statuses(&text), |_| true), 2);
+}
+
+/// Issue 43's campaign: the quasi-static start of the massless Γ_C layer (mod3) failed for
+/// Nitsche and penalty with μ_f 2.3–5 on the sticking blocks (15 of the campaign's runs: "the
+/// quasi-static start: semismooth Newton did not converge in 100 iterations"; the sliding
+/// points' −μ_f v̂ fold makes the start's W no P-matrix). The start now falls back to the
+/// frictionless quasi-static state, as mixed's does: no run fails in its start, and every run
+/// but one ends ok — measured: Nitsche γ0 = 1e-2, backward Euler, on one of the inclines, fails at step 2 (t =
+/// 0.1) in the time loop, neither the continuation nor Gauss–Seidel solving it (issue 43's
+/// remaining class: large μ_f steps).
+#[test]
+fn sticking_block_mod3_start_with_mu_5() {
+    let text = format!(
+        r#"name = "start5"
+{}velocity_tangential = 0.05
+friction = "coulomb"
+friction_coefficient = 5.0
+mass = "mod3"
+T = 0.5
+dt = 0.05
+[grid]
+incline = [0.0, 18.0]
+scheme = [{{ scheme = "crank-nicolson" }}, {{ scheme = "backward-euler" }}]
+space = [
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-4 }},
+  {{ space = "nitsche", nitsche_theta = 1.0, nitsche_gamma0 = 1e-2 }},
+  {{ space = "penalty", penalty_gamma0 = 10.0 }},
+  {{ space = "penalty", penalty_gamma0 = 1000.0 }},
+]
+"#,
+        BLOCK2D_KEYS
+    );
+    let runs = statuses(&text);
+    assert_eq!(runs.len(), 16);
+    for (label, _, message, _) in &runs {
+        let m = message.as_deref().unwrap_or("");
+        assert!(!m.contains("quasi-static start"), "{label}: {m}");
+    }
+    let failed: Vec<&str> = runs
+        .iter()
+        .filter(|r| r.1 != Status::Ok)
+        .map(|r| r.0.as_str())
+        .collect();
+    assert_eq!(
+        failed,
+        ["nitsche(Θ=1, γ0=1e-2) · mod3 · backward-euler · coulomb(μ_f=5)"]
+    );
 }
 
 /// The P2 disc (sweeps/meshes/disc_p2.msh) thrown at 0.5 onto a 26° incline from gap 5,

@@ -236,6 +236,16 @@ impl Stages {
         self.newton + self.closure + self.continuation + self.gauss_seidel + self.polish
     }
 
+    /// The run record's three stage columns: the primary Newton with Tresca's closure, the
+    /// continuation, Gauss–Seidel with its polish.
+    pub fn columns(&self) -> [usize; 3] {
+        [
+            self.newton + self.closure,
+            self.continuation,
+            self.gauss_seidel + self.polish,
+        ]
+    }
+
     /// Whether a stage beyond the primary Newton (and Tresca's closure) was needed.
     pub fn rescued(&self) -> bool {
         self.continuation + self.gauss_seidel + self.polish > 0

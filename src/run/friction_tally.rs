@@ -121,6 +121,8 @@ pub struct FrictionTally {
     v_last: Option<(f64, f64)>,
     stop_time: Option<f64>,
     steps: usize,
+    /// The contact solve's iterations per stage over the run ([`stage_columns`]).
+    stages: [usize; 3],
 }
 
 impl FrictionTally {
@@ -147,6 +149,7 @@ impl FrictionTally {
             v_last: None,
             stop_time: None,
             steps: 0,
+            stages: [0; 3],
         }
     }
 
@@ -256,6 +259,13 @@ impl FrictionTally {
         self.tangential_work_min
     }
 
+    /// A step's contact solve spent `s` iterations in its stages ([`stage_columns`]).
+    pub fn add_stages(&mut self, s: [usize; 3]) {
+        for (a, b) in self.stages.iter_mut().zip(s) {
+            *a += b;
+        }
+    }
+
     /// The friction columns (contract §5) into `metrics`: energies over `energy_scale`, and the
     /// body's final mean tangential (3D: the norm of both) and normal velocities.
     pub fn finish(
@@ -267,6 +277,7 @@ impl FrictionTally {
     ) {
         let scale = energy_scale.abs().max(f64::MIN_POSITIVE);
         metrics.friction_work = Some(self.work / scale);
+        stage_columns(metrics, self.stages);
         metrics.energy_balance_drift = match (self.balance_prev, self.e0) {
             (Some(b), Some(e0)) => Some((b - e0) / scale),
             _ => None,
@@ -288,6 +299,14 @@ impl FrictionTally {
             0.0
         });
     }
+}
+
+/// The frictional solve's iterations per stage over the run into `metrics` (contract §4):
+/// the primary Newton, the continuation in the bound, the fallback (Gauss–Seidel and its polish).
+pub fn stage_columns(metrics: &mut Metrics, s: [usize; 3]) {
+    metrics.friction_newton_iterations = Some(s[0] as i64);
+    metrics.friction_continuation_iterations = Some(s[1] as i64);
+    metrics.friction_fallback_iterations = Some(s[2] as i64);
 }
 
 #[cfg(test)]

@@ -91,6 +91,13 @@ pub struct Metrics {
     /// largest one-step rise of E + W_f, all over energy_scale; contact node-steps in stick
     /// and in slip; max |f_t|/f_n over the contact steps.
     pub friction_work: Option<f64>,
+    /// The frictional contact solve's iterations per stage over the run (contract §4; null
+    /// without friction): the primary Newton (mixed: with Tresca's closure; Nitsche/penalty:
+    /// from the previous forces, then from rest), the continuation in the bound, and the
+    /// fallback (block Gauss–Seidel sweeps and its Newton polish).
+    pub friction_newton_iterations: Option<i64>,
+    pub friction_continuation_iterations: Option<i64>,
+    pub friction_fallback_iterations: Option<i64>,
     pub energy_balance_drift: Option<f64>,
     pub energy_balance_max_increase: Option<f64>,
     pub stick_steps: Option<i64>,

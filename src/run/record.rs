@@ -230,6 +230,9 @@ schema! {
         stick_steps: Option<i64> => "", "friction: contact node-steps in stick (|u_t^{n+1} − u_t^n| ≤ 1e-12·h)";
         slip_steps: Option<i64> => "", "friction: contact node-steps in slip";
         friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |Σf_t|/Σf_n (sums over the contact points, 3D: the norm of Σf_t), the apparent friction coefficient";
+        friction_newton_iterations: Option<i64> => "", "friction: the frictional contact solve's primary semismooth Newton iterations summed over the steps (mixed: the Alart–Curnier Newton with Tresca's closure; Nitsche, penalty: from the previous forces, then from rest); null without friction";
+        friction_continuation_iterations: Option<i64> => "", "friction: Newton iterations of the rescue's continuation in the friction bound (μ_f or s scaled from 0 to 1), summed over the steps where the primary Newton failed";
+        friction_fallback_iterations: Option<i64> => "", "friction: the last fallback's work where the continuation failed too: projected block Gauss–Seidel sweeps plus its Newton polish iterations, summed over the steps";
         tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D; two bodies: A's)";
         normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes; two bodies: A's)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
@@ -377,45 +380,42 @@ impl RunRecord {
     /// Assemble the row of a run.
     pub fn new(sweep: &str, spec: &RunSpec, out: &Outcome, timing: Timing) -> RunRecord {
         let (p, m) = (&spec.params, &out.metrics);
-        let f = |k: Key| p.get(&k).and_then(Value::as_f64);
-        let s = |k: Key| p.get(&k).map(|v| v.to_string()).unwrap_or_default();
-        let scene = spec.scene.name();
         RunRecord {
             run_id: spec.run_id.clone(),
             sweep: sweep.to_string(),
-            scene: scene.to_string(),
+            scene: spec.scene.name().to_string(),
             label: spec.label.clone(),
             status: out.status.as_str().to_string(),
             message: out.message.clone(),
-            T: f(Key::T).unwrap_or(f64::NAN),
-            h: f(Key::H).unwrap_or(f64::NAN),
+            T: num(p, Key::T).unwrap_or(f64::NAN),
+            h: num(p, Key::H).unwrap_or(f64::NAN),
             elements: elements_of(p),
-            dt: f(Key::Dt).unwrap_or(f64::NAN),
-            courant: f(Key::Courant).unwrap_or(f64::NAN),
-            space: s(Key::Space),
-            mass: s(Key::Mass),
+            dt: num(p, Key::Dt).unwrap_or(f64::NAN),
+            courant: num(p, Key::Courant).unwrap_or(f64::NAN),
+            space: text(p, Key::Space),
+            mass: text(p, Key::Mass),
             mass_weights: p.get(&Key::MassWeights).map(weights_text),
             contact_init: p.get(&Key::ContactInit).map(|v| v.to_string()),
-            scheme: s(Key::Scheme),
+            scheme: text(p, Key::Scheme),
             scheme_label: spec.scheme_label.clone(),
-            nitsche_theta: f(Key::NitscheTheta),
-            nitsche_gamma0: f(Key::NitscheGamma0),
-            penalty_gamma0: f(Key::PenaltyGamma0),
-            newmark_beta: f(Key::NewmarkBeta),
-            newmark_gamma: f(Key::NewmarkGamma),
-            theta_scheme: f(Key::ThetaScheme),
-            restitution: f(Key::Restitution),
-            rho_inf: f(Key::RhoInf),
-            hht_alpha: f(Key::HhtAlpha),
-            length: f(Key::Length),
-            young: f(Key::Young),
-            density: f(Key::Density),
-            amplitude: f(Key::Amplitude),
-            gap: f(Key::Gap),
-            lame_lambda: f(Key::LameLambda),
-            lame_mu: f(Key::LameMu),
-            gravity: f(Key::Gravity),
-            degree: f(Key::Degree).map(|x| x as i64),
+            nitsche_theta: num(p, Key::NitscheTheta),
+            nitsche_gamma0: num(p, Key::NitscheGamma0),
+            penalty_gamma0: num(p, Key::PenaltyGamma0),
+            newmark_beta: num(p, Key::NewmarkBeta),
+            newmark_gamma: num(p, Key::NewmarkGamma),
+            theta_scheme: num(p, Key::ThetaScheme),
+            restitution: num(p, Key::Restitution),
+            rho_inf: num(p, Key::RhoInf),
+            hht_alpha: num(p, Key::HhtAlpha),
+            length: num(p, Key::Length),
+            young: num(p, Key::Young),
+            density: num(p, Key::Density),
+            amplitude: num(p, Key::Amplitude),
+            gap: num(p, Key::Gap),
+            lame_lambda: num(p, Key::LameLambda),
+            lame_mu: num(p, Key::LameMu),
+            gravity: num(p, Key::Gravity),
+            degree: num(p, Key::Degree).map(|x| x as i64),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
             search: spec.search.clone(),
@@ -468,53 +468,56 @@ impl RunRecord {
             iterations_max_step: m.iterations_max_step,
             max_penetration: m.max_penetration,
             right_end: p.get(&Key::RightEnd).map(|v| v.to_string()),
-            velocity: f(Key::Velocity),
-            point_mass: f(Key::PointMass),
-            stiffness: f(Key::Stiffness),
-            force: f(Key::Force),
-            impact_law: f(Key::ImpactLaw),
+            velocity: num(p, Key::Velocity),
+            point_mass: num(p, Key::PointMass),
+            stiffness: num(p, Key::Stiffness),
+            force: num(p, Key::Force),
+            impact_law: num(p, Key::ImpactLaw),
             err_v_l2: m.err_v_l2,
             err_impact_time: m.err_impact_time,
             exit_velocity: m.exit_velocity,
             pressure_oscillation: m.pressure_oscillation,
             solver: p.get(&Key::Solver).map(|v| v.to_string()),
-            cg_tol: f(Key::CgTol),
+            cg_tol: num(p, Key::CgTol),
             solver_iterations: m.solver_iterations,
             solver_iterations_max_step: m.solver_iterations_max_step,
             load: p.get(&Key::Load).map(|v| v.to_string()),
             lockstep: m.lockstep,
             friction: p.get(&Key::Friction).map(|v| v.to_string()),
-            friction_coefficient: f(Key::FrictionCoefficient),
-            tresca_threshold: f(Key::TrescaThreshold),
-            height: f(Key::Height),
-            velocity_tangential: f(Key::VelocityTangential),
-            incline: f(Key::Incline),
+            friction_coefficient: num(p, Key::FrictionCoefficient),
+            tresca_threshold: num(p, Key::TrescaThreshold),
+            height: num(p, Key::Height),
+            velocity_tangential: num(p, Key::VelocityTangential),
+            incline: num(p, Key::Incline),
             friction_work: m.friction_work,
             energy_balance_drift: m.energy_balance_drift,
             energy_balance_max_increase: m.energy_balance_max_increase,
             stick_steps: m.stick_steps,
             slip_steps: m.slip_steps,
             friction_ratio_max: m.friction_ratio_max,
+            friction_newton_iterations: m.friction_newton_iterations,
+            friction_continuation_iterations: m.friction_continuation_iterations,
+            friction_fallback_iterations: m.friction_fallback_iterations,
             tangential_velocity_final: m.tangential_velocity_final,
             normal_velocity_final: m.normal_velocity_final,
             err_sigma_t_l2: m.err_sigma_t_l2,
             err_vt_final: m.err_vt_final,
-            friction_force: f(Key::FrictionForce),
+            friction_force: num(p, Key::FrictionForce),
             stop_time: m.stop_time,
             stop_time_exact: m.stop_time_exact,
-            length_b: f(Key::LengthB).filter(|x| !x.is_nan()),
-            young_b: f(Key::YoungB).filter(|x| !x.is_nan()),
-            density_b: f(Key::DensityB).filter(|x| !x.is_nan()),
-            velocity_b: f(Key::VelocityB),
+            length_b: num(p, Key::LengthB).filter(|x| !x.is_nan()),
+            young_b: num(p, Key::YoungB).filter(|x| !x.is_nan()),
+            density_b: num(p, Key::DensityB).filter(|x| !x.is_nan()),
+            velocity_b: num(p, Key::VelocityB),
             far_end: p.get(&Key::FarEnd).map(|v| v.to_string()),
             mass_side: p.get(&Key::MassSide).map(|v| v.to_string()),
             nitsche_sides: p.get(&Key::NitscheSides).map(|v| v.to_string()),
-            height_b: f(Key::HeightB),
-            width: f(Key::Width),
-            mesh_ratio: f(Key::MeshRatio),
-            pressure: f(Key::Pressure),
-            lame_lambda_b: f(Key::LameLambdaB).filter(|x| !x.is_nan()),
-            lame_mu_b: f(Key::LameMuB).filter(|x| !x.is_nan()),
+            height_b: num(p, Key::HeightB),
+            width: num(p, Key::Width),
+            mesh_ratio: num(p, Key::MeshRatio),
+            pressure: num(p, Key::Pressure),
+            lame_lambda_b: num(p, Key::LameLambdaB).filter(|x| !x.is_nan()),
+            lame_mu_b: num(p, Key::LameMuB).filter(|x| !x.is_nan()),
             momentum_drift: m.momentum_drift,
             velocity_a_final: m.velocity_a_final,
             velocity_b_final: m.velocity_b_final,
@@ -525,6 +528,16 @@ impl RunRecord {
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
         }
     }
+}
+
+/// A numeric parameter of the run (None where it does not apply).
+fn num(p: &BTreeMap<Key, Value>, k: Key) -> Option<f64> {
+    p.get(&k).and_then(Value::as_f64)
+}
+
+/// A text parameter of the run ("" where it does not apply).
+fn text(p: &BTreeMap<Key, Value>, k: Key) -> String {
+    p.get(&k).map(|v| v.to_string()).unwrap_or_default()
 }
 
 /// The `elements` column: the run's element count (0 where none was resolved).

@@ -726,6 +726,7 @@ impl<'a> Stepper<'a> {
                     LCP_TOL,
                 )
                 .map_err(|e| Stop::Solver(step, e.to_string()))?;
+            fr.tally.add_stages(fr.solver.stages().columns());
             let (nc, d) = (g.contact.len(), g.mesh.dim());
             for i in 0..nc {
                 self.lambda[i] = fr.forces[i * d];
@@ -889,7 +890,7 @@ impl<'a> Stepper<'a> {
         }
         if let Some(fr) = &self.friction {
             let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
-            fr.finish(metrics, scale);
+            fr.finish(metrics, scale, self.newton_work.stage_columns());
         }
         let reference = match self.record {
             Some((_, data)) if status == Status::Ok => Some(data),

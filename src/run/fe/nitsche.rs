@@ -298,8 +298,8 @@ pub(crate) struct NewtonWork {
     lambda_ok: Vec<f64>,
     lambda_best: Vec<f64>,
     /// The iterations of [`newton_friction`]'s stages over the run: from the previous forces,
-    /// from rest, the continuation in the bound.
-    pub stages: [usize; 3],
+    /// from rest, the continuation in the bound, Gauss–Seidel's sweeps, its Newton polish.
+    pub stages: [usize; 5],
 }
 
 impl NewtonWork {
@@ -320,7 +320,7 @@ impl NewtonWork {
             schur: None,
             lambda_ok: Vec::new(),
             lambda_best: Vec::new(),
-            stages: [0; 3],
+            stages: [0; 5],
         }
     }
 
@@ -376,6 +376,13 @@ impl NewtonWork {
             )?);
         }
         Ok(w)
+    }
+
+    /// [`Self::stages`] as the run record's three stage columns: the Newton from the previous
+    /// forces and from rest, the continuation, Gauss–Seidel's sweeps with its polish.
+    pub fn stage_columns(&self) -> [usize; 3] {
+        let s = self.stages;
+        [s[0] + s[1], s[2], s[3] + s[4]]
     }
 
     /// The Newton's linear solves over the run, when made in the contact dofs' space: (K's
@@ -655,13 +662,175 @@ pub(crate) fn newton_friction(
         return Ok(it + NEWTON_MAX_ITER);
     }
     work.stages[1] += NEWTON_MAX_ITER;
-    match continuation(&p, law, lambda, slides, work) {
-        Ok(it) => {
-            work.stages[2] += it;
-            Ok(it + 2 * NEWTON_MAX_ITER)
+    let mut spent = 0;
+    let second = match continuation(&p, law, lambda, slides, work, &mut spent) {
+        Ok(()) => {
+            work.stages[2] += spent;
+            return Ok(spent + 2 * NEWTON_MAX_ITER);
         }
-        Err(e) => Err(format!("{first}; continuation in the bound: {e}")),
+        Err(e) => e,
+    };
+    work.stages[2] += spent;
+    let before = work.stages[3] + work.stages[4];
+    match gauss_seidel(&p, law, lambda, slides, work) {
+        Ok(()) => Ok(spent + 2 * NEWTON_MAX_ITER + work.stages[3] + work.stages[4] - before),
+        Err(e) => Err(format!(
+            "{first}; continuation in the bound: {second}; Gauss–Seidel: {e}"
+        )),
     }
+}
+
+/// Sweeps of [`gauss_seidel`] at most, and how often its Newton polish is tried.
+const GS_MAX_SWEEPS: usize = 400;
+const GS_POLISH_EVERY: usize = 20;
+
+/// [`newton_friction`]'s last stage, where the continuation stalled too (measured on the
+/// campaign's sticking blocks, Nitsche γ0 = 1e-4 and penalty γ0 = 1e3 at μ_f 3–5: the Newton
+/// of a bound t·μ_f fails however close t is to the last solved one — the solution path
+/// folds): projected block Gauss–Seidel on the law itself, as mixed's rescue
+/// ([`crate::contact::FrictionalContact`]). Point by point, the others' forces held, the
+/// point's d unknowns solve x_q = b_q + cτ² W_qq Λ_q(x_q), b_q = x0_q + cτ² Σ_{r≠q} W_qr λ_r
+/// — a d × d semismooth Newton with backtracking on |G_q|, whose W_qq block makes it a
+/// monotone local problem — and the other points' x follow the change of λ_q. Each sweep is a
+/// descent on the stick problem, slow but not cycling; every [`GS_POLISH_EVERY`] sweeps the
+/// full Newton ([`newton_friction_from`]) is started from its forces, and only its convergence
+/// (to [`NEWTON_TOL`], the primary Newton's test) ends the stage. Counts sweeps and polish
+/// iterations into the stages.
+fn gauss_seidel(
+    p: &Problem,
+    law: FrictionLaw,
+    lambda: &mut [f64],
+    slides: &mut [bool],
+    work: &mut NewtonWork,
+) -> Result<(), String> {
+    let (nq, d) = (p.ops.len(), p.ops.per_point());
+    let nu = nq * d;
+    lambda.copy_from_slice(&work.lambda_ok);
+    let mut last = String::new();
+    for sweep in 1..=GS_MAX_SWEEPS {
+        // x = x0 + cτ² W λ, made afresh each sweep (the Newton polish overwrites it).
+        for j in 0..nu {
+            let row = &p.w[j * nu..(j + 1) * nu];
+            let wl: f64 = row.iter().zip(&*lambda).map(|(a, l)| a * l).sum();
+            work.s[j] = p.x0[j] + p.c_tau2 * wl;
+        }
+        for q in 0..nq {
+            slides[q] = relax_point(p, law, q, lambda, work);
+        }
+        work.stages[3] += 1;
+        if sweep % GS_POLISH_EVERY == 0 || sweep == GS_MAX_SWEEPS {
+            work.lambda_best.copy_from_slice(lambda);
+            match newton_friction_from(p, law, 0.0, lambda, slides, work) {
+                Ok(it) => {
+                    work.stages[4] += it;
+                    return Ok(());
+                }
+                Err(e) => {
+                    work.stages[4] += NEWTON_MAX_ITER;
+                    lambda.copy_from_slice(&work.lambda_best);
+                    last = e;
+                }
+            }
+        }
+    }
+    Err(format!("{GS_MAX_SWEEPS} sweeps: {last}"))
+}
+
+/// One point's block of a [`gauss_seidel`] sweep: solve its d unknowns with the others'
+/// forces held, update λ_q and every x_j by cτ² W_jq Δλ_q. Returns whether it slides.
+fn relax_point(
+    p: &Problem,
+    law: FrictionLaw,
+    q: usize,
+    lambda: &mut [f64],
+    work: &mut NewtonWork,
+) -> bool {
+    let (ops, c) = (p.ops, p.c_tau2);
+    let d = ops.per_point();
+    let nu = ops.unknowns();
+    let base = q * d;
+    // The point's block cτ² W_qq and b = x_q − cτ² W_qq λ_q (the others' part).
+    let (mut wqq, mut b, mut x, mut old) = ([0.0; 9], [0.0; 3], [0.0; 3], [0.0; 3]);
+    for a in 0..d {
+        old[a] = lambda[base + a];
+        x[a] = work.s[base + a];
+        for e in 0..d {
+            wqq[a * d + e] = c * p.w[(base + a) * nu + base + e];
+        }
+        b[a] = x[a] - (0..d).map(|e| wqq[a * d + e] * old[e]).sum::<f64>();
+    }
+    let (mut lq, mut blk, mut g) = ([0.0; 3], [0.0; 9], [0.0; 3]);
+    let local = |x: &[f64; 3], lq: &mut [f64; 3], blk: &mut [f64; 9], g: &mut [f64; 3]| {
+        let (_, slide) = point_forces(
+            &x[..d],
+            ops.gap[q],
+            ops.w[q],
+            ops.gamma[q],
+            law,
+            0.0,
+            &mut lq[..d],
+            &mut blk[..d * d],
+        );
+        let mut norm = 0.0f64;
+        for a in 0..d {
+            g[a] = x[a] - b[a] - (0..d).map(|e| wqq[a * d + e] * lq[e]).sum::<f64>();
+            norm = norm.max(g[a].abs());
+        }
+        (norm, slide)
+    };
+    let scale = x[..d]
+        .iter()
+        .chain(&b[..d])
+        .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+    let (mut norm, mut slide) = local(&x, &mut lq, &mut blk, &mut g);
+    for _ in 0..50 {
+        if norm <= 1e-15 * scale {
+            break;
+        }
+        // J = I − cτ² W_qq D_q; δ = −G.
+        let (mut jac, mut step) = ([0.0; 9], [0.0; 3]);
+        for a in 0..d {
+            for e in 0..d {
+                let wd: f64 = (0..d).map(|f| wqq[a * d + f] * blk[f * d + e]).sum();
+                jac[a * d + e] = f64::from(u8::from(a == e)) - wd;
+            }
+            step[a] = -g[a];
+        }
+        if lu_solve(&mut jac[..d * d], d, &mut [0; 3][..d], &mut step[..d]).is_err() {
+            break;
+        }
+        let start = x;
+        let mut alpha = 1.0;
+        let mut moved = false;
+        for _ in 0..30 {
+            for a in 0..d {
+                x[a] = start[a] + alpha * step[a];
+            }
+            let (n, s) = local(&x, &mut lq, &mut blk, &mut g);
+            if n < norm {
+                (norm, slide, moved) = (n, s, true);
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !moved {
+            // No descent along the step: the full step leaves a kink of Λ (as the Newton's).
+            for a in 0..d {
+                x[a] = start[a] + step[a];
+            }
+            (norm, slide) = local(&x, &mut lq, &mut blk, &mut g);
+        }
+    }
+    for a in 0..d {
+        let dl = lq[a] - old[a];
+        lambda[base + a] = lq[a];
+        if dl != 0.0 {
+            for j in 0..nu {
+                work.s[j] += c * p.w[j * nu + base + a] * dl;
+            }
+        }
+    }
+    slide
 }
 
 /// One step's condensed frictional problem: the rows, W, cτ² and x0 ([`newton_friction`]).
@@ -696,27 +865,28 @@ fn scaled(law: FrictionLaw, t: f64) -> FrictionLaw {
 /// (milder where a reduction fails) to [`NEWTON_TOL`] of it, or to [`NEWTON_FLOOR_TOL`] of it
 /// where no milder reduction goes further — a point left inside the ramp is at its gap to the tolerance with a
 /// bound in [0, s], contract §2.5's closure (a grazing point); elsewhere the law is the
-/// literal one. Returns the iterations of all its stages.
+/// literal one. Adds the iterations of all its stages to `total`.
 fn continuation(
     p: &Problem,
     law: FrictionLaw,
     lambda: &mut [f64],
     slides: &mut [bool],
     work: &mut NewtonWork,
-) -> Result<usize, String> {
+    total: &mut usize,
+) -> Result<(), String> {
     let sc = scales(p.ops, p.x0, 0.0);
     let tresca = matches!(law, FrictionLaw::Tresca { .. });
     let (ramp_end, ramp_ok) = (NEWTON_TOL * sc.n, NEWTON_FLOOR_TOL * sc.n);
     let mut ramp = if tresca { 1e-2 * sc.n } else { 0.0 };
     let (mut prev, mut shrink, mut restarts) = (ramp, 1e-2, 0);
-    let (mut t, mut dt, mut total) = (0.0f64, 0.25f64, 0usize);
+    let (mut t, mut dt) = (0.0f64, 0.25f64);
     lambda.iter_mut().for_each(|l| *l = 0.0);
     work.lambda_ok.copy_from_slice(lambda);
     loop {
         let next = if t < 1.0 { (t + dt).min(1.0) } else { 1.0 };
         match newton_friction_from(p, scaled(law, next), ramp, lambda, slides, work) {
             Ok(it) => {
-                total += it;
+                *total += it;
                 work.lambda_ok.copy_from_slice(lambda);
                 t = next;
                 if t < 1.0 {
@@ -725,11 +895,11 @@ fn continuation(
                     prev = ramp;
                     ramp = (ramp * shrink).max(ramp_end);
                 } else {
-                    return Ok(total);
+                    return Ok(());
                 }
             }
             Err(e) => {
-                total += NEWTON_MAX_ITER;
+                *total += NEWTON_MAX_ITER;
                 lambda.copy_from_slice(&work.lambda_ok);
                 if t == 1.0 {
                     // A reduction of the ramp failed: retried with a milder one (1e-2, 0.1,
@@ -755,8 +925,9 @@ fn continuation(
                         continue;
                     }
                     if prev <= ramp_ok {
-                        let it = newton_friction_from(p, law, prev, lambda, slides, work)?;
-                        return Ok(total + it);
+                        let r = newton_friction_from(p, law, prev, lambda, slides, work);
+                        *total += *r.as_ref().unwrap_or(&NEWTON_MAX_ITER);
+                        return r.map(|_| ());
                     }
                     return Err(format!("the Tresca ramp stalled at width {ramp:.1e}: {e}"));
                 }
@@ -765,8 +936,9 @@ fn continuation(
                     // After a restart: the closure already solved, if within the floor.
                     if restarts > 0 && prev <= ramp_ok {
                         lambda.copy_from_slice(&work.lambda_best);
-                        let it = newton_friction_from(p, law, prev, lambda, slides, work)?;
-                        return Ok(total + it);
+                        let r = newton_friction_from(p, law, prev, lambda, slides, work);
+                        *total += *r.as_ref().unwrap_or(&NEWTON_MAX_ITER);
+                        return r.map(|_| ());
                     }
                     return Err(format!("stalled at t = {t:.4} (ramp {ramp:.1e}): {e}"));
                 }
@@ -1194,10 +1366,12 @@ impl FrictionState {
         self.tally.energy(energy);
     }
 
-    /// The friction columns (contract §5), energies over `scale`.
-    pub fn finish(&self, m: &mut crate::run::Metrics, scale: f64) {
+    /// The friction columns (contract §5), energies over `scale`, with the contact solve's
+    /// iterations per stage `stages` ([`NewtonWork::stage_columns`]).
+    pub fn finish(&self, m: &mut crate::run::Metrics, scale: f64, stages: [usize; 3]) {
         let vt = self.mean.tangential(&self.means);
         self.tally.finish(m, scale, vt, self.means[2]);
+        crate::run::friction_tally::stage_columns(m, stages);
     }
 }
 
@@ -1296,7 +1470,7 @@ mod tests {
         let (ft, v_contact, _) = st.after_step(&ops, &[0.0; 4], &v, &v, &lambda, 1.0);
         assert_eq!((ft, v_contact), (-1.0, 2.5));
         let mut metrics = crate::run::Metrics::default();
-        st.finish(&mut metrics, 1.0);
+        st.finish(&mut metrics, 1.0, [3, 0, 0]);
         assert_eq!(metrics.friction_ratio_max, Some(0.25));
         assert_eq!(metrics.tangential_velocity_final, Some(2.0));
         assert_eq!(metrics.normal_velocity_final, Some(0.0));
@@ -1304,6 +1478,8 @@ mod tests {
             (metrics.stick_steps, metrics.slip_steps),
             (Some(2), Some(0))
         );
+        assert_eq!(metrics.friction_newton_iterations, Some(3));
+        assert_eq!(metrics.friction_fallback_iterations, Some(0));
     }
 
     /// Tresca on coupled rows without a solution (contract §2.5), by hand: one 2D point,
@@ -1358,6 +1534,66 @@ mod tests {
         assert!((0.0..=1e-8).contains(&x[0]), "x_n = {:e}", x[0]);
         assert!((lambda[1] - 0.25).abs() <= 1e-8, "{lambda:?}");
         assert!(slides[0]);
+    }
+
+    /// The last fallback alone ([`gauss_seidel`], from rest as after a failed continuation):
+    /// two 2D penalty points (w = γ = 1, gaps 0), cτ² = 1, W = −S with S symmetric positive
+    /// definite and coupled (off-diagonal 0.3–0.9 of the diagonal's), x0 penetrating at both
+    /// points with large tangential predictors, Coulomb μ_f = 4. Its answer meets contract §4's
+    /// tolerance: G = x − x0 − cτ² W Λ(x) within 1e-12 of the normal scale max|x0_n| = 1 in the
+    /// normal rows and of the tangential scale max|x0_t| = 3 in the tangential ones (the
+    /// Newton polish's test; here both points' forces are O(1), so the rounding of W Λ is
+    /// ~1e-16), and the stages record sweeps and polish.
+    #[test]
+    fn gauss_seidel_fallback_meets_the_tolerance() {
+        let friction = FrictionOps {
+            td: 1,
+            ut: vec![1.0, 1.0],
+            st: vec![0.0; 2],
+            pt: vec![-1.0, -1.0],
+            ct: vec![1.0, 1.0],
+            kt: vec![1.0, 1.0],
+        };
+        let ops = NitscheOps {
+            k: 1,
+            dofs: vec![0, 1],
+            p: vec![1.0, 1.0],
+            c: vec![-1.0, -1.0],
+            s: vec![0.0; 2],
+            w: vec![1.0, 1.0],
+            gamma: vec![1.0, 1.0],
+            gap: vec![0.0, 0.0],
+            theta: 0.0,
+            penalty: true,
+            friction: Some(friction),
+        };
+        let spd = [
+            2.0, 0.6, 0.9, 0.3, //
+            0.6, 1.5, 0.4, 0.5, //
+            0.9, 0.4, 2.5, 0.7, //
+            0.3, 0.5, 0.7, 1.2,
+        ];
+        let w: Vec<f64> = spd.iter().map(|x| -x).collect();
+        let x0 = [1.0, 3.0, 0.7, -2.5];
+        let law = FrictionLaw::Coulomb { coefficient: 4.0 };
+        let p = Problem {
+            ops: &ops,
+            w: &w,
+            c_tau2: 1.0,
+            x0: &x0,
+        };
+        let mut work = NewtonWork::frictional(4, 2);
+        let (mut lambda, mut slides) = ([0.0; 4], [false; 2]);
+        gauss_seidel(&p, law, &mut lambda, &mut slides, &mut work).unwrap();
+        assert!(work.stages[3] >= GS_POLISH_EVERY, "{:?}", work.stages);
+        assert_eq!(work.stage_columns()[2], work.stages[3] + work.stages[4]);
+        for j in 0..4 {
+            let wl: f64 = (0..4).map(|r| w[j * 4 + r] * lambda[r]).sum();
+            let g = work.s[j] - x0[j] - wl;
+            let scale = if j % 2 == 0 { 1.0 } else { 3.0 };
+            assert!(g.abs() <= 1e-12 * scale, "G_{j} = {g:e}");
+        }
+        assert!(lambda[0] > 0.0 && lambda[2] > 0.0, "{lambda:?}");
     }
 
     /// The step in the contact dofs' space ([`SchurNewton`]) is the dense one: two 2D points

@@ -185,6 +185,7 @@ impl Friction {
                 LCP_TOL,
             )
             .map_err(|e| e.to_string())?;
+        self.tally.add_stages(im.solver.stages().columns());
         let n = y.len();
         for (k, (&mk, &col)) in im.mu.iter().zip(&im.cols).enumerate() {
             if mk != 0.0 {

@@ -459,6 +459,7 @@ impl<'a> MethodRun<'a> {
             newton_max,
             observe_timer,
             momentum,
+            newton_work,
             ..
         } = &mut self;
         metrics.steps = *done as i64;
@@ -488,7 +489,7 @@ impl<'a> MethodRun<'a> {
         if let Some(st) = &*nit_fric {
             // As the engine's frictional Nitsche/penalty runs ([`crate::run::fe::newmark`]).
             let scale = metrics.energy_scale.filter(|s| *s != 0.0).unwrap_or(1.0);
-            st.finish(metrics, scale);
+            st.finish(metrics, scale, newton_work.stage_columns());
         }
         let reference = match record.take() {
             Some((_, data)) if status == Status::Ok => Some(data),
