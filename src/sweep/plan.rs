@@ -383,6 +383,7 @@ fn resolve_given(
         revision.push_str("revision=friction-balance-step-1\n");
     }
     chord_revision(scene, &m, &mut revision);
+    two_body_revision(&setup, &m, &mut revision);
     if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
@@ -720,14 +721,29 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 6] = [
+const THIS_VERSION: [&str; 7] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
     "revision=quasi-static-start",
     "revision=increment-step",
     "revision=mixed-friction-chord",
+    "revision=two-body-increment",
 ];
+
+/// Issue 44: the two-body FE runs of the Newmark/θ family and the hybrid step in increments
+/// (`run::fe::newmark`'s header): the same equations, round-off relative to the increment, so
+/// such a run gets a revision line (the §3.2 methods other than central difference kept
+/// their numbers; the one-body runs keep theirs).
+fn two_body_revision(setup: &crate::scene::SceneSetup, m: &Method, revision: &mut String) {
+    let two_body = matches!(
+        setup,
+        crate::scene::SceneSetup::Fe(s) if matches!(s.geometry, crate::scene::FeGeometry::Blocks(_))
+    );
+    if two_body && !m.scheme.is_comparison() {
+        revision.push_str("revision=two-body-increment\n");
+    }
+}
 
 /// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
 /// (`contact::coulomb`'s header): the same solution to the same tolerance, not the same
