@@ -376,14 +376,8 @@ fn resolve_given(
         None => scene.setup(&physics, mesh),
     };
     let mut revision = setup.id_revision();
-    // Issue 42: a frictional Nitsche/penalty run's E + W_f starts from E⁰ (its step 1 had been
-    // left out of `energy_balance_max_increase`) and its series has W_f⁰ = 0 (was null).
-    let fe_scene = scene.fe_dim().is_some();
-    if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
-        revision.push_str("revision=friction-balance-step-1\n");
-    }
-    chord_revision(scene, &m, &mut revision);
-    two_body_revision(&setup, &m, &mut revision);
+    let increments = setup.two_bodies_step_in_increments(&m.scheme);
+    method_revisions(scene, &m, increments, &mut revision);
     if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
@@ -731,29 +725,26 @@ const THIS_VERSION: [&str; 7] = [
     "revision=two-body-increment",
 ];
 
-/// Issue 44: the two-body FE runs of the Newmark/θ family and the hybrid step in increments
-/// (`run::fe::newmark`'s header): the same equations, round-off relative to the increment, so
-/// such a run gets a revision line (the §3.2 methods other than central difference kept
-/// their numbers; the one-body runs keep theirs).
-fn two_body_revision(setup: &crate::scene::SceneSetup, m: &Method, revision: &mut String) {
-    let two_body = matches!(
-        setup,
-        crate::scene::SceneSetup::Fe(s) if matches!(s.geometry, crate::scene::FeGeometry::Blocks(_))
-    );
-    if two_body && !m.scheme.is_comparison() {
-        revision.push_str("revision=two-body-increment\n");
+/// The revision lines that depend on the method. Issue 42: a frictional Nitsche/penalty run's
+/// E + W_f starts from E⁰ (its step 1 had been left out of `energy_balance_max_increase`) and
+/// its series has W_f⁰ = 0 (was null). Issue 43: mixed friction in 3D takes chord steps on a
+/// kept LU while the node kinds repeat (`contact::coulomb`'s header): the same solution to the
+/// same tolerance, not the same round-off, so such a run gets a revision line. Issue 44:
+/// `increments`, a two-body run that now steps in increments (the scene setup's
+/// `two_bodies_step_in_increments`).
+fn method_revisions(scene: &dyn Scene, m: &Method, increments: bool, revision: &mut String) {
+    let fe_scene = scene.fe_dim().is_some();
+    if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
+        revision.push_str("revision=friction-balance-step-1\n");
     }
-}
-
-/// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
-/// (`contact::coulomb`'s header): the same solution to the same tolerance, not the same
-/// round-off, so such a run gets a revision line.
-fn chord_revision(scene: &dyn Scene, m: &Method, revision: &mut String) {
     if scene.fe_dim() == Some(3)
         && m.friction_kind != FrictionKind::None
         && m.contact == ContactMethod::Mixed
     {
         revision.push_str("revision=mixed-friction-chord\n");
+    }
+    if increments {
+        revision.push_str("revision=two-body-increment\n");
     }
 }
 

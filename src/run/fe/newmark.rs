@@ -13,7 +13,8 @@
 //! stored uⁿ, so no residual accumulates: the massless rows' K u^{n+1} = F + f^{n+1} is imposed
 //! afresh every step). The mixed runs that start quasi-static ([`super::start`], new in issue
 //! 42 with their own ids) step in increments, and so does every two-body run (issue 44, their
-//! own ids: two blocks that travel lost 1e-11 of their momentum over 150 steps in totals) —
+//! own ids: two blocks that travel lost 1e-11 of their momentum over 150 steps in totals; not
+//! yet with Nitsche/penalty friction, whose tangential start x0 reads the total u) —
 //! `mixed` and `penalty`, the hybrid midpoint rule included (A Δ = τMvⁿ − τ²/2 K_Θuⁿ + …), the
 //! contact problems reading their gaps at uⁿ + Δ (B(uⁿ + y) + g; the penalty's P uⁿ + P y);
 //! the one-body runs keep the totals and their numbers bit for bit.
@@ -314,10 +315,8 @@ impl<'a> Stepper<'a> {
                 Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
                 Ok(s) => s,
             };
-        // Two bodies step in increments too (module header), but with the frictional
-        // Nitsche/penalty rows, whose tangential start x0 reads the total u.
-        let two_body = g.bodies.is_some() && friction.is_none();
-        let incr = (forces.is_some() && nit.is_none()) || two_body;
+        let incr =
+            (forces.is_some() && nit.is_none()) || (g.bodies.is_some() && friction.is_none());
         if let Some(f) = forces {
             let fr = (fric.as_deref_mut(), friction.as_mut());
             start_forces(g, nit.is_none(), &f, &mut lambda, fr);
@@ -333,7 +332,6 @@ impl<'a> Stepper<'a> {
         let hybrid = matches!(cfg.scheme, Scheme::Hybrid);
         let needs_ku = hybrid || nit.is_some() || incr;
         let obs = observer(cfg, opts, energy_scale);
-        let momentum = momentum_tally(g, cfg, &fac.m, &force_vec);
         metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
         Ok(Stepper {
             cfg,
@@ -348,6 +346,7 @@ impl<'a> Stepper<'a> {
             c_tau2,
             hybrid,
             fall,
+            momentum: momentum_tally(g, cfg, &fac.m, &force_vec),
             force_vec,
             vertical_mass,
             energy_scale,
@@ -380,7 +379,6 @@ impl<'a> Stepper<'a> {
             touched: false,
             done: 0,
             fric,
-            momentum,
             refine: refinement(g, cfg, &fac, n, nc),
             geo,
             fac,
