@@ -108,11 +108,7 @@ impl MethodRun<'_> {
         let g1 = 1.0 - ga.gamma;
         if incr {
             // MΔ = AΔ − cK_ΘΔ, one product KΔ; u, K u, M u carried.
-            g.k.matvec_into(y, kd);
-            for i in 0..n {
-                sd[i] -= c * kd[i];
-            }
-            add_theta_term(ops, y, c, sd);
+            mass_from_step(g, ops, c, y, kd, sd);
             for i in 0..n {
                 let an = (y[i] - pred[i]) / bt2;
                 let man = (sd[i] - (tau * mv[i] + kp * ma[i])) / bt2;
@@ -128,11 +124,7 @@ impl MethodRun<'_> {
         }
         // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
         std::mem::swap(u, y);
-        g.k.matvec_into(u, ku);
-        for i in 0..n {
-            sd[i] -= c * ku[i];
-        }
-        add_theta_term(ops, u, c, sd);
+        mass_from_step(g, ops, c, u, ku, sd);
         for i in 0..n {
             let an = (u[i] - pred[i]) / bt2;
             let mpred = mu[i] + tau * mv[i] + kp * ma[i];
@@ -278,4 +270,21 @@ impl MethodRun<'_> {
         }
         Ok(lambda.iter().sum::<f64>())
     }
+}
+
+/// M x = A x − cK_Θx from the step's A x in `sd` (in place), with the one product K x into
+/// `kx` (the carried K u or K Δ).
+fn mass_from_step(
+    g: &crate::run::fe::geometry::Geometry,
+    ops: &crate::run::fe::nitsche::NitscheOps,
+    c: f64,
+    x: &[f64],
+    kx: &mut [f64],
+    sd: &mut [f64],
+) {
+    g.k.matvec_into(x, kx);
+    for (s, k) in sd.iter_mut().zip(kx.iter()) {
+        *s -= c * k;
+    }
+    add_theta_term(ops, x, c, sd);
 }
