@@ -6,9 +6,10 @@
 //! a matching interface, every node of A's bottom face above a node of B's top face) and
 //! round(H_b/h) up. A moves with `velocity` e_d (+ `velocity_tangential` e_1), B with
 //! `velocity_b` e_d; B's base is free or clamped (`far_end`); a traction −p e_d acts on A's top
-//! (`pressure`). There is no obstacle: the contact rows are node-to-node between the two faces,
-//! δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with n = −e_d ([`crate::run::fe`]'s rows), or Nitsche's
-//! points of both faces (`nitsche_sides` unbiased or one-sided). With no clamp and
+//! (`pressure`) and the weight −ρ_i·gravity e_d on both (`gravity`). There is no obstacle: the
+//! contact rows are node-to-node between the two faces, δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with
+//! n = −e_d ([`crate::run::fe`]'s rows), or Nitsche's points of both faces (`nitsche_sides`
+//! unbiased or one-sided). With no clamp and
 //! no load the total momentum is an exact invariant of every scheme (contract §2.6).
 //!
 //! Why a scene of its own rather than a mesh file: the matching interface, the per-body
@@ -96,6 +97,10 @@ impl BlocksScene {
 }
 
 impl Scene for BlocksScene {
+    /// The weight on both bodies loads their massless dofs (contract §1.3's quasi-static start).
+    fn contact_init_matters(&self, p: &Physics) -> bool {
+        p.get("gravity") != 0.0
+    }
     fn fe_dim(&self) -> Option<usize> {
         Some(self.dim)
     }
@@ -164,7 +169,7 @@ impl Scene for BlocksScene {
     fn supports_physics(
         &self,
         p: &Physics,
-        scheme: &crate::time::Scheme,
+        _scheme: &crate::time::Scheme,
     ) -> Result<(), (&'static str, String)> {
         if p.get("mesh_ratio") != 1.0 {
             return Err((
@@ -181,26 +186,6 @@ impl Scene for BlocksScene {
                 format!(
                     "velocity_b = {} with far_end = \"clamped\": a clamped body B cannot move rigidly",
                     p.get("velocity_b")
-                ),
-            ));
-        }
-        if p.get("gravity") != 0.0 {
-            return Err((
-                "gravity",
-                format!(
-                    "gravity = {} on scene {}: the two bodies' volume load is not implemented yet (issue 44)",
-                    p.get("gravity"),
-                    self.name()
-                ),
-            ));
-        }
-        if *scheme == crate::time::Scheme::Newmark(crate::time::NewmarkParams::central_difference())
-        {
-            return Err((
-                "scheme",
-                format!(
-                    "scheme = central-difference on scene {}: its kinematic impulse acts on obstacle rows only (two bodies: not yet, issue 44)",
-                    self.name()
                 ),
             ));
         }

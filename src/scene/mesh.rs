@@ -164,7 +164,7 @@ fn mesh_bodies(p: &Physics, path: &Path) -> Result<MeshBodies, String> {
     for (key, why) in [
         (
             "gravity",
-            "the two bodies' volume load is not implemented yet (issue 44)",
+            "gravity on a two-body file is not implemented yet (the blocks take it)",
         ),
         ("incline", "there is no plane to tilt between two bodies"),
     ] {

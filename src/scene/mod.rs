@@ -134,6 +134,19 @@ impl SceneSetup {
             | SceneSetup::Oscillator(_) => String::new(),
         }
     }
+
+    /// Issue 44: whether a two-body FE run with `scheme` steps in increments where it stepped
+    /// in totals (`run::fe::newmark`'s header: the Newmark/θ family, the hybrid,
+    /// generalized-α/HHT; the other §3.2 methods solved for Δu or Δv already): the same
+    /// equations, round-off relative to the increment, so its id gets the revision line
+    /// `revision=two-body-increment`. The one-body runs keep their numbers and ids.
+    pub fn two_bodies_step_in_increments(&self, scheme: &crate::time::Scheme) -> bool {
+        let two_body =
+            matches!(self, SceneSetup::Fe(s) if matches!(s.geometry, FeGeometry::Blocks(_)));
+        let stepped =
+            !scheme.is_comparison() || matches!(scheme, crate::time::Scheme::GeneralizedAlpha(_));
+        two_body && stepped
+    }
 }
 
 /// A run's contact treatment (`space`), mass variant and scheme family, as a sweep file names

@@ -386,13 +386,8 @@ fn resolve_given(
         None => scene.setup(&physics, mesh),
     };
     let mut revision = setup.id_revision();
-    // Issue 42: a frictional Nitsche/penalty run's E + W_f starts from E⁰ (its step 1 had been
-    // left out of `energy_balance_max_increase`) and its series has W_f⁰ = 0 (was null).
-    let fe_scene = scene.fe_dim().is_some();
-    if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
-        revision.push_str("revision=friction-balance-step-1\n");
-    }
-    chord_revision(scene, &m, &mut revision);
+    let increments = setup.two_bodies_step_in_increments(&m.scheme);
+    method_revisions(scene, &m, increments, &mut revision);
     if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
@@ -737,7 +732,7 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 8] = [
+const THIS_VERSION: [&str; 9] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
@@ -746,19 +741,31 @@ const THIS_VERSION: [&str; 8] = [
     "revision=mixed-friction-chord",
     "revision=bars1d-b-follows-a",
     "revision=mixed-friction-slip-elimination",
+    "revision=two-body-increment",
 ];
 
-/// Issue 43: mixed friction in 3D takes chord steps on a kept LU while the node kinds repeat
-/// (`contact::coulomb`'s header), and its Newton steps eliminate a slipping node's tangential
-/// component along the slip on faer's blocked LU: the same solution to the same tolerance, not
-/// the same round-off, so such a run gets a revision line for each.
-fn chord_revision(scene: &dyn Scene, m: &Method, revision: &mut String) {
+/// The revision lines that depend on the method. Issue 42: a frictional Nitsche/penalty run's
+/// E + W_f starts from E⁰ (its step 1 had been left out of `energy_balance_max_increase`) and
+/// its series has W_f⁰ = 0 (was null). Issue 43: mixed friction in 3D takes chord steps on a
+/// kept LU while the node kinds repeat (`contact::coulomb`'s header), and its Newton steps
+/// eliminate a slipping node's tangential component along the slip on faer's blocked LU: the
+/// same solution to the same tolerance, not the same round-off, so such a run gets a revision
+/// line for each. Issue 44: `increments`, a two-body run that now steps in increments (the
+/// scene setup's `two_bodies_step_in_increments`).
+fn method_revisions(scene: &dyn Scene, m: &Method, increments: bool, revision: &mut String) {
+    let fe_scene = scene.fe_dim().is_some();
+    if fe_scene && m.friction_kind != FrictionKind::None && m.contact != ContactMethod::Mixed {
+        revision.push_str("revision=friction-balance-step-1\n");
+    }
     if scene.fe_dim() == Some(3)
         && m.friction_kind != FrictionKind::None
         && m.contact == ContactMethod::Mixed
     {
         revision.push_str("revision=mixed-friction-chord\n");
         revision.push_str("revision=mixed-friction-slip-elimination\n");
+    }
+    if increments {
+        revision.push_str("revision=two-body-increment\n");
     }
 }
 

@@ -392,14 +392,20 @@ pub(super) fn momentum(two: &TwoBodies, vertical: &[usize], mv: &[f64]) -> (f64,
 }
 
 /// The two-body columns of a run (contract §5): P^n along e_d at every observed step, its largest
-/// deviation from P⁰ over Σ_i m_i|V_i| (null with a clamp, a load, or every V_i = 0) and each
-/// body's final mean velocity 1ᵀM_i v/m_i.
+/// deviation from P⁰ + tⁿF (F = 1_dᵀF the total load along e_d: the weight of both bodies and
+/// the pressure; 0 without a load) over Σ_i m_i|V_i| + T|F| (null with a clamp, or when
+/// both terms vanish) and each body's final mean velocity 1ᵀM_i v/m_i. Every scheme's momentum
+/// balance gives P^{n+1} = Pⁿ + τF exactly (1_dᵀK = 0, every row's 1_dᵀB_iᵀ = 0, and
+/// 1_dᵀM aⁿ = F from a⁰ on: the quasi-static start puts the massless rows' load into a⁰'s
+/// equation), so the deviation is round-off.
 #[derive(Debug, Clone)]
 pub(super) struct MomentumTally {
     /// m_a, m_b: 1ᵀM_i1 over the e_d component, the run's masses.
     masses: [f64; 2],
-    /// Σ_i m_i|V_i|, or None where the drift is not defined.
+    /// Σ_i m_i|V_i| + T|F|, or None where the drift is not defined.
     scale: Option<f64>,
+    /// F: the total load along e_d.
+    force: f64,
     p0: Option<f64>,
     max_dev: f64,
     last: [f64; 2],
@@ -411,15 +417,16 @@ pub(super) struct MomentumTally {
 }
 
 impl MomentumTally {
-    /// With the run's mass matrix `m`, A's and B's initial e_d velocities, whether a load
-    /// acts (gravity, pressure) and, with friction, the tangential axes' dofs and A's e_1
-    /// velocity (the scale then takes A's speed |V_a|).
+    /// With the run's mass matrix `m`, A's and B's initial e_d velocities, the run's load
+    /// vector `load` (None: no load), its final time and, with friction, the tangential axes'
+    /// dofs and A's e_1 velocity (the scale then takes A's speed |V_a|).
     pub(super) fn new(
         two: &TwoBodies,
         vertical: &[usize],
         m: &SymMatrix,
         (v_a, v_b): (f64, f64),
-        loaded: bool,
+        load: Option<&[f64]>,
+        t_final: f64,
         tangential: Option<(Vec<Vec<usize>>, f64)>,
     ) -> MomentumTally {
         let mut ones = vec![0.0; m.n()];
@@ -433,11 +440,16 @@ impl MomentumTally {
             Some((axes, v_t)) => (axes, v_a.hypot(v_t)),
             None => (Vec::new(), v_a.abs()),
         };
-        let scale = ma * speed_a + mb * v_b.abs();
-        let defined = !two.base_clamped && !loaded && scale > 0.0;
+        let force = load.map_or(0.0, |f| vertical.iter().map(|&r| f[r]).sum());
+        let mut scale = ma * speed_a + mb * v_b.abs();
+        if force != 0.0 {
+            scale += t_final * force.abs();
+        }
+        let defined = !two.base_clamped && scale > 0.0;
         MomentumTally {
             masses: [ma, mb],
             scale: defined.then_some(scale),
+            force,
             p0: None,
             max_dev: 0.0,
             last: [0.0; 2],
@@ -446,12 +458,26 @@ impl MomentumTally {
         }
     }
 
-    /// Step n's momentum from the run's M v; returns P^n.
-    pub(super) fn observe(&mut self, two: &TwoBodies, vertical: &[usize], mv: &[f64]) -> f64 {
+    /// Step n's momentum at time t from the run's M v; returns P^n.
+    pub(super) fn observe(
+        &mut self,
+        two: &TwoBodies,
+        vertical: &[usize],
+        mv: &[f64],
+        t: f64,
+    ) -> f64 {
         let (p, pa, pb) = momentum(two, vertical, mv);
         let first = self.p0.is_none();
         let p0 = *self.p0.get_or_insert(p);
-        self.max_dev = self.max_dev.max((p - p0).abs());
+        // Without a load P⁰ itself, bit for bit (no − 0·t term).
+        let expected = if self.force == 0.0 {
+            p0
+        } else {
+            p0 + t * self.force
+        };
+        self.max_dev = self.max_dev.max((p - expected).abs());
+        // The loads act along e_d only (no incline between two bodies): the tangential
+        // momenta stay at their P⁰.
         for (axis, p0) in self.tangential.iter().zip(&mut self.p0_t) {
             let pt: f64 = axis.iter().map(|&r| mv[r]).sum();
             if first {

@@ -44,7 +44,9 @@ pub(super) static FREQUENCIES: Cache<(f64, f64)> = Cache::new();
 /// factor (δ = 0.5 %, doubled until it is; the Gershgorin bound max_i Σ_j |K_ij|/√(m_i m_j)
 /// caps σ and is itself guaranteed). So the step allowed is stable and at most ~0.25 % below
 /// the true limit (measured against the Gershgorin step: `tests/fe_methods.rs`). Kinematic
-/// contact removes dofs, never adds stiffness, so the contact-free bound holds in contact too.
+/// contact removes dofs, never adds stiffness, so the contact-free bound holds in contact too
+/// — between two bodies as well: a node pair held together is a constraint on the pair's
+/// relative motion, and a constrained system's frequencies lie below the free one's.
 pub(super) fn kinematic_dt_limit(cfg: &FeConfig) -> Result<f64, (&'static str, String)> {
     // Once per geometry and mass (the planner asks for every run of a sweep).
     let key = format!("{}|{:?}|cfl", geometry_key(&cfg.setup), cfg.mass);

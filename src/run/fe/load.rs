@@ -1,8 +1,9 @@
 //! The volume load of a run with gravity (contract §1.3, §1.8): F, the consistent initial
 //! acceleration a⁰ and the free-fall quantities the observers compare the centre of mass with.
 
+use super::bodies::TwoBodies;
 use super::config::FeConfig;
-use super::geometry::Geometry;
+use super::geometry::{FeMesh, Geometry};
 use crate::scene::LoadModel;
 use crate::space::MassVariant;
 use crate::space::cg::{CgOptions, CgWork, jacobi, pcg_into};
@@ -77,7 +78,13 @@ pub(super) fn gravity_load(
     f[0] = f_t;
     f[d - 1] = f_d;
     let all = DofMap::all(mesh.num_nodes() * d);
-    let body = assemble_load(mesh, &all, s.density, f, &|_| 1.0);
+    // Two bodies (contract §1.10): each element with its body's density.
+    let body = match (&g.bodies, &g.mesh) {
+        (Some(two), FeMesh::Bodies { mesh: bm, .. }) => {
+            assemble_load(mesh, &all, 1.0, f, &|e| two.density[bm.element_body(e)])
+        }
+        _ => assemble_load(mesh, &all, s.density, f, &|_| 1.0),
+    };
     // |f_d| ≥ gravity·cos 89.99…° > 0: the planner keeps |α| < 90°.
     let body_mass = body.iter().skip(d - 1).step_by(d).sum::<f64>() / f_d;
     // M e_1 for the inertial load's slope component (only on an incline).
@@ -90,7 +97,7 @@ pub(super) fn gravity_load(
         m.matvec_into(&e1, &mut out);
         out
     });
-    let force: Vec<f64> = match s.load {
+    let mut force: Vec<f64> = match s.load {
         LoadModel::Body => g.dofs.free.iter().map(|&gd| body[gd]).collect(),
         LoadModel::Inertial => match &m_e1 {
             None => m_ed.iter().map(|x| f_d * x).collect(),
@@ -108,12 +115,27 @@ pub(super) fn gravity_load(
             rigid[r] = f_t;
         }
     }
+    // The blocks' pressure on A's top acts with the weight (contract §1.10).
+    let pressure = g.bodies.as_ref().and_then(|two| two.pressure.as_ref());
+    if let Some(p) = pressure {
+        force.iter_mut().zip(p).for_each(|(f, p)| *f += p);
+    }
     let keeps_row_sums = matches!(cfg.mass, MassVariant::Consistent | MassVariant::Lumped);
-    let a0 = if s.load == LoadModel::Inertial || keeps_row_sums {
+    let a0 = if (s.load == LoadModel::Inertial || keeps_row_sums) && pressure.is_none() {
         rigid
     } else {
         inertial_solve(m, &force, rigid)?
     };
+    if g.bodies.is_some() {
+        let energy_scale = blocks_energy_scale(g, cfg, &m_ed, body_mass);
+        return Ok(Some(GravityLoad {
+            force,
+            a0,
+            m_ed,
+            vertical_mass,
+            energy_scale,
+        }));
+    }
     // contract §1.3: m·|f|·d + ½m|v⁰|², d the gap or the body's height on the plane.
     let energy_scale = s.energy_scale(body_mass, || {
         let heights = (0..mesh.num_nodes()).map(|a| mesh.coord(a)[d - 1]);
@@ -129,6 +151,40 @@ pub(super) fn gravity_load(
         vertical_mass,
         energy_scale,
     }))
+}
+
+/// The energy unit of two blocks under gravity (contract §1.10): the weight's work over the gap
+/// m|f|g (m = ∫ρ over both bodies, the same for every mass variant; over the pair's height
+/// H_a + H_b where g = 0), the bodies' kinetic energies ½Σ_i m_i|V_i|² with the run's masses
+/// m_i = 1ᵀM_i1, and with a pressure its static column's strain energy
+/// ([`pressure_load`]'s). A free pair falls together, so the gap is a length, not the work
+/// the weight does on the contact: the unit only has to be continuous and non-zero.
+fn blocks_energy_scale(g: &Geometry, cfg: &FeConfig, m_ed: &[f64], body_mass: f64) -> f64 {
+    let Some(two) = &g.bodies else {
+        return 0.0;
+    };
+    let s = &cfg.setup;
+    let (ma, mb) = body_masses(g, two, m_ed);
+    let ([h_a, h_b], (lambda_b, mu_b), p) = (two.heights, two.lame[1], two.pressure_value);
+    let d = if s.gap != 0.0 { s.gap } else { h_a + h_b };
+    let compliance = h_a / (s.lame_lambda + 2.0 * s.lame_mu) + h_b / (lambda_b + 2.0 * mu_b);
+    body_mass * s.gravity.abs() * d
+        + p * p * g.contact_measure * compliance
+        + 0.5 * ma * (s.v0 * s.v0 + s.v0_tangential * s.v0_tangential)
+        + 0.5 * mb * two.velocity_b * two.velocity_b
+}
+
+/// Each body's run mass 1ᵀM_i1 along e_d from M 1_d.
+fn body_masses(g: &Geometry, two: &TwoBodies, m1: &[f64]) -> (f64, f64) {
+    let (mut ma, mut mb) = (0.0, 0.0);
+    for &r in &g.vertical {
+        if two.body[r] == 0 {
+            ma += m1[r];
+        } else {
+            mb += m1[r];
+        }
+    }
+    (ma, mb)
 }
 
 /// The traction −p e_d on the upper block's top face (contract §1.10 `pressure`; None without
@@ -154,14 +210,7 @@ fn pressure_load(
     }
     let mut m1 = vec![0.0; force.len()];
     m.matvec_into(&ones, &mut m1);
-    let (mut ma, mut mb) = (0.0, 0.0);
-    for &r in &g.vertical {
-        if two.body[r] == 0 {
-            ma += m1[r];
-        } else {
-            mb += m1[r];
-        }
-    }
+    let (ma, mb) = body_masses(g, two, &m1);
     let ([h_a, h_b], (lambda_b, mu_b), p) = (two.heights, two.lame[1], two.pressure_value);
     let compliance = h_a / (s.lame_lambda + 2.0 * s.lame_mu) + h_b / (lambda_b + 2.0 * mu_b);
     let energy_scale = p * p * g.contact_measure * compliance

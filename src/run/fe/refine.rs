@@ -80,7 +80,8 @@ impl Refinement {
     /// that violate the contact conditions at the refined state (an inactive row penetrating,
     /// an active one pulling) change sides and the sweeps resume — an active-set method on the
     /// exact step problem started from the LCP's answer, which the ill-conditioned W can get
-    /// wrong (the patch test: 2 of 5 rows). Returns the sweeps made.
+    /// wrong (the patch test: 2 of 5 rows). Stepping in increments (`base` = uⁿ), `u` is the
+    /// increment and the rows read B(uⁿ + u) + g. Returns the sweeps made.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn refine(
         &mut self,
@@ -88,6 +89,7 @@ impl Refinement {
         fac: &Factored,
         c_tau2: f64,
         gaps: &[f64],
+        base: Option<&[f64]>,
         lambda: &mut [f64],
         u: &mut [f64],
         work: &mut StepWork,
@@ -100,18 +102,19 @@ impl Refinement {
             self.active.clear();
             self.active.extend((0..nc).filter(|&i| lambda[i] != 0.0));
             if !self.active.is_empty() {
-                self.sweeps(g, fac, c_tau2, gaps, lambda, u, work)?;
+                self.sweeps(g, fac, c_tau2, (gaps, base), lambda, u, work)?;
             }
             // The sides: 1e-10 of the state's scale, far above the sweeps' round-off and far
             // below any physical penetration or pull.
             let scale = gaps
                 .iter()
                 .chain(u.iter())
+                .chain(base.unwrap_or(&[]))
                 .fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
             let fscale = lambda.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
             let mut changed = false;
             for i in 0..nc {
-                if lambda[i] == 0.0 && g.rows.dot(i, u) + gaps[i] < -1e-10 * scale {
+                if lambda[i] == 0.0 && row_gap(g, i, base, u) + gaps[i] < -1e-10 * scale {
                     // A tiny seed: the sweeps then find its force.
                     lambda[i] = f64::MIN_POSITIVE;
                     changed = true;
@@ -142,14 +145,15 @@ impl Refinement {
         scale
     }
 
-    /// Correction sweeps on the rows `active` until the residual meets the tolerance.
+    /// Correction sweeps on the rows `active` until the residual meets the tolerance (`base`:
+    /// [`Refinement::refine`]).
     #[allow(clippy::too_many_arguments)]
     fn sweeps(
         &mut self,
         g: &Geometry,
         fac: &Factored,
         c_tau2: f64,
-        gaps: &[f64],
+        (gaps, base): (&[f64], Option<&[f64]>),
         lambda: &mut [f64],
         u: &mut [f64],
         work: &mut StepWork,
@@ -163,11 +167,14 @@ impl Refinement {
                 scale = scale.max((c_tau2 * lambda[i]).abs());
             }
             let res = self.r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            let defect = self
-                .active
+            let defect = self.active.iter().fold(0.0f64, |m, &i| {
+                m.max((row_gap(g, i, base, u) + gaps[i]).abs())
+            });
+            // The defect's round-off is relative to the total uⁿ + u.
+            let uscale = u
                 .iter()
-                .fold(0.0f64, |m, &i| m.max((g.rows.dot(i, u) + gaps[i]).abs()));
-            let uscale = u.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+                .chain(base.unwrap_or(&[]))
+                .fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
             if res <= TOL * scale && defect <= TOL * uscale {
                 break;
             }
@@ -180,7 +187,7 @@ impl Refinement {
             }
             let k = self.active.len();
             for (a, &i) in self.active.iter().enumerate() {
-                self.d[a] = -(g.rows.dot(i, u) + gaps[i]);
+                self.d[a] = -(row_gap(g, i, base, u) + gaps[i]);
                 for (b, &j) in self.active.iter().enumerate() {
                     self.h[a * k + b] = fac.h[i * nc + j];
                 }
@@ -209,6 +216,8 @@ impl Refinement {
     /// points change sides and the sweeps resume. λ = φ(P u) at the end (the forces the energy
     /// and the next Newton start from). The penalty's numbers are those of its own form
     /// (c_q = −p_q exactly, and no Θ-term).
+    /// Stepping in increments (`base` = uⁿ), `u` is the increment and the points read
+    /// P uⁿ + P u.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn refine_penalty(
         &mut self,
@@ -216,13 +225,18 @@ impl Refinement {
         fac: &Factored,
         ops: &NitscheOps,
         c_tau2: f64,
+        base: Option<&[f64]>,
         lambda: &mut [f64],
         u: &mut [f64],
         work: &mut StepWork,
     ) -> Result<(), String> {
         let (n, nq, k) = (u.len(), ops.len(), ops.k);
         let phi = |q: usize, u: &[f64]| {
-            ops.w[q] / ops.gamma[q] * (ops.apply(&ops.p, q, u) - ops.gap[q]).max(0.0)
+            let s = match base {
+                Some(b) => ops.apply(&ops.p, q, b) + ops.apply(&ops.p, q, u),
+                None => ops.apply(&ops.p, q, u),
+            };
+            ops.w[q] / ops.gamma[q] * (s - ops.gap[q]).max(0.0)
         };
         for _ in 0..PENALTY_SWEEPS {
             let mut scale = self.body_residual(g, fac, c_tau2, u);
@@ -279,6 +293,15 @@ impl Refinement {
             *l = phi(q, u);
         }
         Ok(())
+    }
+}
+
+/// B_i·(uⁿ + u) stepping in increments (`base` = uⁿ; each entry's sum first, as the step's
+/// contact problem reads it), else B_i·u.
+fn row_gap(g: &Geometry, i: usize, base: Option<&[f64]>, u: &[f64]) -> f64 {
+    match base {
+        Some(b) => g.rows.dot_sum(i, b, u),
+        None => g.rows.dot(i, u),
     }
 }
 

@@ -129,9 +129,15 @@ pub(super) fn initial_velocity(g: &Geometry, cfg: &FeConfig, v: &mut [f64]) {
     }
 }
 
-/// Two bodies' momentum tally with the run's mass (contract §5), None for one body. A load
-/// (gravity, pressure) or a clamp leaves the drift undefined.
-pub(super) fn momentum_tally(g: &Geometry, cfg: &FeConfig, m: &SymMatrix) -> Option<MomentumTally> {
+/// Two bodies' momentum tally with the run's mass and load vector `force` (contract §5), None for
+/// one body. A clamp leaves the drift undefined; a load (gravity, pressure) moves the
+/// invariant to P⁰ + tF.
+pub(super) fn momentum_tally(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+    force: &[f64],
+) -> Option<MomentumTally> {
     let two = g.bodies.as_ref()?;
     let loaded = cfg.setup.gravity != 0.0 || two.pressure.is_some();
     let v = (cfg.setup.v0, two.velocity_b);
@@ -144,12 +150,15 @@ pub(super) fn momentum_tally(g: &Geometry, cfg: &FeConfig, m: &SymMatrix) -> Opt
             cfg.setup.v0_tangential,
         )
     });
+    let t_final = cfg.steps as f64 * cfg.dt;
+    let load = loaded.then_some(force);
     Some(MomentumTally::new(
         two,
         &g.vertical,
         m,
         v,
-        loaded,
+        load,
+        t_final,
         tangential,
     ))
 }

@@ -1,6 +1,8 @@
 //! Kinematic central difference with the lumped mass (contract §3.2, module header of [`super`]):
-//! explicit, no solve; a contact dof below the obstacle is put on it by a local impulse, and
-//! with friction each node's tangential force is projected onto its disc.
+//! explicit, no solve; a contact dof below the obstacle is put on it by a local impulse (two
+//! bodies: a node pair that would interpenetrate is put in contact by an impulse on both nodes,
+//! action = reaction), and with friction each node's tangential force is projected onto its
+//! disc.
 
 use super::run::MethodRun;
 use crate::run::Stop;
@@ -34,7 +36,16 @@ impl MethodRun<'_> {
             u[i] += tau * v[i];
         }
         let mut force = 0.0;
-        for (j, (&ci, gi)) in g.contact.iter().zip(gaps).enumerate() {
+        if !g.rows.is_unit() {
+            // Two bodies (contract §3.2, §2.6): each row's impulse on its relative position,
+            // its two nodes' masses sharing it (the rows are disjoint and frictionless:
+            // checked at set-up).
+            for (j, gi) in gaps.iter().enumerate() {
+                force += g.rows.impulse(j, *gi, diag, tau, u, v);
+            }
+        }
+        let obstacle = if g.rows.is_unit() { g.contact.len() } else { 0 };
+        for (j, (&ci, gi)) in g.contact.iter().zip(gaps).enumerate().take(obstacle) {
             let (uc, dv, l) = crate::time::kinematic_impulse(u[ci], -gi, diag[ci], tau);
             u[ci] = uc;
             v[ci] += dv;

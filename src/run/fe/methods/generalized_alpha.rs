@@ -1,6 +1,8 @@
 //! Generalized-α/HHT (contract §3.2): the equation at t^{n+1−α} with the history κ_m aⁿ, κ_f Kuⁿ,
 //! κ_f fⁿ, Newmark's updates; one step with the nodal multiplier (LCP or Coulomb/Tresca), one
-//! with Nitsche/penalty (the engine's semismooth Newton, ± friction).
+//! with Nitsche/penalty (the engine's semismooth Newton, ± friction). Two bodies solve for the
+//! increment (M + cK)(u^{n+1} − uⁿ) = … (issue 44: round-off relative to the step, not to the
+//! distance travelled; the one-body runs keep the totals and their numbers).
 
 use super::correction::{add_columns, add_point_columns, add_rows, add_theta_term};
 use super::run::MethodRun;
@@ -32,6 +34,7 @@ impl MethodRun<'_> {
             mv,
             ma,
             ku,
+            kd,
             sd,
             y,
             pred,
@@ -57,11 +60,24 @@ impl MethodRun<'_> {
         let (km, kf) = ga.history_coefficients(tau);
         let kp = t2 * (0.5 - ga.beta);
         let bt2 = ga.beta * t2;
-        for i in 0..n {
-            pred[i] = u[i] + tau * v[i] + kp * a[i];
-            y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+        // Two bodies step in increments (module header of `crate::run::fe::newmark`): the
+        // right-hand side less A uⁿ = M uⁿ + cK_Θuⁿ, ũ − uⁿ in `pred`; not with friction,
+        // whose start reads the total u.
+        let incr = g.bodies.is_some() && nit_fric.is_none();
+        if incr {
+            for i in 0..n {
+                pred[i] = tau * v[i] + kp * a[i];
+                y[i] = tau * mv[i] + (kp - km) * ma[i] - (kf + c) * ku[i] + (c + kf) * force_vec[i];
+            }
+            add_theta_term(ops, u, kf + c, y);
+        } else {
+            for i in 0..n {
+                pred[i] = u[i] + tau * v[i] + kp * a[i];
+                y[i] =
+                    mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+            }
+            add_theta_term(ops, u, kf, y);
         }
-        add_theta_term(ops, u, kf, y);
         add_point_columns(ops, lambda_prev, kf, y);
         sd.copy_from_slice(y);
         f.chol.solve_in_place(y, work);
@@ -75,7 +91,11 @@ impl MethodRun<'_> {
             newton_friction(ops, st.law, &f.h, c, q, lambda, &mut st.slides, newton_work)
         } else {
             for (k, qk) in q.iter_mut().enumerate() {
-                *qk = ops.apply(&ops.p, k, y);
+                *qk = if incr {
+                    ops.apply(&ops.p, k, u) + ops.apply(&ops.p, k, y)
+                } else {
+                    ops.apply(&ops.p, k, y)
+                };
             }
             newton(ops, &f.h, c, q, &ops.gap, lambda, newton_work)
         }
@@ -85,14 +105,26 @@ impl MethodRun<'_> {
         add_columns(&f.z, lambda, c, y);
         add_point_columns(ops, lambda, c, sd);
         lambda_prev.copy_from_slice(lambda);
+        let g1 = 1.0 - ga.gamma;
+        if incr {
+            // MΔ = AΔ − cK_ΘΔ, one product KΔ; u, K u, M u carried.
+            mass_from_step(g, ops, c, y, kd, sd);
+            for i in 0..n {
+                let an = (y[i] - pred[i]) / bt2;
+                let man = (sd[i] - (tau * mv[i] + kp * ma[i])) / bt2;
+                v[i] += tau * (g1 * a[i] + ga.gamma * an);
+                mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+                a[i] = an;
+                ma[i] = man;
+                u[i] += y[i];
+                ku[i] += kd[i];
+                mu[i] += sd[i];
+            }
+            return Ok(lambda.iter().step_by(ops.per_point()).sum::<f64>());
+        }
         // M u^{n+1} = A u^{n+1} − cK_Θu^{n+1}, one product K u^{n+1}.
         std::mem::swap(u, y);
-        g.k.matvec_into(u, ku);
-        for i in 0..n {
-            sd[i] -= c * ku[i];
-        }
-        add_theta_term(ops, u, c, sd);
-        let g1 = 1.0 - ga.gamma;
+        mass_from_step(g, ops, c, u, ku, sd);
         for i in 0..n {
             let an = (u[i] - pred[i]) / bt2;
             let mpred = mu[i] + tau * mv[i] + kp * ma[i];
@@ -128,6 +160,7 @@ impl MethodRun<'_> {
             mv,
             ma,
             ku,
+            kd,
             sd,
             y,
             pred,
@@ -150,9 +183,19 @@ impl MethodRun<'_> {
         let (km, kf) = ga.history_coefficients(tau);
         let kp = t2 * (0.5 - ga.beta);
         let bt2 = ga.beta * t2;
-        for i in 0..n {
-            pred[i] = u[i] + tau * v[i] + kp * a[i];
-            y[i] = mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+        // Two bodies step in increments, as with Nitsche/penalty above.
+        let incr = g.bodies.is_some();
+        if incr {
+            for i in 0..n {
+                pred[i] = tau * v[i] + kp * a[i];
+                y[i] = tau * mv[i] + (kp - km) * ma[i] - (kf + c) * ku[i] + (c + kf) * force_vec[i];
+            }
+        } else {
+            for i in 0..n {
+                pred[i] = u[i] + tau * v[i] + kp * a[i];
+                y[i] =
+                    mu[i] + tau * mv[i] + (kp - km) * ma[i] - kf * ku[i] + (c + kf) * force_vec[i];
+            }
         }
         add_rows(&g.rows, lambda_prev, kf, y);
         if let Some(fr) = fric.as_ref() {
@@ -164,7 +207,11 @@ impl MethodRun<'_> {
             .map_err(|e| Stop::Solver(step, e.to_string()))?;
         let it = if let Some(fr) = fric.as_mut() {
             // y is u^{n+1} without contact: slip = Ty − Tuⁿ + (TZ̄μ)c.
-            fr.set_free(y, |t, j| -t.dot(j, u), |j| g.rows.dot(j, y) + gaps[j]);
+            if incr {
+                fr.set_free(y, |_, _| 0.0, |j| g.rows.dot_sum(j, u, y) + gaps[j]);
+            } else {
+                fr.set_free(y, |t, j| -t.dot(j, u), |j| g.rows.dot(j, y) + gaps[j]);
+            }
             let it = fr
                 .solve(c, false, y, sd, lambda)
                 .map_err(|e| Stop::Solver(step, e))?;
@@ -172,7 +219,11 @@ impl MethodRun<'_> {
             it
         } else {
             for (j, (qi, gi)) in q.iter_mut().zip(gaps).enumerate() {
-                *qi = g.rows.dot(j, y) + gi;
+                *qi = if incr {
+                    g.rows.dot_sum(j, u, y)
+                } else {
+                    g.rows.dot(j, y)
+                } + gi;
             }
             let it = lcp
                 .solve(q, lambda, LCP_MAX_ITER, LCP_TOL)
@@ -184,11 +235,28 @@ impl MethodRun<'_> {
         *newton_max = (*newton_max).max(it);
         *iterations += it as i64;
         lambda_prev.copy_from_slice(lambda);
+        let g1 = 1.0 - ga.gamma;
+        if incr {
+            // One product, KΔ; MΔ = AΔ − cKΔ, M a^{n+1} = (MΔ − M(ũ − uⁿ))/(βτ²).
+            g.k.matvec_into(y, kd);
+            for i in 0..n {
+                let an = (y[i] - pred[i]) / bt2;
+                let md = sd[i] - c * kd[i];
+                let man = (md - (tau * mv[i] + kp * ma[i])) / bt2;
+                v[i] += tau * (g1 * a[i] + ga.gamma * an);
+                mv[i] += tau * (g1 * ma[i] + ga.gamma * man);
+                a[i] = an;
+                ma[i] = man;
+                u[i] += y[i];
+                ku[i] += kd[i];
+                mu[i] += md;
+            }
+            return Ok(lambda.iter().sum::<f64>());
+        }
         // One product, K u^{n+1}; M u^{n+1} = A u^{n+1} − cKu^{n+1}, and
         // M a^{n+1} = (M u^{n+1} − M ũ)/(βτ²) from the carried products.
         std::mem::swap(u, y);
         g.k.matvec_into(u, ku);
-        let g1 = 1.0 - ga.gamma;
         for i in 0..n {
             let an = (u[i] - pred[i]) / bt2;
             let mpred = mu[i] + tau * mv[i] + kp * ma[i];
@@ -202,4 +270,21 @@ impl MethodRun<'_> {
         }
         Ok(lambda.iter().sum::<f64>())
     }
+}
+
+/// M x = A x − cK_Θx from the step's A x in `sd` (in place), with the one product K x into
+/// `kx` (the carried K u or K Δ).
+fn mass_from_step(
+    g: &crate::run::fe::geometry::Geometry,
+    ops: &crate::run::fe::nitsche::NitscheOps,
+    c: f64,
+    x: &[f64],
+    kx: &mut [f64],
+    sd: &mut [f64],
+) {
+    g.k.matvec_into(x, kx);
+    for (s, k) in sd.iter_mut().zip(kx.iter()) {
+        *s -= c * k;
+    }
+    add_theta_term(ops, x, c, sd);
 }

@@ -239,6 +239,7 @@ impl<'a> MethodRun<'a> {
         if let Some((status, msg)) = opts.setup_stop(start, "the workspace") {
             return Err(fail(status, msg, metrics));
         }
+        let momentum = momentum_tally(g, cfg, m, &force_vec);
         metrics.setup_time_s = Some(start.elapsed().as_secs_f64());
         Ok(MethodRun {
             cfg,
@@ -294,7 +295,7 @@ impl<'a> MethodRun<'a> {
             newton_max: 0,
             observe_timer: SampledTimer::default(),
             e_last: 0.0,
-            momentum: momentum_tally(g, cfg, m),
+            momentum,
             own_mass,
             minv,
             fac,
@@ -355,7 +356,7 @@ impl<'a> MethodRun<'a> {
         };
         let uc = contact_mean(g, u);
         if let (Some(mt), Some(two)) = (momentum.as_mut(), g.bodies.as_ref()) {
-            mt.observe(two, &g.vertical, mv);
+            mt.observe(two, &g.vertical, mv, step as f64 * tau);
         }
         if fall != 0.0 && !*touched {
             if force > 0.0 {
@@ -475,7 +476,9 @@ impl<'a> MethodRun<'a> {
         metrics.observe_time_s = observe_timer.estimate_s();
         let (status, message) = Stop::status(stop, *tau, cfg.steps, *start, metrics);
         obs.finish(metrics, status == Status::Ok);
-        metrics.free_fall_error = (*fall != 0.0).then_some(*fall_error);
+        // Two bodies: P⁰ + tF is their free-fall check (newmark.rs's).
+        let falls = *fall != 0.0 && momentum.is_none();
+        metrics.free_fall_error = falls.then_some(*fall_error);
         metrics.err_force_l2 = metrics.err_sigma_l2.take();
         metrics.err_sigma_mid_l2 = None;
         metrics.contact_toggles = Some(metrics.contact_switches);
@@ -536,11 +539,13 @@ fn operators(
             Ok(f) => (Some(f), None),
             Err(e) => return Err((factor_failure(&e), e)),
         },
-        // The kinematic impulse puts one dof on the obstacle: two bodies' rows have two.
-        None if !g.rows.is_unit() => {
+        // The kinematic impulses act row by row: exact when no dof is in two rows (the
+        // node-to-node rows of a matching interface; other pairings share Γ^b's nodes).
+        // Friction on two bodies' relative slip has no kinematic step yet.
+        None if !g.rows.is_unit() && (!g.rows.disjoint() || frictional(cfg)) => {
             return Err((
                 Status::Invalid,
-                "kinematic central difference acts on obstacle rows only (two bodies: not yet, issue 44)".into(),
+                "kinematic central difference on two bodies takes frictionless node-to-node rows on a matching interface (rows sharing a node, and friction, have no kinematic impulse yet)".into(),
             ));
         }
         None => match kinematic_dt_limit(cfg) {
