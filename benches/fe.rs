@@ -61,7 +61,10 @@
 //!   at load ~11; by perf's CPU samples in the stepping loop (150 steps each, same load) 647
 //!   against 700, 1.08×: the frictional contact solve now costs what the LCP does (89 and 92
 //!   samples), the rest is Z's 273 columns against 91 (72 and 178 samples), streamed from
-//!   memory, which the load slows most. The clock's ratio wants a quiet machine.
+//!   memory, which the load slows most. The clock's ratio wants a quiet machine: at load ~1
+//!   (same session, after the builds), ten criterion runs of the two, alternating, gave
+//!   per-run ratios 1.02–1.68 (the frictionless step alone ranges 2.8–4.8 ms between runs) with
+//!   median 1.27×; the medians of the last six runs' medians, 4.17 ms and 5.39 ms, 1.29×.
 //!
 //! - `two-bodies-cost/…` (issue 44, done-when 7): one step of mixed + Crank–Nicolson, consistent
 //!   mass, on two bodies against one body of the same size: `blocks2d` with W = 0.1 and

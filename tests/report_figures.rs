@@ -183,30 +183,30 @@ fn subsection_figures<'a>(html: &'a str, id: &str) -> Vec<&'a str> {
         .collect()
 }
 
+/// The report of sweep `body` (run in a temporary folder): its HTML.
+fn report_of(body: &str) -> String {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = write(tmp.path(), "s.toml", body);
+    let args = [
+        "run",
+        sweep.to_str().unwrap(),
+        "--out",
+        "out",
+        "--threads",
+        "2",
+    ];
+    let o = cli(tmp.path(), &args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    std::fs::read_to_string(tmp.path().join("out/report.html")).unwrap()
+}
+
 #[test]
 fn two_body_runs_draw_both_contact_faces_and_the_momentum() {
     // Two bars (contract §1.9) in three method groups: both faces and the momentum are drawn
-    // for each, in its group's colour; a one-body report has no such subsection (the test
-    // above's bar1d report is checked for its absence).
-    let tmp = tempfile::tempdir().unwrap();
-    let sweep = write(
-        tmp.path(),
-        "bars.toml",
+    // for each, in its group's colour.
+    let html = report_of(
         "name = \"bars\"\nscene = \"bars1d\"\n\n[fixed]\nT = 3.0\ncourant = 1.0\nscheme = \"crank-nicolson\"\nmass = \"zero-contact\"\n\n[grid]\nelements = [10, 20]\ncase = [{ space = \"mixed\" }, { space = \"penalty\", penalty_gamma0 = 10.0 }, { space = \"nitsche\", nitsche_gamma0 = 0.1 }]\n",
     );
-    let o = cli(
-        tmp.path(),
-        &[
-            "run",
-            sweep.to_str().unwrap(),
-            "--out",
-            "out",
-            "--threads",
-            "2",
-        ],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let html = std::fs::read_to_string(tmp.path().join("out/report.html")).unwrap();
     let figs = subsection_figures(&html, "two-body");
     assert_eq!(figs.len(), 2, "u_C^a/u_C^b and the momentum");
     for svg in &figs {
@@ -218,25 +218,9 @@ fn two_body_runs_draw_both_contact_faces_and_the_momentum() {
 
 #[test]
 fn a_one_body_report_has_no_two_body_figures() {
-    let tmp = tempfile::tempdir().unwrap();
-    let sweep = write(
-        tmp.path(),
-        "one.toml",
+    let html = report_of(
         "name = \"one\"\nscene = \"bar1d\"\n\n[fixed]\nT = 2.0\ncourant = 1.0\nscheme = \"crank-nicolson\"\n\n[grid]\nh = [0.125, 0.0625]\n",
     );
-    let o = cli(
-        tmp.path(),
-        &[
-            "run",
-            sweep.to_str().unwrap(),
-            "--out",
-            "out",
-            "--threads",
-            "2",
-        ],
-    );
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let html = std::fs::read_to_string(tmp.path().join("out/report.html")).unwrap();
     assert!(html.contains("<h2 id=\"series\">"));
     assert!(!html.contains("id=\"two-body\""));
 }
