@@ -266,6 +266,15 @@ pub fn assert_momentum(runs: &[(String, Outcome)], tol: f64) -> f64 {
         let drift = o.metrics.momentum_drift.expect("free blocks have a drift");
         assert!(drift <= tol, "{label}: momentum_drift {drift:e}");
         worst = worst.max(drift);
+        // Every scheme writes the two-body series at every kept step (the §3.2 methods'
+        // driver did not, before).
+        for r in o.series.rows() {
+            assert!(
+                r.momentum.is_some_and(f64::is_finite) && r.u_contact_b.is_some_and(f64::is_finite),
+                "{label}: step {} has no momentum or u_contact_b in its series",
+                r.step
+            );
+        }
     }
     worst
 }

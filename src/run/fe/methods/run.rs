@@ -356,7 +356,9 @@ impl<'a> MethodRun<'a> {
         };
         let uc = contact_mean(g, u);
         if let (Some(mt), Some(two)) = (momentum.as_mut(), g.bodies.as_ref()) {
-            mt.observe(two, &g.vertical, mv, step as f64 * tau);
+            // The series' Pⁿ and Γ^b's mean e_d displacement, as the Newmark/θ loop writes them.
+            let p = mt.observe(two, &g.vertical, mv, step as f64 * tau);
+            obs.set_two_body(g.rows.second_mean(&g.contact_weight, u), p);
         }
         if fall != 0.0 && !*touched {
             if force > 0.0 {
