@@ -181,25 +181,9 @@ fn a_bars1d_run_fills_the_two_body_columns() {
 /// 2e-2 at 20 elements: the two-bar test's errors are 1e-2 at that level).
 #[test]
 fn b_material_defaults_to_a() {
-    use contact_sweep::run::{RunOptions, RunRecord, record::Timing, simulate};
-    use contact_sweep::sweep::{SweepFile, expand};
     let text = "name = \"t\"\nscene = \"bars1d\"\n[fixed]\nT = 6.0\nelements = 20\ncourant = 1.0\nmass = \"zero-contact\"\nscheme = \"crank-nicolson\"\nlength = 2.0\nyoung = 4.0\ndensity = 3.0\n[grid]\ncase = [{}, { length_b = 2.0, young_b = 4.0, density_b = 3.0 }]\n";
-    let plan = expand(&SweepFile::parse(std::path::Path::new("t.toml"), text).unwrap()).unwrap();
-    assert_eq!(plan.runs.len(), 2);
-    let timing = Timing {
-        median_s: 0.0,
-        min_s: 0.0,
-        max_s: 0.0,
-        repeats: 1,
-    };
-    let rec: Vec<RunRecord> = plan
-        .runs
-        .iter()
-        .map(|spec| {
-            let out = simulate(&spec.config, &RunOptions::default());
-            RunRecord::new("t", spec, &out, timing)
-        })
-        .collect();
+    let rec = common::run_sweep_text(text);
+    assert_eq!(rec.len(), 2);
     let (omitted, written) = (&rec[0], &rec[1]);
     assert_eq!(omitted.status, "ok");
     assert_ne!(omitted.run_id, written.run_id);
