@@ -6,7 +6,12 @@ with λ = μ = 10, ρ = 1, the consistent mass, gravity 0.1 along −e_2, restin
 (gap 0) and thrown at V along e_1. The engine's E + W_f: E = ½vᵀMv + ½uᵀKu − Fᵀu and
 W_f^{n+1} = W_f^n − f_t^{n+1}·(u_t^{n+1} − u_t^n) with f_t = p_t/τ at the Γ_C nodes.
 
-Usage: python3 block_moreau_jean.py MU V DT T OUT.json — writes {"t": [...], "e_plus_wf": [...]}.
+The optional GAP lifts the block by GAP above the plane at rest (it lands, then rests): Siconos'
+q starts at GAP·e_2 where the engine's u starts at 0, so its potential −Fᵀq is the engine's plus
+the constant −Fᵀq⁰, written as `gap_shift` (the engine's E + W_f = Siconos' − gap_shift).
+
+Usage: python3 block_moreau_jean.py MU V DT T OUT.json [GAP] — writes
+{"t": [...], "e_plus_wf": [...], "gap_shift": ...}.
 """
 import json
 import sys
@@ -16,6 +21,7 @@ import siconos.kernel as sk
 import siconos.numerics as sn
 
 mu_f, V, dt, T, out = float(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), sys.argv[5]
+gap = float(sys.argv[6]) if len(sys.argv) > 6 else 0.0
 NX, NY, LX, LY = 8, 4, 1.0, 0.5
 lam, mu, rho, g = 10.0, 10.0, 1.0, 0.1
 
@@ -55,6 +61,7 @@ for j in range(NY):
         F[dofs] += fe
 
 q0 = np.zeros(ndof)
+q0[1::2] = gap
 v0 = np.zeros(ndof)
 v0[0::2] = V
 block = sk.LagrangianLinearTIDS(q0, v0, M, K, np.zeros((ndof, ndof)))
@@ -64,7 +71,7 @@ model.insertDynamicalSystem(block)
 contact = list(range(NX + 1))  # the bottom row y = 0
 for a in contact:
     H = np.zeros((2, ndof))
-    H[0, 2 * a + 1] = 1.0  # normal e_2: the gap u_2 (gap 0)
+    H[0, 2 * a + 1] = 1.0  # normal e_2: the gap q_2 = GAP + u_2
     H[1, 2 * a] = 1.0  # tangential e_1
     rel = sk.LagrangianLinearTIR(H)
     nsl = sk.NewtonImpactFrictionNSL(0.0, 0.0, mu_f, 2)
@@ -98,4 +105,4 @@ while sim.hasNextEvent():
     sim.nextStep()
 
 with open(out, "w") as f:
-    json.dump({"t": ts, "e_plus_wf": es}, f)
+    json.dump({"t": ts, "e_plus_wf": es, "gap_shift": float(-F @ q0)}, f)
