@@ -16,21 +16,18 @@
 //! mixed + zero-contact + backward Euler, penalty + consistent + CN — with B's velocity giving
 //! P = 0 (the bodies stay put) and P ≠ 0 (they travel).
 //!
-//! What holds, measured (150 steps, h = 0.25, τ = 0.02):
-//! - over the first 10 steps every value agrees to ≤ 7e-15: a modelling difference (a mass, a
-//!   layer, a weight) would show at O(1) there;
-//! - the differences then grow like n² (5e-15 at step 10, 5e-14..3e-13 at 30, 2e-13..4e-12 at
-//!   60, 3e-12..2.3e-11 at 150) while bars1d nudged by one round-off (V·(1 + 1e-15)) moves by
-//!   ≤ 4e-14: the gap is not the problem's conditioning but each engine's own round-off per
-//!   step. Its likely sources (not isolated one by one): the FE engine steps these runs in totals (`run::fe::newmark` header: its round-off
-//!   is relative to |uⁿ|, not to the step's Δu as bars1d's increments are), and Q1's K applied
-//!   to a uniform motion cancels only to round-off where P1's rows cancel exactly; both feed a
-//!   velocity error ~ε|u|/τ per step, integrated twice. The bound is therefore
-//!   2e-15·(n + 10)² (≥ 2× the measured worst at every n), 5e-11 at the last step —
-//!   not the issue's 1e-12, which holds only over the first ~60 steps;
+//! What holds, measured (150 steps, h = 0.25, τ = 0.02), since the two-body runs step in
+//! increments (`revision=two-body-increment`, contract §2.6):
+//! - every value of every run agrees to ≤ 3.2e-13 of its scale over the whole run (worst:
+//!   Nitsche Θ = 1 + CN's u_contact), the issue's 1e-12 with a 3× margin, for mixed +
+//!   zero-contact + backward Euler, penalty + consistent + CN and the six Nitsche runs. (In
+//!   totals the gap grew like n², to 3.3e-11 at step 150: each engine's round-off was relative
+//!   to |uⁿ|, not to the step's Δu, and fed a velocity error ~ε|u|/τ per step.) Over the first
+//!   10 steps a modelling difference (a mass, a layer, a weight) would show at O(1);
 //! - mixed + consistent + CN chatters (12 contact switches): bars1d itself moves by up to 2e-8
-//!   under the one-round-off nudge, and blocks2d's round-off is amplified alike (measured ≤ 4.2×
-//!   the nudge's effect per column): there the bound adds 10× bars1d's nudged difference.
+//!   under a one-round-off nudge of its velocity (V·(1 + 1e-15)), and blocks2d's round-off is
+//!   amplified alike (measured 6.7e-8, ≤ 4.2× the nudge's effect per column): there the bound
+//!   adds 10× bars1d's nudged difference — the problem's conditioning, not the limit's.
 //!
 //! Columns one engine alone writes (asserted as such): bars1d's exact solution
 //! (`u_contact_exact`, `sigma_contact_exact`, the err_* columns), the FE engine's
@@ -253,11 +250,9 @@ fn worst(pairs: &[Pair]) -> Vec<(String, f64)> {
     out
 }
 
-/// The round-off bound after n steps, relative to the run's scales: 2e-15·(n + 10)² (module
-/// header: ~5e-15 over the first 10 steps, growing like n², at most 1e-15·n² measured).
-fn round_off(n: usize) -> f64 {
-    2e-15 * ((n + 10) as f64).powi(2)
-}
+/// The bound on every difference, relative to the run's scales: issue 44's 1e-12 (module
+/// header: measured ≤ 3.2e-13 over the 150 steps).
+const LIMIT: f64 = 1e-12;
 
 #[test]
 fn blocks2d_column_is_bars1d() {
@@ -275,7 +270,7 @@ fn blocks2d_column_is_bars1d() {
 }
 
 /// bars1d against blocks2d, run by run (the same grid, so the same order): the discrete
-/// events exactly, every shared value within the round-off bound — plus 10× bars1d's own
+/// events exactly, every shared value within [`LIMIT`] — plus 10× bars1d's own
 /// nudged difference for the runs `chattering` (their indices).
 fn compare_limit(
     vb: f64,
@@ -312,7 +307,7 @@ fn compare_limit(
             eprintln!("  {name:22} {d:9.2e}  (bars1d nudged: {s:9.2e})");
         }
         for p in &pairs {
-            let mut bound = round_off(p.step.unwrap_or(steps));
+            let mut bound = LIMIT;
             if chattering.contains(&m) {
                 let s = sensitivity
                     .iter()
@@ -364,9 +359,8 @@ const GAMMA0: f64 = 0.1;
 /// an ulp or two). The rest is the same system: along a motion uniform in x, δ is the bars'
 /// ũ_a0 + ũ_b0 at each of Γ^a's three Gauss points, σ_n^i = 2μ_i ∂_d u_d is E_i(ũ_i1 − ũ_i0)/h_i,
 /// the side weights are the bars' rows' w_i and the points' weights sum to W (E_Θ's series,
-/// `energy_theta`, is per unit width as E's). Bounds: the same round-off bound as the other
-/// methods (5e-11 at the last step); measured: worst 3.3e-11 of its scale (u_contact_b),
-/// 2.2e-11 for the energies and E_Θ, 1.7e-11 for momentum_drift, over the 150 steps.
+/// `energy_theta`, is per unit width as E's). Bound: [`LIMIT`], 1e-12 of each value's scale;
+/// measured ≤ 3.2e-13 over the 150 steps (u_contact, Θ = 1 + CN).
 #[test]
 fn blocks2d_column_is_bars1d_with_nitsche() {
     for vb in [-1.0, -0.5] {
