@@ -237,36 +237,47 @@ fn table() -> Vec<(&'static str, BarMaterial, f64, f64)> {
     ]
 }
 
-/// Done-when 1: `mixed` + `zero-contact` on both bars + CN at a fixed Courant number
-/// (ν = 1 on the faster bar, one h on both bars as contract §1.9 says): the mean velocities at
-/// T = 4 (after separation in every row) converge to the table's as h, τ → 0. The rate table
-/// (run with --nocapture), measured, |v̄ − exact| max over both bars:
+/// The Courant number of done-when 1's convergence study: ν = 1/√2 on the faster bar (c0 =
+/// max(c_a, c_b), contract §1.9). P1 with the consistent mass runs fast, ω_h = ω(1 + (kh)²/24 +
+/// …), and CN slow, Ω = ω_h(1 − (ω_hτ)²/12 + …), so Ω = ω(1 + (kh)²(1 − 2ν²)/24 + O((kh)⁴)):
+/// at ν = 1/√2 the leading dispersion of the pair cancels. That matters here because the
+/// answers hinge on a stress *jump* returning to the interface: a dispersive scheme turns the
+/// jump into a wave train of width ∝ (t h²)^{1/3} and the momentum it hands over converges like
+/// h^{2/3} (at ν = 1: 3.7e-3 at 400 elements for L_b = ½, rates ½–¾; contract §6).
+const NU: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+/// Done-when 1: `mixed` + `zero-contact` on both bars + CN at a fixed Courant number ([`NU`]):
+/// the mean velocities at T = 4 (after separation in every row) converge to the table's as
+/// h, τ → 0. One h on both bars (contract §1.9), m the shorter bar's elements (so each bar has
+/// at least m: "m elements per bar"). The rate table (run with --nocapture), measured,
+/// |v̄ − exact| max over both bars:
 ///
-/// | row | m = 50 | 100 | 200 | 400 | 800 | 1600 |
-/// |---|---|---|---|---|---|---|
-/// | equal | 4.8e-3 | 3.6e-3 | 2.6e-3 | 1.8e-3 | 1.2e-3 | 8.3e-4 |
-/// | L_b = 2 | 1.2e-2 | 6.5e-3 | 3.7e-3 | 2.1e-3 | 1.2e-3 | 7.3e-4 |
-/// | L_b = ½ | 2.1e-2 | 1.2e-2 | 6.5e-3 | 3.7e-3 | 2.1e-3 | 1.2e-3 |
-/// | ρ_b = E_b = 2 | 6.4e-3 | 4.8e-3 | 3.4e-3 | 2.4e-3 | 1.6e-3 | 1.1e-3 |
-/// | E_b = 4 | 4.3e-3 | 1.9e-3 | 8.0e-4 | 3.3e-4 | 9.9e-5 | 1.0e-5 |
+/// | row | m = 100 | 200 | 400 | 800 | 1600 |
+/// |---|---|---|---|---|---|
+/// | equal | 4.4e-4 | 3.8e-4 | 2.5e-4 | 1.8e-4 | 1.2e-4 |
+/// | L_b = 2 | 3.9e-3 | 2.0e-3 | 1.1e-3 | 5.6e-4 | 2.9e-4 |
+/// | L_b = ½ | 3.9e-3 | 2.0e-3 | 1.1e-3 | 5.6e-4 | 2.9e-4 |
+/// | ρ_b = E_b = 2 | 5.9e-4 | 5.1e-4 | 3.4e-4 | 2.4e-4 | 1.6e-4 |
+/// | E_b = 4 | 2.0e-3 | 8.7e-4 | 3.4e-4 | 1.0e-4 | 1.1e-5 |
 ///
-/// Rates ½ (equal bars, the impedance mismatch) to ¾ (different lengths), faster for E_b = 4 —
-/// the release of a stress jump, as the flying bar's L2 rates 0.5–0.7. The 2e-3 at 400
-/// elements holds for two rows of five (3.7e-3 for L_b = ½, whose B has 200 elements); at 1600
-/// it holds for all, and the test holds that. Every error must also fall from one m to the next
-/// (5 % slack for the rate's wobble), and so must `err_u_l2l2` over both bars (measured rates
-/// 0.55–1.1: 4.5e-3 … 2.2e-3 at m = 400).
+/// Rates ½ (equal impedances' rows), 1 (different lengths), faster for E_b = 4. The issue's
+/// 2e-3 at 400 elements per bar holds for every row (worst 1.1e-3). (At m = 50 the equal rows
+/// are 2.8e-4 and 3.7e-4, below m = 100's: pre-asymptotic, so the study starts at 100.) Every
+/// error must fall from one m to the next (5 % slack for the rate's wobble), and so must
+/// `err_u_l2l2` over both bars (measured 6.3e-4 … 2.4e-3 at m = 400).
 #[test]
 fn mean_velocities_converge_to_the_table() {
     for (name, b, va, vb) in table() {
         let (mut prev, mut prev_l2) = (f64::INFINITY, f64::INFINITY);
         eprintln!("{name}:  m   |v̄_a − exact|   |v̄_b − exact|");
-        for m in [50, 100, 200, 400, 800, 1600] {
+        for m in [100, 200, 400, 800, 1600] {
             let bars = pair(b, false);
-            let dt = (1.0 / m as f64) / bars.wave_speed();
+            // A gets `elements`, B round(elements·L_b/L_a): the shorter bar has m.
+            let elements = (m as f64 / b.length.min(1.0)).round() as usize;
+            let dt = NU * (1.0 / elements as f64) / bars.wave_speed();
             let out = run(
                 bars,
-                (m, dt, 4.0),
+                (elements, dt, 4.0),
                 (ContactMethod::Mixed, MassVariant::ZeroContact, CN),
             );
             assert_eq!(out.status, Status::Ok, "{name}: {:?}", out.message);
@@ -291,12 +302,14 @@ fn mean_velocities_converge_to_the_table() {
             prev_l2 = l2;
             let e = ea.max(eb);
             assert!(e <= prev * 1.05, "{name}: error grew at m = {m}");
+            if m == 400 {
+                assert!(
+                    e <= 2e-3,
+                    "{name}: |v̄ − exact| = {e:e} at 400 elements per bar"
+                );
+            }
             prev = e;
         }
-        assert!(
-            prev <= 2e-3,
-            "{name}: |v̄ − exact| = {prev:e} at 1600 elements"
-        );
     }
 }
 
@@ -360,37 +373,46 @@ fn equal_bars_are_the_flying_bar_twice() {
 }
 
 /// Done-when 1, the clamped case (contract §1.9): B clamped, L_b = ½, ρ_b = 9/2, E_b = ½
-/// (c_b = ⅓, Z_b = 3/2): contact on [0, 2] and [10/3, 5], then v̄_a = −4/5. Measured at ν = 1
-/// (steps off the exact ends, m = 50 … 800): first phase [+1, +3 … +7], second [−3.7 … −2.7,
-/// 0 … +3] — CN smears the pressure's jumps over a few steps, more steps as m grows (the
-/// issue's "within 2 steps" holds for the starts, not for the release at t = 2, whose tail
-/// lasts 6 steps at m = 400 and 7 at 800). Held here: exactly two phases, each end within
-/// 0.02 (8 steps at m = 800, ν = 1; 0.5 % of the run); v̄_a within 2e-3 (measured 1.45e-3 at
-/// m = 800, 2.0e-3 at 400).
+/// (c_b = ⅓, Z_b = 3/2): contact on [0, 2] and [10/3, 5], then v̄_a = −4/5. Measured at
+/// [`NU`] on A (B, three times slower, runs at ν/3), in steps off the exact ends, m = 100 …
+/// 1600: first phase [+1, +3.2 … +3.6], second [−5.8 … −5.2, −1.4 … +3.3]; v̄_a + 4/5 =
+/// 1.6e-3, 1.6e-3, 1.6e-3, 1.2e-3, 8.6e-4. The offsets stay put in steps as m grows (a time
+/// error O(τ); at ν = 1 the first release came 4, 5, 6, 7, 8 steps late, growing like
+/// h^{−1/3}): CN smears each jump of the contact pressure over about three steps, and B's
+/// echo, stepped at ν/3 where CN and the consistent mass do not cancel, returns a few steps
+/// early. The "within 2 steps" holds for the first contact only; held here: exactly
+/// two phases at every m, each end within 6 steps, v̄_a within 2e-3 at every m and within 1e-3
+/// at m = 1600.
 #[test]
 fn clamped_case_has_two_contact_phases() {
-    let m = 800;
-    let bars = pair(bar(0.5, 0.5, 4.5, 0.0), true);
-    let dt = (1.0 / m as f64) / bars.wave_speed();
-    let out = run(
-        bars,
-        (m, dt, 6.0),
-        (ContactMethod::Mixed, MassVariant::ZeroContact, CN),
-    );
-    assert_eq!(out.status, Status::Ok, "{:?}", out.message);
-    let ph = phases(&out);
-    eprintln!(
-        "clamped: phases {ph:?}, v̄_a = {:?}",
-        out.metrics.velocity_a_final
-    );
-    assert_eq!(ph.len(), 2, "{ph:?}");
-    for ((t0, t1), (e0, e1)) in ph.iter().zip([(0.0, 2.0), (10.0 / 3.0, 5.0)]) {
-        assert!((t0 - e0).abs() <= 0.02 && (t1 - e1).abs() <= 0.02, "{ph:?}");
+    for m in [100, 200, 400, 800, 1600] {
+        let bars = pair(bar(0.5, 0.5, 4.5, 0.0), true);
+        let dt = NU * (1.0 / m as f64) / bars.wave_speed();
+        let out = run(
+            bars,
+            (m, dt, 6.0),
+            (ContactMethod::Mixed, MassVariant::ZeroContact, CN),
+        );
+        assert_eq!(out.status, Status::Ok, "{:?}", out.message);
+        let ph = phases(&out);
+        let va = out.metrics.velocity_a_final.unwrap();
+        let off: Vec<_> = ph
+            .iter()
+            .zip([(0.0, 2.0), (10.0 / 3.0, 5.0)])
+            .map(|((t0, t1), (e0, e1))| ((t0 - e0) / dt, (t1 - e1) / dt))
+            .collect();
+        eprintln!("clamped, m = {m}: phases {ph:?}, steps off {off:.1?}, v̄_a = {va}");
+        assert_eq!(ph.len(), 2, "{ph:?}");
+        for (d0, d1) in off {
+            assert!(d0.abs() <= 6.0 && d1.abs() <= 6.0, "m = {m}: {ph:?}");
+        }
+        assert!((va + 0.8).abs() <= 2e-3, "m = {m}: v̄_a = {va}");
+        if m == 1600 {
+            assert!((va + 0.8).abs() <= 1e-3, "v̄_a = {va}");
+        }
+        // A clamp takes momentum: no drift column.
+        assert_eq!(out.metrics.momentum_drift, None);
     }
-    let va = out.metrics.velocity_a_final.unwrap();
-    assert!((va + 0.8).abs() <= 2e-3, "v̄_a = {va}");
-    // A clamp takes momentum: no drift column.
-    assert_eq!(out.metrics.momentum_drift, None);
 }
 
 /// Code_Aster's SDNL111 (contract §1.9): L = 1 m, ρ = 7800, V = 1 m/s, B clamped; u_a(L_a) at
