@@ -1,7 +1,10 @@
 //! Friction between two bodies (contract §2.5, §2.6; issue 44): `blocks2d`/`blocks3d` with a
 //! matching interface, Coulomb and Tresca acting on the relative slip (u^a − u^b∘π)_t through
 //! the tangential rows e_{a,i,t} − e_{b,π(i),t} — for `mixed` (its multiplier per row and
-//! direction) and `penalty` (f_t = proj(−κ Δ(u^a − u^b)_t)).
+//! direction) and `penalty` (f_t = proj(−κ Δ(u^a − u^b)_t)) — and for `nitsche` (unbiased and
+//! one-sided, every Θ) through the pair points' slip rows: each point of Γ^a and Γ^b carries
+//! u_t = (u^a − u^b∘π)_t and its own body's σ_t, signed as the traction on A
+//! (`run::fe::nitsche_pair`), and f_t = proj(σ_t − Δu_t/(γτ)) acts on A and, opposite, on B.
 //!
 //! Momentum. A tangential row's force acts on A's node and, opposite, on B's partner: its
 //! components sum to zero, as the normal rows' do. With no clamp and no load a rigid
@@ -120,6 +123,74 @@ fn momentum_is_an_invariant_with_friction() {
     assert!(total.1 > 100, "{} runs", total.1);
 }
 
+/// The schemes that take friction with Nitsche (contract §2.5: the Newmark/θ families and
+/// generalized-α/HHT), Coulomb and Tresca, Θ ∈ {−1, 0, 1}, both `nitsche_sides`.
+const NITSCHE: &str = r#"method = [
+  { scheme = "newmark", newmark_beta = 0.3, newmark_gamma = 0.6 },
+  { scheme = "crank-nicolson" },
+  { scheme = "theta", theta_scheme = 0.6 },
+  { scheme = "backward-euler" },
+  { scheme = "generalized-alpha", rho_inf = 0.5 },
+  { scheme = "hht", hht_alpha = 0.1 },
+]
+friction = [
+  { friction = "coulomb", friction_coefficient = 0.3 },
+  { friction = "tresca", tresca_threshold = 0.2 },
+]
+space = ["nitsche"]
+nitsche_theta = [-1.0, 0.0, 1.0]
+nitsche_sides = ["unbiased", "a"]
+"#;
+
+/// The same invariant with two-body Nitsche and friction (issue 44 done-when 3, the last
+/// treatment): random blocks2d and blocks3d runs as above, over the schemes Nitsche's
+/// friction takes × Coulomb and Tresca × Θ × both sides × two mass variants (one per sweep on
+/// a random side). A point's tangential force column u_t − Θγσ_t has −N_a on A's dofs and
+/// +N_b on B's, and σ_t's entries sum to zero over each body, so the invariant is exact as for
+/// the other rows. Tolerance 1e-12 as above: O(10 ε) per step over at most 40 steps of O(1)
+/// momenta (the frictional Nitsche runs step in totals: their round-off is relative to the
+/// displacements, O(1) here too).
+#[test]
+fn nitsche_momentum_is_an_invariant_with_friction() {
+    let mut rng = fastrand::Rng::with_seed(4404);
+    let masses = ["consistent", "lumped", "mod3", "zero-contact"];
+    let sides = ["both", "a", "b"];
+    let mut total = (0.0f64, 0usize);
+    for (k, scene) in ["blocks2d", "blocks2d", "blocks3d"].iter().enumerate() {
+        let (h, t) = if *scene == "blocks3d" {
+            (0.5, 0.5)
+        } else {
+            (1.0 / rng.usize(3..=4) as f64, 0.6)
+        };
+        let mass = masses[rng.usize(0..masses.len())];
+        let other = masses[(k + 2) % masses.len()];
+        let text = format!(
+            "name = \"fn\"\nscene = \"{scene}\"\n[fixed]\nT = {t}\nh = {h}\ndt = {dt}\nvelocity = {va}\nvelocity_tangential = {vt}\nvelocity_b = {vb}\ngap = 0.05\nheight_b = {hb}\ndensity = {ra}\ndensity_b = {rb}\nlame_lambda = {la}\nlame_mu = {ma}\nlame_lambda_b = {lb}\nlame_mu_b = {mb}\nnitsche_gamma0 = {g0}\nmass_side = \"{side}\"\n[grid]\n{NITSCHE}mass = [\"{mass}\", \"{other}\"]\n",
+            dt = 0.015 + 0.02 * rng.f64(),
+            va = -0.5 - rng.f64(),
+            vt = 0.3 + rng.f64(),
+            vb = 0.5 * rng.f64(),
+            hb = [0.5, 1.0][rng.usize(0..2)],
+            ra = 0.5 + rng.f64(),
+            rb = 0.5 + rng.f64(),
+            la = 2.0 * rng.f64(),
+            ma = 0.5 + 1.5 * rng.f64(),
+            lb = 2.0 * rng.f64(),
+            mb = 0.5 + 1.5 * rng.f64(),
+            g0 = [0.02, 0.05, 0.2][rng.usize(0..3)],
+            side = sides[rng.usize(0..3)],
+        );
+        let runs = run_all(&text);
+        let (w, n) = assert_momentum(&runs, 1e-12);
+        total = (total.0.max(w), total.1 + n);
+    }
+    eprintln!(
+        "nitsche friction momentum: {} runs, worst momentum_drift {:e}",
+        total.1, total.0
+    );
+    assert!(total.1 > 200, "{} runs", total.1);
+}
+
 /// A pressed on a clamped B (far_end = "clamped", gap 0, at rest vertically), thrown along e_1
 /// at V: blocks2d, W = H_a = H_b = 1, ρ = 1, λ = 0, μ = 1 (c_p = √2), p on A's top, Coulomb μ_f.
 fn pressed(
@@ -137,8 +208,9 @@ fn pressed(
 }
 
 /// The pressed runs' methods: mixed with CN, backward Euler, kane, generalized-α and
-/// Moreau–Jean; penalty with CN and backward Euler.
-const PRESSED: [(&str, &str); 7] = [
+/// Moreau–Jean; penalty with CN and backward Euler; nitsche (γ0 = 0.05) unbiased with CN
+/// (Θ = 1) and backward Euler (Θ = −1), one-sided with generalized-α (Θ = 0).
+const PRESSED: [(&str, &str); 10] = [
     ("space = \"mixed\"", "scheme = \"crank-nicolson\""),
     ("space = \"mixed\"", "scheme = \"backward-euler\""),
     ("space = \"mixed\"", "scheme = \"kane\""),
@@ -157,6 +229,18 @@ const PRESSED: [(&str, &str); 7] = [
     (
         "space = \"penalty\"\npenalty_gamma0 = 10.0",
         "scheme = \"backward-euler\"",
+    ),
+    (
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05",
+        "scheme = \"crank-nicolson\"",
+    ),
+    (
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05\nnitsche_theta = -1.0",
+        "scheme = \"backward-euler\"",
+    ),
+    (
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05\nnitsche_theta = 0.0\nnitsche_sides = \"a\"",
+        "scheme = \"generalized-alpha\"\nrho_inf = 0.5",
     ),
 ];
 
@@ -239,6 +323,8 @@ fn throwing_a_the_other_way_mirrors_the_run() {
     for space in [
         "space = \"mixed\"",
         "space = \"penalty\"\npenalty_gamma0 = 10.0",
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05",
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05\nnitsche_theta = -1.0\nnitsche_sides = \"a\"",
     ] {
         let run = |vt: f64| {
             let text = format!(
