@@ -413,3 +413,32 @@ nitsche_sides = ["unbiased", "a"]
     }
     eprintln!("two-body nitsche friction runs: worst momentum_drift {worst:e}");
 }
+
+/// Consistency of the two-body frictional Nitsche: the exact solution satisfies Nitsche's
+/// equations for every γ0, so a run depends on γ0 only through the discretisation. A pressed
+/// hard on the clamped B (the sticking case above: μ_f = 2, p = 0.5, V = 0.1, T = 6; lumped
+/// mass, backward Euler, Θ = −1, unbiased) for γ0 = 0.05, 1 and 10 — from nearly a penalty
+/// (k = 1/(γτ) dominating P_t) to nearly the weak traction σ_t alone: A's final mean velocity
+/// v̄_1(T) ≈ −0.018 spreads by 5.3e-4 (measured). This is what checks the sign of B's σ_t rows
+/// (`run::fe::nitsche_pair`'s header: −σ_cd(u^b), the traction on A seen from B): with the
+/// opposite sign Γ^b's term is inconsistent and the spread is 6.5e-3 (measured: v̄_1 from
+/// −0.0173 to −0.0111 as the weight moves to σ_t). Asserted: spread ≤ 2e-3, a factor 3.8
+/// above the consistent runs' and 3.3 below the wrong sign's.
+#[test]
+fn two_body_nitsche_friction_does_not_depend_on_gamma0() {
+    let text = "name = \"g0\"\nscene = \"blocks2d\"\n[fixed]\nT = 6.0\nh = 0.25\ndt = 0.05\nfar_end = \"clamped\"\ngap = 0.0\nvelocity = 0.0\nvelocity_tangential = 0.1\npressure = 0.5\nlame_lambda = 0.0\nlame_mu = 1.0\nfriction = \"coulomb\"\nfriction_coefficient = 2.0\nmass = \"lumped\"\nscheme = \"backward-euler\"\nspace = \"nitsche\"\nnitsche_theta = -1.0\nnitsche_sides = \"unbiased\"\n[grid]\nnitsche_gamma0 = [0.05, 1.0, 10.0]\n";
+    let runs = run_all(text);
+    assert_eq!(runs.len(), 3);
+    let v: Vec<f64> = runs
+        .iter()
+        .map(|(label, o)| {
+            assert_eq!(o.status, "ok", "{label}: {:?}", o.message);
+            o.tangential_velocity_final.unwrap()
+        })
+        .collect();
+    let (lo, hi) = v
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+    eprintln!("v̄_1(T) over γ0: {v:?}, spread {:e}", hi - lo);
+    assert!(hi - lo <= 2e-3, "v̄_1(T) over γ0 = 0.05, 1, 10: {v:?}");
+}
