@@ -332,6 +332,38 @@ fn gmsh_copy_of_blocks3d_is_blocks3d() {
     assert_copies(&k, &g);
 }
 
+/// Friction on a two-body file (contract §2.5, §2.6): `mixed` and `penalty` take the relative
+/// slip through the same tangential rows e_{a,i,t} − e_{b,π(i),t} on a file's node pairs as on
+/// the blocks', so the Gmsh copy of blocks2d with A thrown sideways too (Coulomb μ_f = 0.3)
+/// equals blocks2d with friction — the friction columns (W_f, stick/slip, the tangential
+/// velocities, the all-axes momentum drift) included — to 1e-12 (the same cells, order and
+/// doubles as without friction: round-off at most; measured 0), and in 3D.
+#[test]
+fn gmsh_copies_of_the_blocks_with_friction_are_the_blocks() {
+    let physics = format!(
+        "{PHYSICS}velocity_tangential = 0.5\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n"
+    );
+    let b = Blocks {
+        dim: 2,
+        width: 1.0,
+        height_a: 1.0,
+        height_b: 0.5,
+        across: 4,
+        cells_a: 4,
+        cells_b: 2,
+    };
+    for blocks in [b, CUBES] {
+        let (k, g) = both(blocks, false, &physics, METHODS);
+        assert_eq!((k.len(), g.len()), (3, 3));
+        for (label, o) in &k {
+            let m = &o.metrics;
+            let steps = m.stick_steps.unwrap_or(0) + m.slip_steps.unwrap_or(0);
+            assert!(steps > 0, "{label}: no frictional contact");
+        }
+        assert_copies(&k, &g);
+    }
+}
+
 /// The contact patch test (contract §1.10) on the Gmsh copy of blocks3d, B's base clamped by
 /// the file's `clamped` group, p on its `loaded` face: one backward-Euler step at τ = 1e6 gives
 /// the static solution, patch errors ≤ 1e-8 (done-when 5's bound; measured ≤ 6.5e-13 after
