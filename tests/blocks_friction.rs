@@ -77,6 +77,35 @@ fn assert_momentum(runs: &[(String, RunRecord)], tol: f64) -> (f64, usize) {
     (worst, runs.len())
 }
 
+/// The mass variants the momentum tests draw from.
+const MASSES: [&str; 4] = ["consistent", "lumped", "mod3", "zero-contact"];
+
+/// One random pair of free blocks for the momentum tests: the `[fixed]` lines (T, h, τ, A thrown
+/// down and sideways, B up, B's height, both materials) and a mass variant, drawn from `rng`.
+fn random_blocks(rng: &mut fastrand::Rng, scene: &str) -> (String, &'static str) {
+    let (h, t) = if scene == "blocks3d" {
+        (0.5, 0.5)
+    } else {
+        (1.0 / rng.usize(3..=4) as f64, 0.6)
+    };
+    let mass = MASSES[rng.usize(0..MASSES.len())];
+    let fixed = format!(
+        "T = {t}\nh = {h}\ndt = {dt}\nvelocity = {va}\nvelocity_tangential = {vt}\nvelocity_b = {vb}\ngap = 0.05\nheight_b = {hb}\ndensity = {ra}\ndensity_b = {rb}\nlame_lambda = {la}\nlame_mu = {ma}\nlame_lambda_b = {lb}\nlame_mu_b = {mb}\n",
+        dt = 0.015 + 0.02 * rng.f64(),
+        va = -0.5 - rng.f64(),
+        vt = 0.3 + rng.f64(),
+        vb = 0.5 * rng.f64(),
+        hb = [0.5, 1.0][rng.usize(0..2)],
+        ra = 0.5 + rng.f64(),
+        rb = 0.5 + rng.f64(),
+        la = 2.0 * rng.f64(),
+        ma = 0.5 + 1.5 * rng.f64(),
+        lb = 2.0 * rng.f64(),
+        mb = 0.5 + 1.5 * rng.f64(),
+    );
+    (fixed, mass)
+}
+
 /// contract §2.6's invariant with friction, every axis: random blocks2d and blocks3d runs (a
 /// fixed seed: the suite is reproducible) — A thrown down and sideways onto B, both free —
 /// over mixed and penalty × Coulomb and Tresca × every scheme and §3.2 method × mass variants
@@ -86,30 +115,13 @@ fn assert_momentum(runs: &[(String, RunRecord)], tol: f64) -> (f64, usize) {
 #[test]
 fn momentum_is_an_invariant_with_friction() {
     let mut rng = fastrand::Rng::with_seed(4402);
-    let masses = ["consistent", "lumped", "mod3", "zero-contact"];
     let sides = ["both", "a", "b"];
     let mut total = (0.0f64, 0usize);
     for (k, scene) in ["blocks2d", "blocks2d", "blocks3d"].iter().enumerate() {
-        let (h, t) = if *scene == "blocks3d" {
-            (0.5, 0.5)
-        } else {
-            (1.0 / rng.usize(3..=4) as f64, 0.6)
-        };
-        let mass = masses[rng.usize(0..masses.len())];
-        let other = masses[(k + 1) % masses.len()];
+        let (fixed, mass) = random_blocks(&mut rng, scene);
+        let other = MASSES[(k + 1) % MASSES.len()];
         let text = format!(
-            "name = \"fm\"\nscene = \"{scene}\"\n[fixed]\nT = {t}\nh = {h}\ndt = {dt}\nvelocity = {va}\nvelocity_tangential = {vt}\nvelocity_b = {vb}\ngap = 0.05\nheight_b = {hb}\ndensity = {ra}\ndensity_b = {rb}\nlame_lambda = {la}\nlame_mu = {ma}\nlame_lambda_b = {lb}\nlame_mu_b = {mb}\n[grid]\n{METHODS}mass = [\"{mass}\", \"{other}\"]\nmass_side = [\"both\", \"{side}\"]\n",
-            dt = 0.015 + 0.02 * rng.f64(),
-            va = -0.5 - rng.f64(),
-            vt = 0.3 + rng.f64(),
-            vb = 0.5 * rng.f64(),
-            hb = [0.5, 1.0][rng.usize(0..2)],
-            ra = 0.5 + rng.f64(),
-            rb = 0.5 + rng.f64(),
-            la = 2.0 * rng.f64(),
-            ma = 0.5 + 1.5 * rng.f64(),
-            lb = 2.0 * rng.f64(),
-            mb = 0.5 + 1.5 * rng.f64(),
+            "name = \"fm\"\nscene = \"{scene}\"\n[fixed]\n{fixed}[grid]\n{METHODS}mass = [\"{mass}\", \"{other}\"]\nmass_side = [\"both\", \"{side}\"]\n",
             side = sides[1 + rng.usize(0..2)],
         );
         let runs = run_all(&text);
@@ -153,30 +165,13 @@ nitsche_sides = ["unbiased", "a"]
 #[test]
 fn nitsche_momentum_is_an_invariant_with_friction() {
     let mut rng = fastrand::Rng::with_seed(4404);
-    let masses = ["consistent", "lumped", "mod3", "zero-contact"];
     let sides = ["both", "a", "b"];
     let mut total = (0.0f64, 0usize);
     for (k, scene) in ["blocks2d", "blocks2d", "blocks3d"].iter().enumerate() {
-        let (h, t) = if *scene == "blocks3d" {
-            (0.5, 0.5)
-        } else {
-            (1.0 / rng.usize(3..=4) as f64, 0.6)
-        };
-        let mass = masses[rng.usize(0..masses.len())];
-        let other = masses[(k + 2) % masses.len()];
+        let (fixed, mass) = random_blocks(&mut rng, scene);
+        let other = MASSES[(k + 2) % MASSES.len()];
         let text = format!(
-            "name = \"fn\"\nscene = \"{scene}\"\n[fixed]\nT = {t}\nh = {h}\ndt = {dt}\nvelocity = {va}\nvelocity_tangential = {vt}\nvelocity_b = {vb}\ngap = 0.05\nheight_b = {hb}\ndensity = {ra}\ndensity_b = {rb}\nlame_lambda = {la}\nlame_mu = {ma}\nlame_lambda_b = {lb}\nlame_mu_b = {mb}\nnitsche_gamma0 = {g0}\nmass_side = \"{side}\"\n[grid]\n{NITSCHE}mass = [\"{mass}\", \"{other}\"]\n",
-            dt = 0.015 + 0.02 * rng.f64(),
-            va = -0.5 - rng.f64(),
-            vt = 0.3 + rng.f64(),
-            vb = 0.5 * rng.f64(),
-            hb = [0.5, 1.0][rng.usize(0..2)],
-            ra = 0.5 + rng.f64(),
-            rb = 0.5 + rng.f64(),
-            la = 2.0 * rng.f64(),
-            ma = 0.5 + 1.5 * rng.f64(),
-            lb = 2.0 * rng.f64(),
-            mb = 0.5 + 1.5 * rng.f64(),
+            "name = \"fn\"\nscene = \"{scene}\"\n[fixed]\n{fixed}nitsche_gamma0 = {g0}\nmass_side = \"{side}\"\n[grid]\n{NITSCHE}mass = [\"{mass}\", \"{other}\"]\n",
             g0 = [0.02, 0.05, 0.2][rng.usize(0..3)],
             side = sides[rng.usize(0..3)],
         );

@@ -283,15 +283,7 @@ fn both(b: Blocks, clamped: bool, physics: &str, methods: &str) -> (Runs, Runs) 
 /// here), so they agree to round-off at most; measured: 0 (bit for bit).
 #[test]
 fn gmsh_copy_of_blocks2d_is_blocks2d() {
-    let b = Blocks {
-        dim: 2,
-        width: 1.0,
-        height_a: 1.0,
-        height_b: 0.5,
-        across: 4,
-        cells_a: 4,
-        cells_b: 2,
-    };
+    let b = SQUARES;
     let (k, g) = both(b, false, PHYSICS, METHODS);
     assert_eq!((k.len(), g.len()), (3, 3));
     assert_copies(&k, &g);
@@ -311,6 +303,17 @@ fn assert_copies(k: &Runs, g: &Runs) {
         assert!(d <= 1e-12, "{lk}: {name} differs by {d:e}");
     }
 }
+
+/// blocks2d's squares: 4 × 4 on 4 × 2 (H_b = ½).
+const SQUARES: Blocks = Blocks {
+    dim: 2,
+    width: 1.0,
+    height_a: 1.0,
+    height_b: 0.5,
+    across: 4,
+    cells_a: 4,
+    cells_b: 2,
+};
 
 /// blocks3d's cubes: 2 × 2 × 2 on 2 × 2 × 2.
 const CUBES: Blocks = Blocks {
@@ -343,16 +346,7 @@ fn gmsh_copies_of_the_blocks_with_friction_are_the_blocks() {
     let physics = format!(
         "{PHYSICS}velocity_tangential = 0.5\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n"
     );
-    let b = Blocks {
-        dim: 2,
-        width: 1.0,
-        height_a: 1.0,
-        height_b: 0.5,
-        across: 4,
-        cells_a: 4,
-        cells_b: 2,
-    };
-    for blocks in [b, CUBES] {
+    for blocks in [SQUARES, CUBES] {
         let (k, g) = both(blocks, false, &physics, METHODS);
         assert_eq!((k.len(), g.len()), (3, 3));
         for (label, o) in &k {
@@ -416,15 +410,7 @@ fn triangulated(msh: &str) -> String {
 /// of O(1) momenta.
 #[test]
 fn a_two_body_file_of_triangles_keeps_its_momentum_with_friction() {
-    let b = Blocks {
-        dim: 2,
-        width: 1.0,
-        height_a: 1.0,
-        height_b: 0.5,
-        across: 4,
-        cells_a: 4,
-        cells_b: 2,
-    };
+    let b = SQUARES;
     let dir = tempfile::tempdir().unwrap();
     let msh = triangulated(&blocks_msh(b, false));
     // A's 16 squares and B's 8, as 32 and 16 triangles (type 2).
