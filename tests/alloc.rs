@@ -277,6 +277,24 @@ fn two_body_time_loops_allocate_nothing() {
     }
 }
 
+/// Friction with two-body Nitsche (issue 44): the pair points' slip rows through the one-body
+/// frictional Newton and tally — unbiased with Crank–Nicolson (Coulomb), one-sided with
+/// backward Euler (Tresca), generalized-α — on blocks2d and blocks3d, nothing allocated per
+/// step.
+#[test]
+fn two_body_nitsche_friction_loops_allocate_nothing() {
+    let methods = [
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.05, scheme = "crank-nicolson", friction = "coulomb", friction_coefficient = 0.3 }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.05, nitsche_sides = "a", nitsche_theta = -1.0, scheme = "backward-euler", friction = "tresca", tresca_threshold = 0.2 }"#,
+        r#"{ space = "nitsche", nitsche_gamma0 = 0.05, scheme = "generalized-alpha", rho_inf = 0.5, friction = "coulomb", friction_coefficient = 2.0 }"#,
+    ];
+    let fixed = "h = 0.25\ndt = 0.01\nvelocity = -1.0\nvelocity_tangential = 0.5\nvelocity_b = 0.5\ngap = 0.05";
+    for scene in ["blocks2d", "blocks3d"] {
+        let text = fe_sweep("alloc-blocks-nitsche-friction", scene, fixed, &methods);
+        assert_loop_allocates_nothing_with(&text, 1.0, 1);
+    }
+}
+
 /// The FE engine's contract §3.2 methods (run::fe's methods module) on bar2d: kane with the
 /// consistent and a massless contact mass, contact-stabilized Newmark's two LCPs (M⁻¹Bᵀ built
 /// at setup), generalized-α/hht, Moreau–Jean's masked LCP, kinematic central difference.

@@ -58,26 +58,3 @@ fn nitsche_keeps_the_momentum_of_blocks3d() {
         runs.len()
     );
 }
-
-/// Friction with two-body Nitsche is refused at plan time with its reason (the relative slip's
-/// Nitsche term is not implemented); `mixed` and `penalty` are not refused by this check (their
-/// friction is the scene's `supports_friction`'s to allow), and neither is a one-body scene.
-#[test]
-fn friction_with_two_body_nitsche_is_refused() {
-    use contact_sweep::scene::{BarScene, BlocksScene, Scene};
-    for dim in [2, 3] {
-        let blocks = BlocksScene { dim };
-        let why = blocks.supports_friction_with("nitsche").unwrap_err();
-        assert!(
-            why.contains("nitsche") && why.contains("relative slip") && why.contains(blocks.name()),
-            "{why}"
-        );
-        assert!(blocks.supports_friction_with("mixed").is_ok());
-        assert!(blocks.supports_friction_with("penalty").is_ok());
-    }
-    assert!(
-        BarScene { dim: 2 }
-            .supports_friction_with("nitsche")
-            .is_ok()
-    );
-}

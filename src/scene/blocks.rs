@@ -150,20 +150,10 @@ impl Scene for BlocksScene {
             )
         })
     }
-    /// Friction (contract §2.5) acts on the relative slip (u^a − u^b∘π)_t through the
-    /// tangential rows e_{a,i,t} − e_{b,π(i),t} (`run::fe`), for `mixed` and `penalty`.
+    /// Friction (contract §2.5) acts on the relative slip (u^a − u^b∘π)_t: through the
+    /// tangential rows e_{a,i,t} − e_{b,π(i),t} for `mixed` and `penalty`, through the pair
+    /// points' slip rows for `nitsche` (`run::fe`).
     fn supports_friction(&self) -> Result<(), String> {
-        Ok(())
-    }
-    /// Friction between two bodies acts on the relative slip's rows of `mixed` and `penalty`;
-    /// the relative slip's Nitsche term is not implemented (contract §2.6).
-    fn supports_friction_with(&self, space: &str) -> Result<(), String> {
-        if space == "nitsche" {
-            return Err(format!(
-                "friction with space = nitsche on scene {}: the Nitsche term of the relative slip between two bodies is not implemented (mixed and penalty take friction on the relative slip)",
-                self.name()
-            ));
-        }
         Ok(())
     }
     fn supports_physics(

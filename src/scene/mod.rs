@@ -256,8 +256,8 @@ pub trait Scene: Send + Sync {
         ))
     }
     /// Whether a friction law acts with the contact treatment `space` here (asked once
-    /// [`Scene::supports_friction`] agrees); `Err` says why not. Every treatment by default;
-    /// the two blocks refuse `nitsche` ([`blocks::BlocksScene`]).
+    /// [`Scene::supports_friction`] agrees); `Err` says why not. Every treatment by default
+    /// (every scene today).
     fn supports_friction_with(&self, space: &str) -> Result<(), String> {
         let _ = space;
         Ok(())

@@ -124,11 +124,16 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
             )),
         }
     };
-    // Two bodies with friction: the penalty's points carry the relative slip's rows too.
+    // Two bodies: the frictional penalty's node points carry the relative slip's rows too, and
+    // Nitsche takes both faces' points (which carry them as well).
     let penalty = matches!(cfg.method, ContactMethod::Penalty { .. });
     let slip_points = if penalty && frictional(cfg) && g.bodies.is_some() {
         let nt = g.mesh.dim() - 1;
         Some(frictional_points(points()?, &tangential_rows(g)?, nt))
+    } else if matches!(cfg.method, ContactMethod::Nitsche { .. }) && g.bodies.is_some() {
+        // Two bodies: Nitsche's points of both faces, weighted per `nitsche_sides`
+        // ([`super::nitsche_pair`]); `g.points` are the penalty's node rows there.
+        Some(pair_points(g, cfg)?)
     } else {
         None
     };
@@ -139,11 +144,6 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
         }
     };
     let mut ops = match cfg.method {
-        // Two bodies: Nitsche's points of both faces, weighted per `nitsche_sides`
-        // ([`super::nitsche_pair`]); `g.points` are the penalty's node rows there.
-        ContactMethod::Nitsche { theta, gamma0 } if g.bodies.is_some() => {
-            pair_ops(g, cfg, theta, gamma0)?
-        }
         ContactMethod::Nitsche { theta, gamma0 } => NitscheOps::new(points()?, theta, gamma0),
         ContactMethod::Penalty { gamma0 } => {
             // Young's modulus E = μ(3λ + 2μ)/(λ + μ) of κ = E·γ0/h_K (contract §2.4); two
@@ -169,10 +169,11 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
     factor_nitsche(g, cfg, c_tau2, ops)
 }
 
-/// Nitsche's operators between two bodies (contract §2.6): both faces' points with the side
-/// weights of the run's `nitsche_sides`. Friction is refused: the relative slip's Nitsche term
-/// is not implemented (the planner refuses it first).
-fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<NitscheOps, String> {
+/// Nitsche's points between two bodies (contract §2.6): both faces' points with the side
+/// weights of the run's `nitsche_sides`, each with the relative slip's tangential rows
+/// ([`super::nitsche_pair`]'s friction; a frictional run without them is refused here rather
+/// than run frictionless).
+fn pair_points(g: &Geometry, cfg: &FeConfig) -> Result<Vec<ContactPoint>, String> {
     // The planner refuses Nitsche on a two-body file; kept as an error, not a panic.
     let (Some(two), FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
         return Err(format!(
@@ -180,14 +181,14 @@ fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<Nit
             cfg.setup.scene
         ));
     };
-    if frictional(cfg) {
+    let points = sided_points(&two.nitsche_points, b.nitsche_sides);
+    if frictional(cfg) && points.iter().any(|p| p.ut.is_empty()) {
         return Err(format!(
-            "space = nitsche with friction is not available for scene {} (two bodies: the relative slip's Nitsche term is not implemented; mixed and penalty take friction)",
+            "space = nitsche with friction on scene {}: a point of the interface has no tangential rows",
             cfg.setup.scene
         ));
     }
-    let points = sided_points(&two.nitsche_points, b.nitsche_sides);
-    Ok(NitscheOps::new(&points, theta, gamma0))
+    Ok(points)
 }
 
 /// The mixed method's factor: A = M + cτ²K, Z = A⁻¹Bᵀ, H = cτ² B Z. With friction Z also holds

@@ -397,7 +397,7 @@ impl NewtonWork {
 /// D[b][a] = ∂λ_b/∂x_a (module header). Returns whether the point is in normal contact and
 /// whether it slides (the projection is active).
 #[allow(clippy::too_many_arguments)]
-fn point_forces(
+pub(super) fn point_forces(
     x: &[f64],
     gap: f64,
     w: f64,
