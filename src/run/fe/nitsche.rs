@@ -47,6 +47,7 @@
 
 use super::schur::{ContactSchur, SchurNewton};
 use crate::contact::friction::FrictionLaw;
+use crate::contact::lemke;
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
 use crate::space::fe::nitsche::ContactPoint;
 
@@ -298,8 +299,9 @@ pub(crate) struct NewtonWork {
     lambda_ok: Vec<f64>,
     lambda_best: Vec<f64>,
     /// The iterations of [`newton_friction`]'s stages over the run: from the previous forces,
-    /// from rest, the continuation in the bound, Gauss–Seidel's sweeps, its Newton polish.
-    pub stages: [usize; 5],
+    /// from rest, the continuation in the bound, Gauss–Seidel's sweeps, its Newton polish,
+    /// Lemke's pivots with their Newton polish.
+    pub stages: [usize; 6],
 }
 
 impl NewtonWork {
@@ -320,7 +322,7 @@ impl NewtonWork {
             schur: None,
             lambda_ok: Vec::new(),
             lambda_best: Vec::new(),
-            stages: [0; 5],
+            stages: [0; 6],
         }
     }
 
@@ -379,10 +381,11 @@ impl NewtonWork {
     }
 
     /// [`Self::stages`] as the run record's three stage columns: the Newton from the previous
-    /// forces and from rest, the continuation, Gauss–Seidel's sweeps with its polish.
+    /// forces and from rest, the continuation, the fallbacks (Gauss–Seidel's sweeps, Lemke's
+    /// pivots, with their polish).
     pub fn stage_columns(&self) -> [usize; 3] {
         let s = self.stages;
-        [s[0] + s[1], s[2], s[3] + s[4]]
+        [s[0] + s[1], s[2], s[3] + s[4] + s[5]]
     }
 
     /// The Newton's linear solves over the run, when made in the contact dofs' space: (K's
@@ -671,13 +674,93 @@ pub(crate) fn newton_friction(
         Err(e) => e,
     };
     work.stages[2] += spent;
-    let before = work.stages[3] + work.stages[4];
-    match gauss_seidel(&p, law, lambda, slides, work) {
-        Ok(()) => Ok(spent + 2 * NEWTON_MAX_ITER + work.stages[3] + work.stages[4] - before),
-        Err(e) => Err(format!(
-            "{first}; continuation in the bound: {second}; Gauss–Seidel: {e}"
-        )),
+    // The fallbacks' iterations: Gauss–Seidel's sweeps and polish, then Lemke's pivots and
+    // polish (where Gauss–Seidel fails too, 2D).
+    let fallback = |w: &NewtonWork| w.stages[3] + w.stages[4] + w.stages[5];
+    let before = fallback(work);
+    let gs = gauss_seidel(&p, law, lambda, slides, work);
+    let gs = match gs {
+        Ok(()) => Ok(()),
+        Err(e) => lemke_stage(&p, law, lambda, slides, work)
+            .map_err(|l| format!("Gauss–Seidel: {e}; {l}")),
+    };
+    match gs {
+        Ok(()) => Ok(spent + 2 * NEWTON_MAX_ITER + fallback(work) - before),
+        Err(e) => Err(format!("{first}; continuation in the bound: {second}; {e}")),
     }
+}
+
+/// Widths of Tresca's onset ramp [`lemke_stage`] tries, relative to the normal scale: the
+/// narrowest the continuation aims at ([`NEWTON_TOL`]), then wider ones down to the floor's
+/// ([`NEWTON_FLOOR_TOL`]) — contract §2.5's closure of a grazing point within its tolerance.
+/// And the perturbations of q ([`crate::contact::lemke`]'s header): the smaller first.
+const LEMKE_RAMPS: [f64; 3] = [NEWTON_TOL, 1e-10, NEWTON_FLOOR_TOL];
+const LEMKE_PERTURBATIONS: [f64; 2] = [1e-9, 1e-6];
+
+/// [`newton_friction`]'s last stage in 2D, where Gauss–Seidel failed as well: Lemke's
+/// complementary pivoting on the step's LCP ([`crate::contact::lemke`]), which follows the
+/// solution path through the folds that stall the continuation in the bound (measured on the
+/// issue 43 campaign: Nitsche γ0 = 1e-4 and the penalty γ0 = 1e3 at μ_f 3.4–4.6, and Tresca
+/// s ≈ the weight with HHT — every step solved). Its forces start the full Newton
+/// ([`newton_friction_from`]) on the exact law (Tresca: with the ramp), and only that Newton's
+/// convergence to its tolerance ends the stage. Counts pivots and Newton iterations into the
+/// stages. Allocates the LCP (a rescue, not a step's path).
+fn lemke_stage(
+    p: &Problem,
+    law: FrictionLaw,
+    lambda: &mut [f64],
+    slides: &mut [bool],
+    work: &mut NewtonWork,
+) -> Result<(), String> {
+    let ops = p.ops;
+    if ops.per_point() != 2 {
+        return Err("Lemke: 2D only".into());
+    }
+    let sc = scales(ops, p.x0, 0.0);
+    let lcp = lemke::Frictional2d {
+        gap: &ops.gap,
+        w: &ops.w,
+        gamma: &ops.gamma,
+        wm: p.w,
+        c_tau2: p.c_tau2,
+        x0: p.x0,
+    };
+    let attempts: Vec<(lemke::Bound, f64)> = match law {
+        FrictionLaw::Coulomb { coefficient } => {
+            vec![(lemke::Bound::Coulomb { mu: coefficient }, 0.0)]
+        }
+        FrictionLaw::Tresca { threshold } => LEMKE_RAMPS
+            .iter()
+            .map(|r| {
+                let width = r * sc.n;
+                (lemke::Bound::TrescaRamp { threshold, width }, width)
+            })
+            .collect(),
+        FrictionLaw::None => return Err("Lemke: no friction".into()),
+    };
+    let mut last = String::from("Lemke: not tried");
+    for (bound, ramp) in attempts {
+        for perturb in LEMKE_PERTURBATIONS {
+            match lemke::solve_2d(&lcp, bound, perturb) {
+                Ok((forces, pivots)) => {
+                    work.stages[5] += pivots;
+                    lambda.copy_from_slice(&forces);
+                    match newton_friction_from(p, law, ramp, lambda, slides, work) {
+                        Ok(it) => {
+                            work.stages[5] += it;
+                            return Ok(());
+                        }
+                        Err(e) => {
+                            work.stages[5] += NEWTON_MAX_ITER;
+                            last = format!("Lemke's start: {e}");
+                        }
+                    }
+                }
+                Err(e) => last = e,
+            }
+        }
+    }
+    Err(last)
 }
 
 /// Sweeps of [`gauss_seidel`] at most, and how often its Newton polish is tried.
@@ -1445,6 +1528,7 @@ mod tests {
     #[test]
     fn friction_state_sums_forces_and_averages_velocities() {
         use crate::contact::friction::FrictionLaw;
+        use crate::contact::lemke;
         use crate::run::friction_tally::MeanVelocity;
         use crate::space::fe::SymMatrix;
         let point = |node: usize, weight: f64| ContactPoint {
