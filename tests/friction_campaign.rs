@@ -194,7 +194,7 @@ fn potential_methods(t: Treatment) -> Vec<String> {
 const ASSERT_POTENTIALS: bool = true;
 
 /// Whether the stick criterion is asserted for every scheme; it is for backward Euler always.
-/// Measured on this branch with the mixed treatment (T = 10, window t ≥ 5, μ_f = 1, 1.5, 2,
+/// Measured with the mixed treatment (T = 10, window t ≥ 5, μ_f = 1, 1.5, 2,
 /// flat and 18°, V = 0.05): backward Euler sticks with every mass (drift ≤ 1.5e-16·V); every
 /// other implicit scheme drifts, 6e-4·V (generalized-α, lumped) to 0.67·V (CN, lumped). The
 /// blocks start unstressed at gap 0, so gravity sets them bouncing, and a Γ_C node whose
@@ -204,6 +204,13 @@ const ASSERT_POTENTIALS: bool = true;
 /// step meets the §4 tolerance: not a solver failure; the criterion needs a pre-stressed start
 /// or damping — left to the lead.
 const ASSERT_STICK: bool = false;
+
+/// The sticking blocks' end time (their stick window is t ≥ T/2). T = 5 would halve the
+/// campaign's largest share (the 2D sticking blocks' 82 runs are 30 of its 51 CPU seconds,
+/// measured), but the shorter window is not past the transient: measured at T = 5, a mixed
+/// backward Euler run on the 18° incline (lumped, μ_f 2.34) drifts 2.0e-7·V, over the
+/// criterion's 1e-8·V.
+const STICK_T: f64 = 10.0;
 
 /// The block's weight per unit of Γ_C: ρ·g·H = 1 · 0.1 · 0.5.
 const BLOCK_WEIGHT: f64 = 0.05;
@@ -230,14 +237,14 @@ fn cases(seed: u64) -> Vec<Case> {
     let scenes: Vec<(&str, String, Draw, Option<f64>, bool)> = vec![
         (
             "block2d-flat-stick",
-            block(2, 0.0, 0.05, 10.0, 0.05),
+            block(2, 0.0, 0.05, STICK_T, 0.05),
             stick,
             Some(0.05),
             true,
         ),
         (
             "block2d-incline18-stick",
-            block(2, 18.0, 0.05, 10.0, 0.05),
+            block(2, 18.0, 0.05, STICK_T, 0.05),
             stick,
             Some(0.05),
             true,
@@ -258,7 +265,7 @@ fn cases(seed: u64) -> Vec<Case> {
         ),
         (
             "block3d-flat-stick",
-            block(3, 0.0, 0.05, 10.0, 0.05),
+            block(3, 0.0, 0.05, STICK_T, 0.05),
             stick,
             Some(0.05),
             false,
@@ -682,9 +689,9 @@ space = [{{ space = "mixed" }}, {{ space = "nitsche", nitsche_theta = 1.0, nitsc
 /// quasi-static start: semismooth Newton did not converge in 100 iterations"; the sliding
 /// points' −μ_f v̂ fold makes the start's W no P-matrix). The start now falls back to the
 /// frictionless quasi-static state, as mixed's does: no run fails in its start, and every run
-/// but one ends ok — measured: Nitsche γ0 = 1e-2, backward Euler, on one of the inclines, fails at step 2 (t =
-/// 0.1) in the time loop, neither the continuation nor Gauss–Seidel solving it (issue 43's
-/// remaining class: large μ_f steps).
+/// ends ok — the last one that did not (Nitsche γ0 = 1e-2, backward Euler, failing at step 2
+/// in the time loop, neither the continuation nor Gauss–Seidel solving it) since the solve's
+/// Lemke stage (robust43).
 #[test]
 fn sticking_block_mod3_start_with_mu_5() {
     let text = format!(
@@ -718,10 +725,7 @@ space = [
         .filter(|r| r.1 != Status::Ok)
         .map(|r| r.0.as_str())
         .collect();
-    assert_eq!(
-        failed,
-        ["nitsche(Θ=1, γ0=1e-2) · mod3 · backward-euler · coulomb(μ_f=5)"]
-    );
+    assert_eq!(failed, Vec::<&str>::new());
 }
 
 /// The P2 disc (sweeps/meshes/disc_p2.msh) thrown at 0.5 onto a 26° incline from gap 5,
