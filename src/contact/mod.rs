@@ -27,6 +27,7 @@ pub mod coulomb;
 pub mod friction;
 pub mod gradient;
 pub mod lcp;
+pub mod lemke;
 
 pub use coulomb::{FrictionalContact, FrictionalContactError};
 pub use lcp::{Lcp, LcpError};

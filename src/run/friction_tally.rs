@@ -302,7 +302,8 @@ impl FrictionTally {
 }
 
 /// The frictional solve's iterations per stage over the run into `metrics` (contract §4):
-/// the primary Newton, the continuation in the bound, the fallback (Gauss–Seidel and its polish).
+/// the primary Newton, the continuation in the bound, the fallback (Gauss–Seidel and its polish,
+/// then Nitsche/penalty's Lemke in 2D).
 pub fn stage_columns(metrics: &mut Metrics, s: [usize; 3]) {
     metrics.friction_newton_iterations = Some(s[0] as i64);
     metrics.friction_continuation_iterations = Some(s[1] as i64);

@@ -94,7 +94,8 @@ pub struct Metrics {
     /// The frictional contact solve's iterations per stage over the run (contract §4; null
     /// without friction): the primary Newton (mixed: with Tresca's closure; Nitsche/penalty:
     /// from the previous forces, then from rest), the continuation in the bound, and the
-    /// fallback (block Gauss–Seidel sweeps and its Newton polish).
+    /// fallback (block Gauss–Seidel sweeps and its Newton polish; Nitsche/penalty in 2D, then
+    /// Lemke's pivots and theirs).
     pub friction_newton_iterations: Option<i64>,
     pub friction_continuation_iterations: Option<i64>,
     pub friction_fallback_iterations: Option<i64>,

@@ -232,7 +232,7 @@ schema! {
         friction_ratio_max: Option<f64> => "", "friction: max over the contact steps of |Σf_t|/Σf_n (sums over the contact points, 3D: the norm of Σf_t), the apparent friction coefficient";
         friction_newton_iterations: Option<i64> => "", "friction: the frictional contact solve's primary semismooth Newton iterations summed over the steps (mixed: the Alart–Curnier Newton with Tresca's closure; Nitsche, penalty: from the previous forces, then from rest); null without friction";
         friction_continuation_iterations: Option<i64> => "", "friction: Newton iterations of the rescue's continuation in the friction bound (μ_f or s scaled from 0 to 1), summed over the steps where the primary Newton failed";
-        friction_fallback_iterations: Option<i64> => "", "friction: the last fallback's work where the continuation failed too: projected block Gauss–Seidel sweeps plus its Newton polish iterations, summed over the steps";
+        friction_fallback_iterations: Option<i64> => "", "friction: the last fallback's work where the continuation failed too: projected block Gauss–Seidel sweeps plus its Newton polish iterations, then (Nitsche and penalty, 2D) Lemke pivots plus their Newton polish iterations, summed over the steps";
         tangential_velocity_final: Option<f64> => "m/s", "friction: the tangential component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d; FE scenes: e_1 in 2D, the tangential norm in 3D; two bodies: A's)";
         normal_velocity_final: Option<f64> => "m/s", "friction: the normal (e_d) component of the mean velocity 1ᵀMv/1ᵀM1 at T (layer1d, FE scenes; two bodies: A's)";
         err_sigma_t_l2: Option<f64> => "Pa·s^½", "layer1d: l2(τ) error of the base's tangential stress σ_t against the exact solution";
