@@ -1140,7 +1140,6 @@ fn read_mesh_file(
                 Ok(m) => match scene.setup_from_file(physics, &path, &m) {
                     Err(why) => issues.push(Issue::at(o, why)),
                     Ok((choice, setup)) => {
-                        issues.extend(nitsche_on_bodies_file(&m, given));
                         file_setup = Some((choice, setup));
                         mesh_file = Some((written, path, m));
                     }
@@ -1149,21 +1148,6 @@ fn read_mesh_file(
         }
     }
     (mesh_file, file_setup)
-}
-
-/// `space = nitsche` on a two-body file: Nitsche's points of both faces are built on the
-/// blocks' boxes only (`run::fe::nitsche_pair`), not yet on a file's faces.
-fn nitsche_on_bodies_file(m: &crate::space::fe::GmshMesh, given: &Given) -> Option<Issue> {
-    let (v, o) = given.user.get(&Key::Space)?;
-    (m.bodies.is_some() && v.as_str() == Some("nitsche")).then(|| {
-        Issue::at(
-            o,
-            format!(
-                "space = nitsche on the two-body mesh {}: Nitsche between two bodies is built for blocks2d/blocks3d only, not yet for a file's faces (mixed and penalty take it)",
-                m.file
-            ),
-        )
-    })
 }
 
 /// The mesh: a mesh file's (`from_file`), else from `h` or `elements` (one of the two), else

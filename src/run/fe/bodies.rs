@@ -9,6 +9,7 @@
 
 use std::sync::Arc;
 
+use super::nitsche_interface::PairFaces;
 use super::nitsche_pair::pair_points;
 use super::rows::Rows;
 use crate::run::Metrics;
@@ -46,8 +47,13 @@ pub(super) struct TwoBodies {
     pub(super) measured_layers: bool,
     /// Nitsche's points of Γ^a and Γ^b, each with both bodies' traces and unit side weight
     /// ([`super::nitsche_pair`]; dofs reduced by the geometry). Built for the blocks' boxes;
-    /// empty for a two-body file, which refuses `nitsche` at plan time.
+    /// empty where the interface is general (a file's faces, non-matching blocks): then
+    /// `interface` places them when a Nitsche run is factored.
     pub(super) nitsche_points: [Vec<ContactPoint>; 2],
+    /// Γ^a's and Γ^b's faces for Nitsche's points on a general interface
+    /// ([`super::nitsche_interface`]), or why there are none (a file whose contact groups
+    /// hold no faces: `mixed` and `penalty` still run).
+    pub(super) interface: Result<PairFaces, String>,
 }
 
 /// The parts of a two-body geometry ([`super::geometry::build_bodies`] makes the
@@ -285,6 +291,7 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
             heights: spec.heights,
             measured_layers: spec.measured_layers,
             nitsche_points: [Vec::new(), Vec::new()],
+            interface: Err("the interface's faces were not given".to_string()),
         },
         mesh,
     })

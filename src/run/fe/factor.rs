@@ -5,9 +5,10 @@
 use super::bodies::frictional_points;
 use super::cache::{Cache, geometry_key};
 use super::config::{FeConfig, frictional};
-use super::geometry::{Geometry, tangential_rows};
+use super::geometry::{Geometry, reduce_points, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
+use super::nitsche_interface::PointRule;
 use super::nitsche_pair::sided_points;
 use super::rows::Rows;
 use super::schur::ContactSchur;
@@ -170,13 +171,21 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
 }
 
 /// Nitsche's operators between two bodies (contract §2.6): both faces' points with the side
-/// weights of the run's `nitsche_sides`. Friction is refused: the relative slip's Nitsche term
-/// is not implemented (the planner refuses it first).
+/// weights of the run's `nitsche_sides` — the blocks' matching points
+/// ([`super::nitsche_pair`]), or the points of a general interface placed now
+/// ([`super::nitsche_interface`]: a file's faces, non-matching blocks). Friction is refused:
+/// the relative slip's Nitsche term is not implemented (the planner refuses it first).
 fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<NitscheOps, String> {
-    // The planner refuses Nitsche on a two-body file; kept as an error, not a panic.
-    let (Some(two), FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
+    let sides = match &cfg.setup.geometry {
+        FeGeometry::Blocks(b) => Some(b.nitsche_sides),
+        FeGeometry::Mesh {
+            bodies: Some(m), ..
+        } => Some(m.nitsche_sides),
+        _ => None,
+    };
+    let (Some(two), Some(sides)) = (&g.bodies, sides) else {
         return Err(format!(
-            "space = nitsche between two bodies is built for blocks2d/blocks3d only (scene {})",
+            "space = nitsche between two bodies needs blocks2d/blocks3d or a two-body mesh (scene {})",
             cfg.setup.scene
         ));
     };
@@ -186,7 +195,14 @@ fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<Nit
             cfg.setup.scene
         ));
     }
-    let points = sided_points(&two.nitsche_points, b.nitsche_sides);
+    let points = if two.nitsche_points[0].is_empty() {
+        let faces = two.interface.as_ref().map_err(|e| e.clone())?;
+        let rule = PointRule::Segment;
+        let placed = faces.points(g.mesh.mesh(), two.lame, rule)?;
+        sided_points(&placed.map(|p| reduce_points(p, &g.dofs)), sides)
+    } else {
+        sided_points(&two.nitsche_points, sides)
+    };
     Ok(NitscheOps::new(&points, theta, gamma0))
 }
 

@@ -31,6 +31,7 @@
 //! relative slip's Nitsche term is another operator); the planner refuses it and the factor
 //! checks it again.
 
+use super::nitsche_interface::PairFaces;
 use crate::scene::NitscheSides;
 use crate::space::fe::BoxMesh;
 use crate::space::fe::nitsche::{
@@ -112,6 +113,20 @@ pub(super) fn pair_points(
         ));
     }
     out
+}
+
+/// The blocks' interface as a general one ([`super::nitsche_interface`]): A's bottom faces and
+/// B's top faces as cells of the joined mesh (A's cells, then B's), touching (gap 0, the run's
+/// added where the operators are made); the projection reaches a tenth of the smaller cell.
+pub(super) fn blocks_interface(mesh_a: &BoxMesh, mesh_b: &BoxMesh) -> PairFaces {
+    let offset = mesh_a.num_elements();
+    let mut b = top_faces(mesh_b);
+    b.iter_mut().for_each(|f| f.element += offset);
+    PairFaces {
+        faces: [box_contact_faces(mesh_a), b],
+        reach: 0.1 * mesh_a.spacing[0].min(mesh_b.spacing[0]),
+        lowest: 0.0,
+    }
 }
 
 /// The points of the sides with w_i > 0, each weight times w_i (contract §2.6 `nitsche_sides`:
