@@ -151,6 +151,7 @@ pub(super) fn sided_points(
 mod tests {
     use super::*;
     use crate::run::fe::nitsche::NitscheOps;
+    use crate::run::fe::nitsche_interface::PointRule;
 
     fn apply(p: &ContactPoint, row: &[f64], u: &[f64]) -> f64 {
         row.iter().zip(&p.dofs).map(|(c, &g)| c * u[g]).sum()
@@ -224,17 +225,27 @@ mod tests {
         }
     }
 
-    /// The two blocks of the test above as the engine's operators for Θ, γ0 and the sides.
-    fn ops_of(d: usize, theta: f64, sides: NitscheSides) -> (NitscheOps, usize) {
+    /// Two blocks (A 2 × 1 cells, B below it, 2 or 3 across: a matching or a non-matching
+    /// interface, issue 45's points with `segment` quadrature) as the engine's operators for Θ,
+    /// γ0 and the sides.
+    fn ops_of(d: usize, theta: f64, sides: NitscheSides, matching: bool) -> (NitscheOps, usize) {
         let mut ext = vec![1.0; d];
         let mut cells = vec![2; d];
         let mut a = BoxMesh::new(&ext, &cells);
         a.coords.iter_mut().for_each(|c| c[d - 1] += 1.0);
         ext[d - 1] = 1.0;
+        cells = vec![if matching { 2 } else { 3 }; d];
         cells[d - 1] = 1;
         let b = BoxMesh::new(&ext, &cells);
         let n = (a.coords.len() + b.coords.len()) * d;
-        let pts = pair_points(&a, &b, a.coords.len(), [(0.5, 1.0), (2.0, 3.0)]);
+        let pts = if matching {
+            pair_points(&a, &b, a.coords.len(), [(0.5, 1.0), (2.0, 3.0)])
+        } else {
+            let joined = crate::space::fe::BodiesMesh::new(&[&a, &b]);
+            blocks_interface(&a, &b)
+                .points(&joined, [(0.5, 1.0), (2.0, 3.0)], PointRule::Segment)
+                .unwrap()
+        };
         let mut ops = NitscheOps::new(&sided_points(&pts, sides), theta, 0.05);
         // A gap that leaves some points open and others closed at the test's states.
         ops.gap
@@ -279,8 +290,8 @@ mod tests {
         y
     }
 
-    /// Issue 44: the two-body contact residual against its Newton matrix by central
-    /// differences, at states away from the kinks (every point's P_q − g_q farther than the
+    /// Issues 44 and 45: the two-body contact residual against its Newton matrix by central
+    /// differences, on a matching and a non-matching interface (2 against 3 cells across), at states away from the kinks (every point's P_q − g_q farther than the
     /// step from 0): R is piecewise linear, so the difference quotient is exact up to
     /// round-off, 1e-7 relative (ε = 1e-6 on O(1) values: the quotient's cancellation is
     /// ~1e-16/1e-6). With Θ = 1 the residual is also the gradient of the engine's own energy
@@ -291,9 +302,12 @@ mod tests {
     fn residual_matches_its_newton_matrix() {
         let mut rng = fastrand::Rng::with_seed(4401);
         for d in [2usize, 3] {
-            for sides in [NitscheSides::Unbiased, NitscheSides::A] {
+            for (sides, matching) in [NitscheSides::Unbiased, NitscheSides::A]
+                .into_iter()
+                .flat_map(|s| [(s, true), (s, false)])
+            {
                 for theta in [-1.0, 0.0, 1.0] {
-                    let (ops, n) = ops_of(d, theta, sides);
+                    let (ops, n) = ops_of(d, theta, sides, matching);
                     let mut checked = 0;
                     for _ in 0..20 {
                         let u: Vec<f64> = (0..n).map(|_| 0.1 * (rng.f64() - 0.5)).collect();
