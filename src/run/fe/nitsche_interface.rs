@@ -10,8 +10,9 @@
 //! queries linear in the interface). A point of side i is x on face f_i at the face parameter
 //! s_i, its weight, and Π(x) on face f_j at s_j:
 //! - `segment`: the pieces of Γ^i's segmentation by Γ^j's projected faces ([`segment`]), each
-//!   piece with a rule of degree 5 (3 Gauss points on a sub-segment, the collapsed 3 × 3 rule on
-//!   each triangle of a polygon) — exact for the patch test's integrands (degree ≤ 2 per
+//!   piece with a rule of degree 5 (3 Gauss points on a sub-segment, 3 × 3 on a parallelogram —
+//!   two boxes' faces overlap in rectangles —, the collapsed 3 × 3 rule on each triangle of
+//!   another polygon) — exact for the patch test's integrands (degree ≤ 2 per
 //!   direction on a piece) and as fine as the one-body faces' rule (contract §2.3: 003 §4.2's
 //!   order 5). A piece that is its whole face (the matching case) takes the face's own rule
 //!   (3 Gauss points per direction), so a matching interface is integrated exactly as the
@@ -339,6 +340,7 @@ fn segment_placements(side: &Surface, other: &Projector) -> Result<Vec<Placement
     let mut count = vec![0usize; side.num_faces()];
     seg.pieces.iter().for_each(|p| count[p.face_a] += 1);
     let face = face_rule(side.kind);
+    let square = face_rule(FaceKind::Quad4);
     let on_segment = face_rule(FaceKind::Seg2);
     let on_triangle = face_rule(FaceKind::Tri3);
     let mut out = Vec::new();
@@ -369,6 +371,15 @@ fn segment_placements(side: &Surface, other: &Projector) -> Result<Vec<Placement
                 let s = closest_on_face(side, f, x).map_err(|e| e.to_string())?.0;
                 push(f, piece.face_b, x, s, w * len)?;
             }
+        } else if let Some((e1, e2)) = parallelogram(v) {
+            // A parallelogram piece (two boxes' faces overlap in a rectangle): the face rule
+            // on its own bilinear map, half the points of its two triangles.
+            let area = norm(cross(e1, e2));
+            for &(t, w) in &square {
+                let x = add(v[0], add(scale(e1, t[0]), scale(e2, t[1])));
+                let s = closest_on_face(side, f, x).map_err(|e| e.to_string())?.0;
+                push(f, piece.face_b, x, s, w * area)?;
+            }
         } else {
             for k in 1..v.len() - 1 {
                 let (e1, e2) = (sub(v[k], v[0]), sub(v[k + 1], v[0]));
@@ -384,6 +395,17 @@ fn segment_placements(side: &Surface, other: &Projector) -> Result<Vec<Placement
         }
     }
     Ok(out)
+}
+
+/// The edges v1 − v0, v3 − v0 of a 4-vertex piece that is a parallelogram (v0 + v2 = v1 + v3
+/// to round-off of its size).
+fn parallelogram(v: &[[f64; 3]]) -> Option<([f64; 3], [f64; 3])> {
+    if v.len() != 4 {
+        return None;
+    }
+    let (e1, e2) = (sub(v[1], v[0]), sub(v[3], v[0]));
+    let off = norm(sub(add(v[0], v[2]), add(v[1], v[3])));
+    (off <= 1e-12 * (norm(e1) + norm(e2))).then_some((e1, e2))
 }
 
 /// Both sides' points [Γ^a, Γ^b] on the joined `mesh` (A's nodes and cells, then B's) with
