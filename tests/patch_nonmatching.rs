@@ -83,11 +83,6 @@ fn interface_keys_are_refused_where_they_do_not_apply() {
             "mesh_ratio = 1.4\nspace = \"mixed\"\npairing = \"node-to-node\"\n",
             &["mesh_ratio", "non-matching interface"][..],
         ),
-        // Nitsche on non-matching faces: not yet built.
-        (
-            "mesh_ratio = 1.4\nspace = \"nitsche\"\n",
-            &["mesh_ratio", "not yet built"][..],
-        ),
         // A pairing is mixed's and penalty's.
         (
             "space = \"nitsche\"\npairing = \"mortar\"\n",

@@ -233,14 +233,6 @@ impl Scene for BlocksScene {
                     ),
                 ));
             }
-            if ratio != 1.0 {
-                return Err((
-                    &["mesh_ratio", "space"],
-                    format!(
-                        "mesh_ratio = {ratio} with space = nitsche: Nitsche on a non-matching interface is not yet built (issue 45; mortar and node-to-segment take it with mixed and penalty)"
-                    ),
-                ));
-            }
         }
         if mortar_basis_from_index(p.get("mortar_basis")) != Basis::Standard
             && pairing != Pairing::Mortar

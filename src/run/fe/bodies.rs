@@ -10,7 +10,7 @@
 use std::sync::Arc;
 
 use super::nitsche_interface::PairFaces;
-use super::nitsche_pair::pair_points;
+use super::nitsche_pair::{blocks_interface, pair_points};
 use super::rows::Rows;
 use crate::run::Metrics;
 use crate::scene::{Blocks, FeSetup, MassSide};
@@ -161,9 +161,17 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         .chain((0..eb).map(|e| b.cells_b - 1 - mesh_b.element_layer(e)))
         .collect();
     let a_face = mesh_a.nodes_on_plane(d - 1, 0);
-    // π(i): the node of B's top face with the same horizontal index.
+    // π(i): the node of B's top face with the same horizontal index; on a non-matching
+    // interface (Nitsche's, whose forces are its points) the nearest one, for the observables'
+    // rows only (u_contact_b, max_penetration).
+    let matching = b.across_b == b.across;
     let partner = |n: usize| {
         let mut idx = mesh_a.node_index(n);
+        if !matching {
+            for i in idx.iter_mut().take(d - 1) {
+                *i = (*i as f64 * b.across_b as f64 / b.across as f64).round() as usize;
+            }
+        }
         idx[d - 1] = b.cells_b;
         mesh.node(1, mesh_b.node_id(idx))
     };
@@ -182,7 +190,13 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
     let measure: f64 = b.width.powi(d as i32 - 1);
     let h = b.width / b.across as f64;
     let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
-    let nitsche_points = pair_points(&mesh_a, &mesh_b, b0, lame);
+    // Nitsche's points: the matching path, or the general interface's, placed when a Nitsche
+    // run is factored (`run::fe::nitsche_interface`).
+    let (nitsche_points, interface) = if matching {
+        (pair_points(&mesh_a, &mesh_b, b0, lame), None)
+    } else {
+        (Default::default(), Some(blocks_interface(&mesh_a, &mesh_b)))
+    };
     let mut parts = bodies_parts(
         s,
         BodiesSpec {
@@ -207,6 +221,9 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         },
     )?;
     parts.two.nitsche_points = nitsche_points;
+    if let Some(faces) = interface {
+        parts.two.interface = Ok(faces);
+    }
     Ok(parts)
 }
 

@@ -8,12 +8,11 @@ use super::config::{FeConfig, frictional};
 use super::geometry::{Geometry, reduce_points, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
-use super::nitsche_interface::PointRule;
 use super::nitsche_pair::sided_points;
 use super::rows::Rows;
 use super::schur::ContactSchur;
 use crate::run::Status;
-use crate::scene::FeGeometry;
+use crate::scene::{FeGeometry, InterfaceQuadrature};
 use crate::space::ContactMethod;
 use crate::space::fe::SymMatrix;
 use crate::space::fe::nitsche::ContactPoint;
@@ -176,12 +175,14 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
 /// ([`super::nitsche_interface`]: a file's faces, non-matching blocks). Friction is refused:
 /// the relative slip's Nitsche term is not implemented (the planner refuses it first).
 fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<NitscheOps, String> {
-    let sides = match &cfg.setup.geometry {
-        FeGeometry::Blocks(b) => Some(b.nitsche_sides),
+    // A file's interface is integrated on its segmentation (its `interface_quadrature` is
+    // not a key yet).
+    let (sides, rule) = match &cfg.setup.geometry {
+        FeGeometry::Blocks(b) => (Some(b.nitsche_sides), b.interface_quadrature),
         FeGeometry::Mesh {
             bodies: Some(m), ..
-        } => Some(m.nitsche_sides),
-        _ => None,
+        } => (Some(m.nitsche_sides), InterfaceQuadrature::Segment),
+        _ => (None, InterfaceQuadrature::Segment),
     };
     let (Some(two), Some(sides)) = (&g.bodies, sides) else {
         return Err(format!(
@@ -197,7 +198,6 @@ fn pair_ops(g: &Geometry, cfg: &FeConfig, theta: f64, gamma0: f64) -> Result<Nit
     }
     let points = if two.nitsche_points[0].is_empty() {
         let faces = two.interface.as_ref().map_err(|e| e.clone())?;
-        let rule = PointRule::Segment;
         let placed = faces.points(g.mesh.mesh(), two.lame, rule)?;
         sided_points(&placed.map(|p| reduce_points(p, &g.dofs)), sides)
     } else {

@@ -10,13 +10,15 @@
 //! queries linear in the interface). A point of side i is x on face f_i at the face parameter
 //! s_i, its weight, and Π(x) on face f_j at s_j:
 //! - `segment`: the pieces of Γ^i's segmentation by Γ^j's projected faces ([`segment`]), each
-//!   piece with a rule of degree 5 (3 Gauss points on a sub-segment, 3 × 3 on a parallelogram —
-//!   two boxes' faces overlap in rectangles —, the collapsed 3 × 3 rule on each triangle of
-//!   another polygon) — exact for the patch test's integrands (degree ≤ 2 per
-//!   direction on a piece) and as fine as the one-body faces' rule (contract §2.3: 003 §4.2's
-//!   order 5). A piece that is its whole face (the matching case) takes the face's own rule
-//!   (3 Gauss points per direction), so a matching interface is integrated exactly as the
-//!   blocks' matching path does ([`super::nitsche_pair`]);
+//!   piece with a rule exact for the polynomial integrands on affine faces (the segmentation's
+//!   own: 2 Gauss points on a sub-segment, 2 × 2 on a parallelogram — two boxes' faces overlap
+//!   in rectangles —, the collapsed 3 × 3 rule on each triangle of another polygon): the patch
+//!   test's integrands have degree ≤ 2 per direction on a piece (δ, σ_n^i and the test
+//!   functions bilinear there). Why not the one-body faces' 3 points per direction on every
+//!   piece: the condensed Newton is dense over the points (Q × Q), and the pieces already
+//!   split each face in about (1 + ratio)^{d−1}. A piece that is its whole face (the matching
+//!   case) takes the face's own rule (3 Gauss points per direction), so a matching interface is
+//!   integrated exactly as the blocks' matching path does ([`super::nitsche_pair`]);
 //! - `element`: Γ^i's own face rule, the other body at Π(x) — what GetFEM integrates; not exact
 //!   where Γ^j's shape functions kink inside a face of Γ^i (the patch test shows it, §6).
 //!
@@ -34,6 +36,7 @@
 //! δ = u^b_d − u^a_d; the point's gap is (Π(x) − x)·n^i minus the caller's `lowest` (the run's
 //! gap is added where the operators are made, as for the blocks and the files' node rows).
 
+use crate::scene::InterfaceQuadrature;
 use crate::space::fe::element::{det_inv, physical_gradients, shape};
 use crate::space::fe::interface::surface::{add, cross, dot, norm, scale, sub};
 use crate::space::fe::interface::{FaceKind, Projector, Surface, closest_on_face, segment};
@@ -61,20 +64,11 @@ impl PairFaces {
         &self,
         mesh: &dyn Mesh,
         lame: [(f64, f64); 2],
-        rule: PointRule,
+        rule: InterfaceQuadrature,
     ) -> Result<[Vec<ContactPoint>; 2], String> {
         let faces = [&self.faces[0][..], &self.faces[1][..]];
         interface_points(mesh, faces, lame, rule, self.reach, self.lowest)
     }
-}
-
-/// How the interface integrals are computed (contract §2.6 `interface_quadrature`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum PointRule {
-    /// On the segmentation of Γ^i by the projected faces of Γ^j.
-    Segment,
-    /// On Γ^i's own faces, the other body at the projected points.
-    Element,
 }
 
 /// A face of one side on the joined mesh: its cell, the face's reference vertices in the
@@ -292,16 +286,16 @@ struct Placement {
     other_s: [f64; 2],
 }
 
-/// The face rule in the surface's parameter (3 Gauss points per direction; the collapsed 3 × 3
-/// rule on a triangle): the one-body faces' rule (contract §2.3).
-fn face_rule(kind: FaceKind) -> Vec<([f64; 2], f64)> {
-    let g: Vec<(f64, f64)> = gauss_legendre_any(3)
+/// A rule in the surface's parameter with `n` Gauss points per direction (the collapsed n × n
+/// rule on a triangle); n = 3 is the one-body faces' rule (contract §2.3).
+fn face_rule(kind: FaceKind, n: usize) -> Vec<([f64; 2], f64)> {
+    let g: Vec<(f64, f64)> = gauss_legendre_any(n)
         .into_iter()
         .map(|(t, w)| (0.5 * (t + 1.0), 0.5 * w))
         .collect();
     match kind {
         FaceKind::Seg2 => g.iter().map(|&(s, w)| ([s, 0.0], w)).collect(),
-        FaceKind::Tri3 => collapsed_simplex_rule(2, 3)
+        FaceKind::Tri3 => collapsed_simplex_rule(2, n)
             .into_iter()
             .map(|(p, w)| ([p[0], p[1]], w))
             .collect(),
@@ -315,7 +309,7 @@ fn face_rule(kind: FaceKind) -> Vec<([f64; 2], f64)> {
 /// `element`: side i's face rule, Π(x) by the projector; points with no projection within the
 /// reach (Γ^i beyond Γ^j) carry no contact.
 fn element_placements(side: &Surface, other: &Projector) -> Vec<Placement> {
-    let rule = face_rule(side.kind);
+    let rule = face_rule(side.kind, 3);
     let mut out = Vec::with_capacity(side.num_faces() * rule.len());
     for f in 0..side.num_faces() {
         for &(s, w) in &rule {
@@ -339,10 +333,10 @@ fn segment_placements(side: &Surface, other: &Projector) -> Result<Vec<Placement
     let b = other.surface();
     let mut count = vec![0usize; side.num_faces()];
     seg.pieces.iter().for_each(|p| count[p.face_a] += 1);
-    let face = face_rule(side.kind);
-    let square = face_rule(FaceKind::Quad4);
-    let on_segment = face_rule(FaceKind::Seg2);
-    let on_triangle = face_rule(FaceKind::Tri3);
+    let face = face_rule(side.kind, 3);
+    let square = face_rule(FaceKind::Quad4, 2);
+    let on_segment = face_rule(FaceKind::Seg2, 2);
+    let on_triangle = face_rule(FaceKind::Tri3, 3);
     let mut out = Vec::new();
     let mut push = |f: usize, fb: usize, x: [f64; 3], s: [f64; 2], w: f64| -> Result<(), String> {
         let (other_s, _) = closest_on_face(b, fb, x).map_err(|e| e.to_string())?;
@@ -416,7 +410,7 @@ pub(super) fn interface_points(
     mesh: &dyn Mesh,
     faces: [&[ContactFace]; 2],
     lame: [(f64, f64); 2],
-    rule: PointRule,
+    rule: InterfaceQuadrature,
     reach: f64,
     lowest: f64,
 ) -> Result<[Vec<ContactPoint>; 2], String> {
@@ -429,8 +423,8 @@ pub(super) fn interface_points(
         let (own, other) = (&sides[i], &sides[1 - i]);
         let projector = Projector::new(&other.surface, reach);
         let placed = match rule {
-            PointRule::Element => element_placements(&own.surface, &projector),
-            PointRule::Segment => segment_placements(&own.surface, &projector)?,
+            InterfaceQuadrature::Element => element_placements(&own.surface, &projector),
+            InterfaceQuadrature::Segment => segment_placements(&own.surface, &projector)?,
         };
         if placed.is_empty() {
             return Err(format!(
@@ -492,7 +486,7 @@ mod tests {
         for d in [2usize, 3] {
             let (a, b, m) = blocks(d, 3, 3);
             let old = pair_points(&a, &b, a.coords.len(), LAME);
-            for rule in [PointRule::Segment, PointRule::Element] {
+            for rule in [InterfaceQuadrature::Segment, InterfaceQuadrature::Element] {
                 let new = blocks_interface(&a, &b).points(&m, LAME, rule).unwrap();
                 for (o, n) in old.iter().zip(&new) {
                     assert_eq!(o.len(), n.len(), "{d}D {rule:?}");
@@ -565,7 +559,7 @@ mod tests {
             let n = m.num_nodes() * d;
             let exact = face_integrals(&m, d, 0.5);
             let scale = exact.iter().fold(0.0f64, |x, v| x.max(v.abs()));
-            for rule in [PointRule::Segment, PointRule::Element] {
+            for rule in [InterfaceQuadrature::Segment, InterfaceQuadrature::Element] {
                 let sides = blocks_interface(&a, &b).points(&m, LAME, rule).unwrap();
                 let mut worst: f64 = 0.0;
                 for pts in &sides {
@@ -577,8 +571,8 @@ mod tests {
                 }
                 eprintln!("{d}D {rule:?}: ∫δ rows off by {worst:e} of the face measures");
                 match rule {
-                    PointRule::Segment => assert!(worst <= 1e-14, "{worst:e}"),
-                    PointRule::Element => assert!(worst >= 1e-4, "{worst:e}"),
+                    InterfaceQuadrature::Segment => assert!(worst <= 1e-14, "{worst:e}"),
+                    InterfaceQuadrature::Element => assert!(worst >= 1e-4, "{worst:e}"),
                 }
             }
         }

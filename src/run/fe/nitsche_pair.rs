@@ -151,7 +151,7 @@ pub(super) fn sided_points(
 mod tests {
     use super::*;
     use crate::run::fe::nitsche::NitscheOps;
-    use crate::run::fe::nitsche_interface::PointRule;
+    use crate::scene::InterfaceQuadrature;
 
     fn apply(p: &ContactPoint, row: &[f64], u: &[f64]) -> f64 {
         row.iter().zip(&p.dofs).map(|(c, &g)| c * u[g]).sum()
@@ -243,7 +243,11 @@ mod tests {
         } else {
             let joined = crate::space::fe::BodiesMesh::new(&[&a, &b]);
             blocks_interface(&a, &b)
-                .points(&joined, [(0.5, 1.0), (2.0, 3.0)], PointRule::Segment)
+                .points(
+                    &joined,
+                    [(0.5, 1.0), (2.0, 3.0)],
+                    InterfaceQuadrature::Segment,
+                )
                 .unwrap()
         };
         let mut ops = NitscheOps::new(&sided_points(&pts, sides), theta, 0.05);
