@@ -548,7 +548,7 @@ mod tests {
     /// Non-matching blocks (3 against 4 cells across, 3 × 3 against 4 × 4): on each side's
     /// points the integral of δ's row is ±∫_Γ N_j for every node of both bodies — exact on the
     /// segmentation (each piece's integrand one polynomial: round-off, 1e-14 of the face
-    /// measures; measured 2.2e-16 (2D), 5.6e-16 (3D)), not with the element rule (B's shape
+    /// measures; measured 4.4e-16 (2D), 6.7e-16 (3D)), not with the element rule (B's shape
     /// functions kink inside A's faces: measured 6.5e-2 (2D), 0.10 (3D); asserted ≥ 1e-4). Both rules: for u linear on each body
     /// δ and σ_n are exact at every point (Q1 holds linear fields, Π is exact on flat faces),
     /// and a rigid translation has δ = σ_n = 0 (action = reaction).
