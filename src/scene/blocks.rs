@@ -223,16 +223,15 @@ impl Scene for BlocksScene {
             };
             words[p.get(key) as usize]
         };
-        if space == "nitsche" {
-            if pairing != Pairing::NodeToNode {
-                return Err((
-                    &["pairing", "space"],
-                    format!(
-                        "pairing = {} with space = nitsche: a pairing makes the rows of mixed and penalty; nitsche integrates over the interface (interface_quadrature)",
-                        word("pairing")
-                    ),
-                ));
-            }
+        // Nitsche takes any mesh_ratio (its points come from the interface geometry).
+        if space == "nitsche" && pairing != Pairing::NodeToNode {
+            return Err((
+                &["pairing", "space"],
+                format!(
+                    "pairing = {} with space = nitsche: a pairing makes the rows of mixed and penalty; nitsche integrates over the interface (interface_quadrature)",
+                    word("pairing")
+                ),
+            ));
         }
         if mortar_basis_from_index(p.get("mortar_basis")) != Basis::Standard
             && pairing != Pairing::Mortar
