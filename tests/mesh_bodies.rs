@@ -2,7 +2,8 @@
 //! a `mesh2d`/`mesh3d` file whose cells carry `body_a` and `body_b` runs through the same
 //! engine data as the blocks (bodies and node-to-node rows), so a file that holds blocks2d's Q1
 //! mesh — the two boxes touching at g = 0, A's nodes first in the blocks' order — runs exactly
-//! as `blocks2d` at the same gap; and a file that is no pair of matching bodies is refused at
+//! as `blocks2d` at the same gap (`nitsche` too, its points placed on the file's faces); and a
+//! file that is no pair of matching bodies is refused at
 //! plan time, naming the file, the node and why.
 //!
 //! The files are written here (MSH 4.1 ASCII, coordinates from the library's own box so they
@@ -276,35 +277,7 @@ fn both(b: Blocks, clamped: bool, physics: &str, methods: &str) -> (Runs, Runs) 
     (outcomes_at(&path, &blocks), outcomes_at(&path, &mesh))
 }
 
-/// Done-when 4: the Gmsh copy of blocks2d equals blocks2d in every shared column and series
-/// value, for three methods, to 1e-12 relative to each column's scale. The two runs assemble
-/// the same cells in the same order on the same doubles (the file's nodes are the blocks'
-/// numbering; the Γ^a weights h/2, h over the sum are the blocks' ½, 1 over theirs, exact
-/// here), so they agree to round-off at most; measured: 0 (bit for bit).
-#[test]
-fn gmsh_copy_of_blocks2d_is_blocks2d() {
-    let b = SQUARES;
-    let (k, g) = both(b, false, PHYSICS, METHODS);
-    assert_eq!((k.len(), g.len()), (3, 3));
-    assert_copies(&k, &g);
-}
-
-/// Every run of the copy ended ok and equals its blocks run to 1e-12 (module header).
-fn assert_copies(k: &Runs, g: &Runs) {
-    for ((lk, ok), (lg, og)) in k.iter().zip(g) {
-        assert_eq!(ok.status, Status::Ok, "{lk}: {:?}", ok.message);
-        assert_eq!(og.status, Status::Ok, "{lg}: {:?}", og.message);
-        assert!(
-            ok.metrics.contact_phases.unwrap_or(0) >= 1,
-            "{lk}: no contact"
-        );
-        let (d, name) = difference(ok, og, f64::MIN_POSITIVE);
-        eprintln!("{lk}: largest difference {d:e} ({name})");
-        assert!(d <= 1e-12, "{lk}: {name} differs by {d:e}");
-    }
-}
-
-/// blocks2d's squares: 4 × 4 on 4 × 2 (H_b = ½).
+/// blocks2d's squares: 4 × 4 on 4 × 2.
 const SQUARES: Blocks = Blocks {
     dim: 2,
     width: 1.0,
@@ -314,6 +287,34 @@ const SQUARES: Blocks = Blocks {
     cells_a: 4,
     cells_b: 2,
 };
+
+/// Done-when 4: the Gmsh copy of blocks2d equals blocks2d in every shared column and series
+/// value, for three methods, to 1e-12 relative to each column's scale. The two runs assemble
+/// the same cells in the same order on the same doubles (the file's nodes are the blocks'
+/// numbering; the Γ^a weights h/2, h over the sum are the blocks' ½, 1 over theirs, exact
+/// here), so they agree to round-off at most; measured: 0 (bit for bit).
+#[test]
+fn gmsh_copy_of_blocks2d_is_blocks2d() {
+    let (k, g) = both(SQUARES, false, PHYSICS, METHODS);
+    assert_eq!((k.len(), g.len()), (3, 3));
+    assert_copies(&k, &g, f64::MIN_POSITIVE);
+}
+
+/// Every run of the copy ended ok and equals its blocks run to 1e-12 (module header), each
+/// value against the larger of its column's scale and `floor`.
+fn assert_copies(k: &Runs, g: &Runs, floor: f64) {
+    for ((lk, ok), (lg, og)) in k.iter().zip(g) {
+        assert_eq!(ok.status, Status::Ok, "{lk}: {:?}", ok.message);
+        assert_eq!(og.status, Status::Ok, "{lg}: {:?}", og.message);
+        assert!(
+            ok.metrics.contact_phases.unwrap_or(0) >= 1,
+            "{lk}: no contact"
+        );
+        let (d, name) = difference(ok, og, floor);
+        eprintln!("{lk}: largest difference {d:e} ({name})");
+        assert!(d <= 1e-12, "{lk}: {name} differs by {d:e}");
+    }
+}
 
 /// blocks3d's cubes: 2 × 2 × 2 on 2 × 2 × 2.
 const CUBES: Blocks = Blocks {
@@ -332,7 +333,7 @@ const CUBES: Blocks = Blocks {
 fn gmsh_copy_of_blocks3d_is_blocks3d() {
     let (k, g) = both(CUBES, false, PHYSICS, METHODS);
     assert_eq!((k.len(), g.len()), (3, 3));
-    assert_copies(&k, &g);
+    assert_copies(&k, &g, f64::MIN_POSITIVE);
 }
 
 /// Friction on a two-body file (contract §2.5, §2.6): `mixed` and `penalty` take the relative
@@ -445,8 +446,15 @@ fn gmsh_copy_passes_the_patch_test() {
     let b = CUBES;
     let physics = "T = 1e6\ndt = 1e6\ngap = 0.0\nvelocity = 0.0\nvelocity_b = 0.0\nlame_lambda = 0.0\nlame_mu = 1.0\nlame_lambda_b = 0.0\nlame_mu_b = 2.0\npressure = 1e-2\npenalty_gamma0 = 10.0\n";
     let methods = "space = [\"mixed\", \"penalty\"]\nscheme = [\"backward-euler\"]\n";
+    assert_patch_copies(b, physics, methods, 2, f64::MIN_POSITIVE);
+}
+
+/// The patch test's runs (`physics`, `methods`) on blocks `b` (B's base clamped) and its Gmsh
+/// copy: `n` runs, each ok with both patch errors ≤ 1e-8, the copy equal to the blocks to 1e-12
+/// against each column's scale or `floor` ([`assert_copies`]).
+fn assert_patch_copies(b: Blocks, physics: &str, methods: &str, n: usize, floor: f64) {
     let (k, g) = both(b, true, physics, methods);
-    assert_eq!(g.len(), 2);
+    assert_eq!(g.len(), n);
     for (lg, og) in &g {
         assert_eq!(og.status, Status::Ok, "{lg}: {:?}", og.message);
         let stress = og.metrics.patch_stress_error.expect("a patch test");
@@ -457,7 +465,53 @@ fn gmsh_copy_passes_the_patch_test() {
             "{lg}: {stress:e}, {pressure:e}"
         );
     }
-    assert_copies(&k, &g);
+    assert_copies(&k, &g, floor);
+}
+
+/// Nitsche between two bodies on a file (issue 45): the file's faces make the points
+/// (`run::fe::nitsche_interface`, the segmentation of each side by the other's projected
+/// faces), the blocks their matching points (`run::fe::nitsche_pair`): on the Gmsh copy they
+/// are the same points in the same order, each other body's reference point found from Π's
+/// face parameter instead of read off the other face's rule, so the rows agree to round-off.
+/// The copy equals the blocks to 1e-12 in every column, both sides, Θ = −1 and 1, 2D and 3D
+/// (CN and backward Euler; the hybrid's count of factorizations, one per change of its active
+/// set, differs by one in 2D at Θ = −1 — a point at a kink to round-off), each
+/// value against the larger of its column's scale and 1: the columns that are round-off
+/// themselves (momentum_drift ~1e-16, the patch test's max_penetration) differ in their own
+/// digits once the rows are not bit for bit. Measured ≤ 1.1e-13 (v_contact, CN).
+const NITSCHE: &str = r#"space = ["nitsche"]
+nitsche_gamma0 = [0.05]
+mass = ["zero-contact"]
+scheme = ["crank-nicolson", "backward-euler"]
+nitsche_theta = [-1.0, 1.0]
+nitsche_sides = ["unbiased", "a"]
+"#;
+
+#[test]
+fn gmsh_copy_runs_nitsche_as_the_blocks() {
+    for b in [SQUARES, CUBES] {
+        let (k, g) = both(b, false, PHYSICS, NITSCHE);
+        assert_eq!((k.len(), g.len()), (8, 8));
+        assert_copies(&k, &g, 1.0);
+    }
+}
+
+/// The contact patch test with `nitsche` on the Gmsh copy of blocks2d and blocks3d (B's base
+/// clamped by the file's group, p on its `loaded` face), both sides, Θ = −1, 0, 1: ≤ 1e-8
+/// (issue 44's bound; the blocks measure 5e-13 to 6.3e-13, tests/blocks_nitsche.rs), and the
+/// copy equals the blocks to 1e-12.
+#[test]
+fn gmsh_copy_passes_the_nitsche_patch_test() {
+    let physics = "T = 1e6\ndt = 1e6\ngap = 0.0\nvelocity = 0.0\nvelocity_b = 0.0\nlame_lambda = 0.0\nlame_mu = 1.0\nlame_lambda_b = 0.0\nlame_mu_b = 2.0\npressure = 1e-2\n";
+    let methods = "space = [\"nitsche\"]\nnitsche_gamma0 = [0.05]\nscheme = [\"backward-euler\"]\nnitsche_theta = [-1.0, 0.0, 1.0]\nnitsche_sides = [\"unbiased\", \"a\"]\n";
+    let b2 = Blocks {
+        height_b: 1.0,
+        cells_b: 4,
+        ..SQUARES
+    };
+    for b in [b2, CUBES] {
+        assert_patch_copies(b, physics, methods, 6, 1.0);
+    }
 }
 
 /// The run's `gap` is the initial distance of the closest pair, whatever the file's (contract
@@ -524,6 +578,15 @@ const SMALL: Blocks = Blocks {
 #[test]
 fn bad_two_body_meshes_are_refused() {
     let good = blocks_msh(SMALL, false);
+    // Friction with Nitsche on a file: its interface points carry no slip rows yet.
+    let e = refused(
+        &good,
+        "space = \"nitsche\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+    );
+    assert!(
+        e.contains("two.msh") && e.contains("friction with space = nitsche"),
+        "{e}"
+    );
     // No contact_b: the group list names it.
     let no_b = good.replace("\"contact_b\"", "\"other\"");
     let e = refused(&no_b, "");
@@ -553,12 +616,6 @@ fn bad_two_body_meshes_are_refused() {
     );
     let e = refused(&good, "gap = -0.1\n");
     assert!(e.contains("gap") && e.contains("must be ≥ 0"), "{e}");
-    // Nitsche between two bodies is built on the blocks' boxes, not on a file's faces.
-    let e = refused(&good, "space = \"nitsche\"\nnitsche_gamma0 = 0.1\n");
-    assert!(
-        e.contains("`fixed.space`") && e.contains("space = nitsche on the two-body mesh"),
-        "{e}"
-    );
 }
 
 /// Two bodies touching at g = 0 share coordinates but not nodes: accepted (the coincident

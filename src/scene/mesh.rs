@@ -41,8 +41,8 @@
 use std::path::Path;
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, Physics,
-    PhysicsKey, Scene, SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, NitscheSides,
+    Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
 };
 use crate::space::fe::{GmshMesh, Mesh};
 
@@ -62,21 +62,24 @@ pub struct MeshBodies {
     pub velocity_b: f64,
     pub pressure: f64,
     pub mass_side: MassSide,
+    /// The weights of Nitsche's two sides (contract §2.6 `nitsche_sides`).
+    pub nitsche_sides: NitscheSides,
 }
 
 /// The two-body keys (contract §1.10), all NaN by default — "not given": the column is null
 /// and the id unchanged, so the one-body files' runs keep their ids and columns, and a
 /// one-body file refuses any of them ([`two_body_keys_on_one_body`]).
-const TWO_BODY_KEYS: [&str; 6] = [
+const TWO_BODY_KEYS: [&str; 7] = [
     "density_b",
     "lame_lambda_b",
     "lame_mu_b",
     "velocity_b",
     "pressure",
     "mass_side",
+    "nitsche_sides",
 ];
 
-const MESH_PHYSICS: [PhysicsKey; 15] = [
+const MESH_PHYSICS: [PhysicsKey; 16] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -142,6 +145,10 @@ const MESH_PHYSICS: [PhysicsKey; 15] = [
         name: TWO_BODY_KEYS[5],
         default: f64::NAN,
     },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[6],
+        default: f64::NAN,
+    },
 ];
 
 /// A key's value, `or` where the sweep gives none (NaN).
@@ -183,6 +190,7 @@ fn mesh_bodies(p: &Physics, path: &Path) -> Result<MeshBodies, String> {
         velocity_b: given_or(p, "velocity_b", 0.0),
         pressure: given_or(p, "pressure", 0.0),
         mass_side: MassSide::from_index(given_or(p, "mass_side", 0.0)),
+        nitsche_sides: NitscheSides::from_index(given_or(p, "nitsche_sides", 0.0)),
     })
 }
 

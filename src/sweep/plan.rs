@@ -352,6 +352,7 @@ fn resolve_given(
 
     // Physics, mesh and time step: the scene's.
     let mut physics = physics_of(given, &m.scheme)?;
+    interface_of(given, &m, &physics)?;
     let c0 = scene.wave_speed(&physics);
     let mut mesh_file: Option<MeshFile> = None;
     let mut file_setup = None;
@@ -991,6 +992,35 @@ fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
     Ok(physics)
 }
 
+/// The interface keys against the treatment and friction ([`Scene::supports_interface`]:
+/// the blocks' `pairing`, `mortar_basis`, `interface_quadrature`, `mesh_ratio`): one
+/// combination left out where any of the keys at stake varies along an axis or a search, a
+/// mistake refused at each of them the file gives (the first at stake where it gives none).
+fn interface_of(given: &Given, m: &Method, physics: &Physics) -> Result<(), Outcome> {
+    let frictional = m.friction_kind != FrictionKind::None;
+    let Err((names, why)) = given
+        .scene
+        .supports_interface(physics, &m.space_name, frictional)
+    else {
+        return Ok(());
+    };
+    let keys: Vec<Key> = names
+        .iter()
+        .map(|n| Key::from_name(n).expect("scenes name sweep keys"))
+        .collect();
+    let varies = |k: Key| given.on_axis(k) || given.origin(k).path.starts_with("search");
+    if keys.iter().any(|&k| varies(k)) {
+        return Err(Outcome::Inapplicable(why));
+    }
+    let set: Vec<Key> = keys.iter().copied().filter(|&k| given.has(k)).collect();
+    let at = if set.is_empty() { vec![keys[0]] } else { set };
+    Err(Outcome::Invalid(
+        at.iter()
+            .map(|&k| Issue::at(&given.origin(k), why.clone()))
+            .collect(),
+    ))
+}
+
 /// The scene's physics keys as given (a choice key as its index), defaults elsewhere; not
 /// yet checked.
 fn physics_values(given: &Given) -> Physics {
@@ -1140,7 +1170,7 @@ fn read_mesh_file(
                 Ok(m) => match scene.setup_from_file(physics, &path, &m) {
                     Err(why) => issues.push(Issue::at(o, why)),
                     Ok((choice, setup)) => {
-                        issues.extend(nitsche_on_bodies_file(&m, given));
+                        issues.extend(nitsche_friction_on_bodies_file(&m, given));
                         file_setup = Some((choice, setup));
                         mesh_file = Some((written, path, m));
                     }
@@ -1151,15 +1181,21 @@ fn read_mesh_file(
     (mesh_file, file_setup)
 }
 
-/// `space = nitsche` on a two-body file: Nitsche's points of both faces are built on the
-/// blocks' boxes only (`run::fe::nitsche_pair`), not yet on a file's faces.
-fn nitsche_on_bodies_file(m: &crate::space::fe::GmshMesh, given: &Given) -> Option<Issue> {
-    let (v, o) = given.user.get(&Key::Space)?;
-    (m.bodies.is_some() && v.as_str() == Some("nitsche")).then(|| {
+/// Friction with `space = nitsche` on a two-body file: the file's interface points
+/// (`run::fe::nitsche_interface`) carry no tangential rows yet — the relative slip's Nitsche
+/// rows are built on the matching blocks only.
+fn nitsche_friction_on_bodies_file(
+    m: &crate::space::fe::GmshMesh,
+    given: &Given,
+) -> Option<Issue> {
+    let (v, _) = given.user.get(&Key::Space)?;
+    let (f, o) = given.user.get(&Key::Friction)?;
+    let frictional = f.as_str().is_some_and(|f| f != "none");
+    (m.bodies.is_some() && v.as_str() == Some("nitsche") && frictional).then(|| {
         Issue::at(
             o,
             format!(
-                "space = nitsche on the two-body mesh {}: Nitsche between two bodies is built for blocks2d/blocks3d only, not yet for a file's faces (mixed and penalty take it)",
+                "friction with space = nitsche on the two-body mesh {}: the relative slip's Nitsche rows are built for blocks2d/blocks3d with a matching interface only (mixed and penalty take friction on a file)",
                 m.file
             ),
         )

@@ -9,7 +9,8 @@
 
 use std::sync::Arc;
 
-use super::nitsche_pair::pair_points;
+use super::nitsche_interface::PairFaces;
+use super::nitsche_pair::{blocks_interface, pair_points};
 use super::rows::Rows;
 use crate::run::Metrics;
 use crate::scene::{Blocks, FeSetup, MassSide};
@@ -46,8 +47,13 @@ pub(super) struct TwoBodies {
     pub(super) measured_layers: bool,
     /// Nitsche's points of Γ^a and Γ^b, each with both bodies' traces and unit side weight
     /// ([`super::nitsche_pair`]; dofs reduced by the geometry). Built for the blocks' boxes;
-    /// empty for a two-body file, which refuses `nitsche` at plan time.
+    /// empty where the interface is general (a file's faces, non-matching blocks): then
+    /// `interface` places them when a Nitsche run is factored.
     pub(super) nitsche_points: [Vec<ContactPoint>; 2],
+    /// Γ^a's and Γ^b's faces for Nitsche's points on a general interface
+    /// ([`super::nitsche_interface`]), or why there are none (a file whose contact groups
+    /// hold no faces: `mixed` and `penalty` still run).
+    pub(super) interface: Result<PairFaces, String>,
 }
 
 /// The parts of a two-body geometry ([`super::geometry::build_bodies`] makes the
@@ -122,6 +128,12 @@ fn face_weight(idx: [usize; 3], cells: &[usize], d: usize) -> f64 {
 /// height H_a placed on B's top (body 0; the gap is the run's, in the rows, so every gap shares
 /// the geometry), Q1, the same elements across so every Γ^a node lies above a Γ^b node.
 pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, String> {
+    if b.pairing != crate::scene::Pairing::NodeToNode {
+        return Err(format!(
+            "pairing {:?}: its rows are not built yet (issue 45)",
+            b.pairing
+        ));
+    }
     let d = s.dim;
     let mut ext = vec![b.width; d];
     let mut cells = vec![b.across; d];
@@ -134,6 +146,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         .for_each(|c| c[d - 1] += b.height_b);
     let cells_a = cells.clone();
     ext[d - 1] = b.height_b;
+    cells = vec![b.across_b; d];
     cells[d - 1] = b.cells_b;
     let mesh_b = BoxMesh::try_new(&ext, &cells).map_err(|e| e.to_string())?;
     let mesh = BodiesMesh::new(&[&mesh_a, &mesh_b]);
@@ -148,9 +161,17 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         .chain((0..eb).map(|e| b.cells_b - 1 - mesh_b.element_layer(e)))
         .collect();
     let a_face = mesh_a.nodes_on_plane(d - 1, 0);
-    // π(i): the node of B's top face with the same horizontal index.
+    // π(i): the node of B's top face with the same horizontal index; on a non-matching
+    // interface (Nitsche's, whose forces are its points) the nearest one, for the observables'
+    // rows only (u_contact_b, max_penetration).
+    let matching = b.across_b == b.across;
     let partner = |n: usize| {
         let mut idx = mesh_a.node_index(n);
+        if !matching {
+            for i in idx.iter_mut().take(d - 1) {
+                *i = (*i as f64 * b.across_b as f64 / b.across as f64).round() as usize;
+            }
+        }
         idx[d - 1] = b.cells_b;
         mesh.node(1, mesh_b.node_id(idx))
     };
@@ -169,7 +190,13 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
     let measure: f64 = b.width.powi(d as i32 - 1);
     let h = b.width / b.across as f64;
     let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
-    let nitsche_points = pair_points(&mesh_a, &mesh_b, b0, lame);
+    // Nitsche's points: the matching path, or the general interface's, placed when a Nitsche
+    // run is factored (`run::fe::nitsche_interface`).
+    let (nitsche_points, interface) = if matching {
+        (pair_points(&mesh_a, &mesh_b, b0, lame), None)
+    } else {
+        (Default::default(), Some(blocks_interface(&mesh_a, &mesh_b)))
+    };
     let mut parts = bodies_parts(
         s,
         BodiesSpec {
@@ -194,6 +221,9 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         },
     )?;
     parts.two.nitsche_points = nitsche_points;
+    if let Some(faces) = interface {
+        parts.two.interface = Ok(faces);
+    }
     Ok(parts)
 }
 
@@ -285,6 +315,7 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
             heights: spec.heights,
             measured_layers: spec.measured_layers,
             nitsche_points: [Vec::new(), Vec::new()],
+            interface: Err("the interface's faces were not given".to_string()),
         },
         mesh,
     })

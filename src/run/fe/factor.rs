@@ -5,14 +5,14 @@
 use super::bodies::frictional_points;
 use super::cache::{Cache, geometry_key};
 use super::config::{FeConfig, frictional};
-use super::geometry::{Geometry, tangential_rows};
+use super::geometry::{Geometry, reduce_points, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
 use super::nitsche_pair::sided_points;
 use super::rows::Rows;
 use super::schur::ContactSchur;
 use crate::run::Status;
-use crate::scene::FeGeometry;
+use crate::scene::{FeGeometry, InterfaceQuadrature};
 use crate::space::ContactMethod;
 use crate::space::fe::SymMatrix;
 use crate::space::fe::nitsche::ContactPoint;
@@ -170,21 +170,37 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
 }
 
 /// Nitsche's points between two bodies (contract §2.6): both faces' points with the side
-/// weights of the run's `nitsche_sides`, each with the relative slip's tangential rows
-/// ([`super::nitsche_pair`]'s friction; a frictional run without them is refused here rather
-/// than run frictionless).
+/// weights of the run's `nitsche_sides` — the blocks' matching points
+/// ([`super::nitsche_pair`], each with the relative slip's tangential rows), or the points of
+/// a general interface placed now ([`super::nitsche_interface`]: a file's faces, non-matching
+/// blocks; no tangential rows yet, so a frictional run there is refused here rather than run
+/// frictionless — the planner refuses it first).
 fn pair_points(g: &Geometry, cfg: &FeConfig) -> Result<Vec<ContactPoint>, String> {
-    // The planner refuses Nitsche on a two-body file; kept as an error, not a panic.
-    let (Some(two), FeGeometry::Blocks(b)) = (&g.bodies, &cfg.setup.geometry) else {
+    // A file's interface is integrated on its segmentation (its `interface_quadrature` is
+    // not a key yet).
+    let (sides, rule) = match &cfg.setup.geometry {
+        FeGeometry::Blocks(b) => (Some(b.nitsche_sides), b.interface_quadrature),
+        FeGeometry::Mesh {
+            bodies: Some(m), ..
+        } => (Some(m.nitsche_sides), InterfaceQuadrature::Segment),
+        _ => (None, InterfaceQuadrature::Segment),
+    };
+    let (Some(two), Some(sides)) = (&g.bodies, sides) else {
         return Err(format!(
-            "space = nitsche between two bodies is built for blocks2d/blocks3d only (scene {})",
+            "space = nitsche between two bodies needs blocks2d/blocks3d or a two-body mesh (scene {})",
             cfg.setup.scene
         ));
     };
-    let points = sided_points(&two.nitsche_points, b.nitsche_sides);
+    let points = if two.nitsche_points[0].is_empty() {
+        let faces = two.interface.as_ref().map_err(|e| e.clone())?;
+        let placed = faces.points(g.mesh.mesh(), two.lame, rule)?;
+        sided_points(&placed.map(|p| reduce_points(p, &g.dofs)), sides)
+    } else {
+        sided_points(&two.nitsche_points, sides)
+    };
     if frictional(cfg) && points.iter().any(|p| p.ut.is_empty()) {
         return Err(format!(
-            "space = nitsche with friction on scene {}: a point of the interface has no tangential rows",
+            "space = nitsche with friction on scene {}: a point of the interface has no tangential rows (friction with two-body Nitsche is built for the matching blocks)",
             cfg.setup.scene
         ));
     }

@@ -17,8 +17,10 @@
 //! blocks' h on the blocks' lattice.
 
 use super::bodies::{BlocksParts, BodiesSpec, bodies_parts};
+use super::nitsche_interface::PairFaces;
 use crate::scene::{FeSetup, MeshBodies};
 use crate::space::fe::mesh::mesh_layers;
+use crate::space::fe::nitsche::{ContactFace, gmsh_contact_faces};
 use crate::space::fe::{BodiesMesh, GmshMesh, Mesh};
 
 /// The measure of each face of a face group (its vertices' straight line or flat polygon, Gmsh's
@@ -131,7 +133,8 @@ pub(super) fn mesh_bodies_parts(
         None => (Vec::new(), 0.0),
     };
     let extent = |body: u8| mesh.extent(|n| gb.node_body[n] == body);
-    bodies_parts(
+    let interface = pair_faces(mesh, &gb.node_body, lowest, &gb.distance);
+    let mut parts = bodies_parts(
         s,
         BodiesSpec {
             layers,
@@ -153,5 +156,42 @@ pub(super) fn mesh_bodies_parts(
             pressure: keys.pressure,
             mesh: bm,
         },
-    )
+    )?;
+    parts.two.interface = interface;
+    Ok(parts)
+}
+
+/// Γ^a's and Γ^b's faces for Nitsche ([`super::nitsche_interface`]) as cells of the joined
+/// mesh ([`BodiesMesh::split`] numbers A's cells, then B's, each in the file's order); the
+/// projection reaches the farthest pair's distance and a tenth of the largest cell beyond it.
+fn pair_faces(
+    mesh: &GmshMesh,
+    node_body: &[u8],
+    lowest: f64,
+    distance: &[f64],
+) -> Result<PairFaces, String> {
+    let mut cell = vec![0usize; mesh.num_elements()];
+    let mut next = 0;
+    for body in 0..2u8 {
+        for (e, c) in cell.iter_mut().enumerate() {
+            if node_body[mesh.element_nodes(e)[0]] == body {
+                *c = next;
+                next += 1;
+            }
+        }
+    }
+    let side = |name: &str| -> Result<Vec<ContactFace>, String> {
+        let group = mesh
+            .group(name)
+            .ok_or_else(|| format!("{}: no group \"{name}\"", mesh.file))?;
+        let mut faces = gmsh_contact_faces(mesh, group)?;
+        faces.iter_mut().for_each(|f| f.element = cell[f.element]);
+        Ok(faces)
+    };
+    let farthest = distance.iter().copied().fold(lowest, f64::max);
+    Ok(PairFaces {
+        faces: [side("contact_a")?, side("contact_b")?],
+        reach: farthest + 0.1 * mesh.h,
+        lowest,
+    })
 }

@@ -49,6 +49,7 @@ mod mesh_bodies;
 mod methods;
 mod newmark;
 pub mod nitsche;
+mod nitsche_interface;
 mod nitsche_pair;
 mod products;
 mod reference;

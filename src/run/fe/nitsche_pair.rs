@@ -48,6 +48,7 @@
 //! gradients, whose sum over a body vanishes, so the momentum along every axis is an
 //! invariant, and −Θ w γ σ_t σ_tᵀ adds nothing to a rigid translation either.
 //!
+use super::nitsche_interface::PairFaces;
 use crate::scene::NitscheSides;
 use crate::space::fe::BoxMesh;
 use crate::space::fe::nitsche::{
@@ -156,6 +157,20 @@ fn slip_rows(a: &ContactPoint, b: &ContactPoint, own: usize) -> (Vec<f64>, Vec<f
     (ut, st)
 }
 
+/// The blocks' interface as a general one ([`super::nitsche_interface`]): A's bottom faces and
+/// B's top faces as cells of the joined mesh (A's cells, then B's), touching (gap 0, the run's
+/// added where the operators are made); the projection reaches a tenth of the smaller cell.
+pub(super) fn blocks_interface(mesh_a: &BoxMesh, mesh_b: &BoxMesh) -> PairFaces {
+    let offset = mesh_a.num_elements();
+    let mut b = top_faces(mesh_b);
+    b.iter_mut().for_each(|f| f.element += offset);
+    PairFaces {
+        faces: [box_contact_faces(mesh_a), b],
+        reach: 0.1 * mesh_a.spacing[0].min(mesh_b.spacing[0]),
+        lowest: 0.0,
+    }
+}
+
 /// The points of the sides with w_i > 0, each weight times w_i (contract §2.6 `nitsche_sides`:
 /// w_a = w_b = ½ unbiased, w_a = 1 and no Γ^b point one-sided).
 pub(super) fn sided_points(
@@ -179,6 +194,7 @@ mod tests {
     use super::*;
     use crate::contact::friction::FrictionLaw;
     use crate::run::fe::nitsche::{NitscheOps, point_forces};
+    use crate::scene::InterfaceQuadrature;
 
     fn apply(p: &ContactPoint, row: &[f64], u: &[f64]) -> f64 {
         row.iter().zip(&p.dofs).map(|(c, &g)| c * u[g]).sum()
@@ -286,18 +302,38 @@ mod tests {
         }
     }
 
-    /// The two blocks of the test above as the engine's operators for Θ, γ0 and the sides,
-    /// with friction's tangential rows for the step τ where `tau` is given.
-    fn ops_of(d: usize, theta: f64, sides: NitscheSides, tau: Option<f64>) -> (NitscheOps, usize) {
+    /// Two blocks (A 2 × 1 cells, B below it, 2 or 3 across: a matching or a non-matching
+    /// interface, issue 45's points with `segment` quadrature) as the engine's operators for Θ,
+    /// γ0 and the sides, with friction's tangential rows for the step τ where `tau` is given
+    /// (matching only: the general interface's points carry no tangential rows yet).
+    fn ops_of(
+        d: usize,
+        theta: f64,
+        sides: NitscheSides,
+        matching: bool,
+        tau: Option<f64>,
+    ) -> (NitscheOps, usize) {
         let mut ext = vec![1.0; d];
         let mut cells = vec![2; d];
         let mut a = BoxMesh::new(&ext, &cells);
         a.coords.iter_mut().for_each(|c| c[d - 1] += 1.0);
         ext[d - 1] = 1.0;
+        cells = vec![if matching { 2 } else { 3 }; d];
         cells[d - 1] = 1;
         let b = BoxMesh::new(&ext, &cells);
         let n = (a.coords.len() + b.coords.len()) * d;
-        let pts = pair_points(&a, &b, a.coords.len(), [(0.5, 1.0), (2.0, 3.0)]);
+        let pts = if matching {
+            pair_points(&a, &b, a.coords.len(), [(0.5, 1.0), (2.0, 3.0)])
+        } else {
+            let joined = crate::space::fe::BodiesMesh::new(&[&a, &b]);
+            blocks_interface(&a, &b)
+                .points(
+                    &joined,
+                    [(0.5, 1.0), (2.0, 3.0)],
+                    InterfaceQuadrature::Segment,
+                )
+                .unwrap()
+        };
         let points = sided_points(&pts, sides);
         let mut ops = NitscheOps::new(&points, theta, 0.05);
         if let Some(tau) = tau {
@@ -346,8 +382,8 @@ mod tests {
         y
     }
 
-    /// Issue 44: the two-body contact residual against its Newton matrix by central
-    /// differences, at states away from the kinks (every point's P_q − g_q farther than the
+    /// Issues 44 and 45: the two-body contact residual against its Newton matrix by central
+    /// differences, on a matching and a non-matching interface (2 against 3 cells across), at states away from the kinks (every point's P_q − g_q farther than the
     /// step from 0): R is piecewise linear, so the difference quotient is exact up to
     /// round-off, 1e-7 relative (ε = 1e-6 on O(1) values: the quotient's cancellation is
     /// ~1e-16/1e-6). With Θ = 1 the residual is also the gradient of the engine's own energy
@@ -358,9 +394,12 @@ mod tests {
     fn residual_matches_its_newton_matrix() {
         let mut rng = fastrand::Rng::with_seed(4401);
         for d in [2usize, 3] {
-            for sides in [NitscheSides::Unbiased, NitscheSides::A] {
+            for (sides, matching) in [NitscheSides::Unbiased, NitscheSides::A]
+                .into_iter()
+                .flat_map(|s| [(s, true), (s, false)])
+            {
                 for theta in [-1.0, 0.0, 1.0] {
-                    let (ops, n) = ops_of(d, theta, sides, None);
+                    let (ops, n) = ops_of(d, theta, sides, matching, None);
                     let mut checked = 0;
                     for _ in 0..20 {
                         let u: Vec<f64> = (0..n).map(|_| 0.1 * (rng.f64() - 0.5)).collect();
@@ -494,7 +533,7 @@ mod tests {
                 let (mut stick, mut slip) = (0, 0);
                 for sides in [NitscheSides::Unbiased, NitscheSides::A] {
                     for theta in [-1.0, 0.0, 1.0] {
-                        let (ops, n) = ops_of(d, theta, sides, Some(0.5));
+                        let (ops, n) = ops_of(d, theta, sides, true, Some(0.5));
                         let mut checked = 0;
                         for _ in 0..40 {
                             let u: Vec<f64> = (0..n).map(|_| 0.1 * (rng.f64() - 0.5)).collect();
