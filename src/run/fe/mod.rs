@@ -50,6 +50,7 @@ mod methods;
 mod newmark;
 pub mod nitsche;
 mod nitsche_pair;
+mod pairing;
 mod products;
 mod reference;
 mod refine;

@@ -18,7 +18,10 @@ pub mod projection;
 pub mod segment;
 pub mod surface;
 
-pub use mortar::{Basis, Mortar, SparseRows, basis_coefficients, face_integrals, mortar_matrices};
+pub use mortar::{
+    Basis, Mortar, SparseRows, basis_coefficients, face_integrals, mortar_matrices,
+    mortar_matrices_element,
+};
 pub use projection::{Projection, Projector, closest_on_face, project_brute};
 pub use segment::{Piece, PiecePoint, Segmentation, segment};
 pub use surface::{FaceKind, InterfaceError, Surface};
