@@ -18,9 +18,9 @@
 //! two-body Gmsh meshes reuse the same engine data (bodies and rows).
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, InterfaceQuadrature, LoadModel, MassSide, MeshChoice,
-    MethodNames, NitscheSides, Pairing, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
-    mortar_basis_from_index,
+    ErrorSource, FeGeometry, FeSetup, InterfaceQuadrature, InterfaceUse, LoadModel, MassSide,
+    MeshChoice, MethodNames, NitscheSides, Pairing, Physics, PhysicsKey, Scene, SceneFacts,
+    SceneSetup, mortar_basis_from_index,
 };
 use crate::space::fe::interface::Basis;
 
@@ -198,9 +198,9 @@ impl Scene for BlocksScene {
     fn supports_interface(
         &self,
         p: &Physics,
-        space: &str,
-        frictional: bool,
+        m: InterfaceUse<'_>,
     ) -> Result<(), (&'static [&'static str], String)> {
+        let (space, frictional) = (m.space, m.frictional);
         let pairing = Pairing::from_index(p.get("pairing"));
         let ratio = p.get("mesh_ratio");
         // The words of the choice keys (the model's `Key::choices`, which this layer does
@@ -254,6 +254,15 @@ impl Scene for BlocksScene {
                 &["mesh_ratio", "pairing", "space"],
                 format!(
                     "mesh_ratio = {ratio} with pairing = node-to-node: non-matching interface: choose node-to-segment or mortar, or nitsche (issue 45; node-to-node needs every Γ^a node above a Γ^b node)"
+                ),
+            ));
+        }
+        if m.kinematic && pairing != Pairing::NodeToNode {
+            return Err((
+                &["pairing", "scheme", "mass"],
+                format!(
+                    "central-difference with mass = lumped and pairing = {}: kinematic contact acts row by row on rows that share no node (node-to-node pairs; these rows share Γ^b's nodes)",
+                    word("pairing")
                 ),
             ));
         }

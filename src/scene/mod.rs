@@ -158,6 +158,16 @@ pub struct MethodNames<'a> {
     pub scheme: &'a str,
 }
 
+/// What the interface keys are judged against ([`Scene::supports_interface`]): the contact
+/// treatment (`space`), whether a friction law acts, and whether the scheme is kinematic central
+/// difference (its impulses act row by row, on rows that share no dof).
+#[derive(Clone, Copy, Debug)]
+pub struct InterfaceUse<'a> {
+    pub space: &'a str,
+    pub frictional: bool,
+    pub kinematic: bool,
+}
+
 /// `Ok` when `value` is one of `allowed`, else the sweep error of `key` with `why` — the one
 /// shape of every scene's refusal of a method it does not take.
 pub(crate) fn require(
@@ -271,14 +281,13 @@ pub trait Scene: Send + Sync {
     ) -> Result<(), (&'static str, String)> {
         Ok(())
     }
-    /// Whether the physics values go with the contact treatment `space` and a friction law
-    /// (`frictional`): the two blocks' interface keys (contract §2.6, issue 45). `Err` names the
+    /// Whether the physics values go with the run's contact treatment, friction and scheme
+    /// ([`InterfaceUse`]): the two blocks' interface keys (contract §2.6, issue 45). `Err` names the
     /// keys that together rule the run out, the one at fault first, and says why.
     fn supports_interface(
         &self,
         _physics: &Physics,
-        _space: &str,
-        _frictional: bool,
+        _method: InterfaceUse<'_>,
     ) -> Result<(), (&'static [&'static str], String)> {
         Ok(())
     }

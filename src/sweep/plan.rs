@@ -23,7 +23,7 @@ use super::{Axis, Entry, Issue, Key, Origin, SweepError, SweepFile, Value};
 use crate::contact::friction::{FrictionKind, FrictionLaw};
 use crate::run::RunConfig;
 use crate::run::estimate::human_bytes;
-use crate::scene::{FileSetup, MeshChoice, MethodNames, Physics, Scene, SceneKind};
+use crate::scene::{FileSetup, InterfaceUse, MeshChoice, MethodNames, Physics, Scene, SceneKind};
 use crate::space::step_solver::Solver;
 use crate::space::{ContactInit, ContactMethod, MassVariant};
 use crate::time::{
@@ -997,11 +997,15 @@ fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
 /// combination left out where any of the keys at stake varies along an axis or a search, a
 /// mistake refused at each of them the file gives (the first at stake where it gives none).
 fn interface_of(given: &Given, m: &Method, physics: &Physics) -> Result<(), Outcome> {
-    let frictional = m.friction_kind != FrictionKind::None;
-    let Err((names, why)) = given
-        .scene
-        .supports_interface(physics, &m.space_name, frictional)
-    else {
+    let kinematic = m.scheme == Scheme::Newmark(NewmarkParams::central_difference())
+        && m.mass == MassVariant::Lumped
+        && m.contact == ContactMethod::Mixed;
+    let method = InterfaceUse {
+        space: &m.space_name,
+        frictional: m.friction_kind != FrictionKind::None,
+        kinematic,
+    };
+    let Err((names, why)) = given.scene.supports_interface(physics, method) else {
         return Ok(());
     };
     let keys: Vec<Key> = names

@@ -11,9 +11,10 @@ use std::sync::Arc;
 
 use super::nitsche_interface::PairFaces;
 use super::nitsche_pair::{blocks_interface, pair_points};
+use super::pairing::{GeneralRows, RowEntries, box_face, general_rows};
 use super::rows::Rows;
 use crate::run::Metrics;
-use crate::scene::{Blocks, FeSetup, MassSide};
+use crate::scene::{Blocks, FeSetup, MassSide, Pairing};
 use crate::space::fe::element::q1_gradient_at;
 use crate::space::fe::nitsche::ContactPoint;
 use crate::space::fe::{
@@ -92,8 +93,11 @@ pub(super) struct BodiesSpec {
     /// Per global node: every component fixed.
     pub(super) clamped: Vec<bool>,
     /// (Γ^a node, Γ^b node), global ids, one per row; each row's gap beyond the run's, its
-    /// weight (sum 1) and its γ = h (the penalty's size), and |Γ^a|.
+    /// weight (sum 1) and its γ = h (the penalty's size), and |Γ^a|. A projecting pairing
+    /// (node-to-segment, mortar: `general`) gives its rows instead of the pairs, one per Γ^a
+    /// node, with these gaps and weights.
     pub(super) pairs: Vec<(usize, usize)>,
+    pub(super) general: Option<GeneralRows>,
     pub(super) height: Vec<f64>,
     pub(super) weight: Vec<f64>,
     pub(super) row_h: Vec<f64>,
@@ -128,12 +132,6 @@ fn face_weight(idx: [usize; 3], cells: &[usize], d: usize) -> f64 {
 /// height H_a placed on B's top (body 0; the gap is the run's, in the rows, so every gap shares
 /// the geometry), Q1, the same elements across so every Γ^a node lies above a Γ^b node.
 pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, String> {
-    if b.pairing != crate::scene::Pairing::NodeToNode {
-        return Err(format!(
-            "pairing {:?}: its rows are not built yet (issue 45)",
-            b.pairing
-        ));
-    }
     let d = s.dim;
     let mut ext = vec![b.width; d];
     let mut cells = vec![b.across; d];
@@ -175,19 +173,34 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         idx[d - 1] = b.cells_b;
         mesh.node(1, mesh_b.node_id(idx))
     };
-    let pairs = a_face.iter().map(|&n| (n, partner(n))).collect();
     let mut weight: Vec<f64> = a_face
         .iter()
         .map(|&n| face_weight(mesh_a.node_index(n), &cells_a, d))
         .collect();
     let total: f64 = weight.iter().sum();
     weight.iter_mut().for_each(|w| *w /= total);
+    let mut measure: f64 = b.width.powi(d as i32 - 1);
+    let loaded_measure = measure;
+    let (pairs, general) = if b.pairing == Pairing::NodeToNode {
+        (a_face.iter().map(|&n| (n, partner(n))).collect(), None)
+    } else {
+        let side_a = box_face(&mesh_a, 0, b.height_b, true, |n| mesh.node(0, n))?;
+        let side_b = box_face(&mesh_b, b.cells_b, b.height_b, false, |n| mesh.node(1, n))?;
+        // Π's reach: the faces coincide (gap 0 in the reference configuration), so any point
+        // of Γ^a is within round-off of Γ^b; half an element leaves room and finds one face.
+        let reach = 0.5 * b.width / b.across.max(b.across_b) as f64;
+        let rows = general_rows(b, &side_a, &side_b, reach)?;
+        // |Γ^a| as the rows' weights sum it, so weight·measure is each row's ∫φ_i or ∫ψ_k.
+        measure = rows.weight.iter().sum();
+        weight = rows.weight.iter().map(|w| w / measure).collect();
+        (Vec::new(), Some(rows))
+    };
+    let rows_len = weight.len();
     let loaded = mesh_a
         .nodes_on_plane(d - 1, b.cells_a)
         .into_iter()
         .map(|n| (n, face_weight(mesh_a.node_index(n), &cells_a, d) / total))
         .collect();
-    let measure: f64 = b.width.powi(d as i32 - 1);
     let h = b.width / b.across as f64;
     let lame = [(s.lame_lambda, s.lame_mu), (b.lame_lambda_b, b.lame_mu_b)];
     // Nitsche's points: the matching path, or the general interface's, placed when a Nitsche
@@ -203,13 +216,16 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
             layers,
             layer_counts: [b.cells_a, b.cells_b],
             clamped,
-            height: vec![0.0; a_face.len()],
-            row_h: vec![h; a_face.len()],
+            height: general
+                .as_ref()
+                .map_or_else(|| vec![0.0; rows_len], |g| g.height.clone()),
+            row_h: vec![h; rows_len],
             pairs,
+            general,
             weight,
             measure,
             loaded,
-            loaded_measure: measure,
+            loaded_measure,
             heights: [b.height_a, b.height_b],
             measured_layers: false,
             density_b: b.density_b,
@@ -265,12 +281,37 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
     for &(a, b) in &spec.pairs {
         pairs.push((free(a)?, free(b)?));
     }
-    let contact: Vec<usize> = pairs.iter().map(|p| p.0).collect();
+    let mut contact: Vec<usize> = pairs.iter().map(|p| p.0).collect();
     let mut contact_node = vec![false; nn];
     for &(a, b) in &spec.pairs {
         contact_node[a] |= spec.mass_side.includes(0);
         contact_node[b] |= spec.mass_side.includes(1);
     }
+    let rows = match &spec.general {
+        None => Rows::pairs(&pairs),
+        Some(g) => {
+            contact = g
+                .a_node
+                .iter()
+                .map(|&a| free(a))
+                .collect::<Result<_, _>>()?;
+            for &a in &g.a_node {
+                contact_node[a] |= spec.mass_side.includes(0);
+            }
+            for &b in &g.b_nodes {
+                contact_node[b] |= spec.mass_side.includes(1);
+            }
+            let on_dofs = |e: &[(usize, f64)]| -> Result<Vec<(usize, f64)>, String> {
+                e.iter().map(|&(n, c)| Ok((free(n)?, c))).collect()
+            };
+            let rows: Vec<RowEntries> = g
+                .rows
+                .iter()
+                .map(|(a, b)| Ok((on_dofs(a)?, on_dofs(b)?)))
+                .collect::<Result<_, String>>()?;
+            Rows::general(&rows)
+        }
+    };
     let body = dofs.free.iter().map(|&g| u8::from(b_node(g / d))).collect();
     // −p ∫φ_i on A's loaded nodes: the weights times the face's measure.
     let pressure = if spec.pressure != 0.0 {
@@ -284,8 +325,8 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
     } else {
         None
     };
-    let points = node_rows_as_points(
-        &pairs,
+    let points = rows_as_points(
+        &rows,
         (&spec.weight, &spec.height),
         spec.measure,
         &spec.row_h,
@@ -296,7 +337,7 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
         dofs,
         pattern,
         k,
-        rows: Rows::pairs(&pairs),
+        rows,
         contact,
         contact_height: spec.height,
         contact_weight: spec.weight,
@@ -321,35 +362,47 @@ pub(super) fn bodies_parts(s: &FeSetup, spec: BodiesSpec) -> Result<BlocksParts,
     })
 }
 
-/// The node-to-node rows of `penalty` (contract §2.6) in the form the engine's Nitsche/penalty
-/// operators take ([`super::nitsche::NitscheOps::penalty`]): one "point" per pair with dofs
-/// (a, b), u_n = δ_i = (u^a_i − u^b_{π(i)})·n = −u^a_d + u^b_d (n = −e_d), σ_n = 0 (no Nitsche
-/// term: `nitsche` takes its own points, [`super::nitsche_pair`]), weight w_i = ∫_Γa φ_i and γ = h, A's mesh size,
-/// so κ_i = E_a γ0/h and the row force is w_i κ [δ_i − g_i]_+ — the weighted rows that pass the
-/// patch test (an unweighted force gives the end nodes twice their share). Each row's gap is
-/// its height beyond the run's gap (0 for the blocks): the run's gap is added where the
-/// operators are made, as for the one-body box. `h` per row (a Gmsh interface's faces differ
-/// in size).
-fn node_rows_as_points(
-    pairs: &[(usize, usize)],
+/// The rows of `penalty` (contract §2.6) in the form the engine's Nitsche/penalty operators
+/// take ([`super::nitsche::NitscheOps::penalty`]): one "point" per row with the row's dofs,
+/// u_n = δ_i = −B_i·u (a node-to-node pair: (u^a_i − u^b_{π(i)})·n = −u^a_d + u^b_d, n = −e_d),
+/// σ_n = 0 (no Nitsche term: `nitsche` takes its own points, [`super::nitsche_pair`]), weight
+/// w_i = ∫_Γa φ_i (a mortar row: ∫ψ_k) and γ = h, A's mesh size, so κ_i = E_a γ0/h and the
+/// row force is w_i κ [δ_i − g_i]_+ — the weighted rows that pass the patch test (an unweighted
+/// force gives the end nodes twice their share). Each row's gap is its height beyond the run's
+/// gap (0 for the blocks): the run's gap is added where the operators are made, as for the
+/// one-body box. `h` per row (a Gmsh interface's faces differ in size). The operators take
+/// one dof count for every point: shorter rows (node-to-segment, mortar) are padded with
+/// their first dof at coefficient 0, which adds nothing.
+fn rows_as_points(
+    rows: &Rows,
     (weight, height): (&[f64], &[f64]),
     measure: f64,
     h: &[f64],
 ) -> Vec<ContactPoint> {
-    pairs
-        .iter()
+    let k = (0..rows.len())
+        .map(|i| rows.entries(i).0.len())
+        .max()
+        .unwrap_or(0);
+    (0..rows.len())
         .zip(weight)
         .zip(h)
         .zip(height)
-        .map(|(((&(a, b), w), &h), &gap)| ContactPoint {
-            weight: w * measure,
-            gamma: h,
-            gap,
-            dofs: vec![a, b],
-            un: vec![-1.0, 1.0],
-            sn: vec![0.0, 0.0],
-            ut: Vec::new(),
-            st: Vec::new(),
+        .map(|(((i, w), &h), &gap)| {
+            let (dofs, coef) = rows.entries(i);
+            let mut dofs = dofs.to_vec();
+            let mut un: Vec<f64> = coef.iter().map(|c| -c).collect();
+            dofs.resize(k, dofs[0]);
+            un.resize(k, 0.0);
+            ContactPoint {
+                weight: w * measure,
+                gamma: h,
+                gap,
+                dofs,
+                un,
+                sn: vec![0.0; k],
+                ut: Vec::new(),
+                st: Vec::new(),
+            }
         })
         .collect()
 }

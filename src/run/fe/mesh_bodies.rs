@@ -141,6 +141,7 @@ pub(super) fn mesh_bodies_parts(
             layer_counts,
             clamped,
             pairs: gb.pairs.iter().map(|&(a, b)| (id[a], id[b])).collect(),
+            general: None,
             height: gb.distance.iter().map(|g| g - lowest).collect(),
             row_h: gb.pairs.iter().map(|&(a, _)| size[a]).collect(),
             weight,

@@ -51,6 +51,7 @@ mod newmark;
 pub mod nitsche;
 mod nitsche_interface;
 mod nitsche_pair;
+mod pairing;
 mod products;
 mod reference;
 mod refine;

@@ -9,6 +9,11 @@
 //! pushes A up and B down by the same amount — action = reaction, so Σ_j (B_iᵀ)_j over a
 //! component vanishes and the total momentum is an exact invariant (contract §2.6).
 //!
+//! The non-matching pairings (issue 45) give rows with more entries: node-to-segment
+//! e_{a,i,d} − Σ_j N_j(ξ_i) e_{b,j,d}, mortar Σ_i D_ki e_{a,i,d} − Σ_j M_kj e_{b,j,d} (scaled by
+//! 1/∫ψ_k, [`super::pairing`]); each row's coefficients sum to zero up to round-off, which keeps
+//! the invariant. A row records where its Γ^b entries start, for Γ^b's mean displacement.
+//!
 //! Why one type for both: the condensation Z = A⁻¹Bᵀ, W = BZ, the LCP, the energies and the
 //! §3.2 methods only ever take B·x and Bᵀλ, so a second body is data (rows with two entries),
 //! not a branch. A one-entry row with coefficient 1 computes exactly what the obstacle engine
@@ -21,6 +26,9 @@ pub(super) struct Rows {
     start: Vec<usize>,
     dof: Vec<usize>,
     coef: Vec<f64>,
+    /// Per row, the offset of its first Γ^b entry ([`Rows::general`]); empty: 1 for every row
+    /// (unit rows have none, a node-to-node pair's second entry is Γ^b's).
+    b_from: Vec<usize>,
 }
 
 impl Rows {
@@ -30,6 +38,7 @@ impl Rows {
             start: (0..=dofs.len()).collect(),
             dof: dofs.to_vec(),
             coef: vec![1.0; dofs.len()],
+            b_from: Vec::new(),
         }
     }
 
@@ -42,6 +51,24 @@ impl Rows {
         for &(a, b) in pairs {
             r.dof.extend([a, b]);
             r.coef.extend([1.0, -1.0]);
+            r.start.push(r.dof.len());
+        }
+        r
+    }
+
+    /// General two-body rows, one per (A's entries, B's entries): B_i = Σ_a c_a e_a + Σ_b c_b e_b
+    /// (node-to-segment and mortar, issue 45).
+    pub(super) fn general(rows: &[(Vec<(usize, f64)>, Vec<(usize, f64)>)]) -> Rows {
+        let mut r = Rows {
+            start: vec![0],
+            ..Rows::default()
+        };
+        for (a, b) in rows {
+            r.b_from.push(a.len());
+            for &(dof, c) in a.iter().chain(b) {
+                r.dof.push(dof);
+                r.coef.push(c);
+            }
             r.start.push(r.dof.len());
         }
         r
@@ -161,15 +188,34 @@ impl Rows {
         lambda
     }
 
-    /// Σ_i w_i x at row i's second entry (a node-to-node row's Γ^b dof; unit rows add nothing):
-    /// Γ^b's mean displacement with Γ^a's weights, the `u_contact_b` series of a matching
-    /// interface (contract §5).
+    /// Σ_i w_i (−Σ_{Γ^b entries k} c_k x_k) (a node-to-node row's Γ^b dof; unit rows add
+    /// nothing): Γ^b's mean displacement with Γ^a's weights, the `u_contact_b` series (contract
+    /// §5) — B's displacement at Π(x_i) for node-to-segment rows, its ψ_k-weighted mean for
+    /// mortar rows.
     pub(super) fn second_mean(&self, w: &[f64], x: &[f64]) -> f64 {
         (0..self.len())
             .zip(w)
-            .filter(|&(i, _)| self.start[i + 1] - self.start[i] > 1)
-            .map(|(i, w)| w * x[self.dof[self.start[i] + 1]])
+            .filter(|&(i, _)| self.start[i + 1] - self.start[i] > self.b_from(i))
+            .map(|(i, w)| {
+                let (s, e) = (self.start[i] + self.b_from(i), self.start[i + 1]);
+                // −(−1)·x = x: a pair's one Γ^b entry gives w·x bit for bit.
+                let mut b = -self.coef[s] * x[self.dof[s]];
+                for k in s + 1..e {
+                    b -= self.coef[k] * x[self.dof[k]];
+                }
+                w * b
+            })
             .sum()
+    }
+
+    /// Whether these are a projecting pairing's rows ([`Rows::general`]).
+    pub(super) fn is_general(&self) -> bool {
+        !self.b_from.is_empty()
+    }
+
+    /// The offset of row i's first Γ^b entry.
+    fn b_from(&self, i: usize) -> usize {
+        self.b_from.get(i).copied().unwrap_or(1)
     }
 
     /// B_i·x, summed from the first entry on (a one-entry row gives x_c itself, bit for bit).

@@ -1,6 +1,7 @@
 //! The geometry of a non-matching two-body interface and its mortar matrices (contract §2.6,
 //! issue 45): a self-contained library the pairings `node-to-segment` and `mortar` and the
-//! `segment` interface quadrature build on. Nothing in the engine uses it yet.
+//! `segment` interface quadrature build on; the blocks' node-to-segment and mortar rows take it
+//! (`run::fe::pairing`).
 //!
 //! - [`surface`]: the two sides Γ^a, Γ^b as face sets (segments; triangles, bilinear
 //!   quadrilaterals), their shape functions and normals, the typed [`InterfaceError`]s;
@@ -18,7 +19,10 @@ pub mod projection;
 pub mod segment;
 pub mod surface;
 
-pub use mortar::{Basis, Mortar, SparseRows, basis_coefficients, face_integrals, mortar_matrices};
+pub use mortar::{
+    Basis, Mortar, SparseRows, basis_coefficients, face_integrals, mortar_matrices,
+    mortar_matrices_element,
+};
 pub use projection::{Projection, Projector, closest_on_face, project_brute};
 pub use segment::{Piece, PiecePoint, Segmentation, segment};
 pub use surface::{FaceKind, InterfaceError, Surface};

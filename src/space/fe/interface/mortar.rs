@@ -12,6 +12,11 @@
 //!   diagonal with D_kk = ∫φ_k wherever the segmentation covers Γ^a. ψ_k is discontinuous
 //!   across faces, which the mortar rows do not mind (they are integrals).
 //!
+//! With `interface_quadrature = "element"` ([`mortar_matrices_element`]) the same integrals
+//! are taken with Γ^a's own face rule, φ^b_j∘Π at the projected rule points: D is then exact
+//! and M is not (φ^b_j∘Π has kinks inside a face of Γ^a where Γ^b's faces meet) — what an
+//! element-by-element code computes, which the contact patch test exposes (contract §6).
+//!
 //! Why integrate D on the pieces too (not on Γ^a's faces): then Σ_i D_ki = Σ_j M_kj = ∫ψ_k
 //! over the covered part exactly (Σ_i φ^a_i = Σ_j φ^b_j = 1 at every point), so a rigid
 //! translation makes no weighted gap and every row acts equally and oppositely on the two
@@ -20,6 +25,7 @@
 use nalgebra::DMatrix;
 
 use super::super::quadrature::{collapsed_simplex_rule, gauss_legendre_any};
+use super::projection::Projector;
 use super::segment::{PiecePoint, Segmentation};
 use super::surface::{FaceKind, InterfaceError, Surface, dot, sub};
 
@@ -100,26 +106,34 @@ pub struct Mortar {
     pub psi_integral: Vec<f64>,
 }
 
+/// n Gauss points on [0, 1].
+fn unit_gauss(n: usize) -> Vec<(f64, f64)> {
+    gauss_legendre_any(n)
+        .into_iter()
+        .map(|(t, w)| (0.5 * (t + 1.0), 0.5 * w))
+        .collect()
+}
+
+/// The n × n tensor Gauss rule on the unit square.
+fn square_gauss(n: usize) -> Vec<([f64; 2], f64)> {
+    let g = unit_gauss(n);
+    g.iter()
+        .flat_map(|&(s, ws)| g.iter().map(move |&(t, wt)| ([s, t], ws * wt)))
+        .collect()
+}
+
 /// Gauss points of a whole face of `kind` (exact for φ_k φ_l J on an affine face).
 fn face_rule(kind: FaceKind) -> Vec<([f64; 2], f64)> {
-    let g = |n| -> Vec<(f64, f64)> {
-        gauss_legendre_any(n)
-            .into_iter()
-            .map(|(t, w)| (0.5 * (t + 1.0), 0.5 * w))
-            .collect()
-    };
     match kind {
-        FaceKind::Seg2 => g(2).into_iter().map(|(t, w)| ([t, 0.0], w)).collect(),
+        FaceKind::Seg2 => unit_gauss(2)
+            .into_iter()
+            .map(|(t, w)| ([t, 0.0], w))
+            .collect(),
         FaceKind::Tri3 => collapsed_simplex_rule(2, 2)
             .into_iter()
             .map(|(p, w)| ([p[0], p[1]], w))
             .collect(),
-        FaceKind::Quad4 => {
-            let g3 = g(3);
-            g3.iter()
-                .flat_map(|&(s, ws)| g3.iter().map(move |&(t, wt)| ([s, t], ws * wt)))
-                .collect()
-        }
+        FaceKind::Quad4 => square_gauss(3),
     }
 }
 
@@ -225,6 +239,71 @@ pub fn mortar_matrices(
             }
             weighted_gap[fa[k]] += gl[k];
             psi_integral[fa[k]] += sl[k];
+        }
+    }
+    Ok(Mortar {
+        basis,
+        d: SparseRows::from_triplets(a.num_nodes(), a.num_nodes(), d),
+        m: SparseRows::from_triplets(a.num_nodes(), b.num_nodes(), m),
+        weighted_gap,
+        psi_integral,
+    })
+}
+
+/// Γ^a's own face rule: the trace of its elements' rule, 2 Gauss points per direction (the
+/// Q1/P1 elements' 2^d-point rule; GetFEM's order-2 face rule), exact for φ_k φ_l J on an
+/// affine face — D is exact, M is not.
+fn element_rule(kind: FaceKind) -> Vec<([f64; 2], f64)> {
+    match kind {
+        FaceKind::Quad4 => square_gauss(2),
+        _ => face_rule(kind),
+    }
+}
+
+/// The mortar matrices with Γ^a's own face rule (`interface_quadrature = "element"`, module
+/// header): each rule point x of each face of Γ^a projected by `proj` onto Γ^b (a point with
+/// no projection within the reach is refused), the integrands summed there. Σ_i D_ki =
+/// Σ_j M_kj = ∫ψ_k still hold at every point (Σ_i φ^a_i = Σ_j φ^b_j = 1), so the rows keep the
+/// momentum invariant; only the M entries are inexact.
+pub fn mortar_matrices_element(
+    a: &Surface,
+    proj: &Projector,
+    basis: Basis,
+) -> Result<Mortar, InterfaceError> {
+    let b = proj.surface();
+    if a.kind.dim() != b.kind.dim() {
+        return Err(InterfaceError::MixedDimensions {
+            a: a.kind,
+            b: b.kind,
+        });
+    }
+    let (pa, pb) = (a.kind.nodes(), b.kind.nodes());
+    let rule = element_rule(a.kind);
+    let (mut d, mut m) = (Vec::new(), Vec::new());
+    let mut weighted_gap = vec![0.0; a.num_nodes()];
+    let mut psi_integral = vec![0.0; a.num_nodes()];
+    for f in 0..a.num_faces() {
+        let coef = basis_coefficients(a, f, basis);
+        let (fa, normal) = (a.face(f), a.normal(f));
+        for &(xi, w) in &rule {
+            let x = a.point(f, xi);
+            let pi = proj.project(x)?;
+            let (na, nb) = (a.kind.shape(xi), b.kind.shape(pi.xi));
+            let jw = w * a.jacobian(f, xi);
+            let g = dot(sub(pi.point, x), normal);
+            let fb = b.face(pi.face);
+            for k in 0..pa {
+                let psi: f64 = (0..pa).map(|l| coef[k][l] * na[l]).sum();
+                let wk = jw * psi;
+                for i in 0..pa {
+                    d.push((fa[k], fa[i], wk * na[i]));
+                }
+                for j in 0..pb {
+                    m.push((fa[k], fb[j], wk * nb[j]));
+                }
+                weighted_gap[fa[k]] += wk * g;
+                psi_integral[fa[k]] += wk;
+            }
         }
     }
     Ok(Mortar {
