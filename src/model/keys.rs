@@ -101,6 +101,14 @@ pub enum Key {
     Pressure,
     LameLambdaB,
     LameMuB,
+    /// The two-body pairing of `mixed` and `penalty` (contract §2.6; issue 45): `node-to-node`
+    /// (default: every existing id unchanged), `node-to-segment` or `mortar`; the mortar
+    /// multiplier's basis (`standard`, default, or `dual`); and where the interface integrals
+    /// are computed (`segment`, default: the segmentation of Γ^a by Γ^b's projected faces, or
+    /// `element`: Γ^a's own face rule).
+    Pairing,
+    MortarBasis,
+    InterfaceQuadrature,
 }
 
 /// What a key's value must look like.
@@ -186,7 +194,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 59] = [
+    pub const ALL: [Key; 62] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -246,6 +254,9 @@ impl Key {
         Key::Pressure,
         Key::LameLambdaB,
         Key::LameMuB,
+        Key::Pairing,
+        Key::MortarBasis,
+        Key::InterfaceQuadrature,
     ];
 
     pub fn name(self) -> &'static str {
@@ -309,6 +320,9 @@ impl Key {
             Key::Pressure => "pressure",
             Key::LameLambdaB => "lame_lambda_b",
             Key::LameMuB => "lame_mu_b",
+            Key::Pairing => "pairing",
+            Key::MortarBasis => "mortar_basis",
+            Key::InterfaceQuadrature => "interface_quadrature",
         }
     }
 
@@ -349,6 +363,9 @@ impl Key {
                 | Key::FarEnd
                 | Key::MassSide
                 | Key::NitscheSides
+                | Key::Pairing
+                | Key::MortarBasis
+                | Key::InterfaceQuadrature
         )
     }
 
@@ -362,6 +379,9 @@ impl Key {
             Key::FarEnd => Some(&["free", "clamped"]),
             Key::MassSide => Some(&["both", "a", "b"]),
             Key::NitscheSides => Some(&["unbiased", "a"]),
+            Key::Pairing => Some(&["node-to-node", "node-to-segment", "mortar"]),
+            Key::MortarBasis => Some(&["standard", "dual"]),
+            Key::InterfaceQuadrature => Some(&["segment", "element"]),
             _ => None,
         }
     }
@@ -384,7 +404,10 @@ impl Key {
             | Key::Friction
             | Key::FarEnd
             | Key::MassSide
-            | Key::NitscheSides => ValueType::Str,
+            | Key::NitscheSides
+            | Key::Pairing
+            | Key::MortarBasis
+            | Key::InterfaceQuadrature => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -491,7 +514,12 @@ impl Key {
                     ))
                 }
             }
-            Key::FarEnd | Key::MassSide | Key::NitscheSides => {
+            Key::FarEnd
+            | Key::MassSide
+            | Key::NitscheSides
+            | Key::Pairing
+            | Key::MortarBasis
+            | Key::InterfaceQuadrature => {
                 let words = self.choices().expect("choice keys");
                 if words.contains(&s) {
                     Ok(())

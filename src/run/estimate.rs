@@ -110,8 +110,10 @@ impl RunConfig {
                     // Two blocks (contract §1.10): all their nodes, one row per Γ^a node.
                     FeGeometry::Blocks(b) => {
                         let d = c.setup.dim;
-                        let face = (b.across as f64 + 1.0).powi(d as i32 - 1);
-                        let nodes = face * (b.cells_a + b.cells_b + 2) as f64;
+                        let face_of = |n: usize| (n as f64 + 1.0).powi(d as i32 - 1);
+                        let face = face_of(b.across);
+                        let nodes = face * (b.cells_a + 1) as f64
+                            + face_of(b.across_b) * (b.cells_b + 1) as f64;
                         (nodes * d as f64, d, 3f64.powi(d as i32) * d as f64, face)
                     }
                     FeGeometry::Ball {

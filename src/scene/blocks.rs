@@ -1,15 +1,16 @@
 //! Two elastic blocks, one falling on the other: `blocks2d` (plane strain) and `blocks3d`
 //! (contract §1.10, §2.6; issue 44).
 //!
-//! B = [0, W]^{d−1} × [0, H_b] below A = [0, W]^{d−1} × [H_b + g, H_b + g + H_a], Q1 squares or
-//! cubes of side h; A has W/h elements across and H_a/h up, B the same across (`mesh_ratio` = 1:
-//! a matching interface, every node of A's bottom face above a node of B's top face) and
-//! round(H_b/h) up. A moves with `velocity` e_d (+ `velocity_tangential` e_1), B with
-//! `velocity_b` e_d; B's base is free or clamped (`far_end`); a traction −p e_d acts on A's top
-//! (`pressure`) and the weight −ρ_i·gravity e_d on both (`gravity`). There is no obstacle: the
-//! contact rows are node-to-node between the two faces, δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with
-//! n = −e_d ([`crate::run::fe`]'s rows), or Nitsche's points of both faces (`nitsche_sides`
-//! unbiased or one-sided). With no clamp and
+//! B = [0, W]^{d−1} × [0, H_b] below A = [0, W]^{d−1} × [H_b + g, H_b + g + H_a], Q1 cells;
+//! A has W/h elements across and H_a/h up (squares or cubes of side h), B round(`mesh_ratio`·W/h)
+//! across (`mesh_ratio` = 1: a matching interface, every node of A's bottom face above a node of
+//! B's top face; 4/3, 7/5: a non-matching one, issue 45) and round(H_b/h) up. A moves with
+//! `velocity` e_d (+ `velocity_tangential` e_1), B with `velocity_b` e_d; B's base is free or
+//! clamped (`far_end`); a traction −p e_d acts on A's top (`pressure`) and the weight
+//! −ρ_i·gravity e_d on both (`gravity`). There is no obstacle: the contact rows pair the two
+//! faces (`pairing`: node-to-node, δ_i = (u^a_i − u^b_{π(i)})·n ≤ g with n = −e_d; node-to-segment;
+//! mortar with its `mortar_basis` and `interface_quadrature`; [`crate::run::fe`]'s rows), or
+//! Nitsche's points of both faces (`nitsche_sides` unbiased or one-sided). With no clamp and
 //! no load the total momentum is an exact invariant of every scheme (contract §2.6).
 //!
 //! Why a scene of its own rather than a mesh file: the matching interface, the per-body
@@ -17,9 +18,11 @@
 //! two-body Gmsh meshes reuse the same engine data (bodies and rows).
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, NitscheSides,
-    Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, InterfaceQuadrature, LoadModel, MassSide, MeshChoice,
+    MethodNames, NitscheSides, Pairing, Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+    mortar_basis_from_index,
 };
+use crate::space::fe::interface::Basis;
 
 /// The two blocks as the engine meshes them (A's material, gap and velocities are the
 /// [`FeSetup`]'s own fields).
@@ -28,8 +31,10 @@ pub struct Blocks {
     pub width: f64,
     pub height_a: f64,
     pub height_b: f64,
-    /// Elements across (each horizontal axis), up A and up B.
+    /// A's elements across (each horizontal axis), B's (round(`mesh_ratio`·W/h): `across`
+    /// on a matching interface), up A and up B.
     pub across: usize,
+    pub across_b: usize,
     pub cells_a: usize,
     pub cells_b: usize,
     /// B's base x_d = 0 held at u = 0 (`far_end = "clamped"`).
@@ -44,6 +49,12 @@ pub struct Blocks {
     pub mass_side: MassSide,
     /// The weights of Nitsche's two sides (contract §2.6 `nitsche_sides`).
     pub nitsche_sides: NitscheSides,
+    /// How `mixed` and `penalty` pair the faces, the mortar multiplier's basis and where the
+    /// interface integrals are computed (contract §2.6 `pairing`, `mortar_basis`,
+    /// `interface_quadrature`; issue 45).
+    pub pairing: Pairing,
+    pub mortar_basis: Basis,
+    pub interface_quadrature: InterfaceQuadrature,
 }
 
 /// The scenes `blocks2d` (dim 2) and `blocks3d` (dim 3).
@@ -57,9 +68,10 @@ const fn key(name: &'static str, default: f64) -> PhysicsKey {
 }
 
 /// contract §1.10's keys and defaults; B's material keys default to A's (NaN here, resolved in
-/// [`BlocksScene::setup`]), `far_end`, `mass_side` and `nitsche_sides` are indices into their
-/// words.
-const BLOCKS_PHYSICS: [PhysicsKey; 19] = [
+/// [`BlocksScene::setup`]), `far_end`, `mass_side`, `nitsche_sides`, `pairing`, `mortar_basis`
+/// and `interface_quadrature` are indices into their words (default: the first, which keeps
+/// every id of the matching blocks).
+const BLOCKS_PHYSICS: [PhysicsKey; 22] = [
     key("width", 1.0),
     key("height", 1.0),
     key("height_b", 1.0),
@@ -79,6 +91,9 @@ const BLOCKS_PHYSICS: [PhysicsKey; 19] = [
     key("mass_side", 0.0),
     key("mesh_ratio", 1.0),
     key("nitsche_sides", 0.0),
+    key("pairing", 0.0),
+    key("mortar_basis", 0.0),
+    key("interface_quadrature", 0.0),
 ];
 
 impl BlocksScene {
@@ -93,6 +108,11 @@ impl BlocksScene {
             ));
         }
         Ok(n as usize)
+    }
+
+    /// B's elements across: round(`mesh_ratio`·W/h) (contract §1.10), at least one.
+    fn across_b(p: &Physics, across: usize) -> usize {
+        (p.get("mesh_ratio") * across as f64).round().max(1.0) as usize
     }
 }
 
@@ -144,7 +164,7 @@ impl Scene for BlocksScene {
         super::fe_supports(self.name(), m)?;
         super::require("space", m.space, &["mixed", "penalty", "nitsche"], || {
             format!(
-                "space = {} is not available for scene {} (mixed and penalty node-to-node, nitsche unbiased or one-sided)",
+                "space = {} is not available for scene {} (mixed and penalty with a pairing, nitsche unbiased or one-sided)",
                 m.space,
                 self.name()
             )
@@ -171,21 +191,97 @@ impl Scene for BlocksScene {
         p: &Physics,
         _scheme: &crate::time::Scheme,
     ) -> Result<(), (&'static str, String)> {
-        if p.get("mesh_ratio") != 1.0 {
-            return Err((
-                "mesh_ratio",
-                format!(
-                    "mesh_ratio = {}: non-matching interfaces: issue 45 (only mesh_ratio = 1, a matching interface, is implemented)",
-                    p.get("mesh_ratio")
-                ),
-            ));
-        }
         if p.get("far_end") == 1.0 && p.get("velocity_b") != 0.0 {
             return Err((
                 "velocity_b",
                 format!(
                     "velocity_b = {} with far_end = \"clamped\": a clamped body B cannot move rigidly",
                     p.get("velocity_b")
+                ),
+            ));
+        }
+        Ok(())
+    }
+    /// contract §2.6: `pairing` and `mortar_basis` are the rows of `mixed` and `penalty`;
+    /// `interface_quadrature` integrates mortar's and Nitsche's interface terms; a
+    /// non-matching interface (`mesh_ratio` ≠ 1) needs a pairing that projects.
+    fn supports_interface(
+        &self,
+        p: &Physics,
+        space: &str,
+        frictional: bool,
+    ) -> Result<(), (&'static [&'static str], String)> {
+        let pairing = Pairing::from_index(p.get("pairing"));
+        let ratio = p.get("mesh_ratio");
+        // The words of the choice keys (the model's `Key::choices`, which this layer does
+        // not see), by their indices.
+        let word = |key: &str| {
+            let words: &[&str] = match key {
+                "pairing" => &["node-to-node", "node-to-segment", "mortar"],
+                "mortar_basis" => &["standard", "dual"],
+                _ => &["segment", "element"],
+            };
+            words[p.get(key) as usize]
+        };
+        if space == "nitsche" {
+            if pairing != Pairing::NodeToNode {
+                return Err((
+                    &["pairing", "space"],
+                    format!(
+                        "pairing = {} with space = nitsche: a pairing makes the rows of mixed and penalty; nitsche integrates over the interface (interface_quadrature)",
+                        word("pairing")
+                    ),
+                ));
+            }
+            if ratio != 1.0 {
+                return Err((
+                    &["mesh_ratio", "space"],
+                    format!(
+                        "mesh_ratio = {ratio} with space = nitsche: Nitsche on a non-matching interface is not yet built (issue 45; mortar and node-to-segment take it with mixed and penalty)"
+                    ),
+                ));
+            }
+        }
+        if mortar_basis_from_index(p.get("mortar_basis")) != Basis::Standard
+            && pairing != Pairing::Mortar
+        {
+            return Err((
+                &["mortar_basis", "pairing", "space"],
+                format!(
+                    "mortar_basis = {} with pairing = {}: the basis of the mortar multiplier applies to pairing = \"mortar\" only",
+                    word("mortar_basis"),
+                    word("pairing")
+                ),
+            ));
+        }
+        let quadrature = InterfaceQuadrature::from_index(p.get("interface_quadrature"));
+        if quadrature != InterfaceQuadrature::Segment
+            && space != "nitsche"
+            && pairing != Pairing::Mortar
+        {
+            return Err((
+                &["interface_quadrature", "pairing", "space"],
+                format!(
+                    "interface_quadrature = {} with pairing = {}: it applies to the interface integrals of pairing = \"mortar\" and of space = nitsche only (node rows carry no interface integral)",
+                    word("interface_quadrature"),
+                    word("pairing")
+                ),
+            ));
+        }
+        if space != "nitsche" && ratio != 1.0 && pairing == Pairing::NodeToNode {
+            return Err((
+                &["mesh_ratio", "pairing", "space"],
+                format!(
+                    "mesh_ratio = {ratio} with pairing = node-to-node: non-matching interface: choose node-to-segment or mortar, or nitsche (issue 45; node-to-node needs every Γ^a node above a Γ^b node)"
+                ),
+            ));
+        }
+        if frictional && pairing != Pairing::NodeToNode {
+            return Err((
+                &["pairing", "friction"],
+                format!(
+                    "friction with pairing = {}: the relative slip's rows are built for node-to-node pairs only (contract §2.6)",
+                    word("pairing")
                 ),
             ));
         }
@@ -206,6 +302,10 @@ impl Scene for BlocksScene {
     fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
         let across = (p.get("width") / mesh.h).round() as usize;
         let blocks = Blocks {
+            across_b: Self::across_b(p, across),
+            pairing: Pairing::from_index(p.get("pairing")),
+            mortar_basis: mortar_basis_from_index(p.get("mortar_basis")),
+            interface_quadrature: InterfaceQuadrature::from_index(p.get("interface_quadrature")),
             width: p.get("width"),
             height_a: p.get("height"),
             height_b: p.get("height_b"),

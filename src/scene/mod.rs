@@ -31,7 +31,7 @@ pub use blocks::{Blocks, BlocksScene};
 pub use layer1d::{Layer1dScene, LayerExact, LayerParams, PlaneWave};
 pub use mesh::{MeshBodies, MeshScene};
 pub use oscillator::{DryFrictionExact, OscillatorExact, OscillatorParams, OscillatorScene};
-pub use two_body::{MassSide, NitscheSides};
+pub use two_body::{InterfaceQuadrature, MassSide, NitscheSides, Pairing, mortar_basis_from_index};
 
 /// A physics parameter of a scene: its key name (contract §7) and default value.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -269,6 +269,17 @@ pub trait Scene: Send + Sync {
         _physics: &Physics,
         _scheme: &crate::time::Scheme,
     ) -> Result<(), (&'static str, String)> {
+        Ok(())
+    }
+    /// Whether the physics values go with the contact treatment `space` and a friction law
+    /// (`frictional`): the two blocks' interface keys (contract §2.6, issue 45). `Err` names the
+    /// keys that together rule the run out, the one at fault first, and says why.
+    fn supports_interface(
+        &self,
+        _physics: &Physics,
+        _space: &str,
+        _frictional: bool,
+    ) -> Result<(), (&'static [&'static str], String)> {
         Ok(())
     }
     /// The description the engines run.

@@ -75,3 +75,54 @@ impl NitscheSides {
         }
     }
 }
+
+/// How `mixed` and `penalty` pair the two faces (contract §2.6 `pairing`; issue 45).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Pairing {
+    /// One row per Γ^a node against the Γ^b node below it (a matching interface).
+    NodeToNode,
+    /// One row per Γ^a node against Γ^b's face below it (one pass, A the slave).
+    NodeToSegment,
+    /// One row per multiplier function ψ_k of Γ^a, weighted by ∫ψ_k over the interface.
+    Mortar,
+}
+
+impl Pairing {
+    /// From the `pairing` key's index into its choices (node-to-node, node-to-segment, mortar).
+    pub fn from_index(x: f64) -> Pairing {
+        match x as usize {
+            1 => Pairing::NodeToSegment,
+            2 => Pairing::Mortar,
+            _ => Pairing::NodeToNode,
+        }
+    }
+}
+
+/// Where the interface integrals are computed (contract §2.6 `interface_quadrature`): on the
+/// segmentation of Γ^a by Γ^b's projected faces (exact on non-matching faces) or with Γ^a's
+/// own face rule, the other body evaluated at the projected points (what GetFEM does).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InterfaceQuadrature {
+    Segment,
+    Element,
+}
+
+impl InterfaceQuadrature {
+    /// From the `interface_quadrature` key's index into its choices (segment, element).
+    pub fn from_index(x: f64) -> InterfaceQuadrature {
+        if x == 1.0 {
+            InterfaceQuadrature::Element
+        } else {
+            InterfaceQuadrature::Segment
+        }
+    }
+}
+
+/// The mortar multiplier's basis from the `mortar_basis` key's index (standard, dual).
+pub fn mortar_basis_from_index(x: f64) -> crate::space::fe::interface::Basis {
+    if x == 1.0 {
+        crate::space::fe::interface::Basis::Dual
+    } else {
+        crate::space::fe::interface::Basis::Standard
+    }
+}

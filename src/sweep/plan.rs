@@ -352,6 +352,7 @@ fn resolve_given(
 
     // Physics, mesh and time step: the scene's.
     let mut physics = physics_of(given, &m.scheme)?;
+    interface_of(given, &m, &physics)?;
     let c0 = scene.wave_speed(&physics);
     let mut mesh_file: Option<MeshFile> = None;
     let mut file_setup = None;
@@ -989,6 +990,35 @@ fn physics_of(given: &Given, scheme: &Scheme) -> Result<Physics, Outcome> {
     }
     incline_without_gravity(given, &physics)?;
     Ok(physics)
+}
+
+/// The interface keys against the treatment and friction ([`Scene::supports_interface`]:
+/// the blocks' `pairing`, `mortar_basis`, `interface_quadrature`, `mesh_ratio`): one
+/// combination left out where any of the keys at stake varies along an axis or a search, a
+/// mistake refused at each of them the file gives (the first at stake where it gives none).
+fn interface_of(given: &Given, m: &Method, physics: &Physics) -> Result<(), Outcome> {
+    let frictional = m.friction_kind != FrictionKind::None;
+    let Err((names, why)) = given
+        .scene
+        .supports_interface(physics, &m.space_name, frictional)
+    else {
+        return Ok(());
+    };
+    let keys: Vec<Key> = names
+        .iter()
+        .map(|n| Key::from_name(n).expect("scenes name sweep keys"))
+        .collect();
+    let varies = |k: Key| given.on_axis(k) || given.origin(k).path.starts_with("search");
+    if keys.iter().any(|&k| varies(k)) {
+        return Err(Outcome::Inapplicable(why));
+    }
+    let set: Vec<Key> = keys.iter().copied().filter(|&k| given.has(k)).collect();
+    let at = if set.is_empty() { vec![keys[0]] } else { set };
+    Err(Outcome::Invalid(
+        at.iter()
+            .map(|&k| Issue::at(&given.origin(k), why.clone()))
+            .collect(),
+    ))
 }
 
 /// The scene's physics keys as given (a choice key as its index), defaults elsewhere; not

@@ -122,6 +122,12 @@ fn face_weight(idx: [usize; 3], cells: &[usize], d: usize) -> f64 {
 /// height H_a placed on B's top (body 0; the gap is the run's, in the rows, so every gap shares
 /// the geometry), Q1, the same elements across so every Γ^a node lies above a Γ^b node.
 pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, String> {
+    if b.pairing != crate::scene::Pairing::NodeToNode {
+        return Err(format!(
+            "pairing {:?}: its rows are not built yet (issue 45)",
+            b.pairing
+        ));
+    }
     let d = s.dim;
     let mut ext = vec![b.width; d];
     let mut cells = vec![b.across; d];
@@ -134,6 +140,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         .for_each(|c| c[d - 1] += b.height_b);
     let cells_a = cells.clone();
     ext[d - 1] = b.height_b;
+    cells = vec![b.across_b; d];
     cells[d - 1] = b.cells_b;
     let mesh_b = BoxMesh::try_new(&ext, &cells).map_err(|e| e.to_string())?;
     let mesh = BodiesMesh::new(&[&mesh_a, &mesh_b]);

@@ -56,9 +56,11 @@ impl FeConfig {
             // Two blocks (contract §1.10): every node of both, B's base less when clamped.
             FeGeometry::Blocks(b) => {
                 let d = self.setup.dim;
-                let face = (b.across + 1).saturating_pow(d as u32 - 1);
-                let layers = b.cells_a + b.cells_b + 2 - usize::from(b.base_clamped);
-                face.saturating_mul(layers).saturating_mul(d)
+                let face = |n: usize| (n + 1).saturating_pow(d as u32 - 1);
+                let a = face(b.across).saturating_mul(b.cells_a + 1);
+                let layers_b = b.cells_b + 1 - usize::from(b.base_clamped);
+                let nodes = a.saturating_add(face(b.across_b).saturating_mul(layers_b));
+                nodes.saturating_mul(d)
             }
             FeGeometry::Ball {
                 dim,
