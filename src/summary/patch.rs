@@ -283,9 +283,32 @@ fn collect(runs: &Runs) -> (Vec<Row<'_>>, Vec<Place>) {
             row.cells.insert(new_index(pi), levels);
         }
     }
-    out.sort_by(|a, b| a.label.cmp(&b.label));
+    out.sort_by_cached_key(|row| (rank(runs, row.first), row.label.clone()));
     let places = order.into_iter().map(|i| places[i].clone()).collect();
     (out, places)
+}
+
+/// A row's place in the table: the textbook's order of the contact keys' values (treatment,
+/// then pairing, basis, quadrature, sides, Θ = 1, 0, −1), unknown values after the known ones.
+fn rank(runs: &Runs, r: &Run) -> Vec<usize> {
+    const ORDER: &[(&str, &[&str])] = &[
+        ("space", &["mixed", "penalty", "nitsche"]),
+        ("pairing", &["node-to-node", "node-to-segment", "mortar"]),
+        ("mortar_basis", &["standard", "dual"]),
+        ("interface_quadrature", &["segment", "element"]),
+        ("nitsche_sides", &["unbiased", "a"]),
+        ("nitsche_theta", &["1", "0", "-1"]),
+    ];
+    ORDER
+        .iter()
+        .map(|(k, words)| {
+            let v = applies(runs, r, k)
+                .then(|| runs.param(r, k).and_then(Cell::show))
+                .flatten();
+            v.and_then(|v| words.iter().position(|w| *w == v))
+                .unwrap_or(words.len())
+        })
+        .collect()
 }
 
 fn place_is_blocks(p: &Place) -> bool {
