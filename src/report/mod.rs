@@ -9,7 +9,8 @@
 //! 2. figures: convergence of every displayed error column with slope triangles (the group's
 //!    main refinement path and its least-squares slope), work-precision with the Pareto front,
 //!    contact displacement / pressure / energy against time with the exact solution;
-//! 3. the method table (one line per group with its rates, as on the terminal, with its legend);
+//! 3. the method table (one line per group with its rates, as on the terminal, with its legend),
+//!    the method classes and, for a folder with patch-test runs, the contact patch test;
 //! 4. the energy behaviour, the stability map when the sweep has one, the convergence and
 //!    work-precision tables (the summary's Markdown, rendered);
 //! 5. the sweep file as run (with its `--set` overrides) and its plan.
@@ -102,6 +103,7 @@ fn render(dir: &Path, sections: &Sections) -> anyhow::Result<Html> {
     plots::time_series(&mut page, dir, sections)?;
     // 3. The method table and classes.
     text::methods(&mut page.body, sections);
+    text::patch(&mut page.body, sections);
     // 4. Energy and the full tables.
     text::tables(&mut page.body, sections);
     // 5. The sweep file and the plan.

@@ -1,6 +1,6 @@
 //! The report's text sections: the sweep (name, description, what ran, the "what to look
 //! at" hints), the method table with every parameter of each group, the method classes, the
-//! energy behaviour, the stability map, the summary's convergence and work-precision tables
+//! contact patch test's table, the energy behaviour, the stability map, the summary's convergence and work-precision tables
 //! (its Markdown, rendered), the sweep file as run with its plan, and the figures not drawn.
 //! Everything comes from the summary's sections, so the report and `DIR/summary/` agree.
 
@@ -50,7 +50,16 @@ pub(super) fn sweep(body: &mut String, dir: &Path, ses: &Session, name: &str, s:
             .map(|f| format!(", finished {}", esc(f)))
             .unwrap_or_default(),
     );
-    body.push_str("<nav><a href=\"#convergence\">convergence</a><a href=\"#work\">work-precision</a><a href=\"#series\">time series</a><a href=\"#methods\">method table</a><a href=\"#classes\">method classes</a><a href=\"#energy\">energy</a><a href=\"#tables\">all tables</a><a href=\"#sweep\">sweep file and plan</a></nav>\n");
+    // The patch-test link only where the section is.
+    let patch = if s.patch.is_empty() {
+        ""
+    } else {
+        "<a href=\"#patch\">patch test</a>"
+    };
+    let _ = writeln!(
+        body,
+        "<nav><a href=\"#convergence\">convergence</a><a href=\"#work\">work-precision</a><a href=\"#series\">time series</a><a href=\"#methods\">method table</a><a href=\"#classes\">method classes</a>{patch}<a href=\"#energy\">energy</a><a href=\"#tables\">all tables</a><a href=\"#sweep\">sweep file and plan</a></nav>"
+    );
     if !conv.groups.hints.is_empty() {
         body.push_str("<div class=\"hints\"><b>What to look at</b><ul>");
         for h in &conv.groups.hints {
@@ -115,6 +124,27 @@ pub(super) fn methods(body: &mut String, s: &Sections) {
             &methods.rows,
         ));
         let _ = writeln!(body, "<p class=\"note\">{}</p>", esc(&methods.legend));
+    }
+}
+
+/// The contact patch test (contract §1.10), as `summary/patch_test.md`: the verdict of every
+/// method per dimension and mesh ratio, then each column group's errors per refinement. Only
+/// for a folder with patch-test runs.
+pub(super) fn patch(body: &mut String, s: &Sections) {
+    let p = &s.patch;
+    if p.is_empty() {
+        return;
+    }
+    body.push_str("<h2 id=\"patch\">Contact patch test</h2>\n");
+    let _ = writeln!(body, "<p class=\"note\">{}</p>", esc(&p.legend));
+    body.push_str(&html_table(
+        p.verdicts.header(),
+        &p.verdicts.right(),
+        p.verdicts.rows(),
+    ));
+    for (head, d) in &p.details {
+        let _ = writeln!(body, "<h3>{}</h3>", esc(head));
+        body.push_str(&html_table(d.header(), &d.right(), d.rows()));
     }
 }
 

@@ -285,8 +285,17 @@ impl Scene for BlocksScene {
         }
         Ok(())
     }
+    /// Errors against a finer reference run (contract §1.10, as §1.2), evaluated as §1.6's: the
+    /// two bodies make one mesh that is no box, so the reference stores it whole and each run
+    /// node is located in it (with a gap the bodies do not touch, so a node's element is its
+    /// own body's).
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
-        None
+        Some(ErrorSource::ReferenceRun)
+    }
+    /// The run's and the reference's meshes are read through the interpolation (above), whether
+    /// or not their lattices nest (B's round(mesh_ratio·W/h) across does not, in general).
+    fn nested_meshes(&self) -> bool {
+        false
     }
     fn setup(&self, p: &Physics, mesh: MeshChoice) -> SceneSetup {
         let across = (p.get("width") / mesh.h).round() as usize;

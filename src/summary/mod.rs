@@ -55,7 +55,8 @@
 //! `impacts.{parquet,csv}`, `ensemble.{parquet,csv,md}`, `stability_map.{parquet,csv,md}`
 //! ([`stability`]: per method and pair of swept axes, the state of every cell),
 //! `search.{parquet,csv,md}` (the boundaries of a `[search]`),
-//! `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`.
+//! `work_precision.{parquet,csv,md}`, `cost_to_error.{parquet,csv}`, and where the folder has
+//! runs of the contact patch test, `patch_test.{parquet,csv,md}` ([`patch`]).
 
 use std::path::{Path, PathBuf};
 
@@ -67,6 +68,7 @@ pub mod energy;
 pub mod ensemble;
 mod latex;
 pub mod methods;
+pub mod patch;
 /// The column choice of the text tables: plain data, one layer down ([`crate::model`]) so the
 /// planner can parse it without importing the summaries.
 pub use crate::model::summary_options as options;
@@ -175,6 +177,7 @@ pub(crate) struct Sections {
     pub(crate) se: search::Section,
     pub(crate) wp: work::Section,
     pub(crate) methods: methods::Section,
+    pub(crate) patch: patch::Section,
     pub(crate) warnings: Vec<String>,
 }
 
@@ -215,6 +218,7 @@ impl Sections {
             rest.map_err(|_| anyhow::anyhow!("a summary section panicked"))?;
         let en = en?;
         let methods = methods::section(&runs);
+        let patch = patch::section(&runs);
         Ok(Sections {
             runs,
             title,
@@ -225,6 +229,7 @@ impl Sections {
             se,
             wp,
             methods,
+            patch,
             warnings,
         })
     }
@@ -239,7 +244,7 @@ impl Sections {
         // The tables are encoded concurrently (one scoped thread each; Parquet and CSV
         // encoding is CPU-bound and the sweep's workers are done by now), the files listed in
         // a fixed order whatever finishes first.
-        let jobs = [
+        let mut jobs = vec![
             Output::Table("convergence", &conv.table),
             Output::Text("convergence.md", &conv.markdown),
             Output::Text("convergence.tex", &conv.latex),
@@ -261,6 +266,13 @@ impl Sections {
             Output::Text("methods.md", &methods.markdown),
             Output::Text("methods.tex", &methods.latex),
         ];
+        // The patch-test table only where the folder has patch-test runs: the other folders'
+        // summaries keep their files.
+        let patch = &self.patch;
+        if !patch.is_empty() {
+            jobs.push(Output::Table("patch_test", &patch.table));
+            jobs.push(Output::Text("patch_test.md", &patch.markdown));
+        }
         let out_dir: &Path = &out;
         let results: Vec<anyhow::Result<Vec<PathBuf>>> = std::thread::scope(|scope| {
             let handles: Vec<_> = jobs
@@ -305,13 +317,15 @@ impl Sections {
         terminal.push_str(&conv.terminal);
         terminal.push_str(&en.terminal);
         terminal.push_str(&methods.terminal);
+        terminal.push_str(&patch.terminal);
         terminal.push_str(&ens.terminal);
         terminal.push_str(&st.terminal);
         terminal.push_str(&se.terminal);
         terminal.push_str(&wp.terminal);
         terminal.push_str(&format!(
-            "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error, methods as .parquet/.csv; .md; convergence.tex, convergence_doc.tex, methods.tex)\n",
-            out.display()
+            "tables: {} (convergence, energy, impacts, ensemble, stability_map, search, work_precision, cost_to_error, methods{} as .parquet/.csv; .md; convergence.tex, convergence_doc.tex, methods.tex)\n",
+            out.display(),
+            if patch.is_empty() { "" } else { ", patch_test" }
         ));
         if !conv.groups.hints.is_empty() {
             terminal.push_str("look at:\n");

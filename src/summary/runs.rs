@@ -28,7 +28,9 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &columns![
     T: F64, ensemble_sample: I64, ensemble_perturbation: F64, friction: Str,
     friction_coefficient: F64, tresca_threshold: F64, height: F64, velocity_tangential: F64,
     friction_force: F64, incline: F64, length_b: F64, young_b: F64, density_b: F64,
-    velocity_b: F64, far_end: Str, mass_side: Str, nitsche_sides: Str,
+    velocity_b: F64, far_end: Str, mass_side: Str, nitsche_sides: Str, width: F64, height_b: F64,
+    lame_lambda_b: F64, lame_mu_b: F64, pressure: F64, mesh_ratio: F64, pairing: Str,
+    mortar_basis: Str, interface_quadrature: Str,
 ];
 
 /// The parameters already spelled out in a run's `label` (contact method · mass · scheme);
@@ -75,7 +77,7 @@ const MEASURED: &[(&str, Kind)] = &columns![
     energy_theta_max_increase: F64, energy_theta_drift: F64, energy_theta_initial: F64,
     length_scale: F64, energy_scale: F64, search: Str, max_penetration: F64,
     pressure_oscillation: F64, friction_work: F64, energy_balance_drift: F64,
-    energy_balance_max_increase: F64,
+    energy_balance_max_increase: F64, patch_stress_error: F64, patch_pressure_error: F64,
 ];
 
 /// One parameter value.
@@ -167,6 +169,10 @@ pub(crate) struct Run {
     pub friction_work: Option<f64>,
     pub energy_balance_drift: Option<f64>,
     pub energy_balance_max_increase: Option<f64>,
+    /// Runs columns `patch_stress_error`, `patch_pressure_error` (two bodies with a pressure,
+    /// contract §1.10; None elsewhere and in older folders).
+    pub patch_stress_error: Option<f64>,
+    pub patch_pressure_error: Option<f64>,
     /// The `[search]` whose probe this run is (null for grid runs).
     pub search: Option<String>,
     /// The runs part the row was read from (`series/` holds the run's rows under the same name).
@@ -692,6 +698,7 @@ struct RunColumns {
     w_f: Vec<Option<f64>>,
     balance_drift: Vec<Option<f64>>,
     balance_inc: Vec<Option<f64>>,
+    patch: [Vec<Option<f64>>; 2],
     sample: Vec<Option<i64>>,
     search: Option<Vec<Option<String>>>,
     e_init: Vec<Option<f64>>,
@@ -770,6 +777,7 @@ impl RunColumns {
             get_f("energy_balance_drift")?,
             get_f("energy_balance_max_increase")?,
         );
+        let patch = [get_f("patch_stress_error")?, get_f("patch_pressure_error")?];
         let sample = get_i("ensemble_sample")?;
         let search = strs(df, "search")?;
         let (e_init, e_fin, drift, max_dev, max_inc, theta_inc) = (
@@ -816,6 +824,7 @@ impl RunColumns {
             w_f,
             balance_drift,
             balance_inc,
+            patch,
             sample,
             search,
             e_init,
@@ -871,6 +880,8 @@ impl RunColumns {
             friction_work: self.w_f[i],
             energy_balance_drift: self.balance_drift[i],
             energy_balance_max_increase: self.balance_inc[i],
+            patch_stress_error: finite(self.patch[0][i]),
+            patch_pressure_error: finite(self.patch[1][i]),
             search: self.search.as_ref().and_then(|v| v[i].clone()),
             part: self.part.as_ref().and_then(|v| v[i].clone()),
             impacts: self.impacts.as_ref().and_then(|v| v[i].clone()),
