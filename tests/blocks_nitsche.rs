@@ -60,6 +60,9 @@ fn nitsche_keeps_the_momentum_of_blocks3d() {
     );
 }
 
+/// `mesh_ratio` 4/3 and 7/5 as the sweep files write them.
+const RATIOS: [(&str, &str); 2] = [("4/3", "1.3333333333333333"), ("7/5", "1.4")];
+
 /// A's cells across (n_a = 1/h) per scene and ratio: three refinements, each a mesh of its
 /// own (§1.10's rounding makes 7/5 at n_a = 3, 6 the meshes of 4/3, so 7/5 takes 5 and 10).
 /// 3D stops at n_a = 4 (4/3) and 5 (7/5): Nitsche's condensation W = P Z is dense over the
@@ -186,4 +189,3 @@ fn friction_with_nitsche_on_nonmatching_blocks_is_refused() {
     let plan = expand(&SweepFile::parse(path, &axis).unwrap()).expect("one combination left out");
     assert_eq!(plan.runs.len(), 1);
 }
-

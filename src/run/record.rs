@@ -89,7 +89,7 @@ impl ColumnValue for Option<Vec<Option<f64>>> {
 macro_rules! schema {
     ($(#[$meta:meta])* $name:ident, $consts:ident { $($field:ident : $ty:ty => $unit:literal, $doc:literal;)* }) => {
         $(#[$meta])*
-        #[derive(Debug, Clone, PartialEq)]
+        #[derive(Debug, Clone, PartialEq, Default)]
         #[allow(non_snake_case)] // `T` is the column name of contract §7
         pub struct $name {
             $(#[doc = $doc] pub $field: $ty,)*
@@ -253,6 +253,9 @@ schema! {
         pressure: Option<f64> => "Pa", "blocks2d, blocks3d: the traction −p e_d on A's top face (the patch test's p)";
         lame_lambda_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's λ (null: A's)";
         lame_mu_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's μ (null: A's)";
+        pairing: Option<String> => "", "blocks2d, blocks3d: how mixed and penalty pair the faces: node-to-node, node-to-segment (one pass, A the slave) or mortar (contract §2.6)";
+        mortar_basis: Option<String> => "", "blocks2d, blocks3d: the mortar multiplier's basis, standard or dual (Wohlmuth's biorthogonal; contract §2.6)";
+        interface_quadrature: Option<String> => "", "blocks2d, blocks3d: where mortar's and Nitsche's interface integrals are computed: segment (the segmentation of Γ^a by Γ^b's projected faces) or element (Γ^a's own face rule; contract §2.6)";
         momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰ − tⁿF) / (Σ_i m_i·abs(V_i) + T·abs(F)), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d (with friction: the largest over every axis, V_i the full velocity), m_i = 1ᵀM_i1 the run's masses, F the total load along that axis (both bodies' weight and the pressure; 0 without) (contract §5; null when a clamp or an obstacle acts, or when the velocities and the load all vanish)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T along e_x (1D) or e_d";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T along e_x (1D) or e_d";
@@ -379,7 +382,7 @@ pub struct Timing {
 impl RunRecord {
     /// Assemble the row of a run.
     pub fn new(sweep: &str, spec: &RunSpec, out: &Outcome, timing: Timing) -> RunRecord {
-        let (p, m) = (&spec.params, &out.metrics);
+        let m = &out.metrics;
         RunRecord {
             run_id: spec.run_id.clone(),
             sweep: sweep.to_string(),
@@ -387,35 +390,7 @@ impl RunRecord {
             label: spec.label.clone(),
             status: out.status.as_str().to_string(),
             message: out.message.clone(),
-            T: num(p, Key::T).unwrap_or(f64::NAN),
-            h: num(p, Key::H).unwrap_or(f64::NAN),
-            elements: elements_of(p),
-            dt: num(p, Key::Dt).unwrap_or(f64::NAN),
-            courant: num(p, Key::Courant).unwrap_or(f64::NAN),
-            space: text(p, Key::Space),
-            mass: text(p, Key::Mass),
-            mass_weights: p.get(&Key::MassWeights).map(weights_text),
-            contact_init: p.get(&Key::ContactInit).map(|v| v.to_string()),
-            scheme: text(p, Key::Scheme),
             scheme_label: spec.scheme_label.clone(),
-            nitsche_theta: num(p, Key::NitscheTheta),
-            nitsche_gamma0: num(p, Key::NitscheGamma0),
-            penalty_gamma0: num(p, Key::PenaltyGamma0),
-            newmark_beta: num(p, Key::NewmarkBeta),
-            newmark_gamma: num(p, Key::NewmarkGamma),
-            theta_scheme: num(p, Key::ThetaScheme),
-            restitution: num(p, Key::Restitution),
-            rho_inf: num(p, Key::RhoInf),
-            hht_alpha: num(p, Key::HhtAlpha),
-            length: num(p, Key::Length),
-            young: num(p, Key::Young),
-            density: num(p, Key::Density),
-            amplitude: num(p, Key::Amplitude),
-            gap: num(p, Key::Gap),
-            lame_lambda: num(p, Key::LameLambda),
-            lame_mu: num(p, Key::LameMu),
-            gravity: num(p, Key::Gravity),
-            degree: num(p, Key::Degree).map(|x| x as i64),
             ensemble_sample: spec.sample.map(|(k, _)| k as i64),
             ensemble_perturbation: spec.sample.map(|(_, p)| p),
             search: spec.search.clone(),
@@ -467,28 +442,13 @@ impl RunRecord {
             free_fall_error: m.free_fall_error,
             iterations_max_step: m.iterations_max_step,
             max_penetration: m.max_penetration,
-            right_end: p.get(&Key::RightEnd).map(|v| v.to_string()),
-            velocity: num(p, Key::Velocity),
-            point_mass: num(p, Key::PointMass),
-            stiffness: num(p, Key::Stiffness),
-            force: num(p, Key::Force),
-            impact_law: num(p, Key::ImpactLaw),
             err_v_l2: m.err_v_l2,
             err_impact_time: m.err_impact_time,
             exit_velocity: m.exit_velocity,
             pressure_oscillation: m.pressure_oscillation,
-            solver: p.get(&Key::Solver).map(|v| v.to_string()),
-            cg_tol: num(p, Key::CgTol),
             solver_iterations: m.solver_iterations,
             solver_iterations_max_step: m.solver_iterations_max_step,
-            load: p.get(&Key::Load).map(|v| v.to_string()),
             lockstep: m.lockstep,
-            friction: p.get(&Key::Friction).map(|v| v.to_string()),
-            friction_coefficient: num(p, Key::FrictionCoefficient),
-            tresca_threshold: num(p, Key::TrescaThreshold),
-            height: num(p, Key::Height),
-            velocity_tangential: num(p, Key::VelocityTangential),
-            incline: num(p, Key::Incline),
             friction_work: m.friction_work,
             energy_balance_drift: m.energy_balance_drift,
             energy_balance_max_increase: m.energy_balance_max_increase,
@@ -502,9 +462,67 @@ impl RunRecord {
             normal_velocity_final: m.normal_velocity_final,
             err_sigma_t_l2: m.err_sigma_t_l2,
             err_vt_final: m.err_vt_final,
-            friction_force: num(p, Key::FrictionForce),
             stop_time: m.stop_time,
             stop_time_exact: m.stop_time_exact,
+            momentum_drift: m.momentum_drift,
+            velocity_a_final: m.velocity_a_final,
+            velocity_b_final: m.velocity_b_final,
+            err_velocity_a_final: m.err_velocity_a_final,
+            err_velocity_b_final: m.err_velocity_b_final,
+            patch_stress_error: m.patch_stress_error,
+            patch_pressure_error: m.patch_pressure_error,
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+            ..Self::parameters(&spec.params)
+        }
+    }
+
+    /// The run's parameter columns (the rest left at their defaults for [`RunRecord::new`]).
+    fn parameters(p: &BTreeMap<Key, Value>) -> RunRecord {
+        RunRecord {
+            T: num(p, Key::T).unwrap_or(f64::NAN),
+            h: num(p, Key::H).unwrap_or(f64::NAN),
+            elements: elements_of(p),
+            dt: num(p, Key::Dt).unwrap_or(f64::NAN),
+            courant: num(p, Key::Courant).unwrap_or(f64::NAN),
+            space: text(p, Key::Space),
+            mass: text(p, Key::Mass),
+            mass_weights: p.get(&Key::MassWeights).map(weights_text),
+            contact_init: p.get(&Key::ContactInit).map(|v| v.to_string()),
+            scheme: text(p, Key::Scheme),
+            nitsche_theta: num(p, Key::NitscheTheta),
+            nitsche_gamma0: num(p, Key::NitscheGamma0),
+            penalty_gamma0: num(p, Key::PenaltyGamma0),
+            newmark_beta: num(p, Key::NewmarkBeta),
+            newmark_gamma: num(p, Key::NewmarkGamma),
+            theta_scheme: num(p, Key::ThetaScheme),
+            restitution: num(p, Key::Restitution),
+            rho_inf: num(p, Key::RhoInf),
+            hht_alpha: num(p, Key::HhtAlpha),
+            length: num(p, Key::Length),
+            young: num(p, Key::Young),
+            density: num(p, Key::Density),
+            amplitude: num(p, Key::Amplitude),
+            gap: num(p, Key::Gap),
+            lame_lambda: num(p, Key::LameLambda),
+            lame_mu: num(p, Key::LameMu),
+            gravity: num(p, Key::Gravity),
+            degree: num(p, Key::Degree).map(|x| x as i64),
+            right_end: p.get(&Key::RightEnd).map(|v| v.to_string()),
+            velocity: num(p, Key::Velocity),
+            point_mass: num(p, Key::PointMass),
+            stiffness: num(p, Key::Stiffness),
+            force: num(p, Key::Force),
+            impact_law: num(p, Key::ImpactLaw),
+            solver: p.get(&Key::Solver).map(|v| v.to_string()),
+            cg_tol: num(p, Key::CgTol),
+            load: p.get(&Key::Load).map(|v| v.to_string()),
+            friction: p.get(&Key::Friction).map(|v| v.to_string()),
+            friction_coefficient: num(p, Key::FrictionCoefficient),
+            tresca_threshold: num(p, Key::TrescaThreshold),
+            height: num(p, Key::Height),
+            velocity_tangential: num(p, Key::VelocityTangential),
+            incline: num(p, Key::Incline),
+            friction_force: num(p, Key::FrictionForce),
             length_b: num(p, Key::LengthB).filter(|x| !x.is_nan()),
             young_b: num(p, Key::YoungB).filter(|x| !x.is_nan()),
             density_b: num(p, Key::DensityB).filter(|x| !x.is_nan()),
@@ -518,14 +536,10 @@ impl RunRecord {
             pressure: num(p, Key::Pressure),
             lame_lambda_b: num(p, Key::LameLambdaB).filter(|x| !x.is_nan()),
             lame_mu_b: num(p, Key::LameMuB).filter(|x| !x.is_nan()),
-            momentum_drift: m.momentum_drift,
-            velocity_a_final: m.velocity_a_final,
-            velocity_b_final: m.velocity_b_final,
-            err_velocity_a_final: m.err_velocity_a_final,
-            err_velocity_b_final: m.err_velocity_b_final,
-            patch_stress_error: m.patch_stress_error,
-            patch_pressure_error: m.patch_pressure_error,
-            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+            pairing: p.get(&Key::Pairing).map(|v| v.to_string()),
+            mortar_basis: p.get(&Key::MortarBasis).map(|v| v.to_string()),
+            interface_quadrature: p.get(&Key::InterfaceQuadrature).map(|v| v.to_string()),
+            ..RunRecord::default()
         }
     }
 }

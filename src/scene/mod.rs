@@ -265,13 +265,6 @@ pub trait Scene: Send + Sync {
             self.name()
         ))
     }
-    /// Whether a friction law acts with the contact treatment `space` here (asked once
-    /// [`Scene::supports_friction`] agrees); `Err` says why not. Every treatment by default
-    /// (every scene today).
-    fn supports_friction_with(&self, space: &str) -> Result<(), String> {
-        let _ = space;
-        Ok(())
-    }
     /// Whether a physics value rules out a scheme (e.g. the oscillator's dry friction with a
     /// scheme that has no frictional step); `Err` names the key and says why.
     fn supports_physics(

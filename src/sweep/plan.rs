@@ -706,13 +706,6 @@ fn friction_of(
     if friction_kind != FrictionKind::None {
         if let Err(why) = given.scene.supports_friction() {
             issues.push(Issue::at(&given.origin(Key::Friction), why));
-        } else if let Err(why) = given.scene.supports_friction_with(&given.word(Key::Space)) {
-            // A combination of two axes is left out; fixed together, it is the input's fault.
-            if friction_fixed && !given.on_axis(Key::Space) {
-                issues.push(Issue::at(&given.origin(Key::Friction), why));
-            } else {
-                return Err(Outcome::Inapplicable(why));
-            }
         }
         // Where the literature defines no frictional version (contract §2.5).
         let undefined = match scheme {
@@ -1193,10 +1186,7 @@ fn read_mesh_file(
 /// Friction with `space = nitsche` on a two-body file: the file's interface points
 /// (`run::fe::nitsche_interface`) carry no tangential rows yet — the relative slip's Nitsche
 /// rows are built on the matching blocks only.
-fn nitsche_friction_on_bodies_file(
-    m: &crate::space::fe::GmshMesh,
-    given: &Given,
-) -> Option<Issue> {
+fn nitsche_friction_on_bodies_file(m: &crate::space::fe::GmshMesh, given: &Given) -> Option<Issue> {
     let (v, _) = given.user.get(&Key::Space)?;
     let (f, o) = given.user.get(&Key::Friction)?;
     let frictional = f.as_str().is_some_and(|f| f != "none");
