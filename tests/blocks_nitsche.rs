@@ -172,7 +172,7 @@ fn nitsche_keeps_the_momentum_of_nonmatching_blocks() {
 #[test]
 fn friction_with_nitsche_on_nonmatching_blocks_is_refused() {
     use contact_sweep::sweep::{SweepFile, expand};
-    let text = "name = \"x\"\nscene = \"blocks2d\"\n[fixed]\nh = 0.25\ndt = 0.02\nT = 0.1\nspace = \"nitsche\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\nmesh_ratio = 1.3333333333333333\n";
+    let text = "name = \"x\"\nscene = \"blocks2d\"\n[fixed]\nh = 0.25\ndt = 0.02\nT = 0.1\nspace = \"nitsche\"\nnitsche_gamma0 = 0.05\nnitsche_theta = 1.0\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\nmesh_ratio = 1.3333333333333333\n";
     let path = std::path::Path::new("t.toml");
     let e = match expand(&SweepFile::parse(path, text).unwrap()) {
         Err(e) => format!("{e:?}"),

@@ -581,7 +581,7 @@ fn bad_two_body_meshes_are_refused() {
     // Friction with Nitsche on a file: its interface points carry no slip rows yet.
     let e = refused(
         &good,
-        "space = \"nitsche\"\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
+        "space = \"nitsche\"\nnitsche_gamma0 = 0.05\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
     );
     assert!(
         e.contains("two.msh") && e.contains("friction with space = nitsche"),
