@@ -11,8 +11,8 @@ use std::sync::Arc;
 
 use super::nitsche_interface::PairFaces;
 use super::nitsche_pair::{blocks_interface, pair_points};
-use super::pairing::{GeneralRows, RowEntries, box_face, general_rows};
-use super::rows::Rows;
+use super::pairing::{GeneralRows, box_face, general_rows};
+use super::rows::{RowEntries, Rows};
 use crate::run::Metrics;
 use crate::scene::{Blocks, FeSetup, MassSide, Pairing};
 use crate::space::fe::element::q1_gradient_at;

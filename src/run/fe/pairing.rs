@@ -22,6 +22,7 @@
 //! surfaces are built on that plane exactly, from the node indices: the reference gaps are 0
 //! with no coordinate round-off.
 
+use super::rows::RowEntries;
 use crate::scene::{Blocks, InterfaceQuadrature, Pairing};
 use crate::space::fe::BoxMesh;
 use crate::space::fe::interface::{
@@ -33,9 +34,6 @@ pub(super) struct Side {
     pub(super) surface: Surface,
     pub(super) global: Vec<usize>,
 }
-
-/// A row's entries as (global node, coefficient of its e_d component): A's, then B's.
-pub(super) type RowEntries = (Vec<(usize, f64)>, Vec<(usize, f64)>);
 
 /// The rows of a projecting pairing over global nodes (module header).
 pub(super) struct GeneralRows {

@@ -20,6 +20,10 @@
 //! computed before rows existed (1·x = x, and a sum is started from its first term, never from
 //! 0.0, which would turn −0 into +0), so the one-body runs keep their numbers bit for bit.
 
+/// A general row's entries as (global node or dof, coefficient of its e_d component): A's,
+/// then B's.
+pub(super) type RowEntries = (Vec<(usize, f64)>, Vec<(usize, f64)>);
+
 /// The rows of one run's contact set, in compressed sparse row form.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub(super) struct Rows {
@@ -58,7 +62,7 @@ impl Rows {
 
     /// General two-body rows, one per (A's entries, B's entries): B_i = Σ_a c_a e_a + Σ_b c_b e_b
     /// (node-to-segment and mortar, issue 45).
-    pub(super) fn general(rows: &[(Vec<(usize, f64)>, Vec<(usize, f64)>)]) -> Rows {
+    pub(super) fn general(rows: &[RowEntries]) -> Rows {
         let mut r = Rows {
             start: vec![0],
             ..Rows::default()
