@@ -241,13 +241,13 @@ pub fn mortar_matrices(
             psi_integral[fa[k]] += sl[k];
         }
     }
-    Ok(Mortar {
+    Ok(Mortar::assemble(
         basis,
-        d: SparseRows::from_triplets(a.num_nodes(), a.num_nodes(), d),
-        m: SparseRows::from_triplets(a.num_nodes(), b.num_nodes(), m),
+        (a, b),
+        (d, m),
         weighted_gap,
         psi_integral,
-    })
+    ))
 }
 
 /// Γ^a's own face rule: the trace of its elements' rule, 2 Gauss points per direction (the
@@ -306,11 +306,32 @@ pub fn mortar_matrices_element(
             }
         }
     }
-    Ok(Mortar {
+    Ok(Mortar::assemble(
         basis,
-        d: SparseRows::from_triplets(a.num_nodes(), a.num_nodes(), d),
-        m: SparseRows::from_triplets(a.num_nodes(), b.num_nodes(), m),
+        (a, b),
+        (d, m),
         weighted_gap,
         psi_integral,
-    })
+    ))
+}
+
+impl Mortar {
+    /// D and M from their (row, column, value) triplets over Γ^a × Γ^a and Γ^a × Γ^b nodes,
+    /// with the per-row weighted gaps and ∫ψ_k: what both quadratures end with.
+    #[allow(clippy::type_complexity)]
+    fn assemble(
+        basis: Basis,
+        (a, b): (&Surface, &Surface),
+        (d, m): (Vec<(usize, usize, f64)>, Vec<(usize, usize, f64)>),
+        weighted_gap: Vec<f64>,
+        psi_integral: Vec<f64>,
+    ) -> Mortar {
+        Mortar {
+            basis,
+            d: SparseRows::from_triplets(a.num_nodes(), a.num_nodes(), d),
+            m: SparseRows::from_triplets(a.num_nodes(), b.num_nodes(), m),
+            weighted_gap,
+            psi_integral,
+        }
+    }
 }
