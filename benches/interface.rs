@@ -30,7 +30,13 @@
 //! medians of 5 rounds interleaved over the rows, in one process. Not a criterion group: a run
 //! lasts seconds under load, and criterion's fewest samples would take minutes per row.
 //!
-//! Measured: see docs/performance.md (the figures of the last run are printed by the bench).
+//! Measured at issue 45 (`cargo bench --bench interface`, 2:45 min; 2 cores shared with other
+//! builds, load average 9–10; docs/performance.md has the tables): the set-up grows linearly,
+//! CPU ×2.03, ×2.06, ×1.54 per doubling of the faces in 3D (27.6, 55.9, 115.1, 177.5 ms;
+//! criterion's wall medians 55.4, 120.5, 253.8, 514.4 ms: ×2.18, ×2.11, ×2.03) and ×2.05, ×2.06,
+//! ×2.08 in 2D (1.08 … 9.44 ms) — target ≤ 2.5× met. A mortar step costs ×0.27 (clock) / ×0.40
+//! (CPU) a node-to-node step at equal dofs with `mixed`, ×0.97 / ×1.00 with `penalty`; ×0.88 /
+//! ×0.76 and ×0.98 / ×0.83 at equal rows — target ≤ 1.3× met.
 
 use std::time::Duration;
 
