@@ -277,6 +277,29 @@ fn two_body_time_loops_allocate_nothing() {
     }
 }
 
+/// Non-matching blocks (issue 45, `mesh_ratio` 4/3: B round(16/3) = 5 elements across under A's 4): the
+/// projecting pairings' rows — node-to-segment, mortar with the standard and the dual basis on
+/// the segmentation, mortar with the `element` quadrature — with mixed and penalty +
+/// Crank–Nicolson, mixed + backward Euler, on blocks2d and blocks3d: rows with more entries
+/// than a node-to-node pair's go through the same products, nothing allocated per step.
+#[test]
+fn non_matching_time_loops_allocate_nothing() {
+    let methods = [
+        r#"{ space = "mixed", pairing = "node-to-segment", scheme = "crank-nicolson" }"#,
+        r#"{ space = "mixed", pairing = "mortar", scheme = "crank-nicolson" }"#,
+        r#"{ space = "mixed", pairing = "mortar", mortar_basis = "dual", scheme = "backward-euler" }"#,
+        r#"{ space = "mixed", pairing = "mortar", interface_quadrature = "element", scheme = "crank-nicolson" }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 10.0, pairing = "mortar", scheme = "crank-nicolson" }"#,
+        r#"{ space = "penalty", penalty_gamma0 = 10.0, pairing = "node-to-segment", scheme = "crank-nicolson" }"#,
+    ];
+    let fixed = "h = 0.25\nmesh_ratio = 1.3333333333333333\ndt = 0.01\nvelocity = -1.0\nvelocity_b = 0.5\ngap = 0.05";
+    // Backward Euler's impact is plastic: the blocks touch and stay (one switch).
+    for scene in ["blocks2d", "blocks3d"] {
+        let text = fe_sweep("alloc-blocks-nonmatching", scene, fixed, &methods);
+        assert_loop_allocates_nothing_with(&text, 1.0, 1);
+    }
+}
+
 /// Friction with two-body Nitsche (issue 44): the pair points' slip rows through the one-body
 /// frictional Newton and tally — unbiased with Crank–Nicolson (Coulomb), one-sided with
 /// backward Euler (Tresca), generalized-α — on blocks2d and blocks3d, nothing allocated per
