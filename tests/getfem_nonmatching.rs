@@ -22,7 +22,9 @@
 
 mod common;
 
-use common::getfem_blocks::{Setting, engine_equals_getfem};
+use common::getfem::run_script_on;
+use common::getfem_blocks::{FaceB, Setting, compare, engine_equals_getfem};
+use contact_sweep::run::RunContext;
 
 /// B's elements across per A's: round(4/3·4) = 5 against A's 4.
 const NODE_TO_SEGMENT: &str = r#"pairing = "node-to-segment"
@@ -40,6 +42,7 @@ const SETTINGS: [Setting; 2] = [
         lame_lambda_b: 0.5,
         lame_mu_b: 1.5,
         far_end: "free",
+        t_final: 4.0,
         mesh_ratio: 1.3333333333333333,
         contact: NODE_TO_SEGMENT,
     },
@@ -53,6 +56,7 @@ const SETTINGS: [Setting; 2] = [
         lame_lambda_b: 2.0,
         lame_mu_b: 0.5,
         far_end: "clamped",
+        t_final: 4.0,
         mesh_ratio: 1.3333333333333333,
         contact: NODE_TO_SEGMENT,
     },
@@ -61,4 +65,57 @@ const SETTINGS: [Setting; 2] = [
 #[test]
 fn engine_node_to_segment_equals_getfem_nodal_brick_on_nonmatching_blocks2d() {
     engine_equals_getfem(&SETTINGS);
+}
+
+/// Nitsche's γ0 (contract §6's patch-test value, at which the blocks' Newton converges) and
+/// the variants: `nitsche_sides` × Θ.
+const GAMMA0: f64 = 0.05;
+const NITSCHE: [(&str, f64); 6] = [
+    ("unbiased", 1.0),
+    ("unbiased", 0.0),
+    ("unbiased", -1.0),
+    ("a", 1.0),
+    ("a", 0.0),
+    ("a", -1.0),
+];
+
+#[test]
+fn engine_nitsche_element_quadrature_equals_getfem_gwfl_nitsche_on_nonmatching_blocks2d() {
+    let ctx = RunContext {
+        reference: None,
+        record_reference: Some((1, 1)),
+    };
+    for base in &SETTINGS {
+        // 50 steps (T = 1): the first contact phase and the flight after it.
+        let s = Setting {
+            t_final: 1.0,
+            ..*base
+        };
+        let variants: Vec<String> = NITSCHE.iter().map(|(w, t)| format!("{w}:{t}")).collect();
+        let gf = run_script_on(
+            "nitsche_blocks.py",
+            None,
+            &[
+                s.params(serde_json::json!({"gamma0": GAMMA0, "mass": "consistent"})),
+                variants.join(","),
+            ],
+        );
+        for ((sides, theta), variant) in NITSCHE.iter().zip(&variants) {
+            let method = format!(
+                "space = \"nitsche\"\nnitsche_gamma0 = {GAMMA0}\nnitsche_sides = \"{sides}\"\ninterface_quadrature = \"element\"\nmesh_ratio = {}\nmass = \"consistent\"",
+                s.mesh_ratio
+            );
+            let sweep = s.sweep(&method, &format!("nitsche_theta = [{theta:?}]"));
+            let runs = common::outcomes_edited(
+                &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("t.toml"),
+                &sweep,
+                |_| {},
+                &ctx,
+            );
+            assert_eq!(runs.len(), 1);
+            let what = format!("{} · nitsche {variant}", s.name);
+            let (g, o) = (&gf["variants"][variant], &runs[0].1);
+            compare(&s, &gf["nodes"], g, &what, o, true, FaceB::Nearest);
+        }
+    }
 }
