@@ -2,11 +2,14 @@
 """Two elastic blocks, A falling on B, with GetFEM 5.4's nodal contact brick between two bodies
 (`add_nodal_contact_between_nonmatching_meshes_brick`, Debian's python3-getfem) and Newmark
 β = ¼, γ = ½ — an implementation of contract §1.10/§2.1/§2.2/§2.6/§3 that shares no code with
-the engine, for tests/getfem_blocks.rs (issue 44).
+the engine, for tests/getfem_blocks.rs (issue 44) and tests/getfem_nonmatching.rs (issue 45).
+The blocks, K, M, the masses and the Newmark loop are tests/getfem/two_blocks.py's (shared with
+tests/getfem/nitsche_blocks.py).
 
 The bodies (contract §1.10): B = [0, W] × [0, H_b] and A = [0, W] × [H_b + g, H_b + g + H_a],
 each a GetFEM mesh of its own (two displacement variables u_a, u_b), Q1 squares of side h
-(GT_QK(2,1), FEM_QK(2,1)), W/h across both (a matching interface), plane strain, each with its
+(GT_QK(2,1), FEM_QK(2,1)), W/h across A and round(mesh_ratio·W/h) across B (1, the default: a
+matching interface), plane strain, each with its
 own ρ, λ, μ. K and M per body with a 3 × 3 Gauss rule (exact for Q1 on rectangles: the mass's
 and the stiffness' integrands have degree ≤ 2 per axis); no load. B's base is free or clamped
 (u_b = 0 on y = 0 by GetFEM's Dirichlet condition with simplification: the dofs leave the
@@ -42,7 +45,7 @@ Usage: blocks.py OUT.json PARAMS_JSON VARIANTS
   PARAMS_JSON: {"width", "height", "height_b", "h", "gap", "velocity", "velocity_tangential",
                 "velocity_b",
                 "density", "lame_lambda", "lame_mu", "density_b", "lame_lambda_b", "lame_mu_b",
-                "far_end" ("free" | "clamped"), "T", "dt"}
+                "far_end" ("free" | "clamped"), "T", "dt", optionally "mesh_ratio"}
   VARIANTS: comma-separated masses.
 Writes per variant the series (force, energy, kinetic, elastic, momentum, Newton iterations),
 the whole displacement field at every step (node by node; `nodes` gives each node's body and
