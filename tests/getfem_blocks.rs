@@ -46,39 +46,10 @@
 
 mod common;
 
-use common::getfem_blocks::{Setting, engine_equals_getfem};
+use common::getfem_blocks::{CLAMPED, FREE, Setting, engine_equals_getfem};
 
 /// The matching blocks (`mesh_ratio` 1, node-to-node rows).
-const SETTINGS: [Setting; 2] = [
-    Setting {
-        name: "free",
-        height_b: 1.0,
-        gap: 0.1,
-        velocity_tangential: 0.3,
-        velocity_b: 0.5,
-        density_b: 2.0,
-        lame_lambda_b: 0.5,
-        lame_mu_b: 1.5,
-        far_end: "free",
-        t_final: 4.0,
-        mesh_ratio: 1.0,
-        contact: "",
-    },
-    Setting {
-        name: "clamped",
-        height_b: 0.75,
-        gap: 0.05,
-        velocity_tangential: 0.0,
-        velocity_b: 0.0,
-        density_b: 1.5,
-        lame_lambda_b: 2.0,
-        lame_mu_b: 0.5,
-        far_end: "clamped",
-        t_final: 4.0,
-        mesh_ratio: 1.0,
-        contact: "",
-    },
-];
+const SETTINGS: [Setting; 2] = [FREE, CLAMPED];
 
 #[test]
 fn engine_equals_getfem_two_body_brick_on_blocks2d() {

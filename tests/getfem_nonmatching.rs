@@ -65,7 +65,7 @@
 mod common;
 
 use common::getfem::run_script_on;
-use common::getfem_blocks::{Check, FaceB, Setting, compare, engine_equals_getfem};
+use common::getfem_blocks::{CLAMPED, Check, FREE, FaceB, Setting, compare, engine_equals_getfem};
 use contact_sweep::run::RunContext;
 
 /// B's elements across per A's: round(4/3·4) = 5 against A's 4.
@@ -76,31 +76,15 @@ mesh_ratio = 1.3333333333333333"#;
 const SETTINGS: [Setting; 2] = [
     Setting {
         name: "free-ratio-4-3",
-        height_b: 1.0,
-        gap: 0.1,
-        velocity_tangential: 0.3,
-        velocity_b: 0.5,
-        density_b: 2.0,
-        lame_lambda_b: 0.5,
-        lame_mu_b: 1.5,
-        far_end: "free",
-        t_final: 4.0,
         mesh_ratio: 1.3333333333333333,
         contact: NODE_TO_SEGMENT,
+        ..FREE
     },
     Setting {
         name: "clamped-ratio-4-3",
-        height_b: 0.75,
-        gap: 0.05,
-        velocity_tangential: 0.0,
-        velocity_b: 0.0,
-        density_b: 1.5,
-        lame_lambda_b: 2.0,
-        lame_mu_b: 0.5,
-        far_end: "clamped",
-        t_final: 4.0,
         mesh_ratio: 1.3333333333333333,
         contact: NODE_TO_SEGMENT,
+        ..CLAMPED
     },
 ];
 

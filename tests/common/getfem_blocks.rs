@@ -34,6 +34,39 @@ pub struct Setting {
     pub t_final: f64,
 }
 
+/// The settings of tests/getfem_blocks.rs (issue 44) on the matching blocks: B free (A at −1,
+/// sliding at 0.3, onto B rising at ½: the momentum an invariant), or B clamped at rest with a
+/// smaller gap and a shorter B; per-body materials.
+pub const FREE: Setting = Setting {
+    name: "free",
+    height_b: 1.0,
+    gap: 0.1,
+    velocity_tangential: 0.3,
+    velocity_b: 0.5,
+    density_b: 2.0,
+    lame_lambda_b: 0.5,
+    lame_mu_b: 1.5,
+    far_end: "free",
+    t_final: 4.0,
+    mesh_ratio: 1.0,
+    contact: "",
+};
+
+pub const CLAMPED: Setting = Setting {
+    name: "clamped",
+    height_b: 0.75,
+    gap: 0.05,
+    velocity_tangential: 0.0,
+    velocity_b: 0.0,
+    density_b: 1.5,
+    lame_lambda_b: 2.0,
+    lame_mu_b: 0.5,
+    far_end: "clamped",
+    t_final: 4.0,
+    mesh_ratio: 1.0,
+    contact: "",
+};
+
 /// A's keys (W = H_a = 1, h = 1/4: 4 × 4 squares in A; ρ = λ = μ = 1, V = −1), τ and T.
 const H: f64 = 0.25;
 const WIDTH: f64 = 1.0;
