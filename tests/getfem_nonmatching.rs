@@ -49,9 +49,10 @@
 //!   contact step (measured: 2.4 → 5.7e-8 in one iteration, then line-search cycling between
 //!   2.6e-8 and 2.4e-7 up to any max_iter; max_res 1e-8 to 1e-10 never met, where the
 //!   interpolate transformation ends at 2e-13) — its projected point is not exact to round-off;
-//!   it meets max_res 1e-6 at every step. Asserted to
-//!   1e-6 against the engine; measured ≤ 3.2e-7 (the field, `a`, Θ = 1, free), the force
-//!   ≤ 3.0e-7: the same solution to that floor.
+//!   it meets max_res 1e-6 at every step. Asserted to 1e-6 against the engine; measured
+//!   ≤ 3.2e-7 (the field, `a`, Θ = 1, free), the force ≤ 3.0e-7: the same solution to that
+//!   floor.
+//!
 //! The engine's `segment` quadrature on the same runs leaves the `element` field by 3.0e-3 to
 //! 2.3e-2 of its scale (asserted > 1e-3): the agreement pins the quadrature, not only the
 //! method.

@@ -192,6 +192,9 @@ fn engine_field(o: &Outcome, nodes: &serde_json::Value, gap: f64) -> Vec<Vec<[f6
         .collect()
 }
 
+/// A value read from one step's field at Γ^a's node k at x.
+type AtNode<'a> = dyn Fn(&[[f64; 2]], usize, f64) -> f64 + 'a;
+
 /// Where the engine's `u_contact_b` reads B: at Π(x_i) below each Γ^a node x_i (the rows of
 /// node-to-node, node-to-segment and mortar), or at the Γ^b node of index
 /// round(i·across_b/across) for Γ^a's node i (Nitsche on a non-matching interface, whose
@@ -248,7 +251,8 @@ fn face_means(
         let t = (x - x0) / (x1 - x0);
         (1.0 - t) * u[k0][1] + t * u[k1][1]
     };
-    let mean = |f: &dyn Fn(&[[f64; 2]], usize, f64) -> f64| -> Vec<f64> {
+    // The weighted mean over Γ^a's nodes (k, x) of f(u, k, x) at every step.
+    let mean = |f: &AtNode| -> Vec<f64> {
         field
             .iter()
             .map(|u| {
