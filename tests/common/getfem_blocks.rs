@@ -32,6 +32,8 @@ pub struct Setting {
     pub far_end: &'static str,
     /// The runs' end time T (τ = 0.02).
     pub t_final: f64,
+    /// `blocks2d` (2) or `blocks3d` (3).
+    pub dim: usize,
 }
 
 /// The settings of tests/getfem_blocks.rs (issue 44) on the matching blocks: B free (A at −1,
@@ -48,6 +50,7 @@ pub const FREE: Setting = Setting {
     lame_mu_b: 1.5,
     far_end: "free",
     t_final: 4.0,
+    dim: 2,
     mesh_ratio: 1.0,
     contact: "",
 };
@@ -63,6 +66,7 @@ pub const CLAMPED: Setting = Setting {
     lame_mu_b: 0.5,
     far_end: "clamped",
     t_final: 4.0,
+    dim: 2,
     mesh_ratio: 1.0,
     contact: "",
 };
@@ -86,7 +90,7 @@ impl Setting {
             "density": 1.0, "lame_lambda": 1.0, "lame_mu": 1.0,
             "density_b": self.density_b, "lame_lambda_b": self.lame_lambda_b,
             "lame_mu_b": self.lame_mu_b, "far_end": self.far_end, "T": self.t_final, "dt": DT,
-            "mesh_ratio": self.mesh_ratio,
+            "mesh_ratio": self.mesh_ratio, "dim": self.dim,
         });
         for (k, v) in extra.as_object().expect("an object") {
             p[k] = v.clone();
@@ -100,7 +104,7 @@ impl Setting {
         format!(
             r#"
 name = "getfem-blocks-{}"
-scene = "blocks2d"
+scene = "blocks{}d"
 [fixed]
 width = {WIDTH}
 height = {HEIGHT}
@@ -125,6 +129,7 @@ scheme = "crank-nicolson"
 {grid}
 "#,
             self.name,
+            self.dim,
             self.height_b,
             self.gap,
             self.velocity_tangential,
@@ -147,29 +152,24 @@ fn max_diff(a: &[f64], b: &[f64], end: usize) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A GetFEM node's coordinates (z = 0 in 2D).
+fn coords(p: &serde_json::Value) -> [f64; 3] {
+    ["x", "y", "z"].map(|k| p.get(k).and_then(|x| x.as_f64()).unwrap_or(0.0))
+}
+
 /// The engine's recorded displacement of every GetFEM node at every step, in GetFEM's node
-/// order (times × nodes × 2): A's nodes are the engine's first (W/h + 1)(H_a/h + 1), placed
-/// on B's top (y − g), B's the rest.
-fn engine_field(o: &Outcome, nodes: &serde_json::Value, gap: f64) -> Vec<Vec<[f64; 2]>> {
+/// order (times × nodes × 3, z = 0 in 2D): A's nodes are the engine's first
+/// (W/h + 1)^{d−1}(H_a/h + 1), placed on B's top (x_d − g), B's the rest.
+fn engine_field(o: &Outcome, nodes: &serde_json::Value, s: &Setting) -> Vec<Vec<[f64; 3]>> {
+    let d = s.dim;
     let data = o.reference.as_ref().expect("the run records its solution");
     let mesh = data.mesh.as_ref().expect("two bodies store their mesh");
     let n = mesh.coords.len();
     let across = (WIDTH / H).round() as usize;
-    let n_a = (across + 1) * ((HEIGHT / H).round() as usize + 1);
-    let key = |body: usize, x: f64, y: f64| {
-        (
-            body,
-            (x / H * 1e6).round() as i64,
-            (y / H * 1e6).round() as i64,
-        )
-    };
+    let n_a = (across + 1).pow(d as u32 - 1) * ((HEIGHT / H).round() as usize + 1);
+    let key = |body: usize, x: [f64; 3]| (body, x.map(|c| (c / H * 1e6).round() as i64));
     let index: HashMap<_, usize> = (0..n)
-        .map(|k| {
-            (
-                key(usize::from(k >= n_a), mesh.coords[k][0], mesh.coords[k][1]),
-                k,
-            )
-        })
+        .map(|k| (key(usize::from(k >= n_a), mesh.coords[k]), k))
         .collect();
     let map: Vec<usize> = nodes
         .as_array()
@@ -177,79 +177,107 @@ fn engine_field(o: &Outcome, nodes: &serde_json::Value, gap: f64) -> Vec<Vec<[f6
         .iter()
         .map(|p| {
             let body = p["body"].as_u64().unwrap() as usize;
-            let (x, y) = (p["x"].as_f64().unwrap(), p["y"].as_f64().unwrap());
-            let y = if body == 0 { y - gap } else { y };
-            index[&key(body, x, y)]
+            let mut x = coords(p);
+            if body == 0 {
+                x[d - 1] -= s.gap;
+            }
+            index[&key(body, x)]
         })
         .collect();
     assert_eq!(map.len(), n, "every node matched");
     (0..data.times)
         .map(|t| {
             map.iter()
-                .map(|&k| [data.u[(t * n + k) * 2], data.u[(t * n + k) * 2 + 1]])
+                .map(|&k| {
+                    let mut u = [0.0; 3];
+                    (0..d).for_each(|c| u[c] = data.u[(t * n + k) * d + c]);
+                    u
+                })
                 .collect()
         })
         .collect()
 }
 
-/// A value read from one step's field at Γ^a's node k at x.
-type AtNode<'a> = dyn Fn(&[[f64; 2]], usize, f64) -> f64 + 'a;
-
 /// Where the engine's `u_contact_b` reads B: at Π(x_i) below each Γ^a node x_i (the rows of
 /// node-to-node, node-to-segment and mortar), or at the Γ^b node of index
-/// round(i·across_b/across) for Γ^a's node i (Nitsche on a non-matching interface, whose
-/// points carry its forces: src/run/fe/bodies.rs's observable pairs).
+/// round(i·across_b/across) (per axis) for Γ^a's node i (Nitsche on a non-matching interface,
+/// whose points carry its forces: src/run/fe/bodies.rs's observable pairs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FaceB {
     Projected,
     Nearest,
 }
 
-/// GetFEM's means of u_y over Γ^a with the trapezoidal weights w_i (the engine's `u_contact`)
-/// and of B's u_y at the points `at` gives for Γ^a's nodes with the same weights
-/// (`u_contact_b`; B's displacement at Π(x_i) is linear along B's face; on a matching interface
-/// both are B's own nodes) at every step.
+/// GetFEM's means of u_d over Γ^a with the trapezoidal weights w_i (per axis ½ at the ends; the
+/// engine's `u_contact`) and of B's u_d at the points `at` gives for Γ^a's nodes with the same
+/// weights (`u_contact_b`; B's displacement at Π(x_i) is multilinear on B's face cell; on a
+/// matching interface both are B's own nodes) at every step.
 fn face_means(
-    field: &[Vec<[f64; 2]>],
+    field: &[Vec<[f64; 3]>],
     nodes: &serde_json::Value,
     s: &Setting,
     at: FaceB,
 ) -> [Vec<f64>; 2] {
+    let d = s.dim;
     let nodes = nodes.as_array().unwrap();
-    // (node, x) of a body's face nodes at height y, by increasing x.
-    let face = |body: usize, y: f64| -> Vec<(usize, f64)> {
-        let mut on: Vec<(usize, f64)> = nodes
+    // (node, coordinates) of a body's face nodes at height `level`.
+    let face = |body: usize, level: f64| -> Vec<(usize, [f64; 3])> {
+        nodes
             .iter()
             .enumerate()
             .filter(|(_, p)| {
                 p["body"].as_u64().unwrap() as usize == body
-                    && (p["y"].as_f64().unwrap() - y).abs() < 1e-9
+                    && (coords(p)[d - 1] - level).abs() < 1e-9
             })
-            .map(|(k, p)| (k, p["x"].as_f64().unwrap()))
-            .collect();
-        on.sort_by(|a, b| a.1.total_cmp(&b.1));
-        on
+            .map(|(k, p)| (k, coords(p)))
+            .collect()
     };
     let (face_a, face_b) = (face(0, s.height_b + s.gap), face(1, s.height_b));
-    let weight = |x: f64| {
-        let end = x.abs() < 1e-9 || (x - WIDTH).abs() < 1e-9;
-        if end { 0.5 } else { 1.0 }
+    let across = (WIDTH / H).round() as usize;
+    let across_b = (s.mesh_ratio * across as f64).round() as usize;
+    // B's face node at lattice index j (per horizontal axis).
+    let b_at: HashMap<[usize; 2], usize> = face_b
+        .iter()
+        .map(|&(k, x)| {
+            let j = |a: usize| (x[a] / WIDTH * across_b as f64).round() as usize;
+            ([0, 1].map(|a| if a < d - 1 { j(a) } else { 0 }), k)
+        })
+        .collect();
+    let weight = |x: [f64; 3]| -> f64 {
+        (0..d - 1)
+            .map(|a| {
+                let end = x[a].abs() < 1e-9 || (x[a] - WIDTH).abs() < 1e-9;
+                if end { 0.5 } else { 1.0 }
+            })
+            .product()
     };
     let total: f64 = face_a.iter().map(|&(_, x)| weight(x)).sum();
-    let (across, across_b) = (face_a.len() - 1, face_b.len() - 1);
-    // B's u_y at x: linear between the face nodes around it, or at the engine's node.
-    let below = |u: &[[f64; 2]], x: f64| {
-        if at == FaceB::Nearest {
-            let i = (x / WIDTH * across as f64).round();
-            return u[face_b[(i * across_b as f64 / across as f64).round() as usize].0][1];
+    // B's u_d below x: multilinear between the lattice nodes around it, or at the engine's
+    // node.
+    let below = |u: &[[f64; 3]], x: [f64; 3]| -> f64 {
+        let mut corners = vec![([0usize; 2], 1.0)];
+        for a in 0..d - 1 {
+            let r = x[a] / WIDTH * across_b as f64;
+            let axis = if at == FaceB::Nearest {
+                let i = (x[a] / WIDTH * across as f64).round();
+                vec![((i * across_b as f64 / across as f64).round() as usize, 1.0)]
+            } else {
+                let j = (r.floor() as usize).min(across_b - 1);
+                let t = r - j as f64;
+                vec![(j, 1.0 - t), (j + 1, t)]
+            };
+            corners = corners
+                .iter()
+                .flat_map(|&(c, w)| {
+                    axis.iter().map(move |&(j, wj)| {
+                        let mut c = c;
+                        c[a] = j;
+                        (c, w * wj)
+                    })
+                })
+                .collect();
         }
-        let j = face_b
-            .windows(2)
-            .position(|w| w[0].1 - 1e-12 <= x && x <= w[1].1 + 1e-12)
-            .expect("every Γ^a node above Γ^b");
-        let ((k0, x0), (k1, x1)) = (face_b[j], face_b[j + 1]);
-        let t = (x - x0) / (x1 - x0);
-        (1.0 - t) * u[k0][1] + t * u[k1][1]
+        corners.iter().map(|(c, w)| w * u[b_at[c]][d - 1]).sum()
     };
     // The weighted mean over Γ^a's nodes (k, x) of f(u, k, x) at every step.
     let mean = |f: &AtNode| -> Vec<f64> {
@@ -264,11 +292,14 @@ fn face_means(
             })
             .collect()
     };
-    [mean(&|u, k, _| u[k][1]), mean(&|u, _, x| below(u, x))]
+    [mean(&|u, k, _| u[k][d - 1]), mean(&|u, _, x| below(u, x))]
 }
 
-/// GetFEM's displacement field at every step (times × nodes × 2).
-fn getfem_field(g: &serde_json::Value) -> Vec<Vec<[f64; 2]>> {
+/// A value read from one step's field at Γ^a's node k at x.
+type AtNode<'a> = dyn Fn(&[[f64; 3]], usize, [f64; 3]) -> f64 + 'a;
+
+/// GetFEM's displacement field at every step (times × nodes × 3, z = 0 in 2D).
+fn getfem_field(g: &serde_json::Value) -> Vec<Vec<[f64; 3]>> {
     g["u"]
         .as_array()
         .unwrap()
@@ -277,7 +308,14 @@ fn getfem_field(g: &serde_json::Value) -> Vec<Vec<[f64; 2]>> {
             t.as_array()
                 .unwrap()
                 .iter()
-                .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+                .map(|p| {
+                    let p = p.as_array().unwrap();
+                    let mut u = [0.0; 3];
+                    for (c, x) in p.iter().enumerate() {
+                        u[c] = x.as_f64().unwrap();
+                    }
+                    u
+                })
                 .collect()
         })
         .collect()
@@ -382,7 +420,7 @@ pub fn compare(
             engine_drift / p_scale
         );
     }
-    let field = engine_field(o, nodes, s.gap);
+    let field = engine_field(o, nodes, s);
     let gf_field = getfem_field(g);
     let u_scale = gf_field
         .iter()
@@ -393,7 +431,7 @@ pub fn compare(
         .iter()
         .zip(&gf_field[..end])
         .flat_map(|(a, b)| a.iter().zip(b))
-        .map(|(a, b)| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()))
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f64::max))
         .fold(0.0, f64::max)
         / u_scale;
     let rows: Vec<_> = o.series.rows().collect();

@@ -45,7 +45,9 @@ Usage: blocks.py OUT.json PARAMS_JSON VARIANTS
   PARAMS_JSON: {"width", "height", "height_b", "h", "gap", "velocity", "velocity_tangential",
                 "velocity_b",
                 "density", "lame_lambda", "lame_mu", "density_b", "lame_lambda_b", "lame_mu_b",
-                "far_end" ("free" | "clamped"), "T", "dt", optionally "mesh_ratio"}
+                "far_end" ("free" | "clamped"), "T", "dt", optionally "mesh_ratio" and
+                "dim" (2 or 3: the vertical axis the last; the rows along e_d, the projection
+                multilinear on B's face cell)}
   VARIANTS: comma-separated masses.
 Writes per variant the series (force, energy, kinetic, elastic, momentum, Newton iterations),
 the whole displacement field at every step (node by node; `nodes` gives each node's body and
@@ -82,31 +84,43 @@ def model(Ms):
     return md, rhs
 
 
-def below(d):
-    """The B face dofs (e_x) at the ends of the B face straight below A's face dof d (e_x),
-    with the linear weights of the point below d: the brick's projection of a slave node on a
-    flat master face (its nearest master node's faces hold that point)."""
-    x = A.xy[0, d]
-    ends = sorted((e for e in B.face_dofs if e % 2 == 0), key=lambda e: B.xy[0, e])
-    for e0, e1 in zip(ends, ends[1:]):
-        x0, x1 = B.xy[0, e0], B.xy[0, e1]
-        if x0 - 1e-12 <= x <= x1 + 1e-12:
-            t = (x - x0) / (x1 - x0)
-            return [(e0, 1.0 - t), (e1, t)]
-    raise ValueError(f'A node at x = {x} above no B face')
+D = S.dim
+# B's face lattice along each horizontal axis (the same along each) and its e_1 dof at each
+# face node.
+LATTICE = np.unique(np.round(B.xy[0, B.face_dofs], 12))
+B_AT = {tuple(np.round(B.xy[:D - 1, e], 12)): e for e in B.face_dofs if e % D == 0}
+
+
+def below(k):
+    """The B face dofs (e_1) at the corners of the B face straight below A's face dof k (e_1),
+    with the (multi)linear weights of the point below k: the brick's projection of a slave node
+    on a flat master face (its nearest master node's faces hold that point)."""
+    axes = []
+    for c in range(D - 1):
+        x = A.xy[c, k]
+        j = min(max(int(np.searchsorted(LATTICE, x + 1e-12)) - 1, 0), len(LATTICE) - 2)
+        x0, x1 = LATTICE[j], LATTICE[j + 1]
+        if not x0 - 1e-12 <= x <= x1 + 1e-12:
+            raise ValueError(f'A node at {A.xy[:, k]} above no B face')
+        t = (x - x0) / (x1 - x0)
+        axes.append([(x0, 1.0 - t), (x1, t)])
+    corners = [([], 1.0)]
+    for ax in axes:
+        corners = [(p + [x], w * wx) for p, w in corners for x, wx in ax]
+    return [(B_AT[tuple(np.round(p, 12))], w) for p, w in corners]
 
 
 # The brick's rows in its order (A's face nodes by increasing dof: getfem's
 # contact_node_list_from_region) with the B face below each and its weights.
-ROWS = [(d, below(d)) for d in sorted(A.face_dofs) if d % 2 == 0]
+ROWS = [(k, below(k)) for k in sorted(A.face_dofs) if k % D == 0]
 
 
 def check(u, lam, worst):
-    """How exactly the step meets Signorini on each row, δ_i = u_b,y(proj) − u_a,y ≤ g,
+    """How exactly the step meets Signorini on each row, δ_i = u_b,d(proj) − u_a,d ≤ g,
     λ_N ≤ 0, λ_N(δ − g) = 0: the largest penetration (δ − g)_+, tension λ_+ and |λ(δ − g)| so
     far."""
     for i, (da, pairs) in enumerate(ROWS):
-        s = sum(w * u[1][e + 1] for e, w in pairs) - u[0][da + 1] - gap
+        s = sum(w * u[1][e + D - 1] for e, w in pairs) - u[0][da + D - 1] - gap
         worst['penetration'] = max(worst['penetration'], max(s, 0.0))
         worst['tension'] = max(worst['tension'], max(lam[i], 0.0))
         worst['complementarity'] = max(worst['complementarity'], abs(lam[i] * s))
@@ -132,7 +146,7 @@ def run(name):
     return {**S.run(Ms, md, rhs, solve), **exact}
 
 
-out = {'nodes': S.nodes(), 'contact_rows': len(A.face_dofs) // 2, 'variants': {}}
+out = {'nodes': S.nodes(), 'contact_rows': len(A.face_dofs) // D, 'variants': {}}
 for name in variants:
     out['variants'][name] = run(name)
 with open(out_path, 'w') as f:

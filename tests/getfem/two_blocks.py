@@ -3,14 +3,17 @@
 body's K and M, the mass variants, and the Newmark β = ¼, γ = ½ loop in numpy around a step
 the caller solves with GetFEM, observing the series and the displacement field.
 
-The bodies: B = [0, W] × [0, H_b] and A = [0, W] × [H_b + g, H_b + g + H_a], each a GetFEM mesh
-of its own (two displacement variables u_a, u_b), Q1 cells (GT_QK(2,1), FEM_QK(2,1)): A W/h
+The bodies (d = 2, or 3 with "dim": 3): B = [0, W]^{d−1} × [0, H_b] and
+A = [0, W]^{d−1} × [H_b + g, H_b + g + H_a], each a GetFEM mesh of its own (two displacement
+variables u_a, u_b), Q1 cells (GT_QK(d,1), FEM_QK(d,1)): A W/h
 squares across and H_a/h up, B round(mesh_ratio·W/h) across (`mesh_ratio` 1: a matching
-interface) and round(H_b/h) up — the engine's lattice (x = kW/n, y = y0 + jH/m). Plane strain,
-each with its own ρ, λ, μ. K and M per body with a 3 × 3 Gauss rule (exact for Q1 on rectangles:
+interface) and round(H_b/h) up — the engine's lattice (x = kW/n, y = y0 + jH/m). Plane strain
+in 2D, each with its own ρ, λ, μ. K and M per body with a 3^d Gauss rule (exact for Q1 on boxes:
 the mass's and the stiffness' integrands have degree ≤ 2 per axis); no load. B's base is free or
 clamped (the caller holds its dofs). Each body's contact face is a region of its mesh (A's
 bottom `RG_A`, B's top `RG_B`).
+
+The vertical axis is the last, e_d; A moves with (V_t, 0, V) and B with V_b e_d.
 
 Newmark: predictor p = u + τv + τ²(½ − β)a; the step's model (the caller's) solves
 (M/(βτ²) + K) u = M p/(βτ²) + the contact forces; then a = (u − p)/(βτ²),
@@ -35,13 +38,14 @@ class Body:
                  clamp_base):
         rho, lam, mu = material
         self.lam, self.mu = lam, mu
-        self.m = gf.Mesh('cartesian', np.linspace(0.0, width, cells + 1),
-                         np.linspace(y0, y0 + height, up + 1))
+        d = self.dim = len(face_normal)
+        across = [np.linspace(0.0, width, cells + 1)] * (d - 1)
+        self.m = gf.Mesh('cartesian', *across, np.linspace(y0, y0 + height, up + 1))
         # The cells' diameter (all equal): the engine's h_K (contract §2.3).
-        self.diameter = float(np.hypot(width / cells, height / up))
-        self.mf = gf.MeshFem(self.m, 2)
-        self.mf.set_fem(gf.Fem('FEM_QK(2,1)'))
-        self.mim = gf.MeshIm(self.m, gf.Integ('IM_GAUSS_PARALLELEPIPED(2,5)'))
+        self.diameter = float(np.sqrt((d - 1) * (width / cells)**2 + (height / up)**2))
+        self.mf = gf.MeshFem(self.m, d)
+        self.mf.set_fem(gf.Fem(f'FEM_QK({d},1)'))
+        self.mim = gf.MeshIm(self.m, gf.Integ(f'IM_GAUSS_PARALLELEPIPED({d},5)'))
         self.n = self.mf.nbdof()
         u0 = np.zeros(self.n)
         self.M = rho * gf.asm('generic', self.mim, 2, 'Test_u.Test2_u', -1, 'u', 1, self.mf,
@@ -51,24 +55,25 @@ class Body:
         self.m.set_region(region, faces)
         self.region = region
         self.xy = self.mf.basic_dof_nodes()
-        self.face_dofs = [d for d in range(self.n)
-                          if abs(self.xy[1, d] - (y0 if face_normal[1] < 0 else y0 + height))
-                          < 1e-9]
-        base = [d for d in range(self.n) if abs(self.xy[1, d] - y0) < 1e-9]
+        up_xy = self.xy[d - 1]
+        face_y = y0 if face_normal[-1] < 0 else y0 + height
+        self.face_dofs = [k for k in range(self.n) if abs(up_xy[k] - face_y) < 1e-9]
+        base = [k for k in range(self.n) if abs(up_xy[k] - y0) < 1e-9]
         self.clamped = sorted(base) if clamp_base else []
         if clamp_base:
-            self.m.set_region(RG_BASE, self.m.outer_faces_with_direction([0.0, -1.0], 0.01))
-        # The e_y dofs whose (M v) the momentum sums: the engine's free ones (a clamped row's
+            self.m.set_region(RG_BASE, self.m.outer_faces_with_direction(
+                [0.0] * (d - 1) + [-1.0], 0.01))
+        # The e_d dofs whose (M v) the momentum sums: the engine's free ones (a clamped row's
         # reaction is not momentum of the body).
-        self.kept_y = [d for d in range(1, self.n, 2) if d not in set(self.clamped)]
+        self.kept_y = [k for k in range(d - 1, self.n, d) if k not in set(self.clamped)]
 
     def nodes(self):
-        """(x, y) of each node, with the index of its x and y dofs."""
+        """The coordinates of each node, with the indices of its dofs (by component)."""
         pts = {}
-        for d in range(self.n):
-            key = (round(self.xy[0, d], 12), round(self.xy[1, d], 12))
-            pts.setdefault(key, []).append(d)
-        return [(x, y, sorted(ds)) for (x, y), ds in sorted(pts.items())]
+        for k in range(self.n):
+            key = tuple(round(self.xy[c, k], 12) for c in range(self.dim))
+            pts.setdefault(key, []).append(k)
+        return [(x, sorted(ds)) for x, ds in sorted(pts.items())]
 
 
 class Blocks:
@@ -84,12 +89,14 @@ class Blocks:
         across = int(round(W / h))
         across_b = max(1, int(round(params.get('mesh_ratio', 1.0) * across)))
         up = lambda height: max(1, int(round(height / h)))
+        d = self.dim = params.get('dim', 2)
+        e = [0.0] * (d - 1)
         self.A = Body(W, across, H_b + self.gap, H_a, up(H_a),
                       (params['density'], params['lame_lambda'], params['lame_mu']),
-                      [0.0, -1.0], RG_A, False)
+                      e + [-1.0], RG_A, False)
         self.B = Body(W, across_b, 0.0, H_b, up(H_b),
                       (params['density_b'], params['lame_lambda_b'], params['lame_mu_b']),
-                      [0.0, 1.0], RG_B, params['far_end'] == 'clamped')
+                      e + [1.0], RG_B, params['far_end'] == 'clamped')
         self.bodies = (self.A, self.B)
 
     def masses(self, name):
@@ -121,14 +128,15 @@ class Blocks:
             md.add_explicit_matrix(name, name, sp)
             rhs.append(md.add_explicit_rhs(name, np.zeros(body.n)))
         if self.B.clamped:
-            md.add_initialized_data('zero', [0.0, 0.0])
+            md.add_initialized_data('zero', [0.0] * self.dim)
             md.add_Dirichlet_condition_with_simplification('ub', RG_BASE, 'zero')
         return md, rhs
 
     def nodes(self):
         """Every node's body and coordinates, A's then B's (the order of the fields)."""
-        return [{'body': k, 'x': x, 'y': y}
-                for k, b in enumerate(self.bodies) for (x, y, _) in b.nodes()]
+        keys = ('x', 'y', 'z')[:self.dim]
+        return [{'body': k, **dict(zip(keys, x))}
+                for k, b in enumerate(self.bodies) for (x, _) in b.nodes()]
 
     def run(self, Ms, md, rhs, solve):
         """The Newmark loop on the step model (md, rhs): `solve(md)` solves one step from the
@@ -137,9 +145,10 @@ class Blocks:
         bodies, tau, p_ = self.bodies, self.tau, self.params
         u = [np.zeros(b.n) for b in bodies]
         v = [np.zeros(b.n) for b in bodies]
+        d = self.dim
         for vb, V in zip(v, (p_['velocity'], p_['velocity_b'])):
-            vb[1::2] = V
-        v[0][0::2] = p_['velocity_tangential']
+            vb[d - 1::d] = V
+        v[0][0::d] = p_['velocity_tangential']
         v[1][self.B.clamped] = 0.0
         a = [np.zeros(b.n) for b in bodies]
         series = {k: [] for k in ('force', 'energy', 'kinetic', 'elastic', 'momentum',
@@ -156,8 +165,8 @@ class Blocks:
             series['momentum'].append(float(sum((M @ vb)[b.kept_y].sum()
                                                 for vb, M, b in zip(v, Ms, bodies))))
             series['iterations'].append(iterations)
-            fields.append([[float(ub[ds[0]]), float(ub[ds[1]])]
-                           for ub, b in zip(u, bodies) for (_, _, ds) in b.nodes()])
+            fields.append([[float(ub[k]) for k in ds]
+                           for ub, b in zip(u, bodies) for (_, ds) in b.nodes()])
 
         observe(0.0, 0)
         for _ in range(self.steps):
@@ -173,5 +182,5 @@ class Blocks:
             u, a = un, an
             observe(force, iterations)
         return {**series, 'u': fields,
-                'mass_total': float(sum(M[0::2, 0::2].sum() for M in Ms)),
-                'body_mass': [float(M[1::2, 1::2].sum()) for M in Ms]}
+                'mass_total': float(sum(M[0::d, 0::d].sum() for M in Ms)),
+                'body_mass': [float(M[d - 1::d, d - 1::d].sum()) for M in Ms]}
