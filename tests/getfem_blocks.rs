@@ -43,6 +43,9 @@
 //! Measured within the compared steps (GetFEM 5.4.2), the largest difference over the
 //! quantities: zero-contact 1.9e-11 of its scale (the elastic energy, free), the field 1.5e-11
 //! (clamped); the consistent mass 3.8e-14 (the elastic energy, free).
+//!
+//! The machinery (settings, sweep, script call, field matching, scales) is
+//! tests/common/getfem_blocks.rs's, shared with tests/getfem_nonmatching.rs (issue 45).
 
 mod common;
 
