@@ -1,8 +1,9 @@
 //! The GetFEM checks' shared set-up (tests/getfem_disc.rs, tests/friction_nitsche.rs,
-//! tests/getfem_blocks.rs): the 003 disc as P2 triangles (`sweeps/meshes/disc_p2.msh`), its
-//! sweep text for the engine, and the scripts of tests/getfem/ run by Debian's python3-getfem —
-//! installed, when missing, by tests/install_getfem.sh (a failed install fails the test: nothing
-//! is skipped) — with their JSON read back.
+//! tests/getfem_blocks.rs, tests/getfem_nonmatching.rs): the 003 disc as P2 triangles
+//! (`sweeps/meshes/disc_p2.msh`), its sweep text for the engine, and the scripts of
+//! tests/getfem/ run by Debian's python3-getfem — installed, when missing, by
+//! tests/install_getfem.sh (a failed install fails the test: nothing is skipped) — with their
+//! JSON read back.
 
 use std::path::PathBuf;
 use std::process::Command;

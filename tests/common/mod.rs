@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod getfem;
+pub mod getfem_blocks;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -2,11 +2,14 @@
 """Two elastic blocks, A falling on B, with GetFEM 5.4's nodal contact brick between two bodies
 (`add_nodal_contact_between_nonmatching_meshes_brick`, Debian's python3-getfem) and Newmark
 β = ¼, γ = ½ — an implementation of contract §1.10/§2.1/§2.2/§2.6/§3 that shares no code with
-the engine, for tests/getfem_blocks.rs (issue 44).
+the engine, for tests/getfem_blocks.rs (issue 44) and tests/getfem_nonmatching.rs (issue 45).
+The blocks, K, M, the masses and the Newmark loop are tests/getfem/two_blocks.py's (shared with
+tests/getfem/nitsche_blocks.py).
 
 The bodies (contract §1.10): B = [0, W] × [0, H_b] and A = [0, W] × [H_b + g, H_b + g + H_a],
 each a GetFEM mesh of its own (two displacement variables u_a, u_b), Q1 squares of side h
-(GT_QK(2,1), FEM_QK(2,1)), W/h across both (a matching interface), plane strain, each with its
+(GT_QK(2,1), FEM_QK(2,1)), W/h across A and round(mesh_ratio·W/h) across B (1, the default: a
+matching interface), plane strain, each with its
 own ρ, λ, μ. K and M per body with a 3 × 3 Gauss rule (exact for Q1 on rectangles: the mass's
 and the stiffness' integrands have degree ≤ 2 per axis); no load. B's base is free or clamped
 (u_b = 0 on y = 0 by GetFEM's Dirichlet condition with simplification: the dofs leave the
@@ -42,7 +45,9 @@ Usage: blocks.py OUT.json PARAMS_JSON VARIANTS
   PARAMS_JSON: {"width", "height", "height_b", "h", "gap", "velocity", "velocity_tangential",
                 "velocity_b",
                 "density", "lame_lambda", "lame_mu", "density_b", "lame_lambda_b", "lame_mu_b",
-                "far_end" ("free" | "clamped"), "T", "dt"}
+                "far_end" ("free" | "clamped"), "T", "dt", optionally "mesh_ratio" and
+                "dim" (2 or 3: the vertical axis the last; the rows along e_d, the projection
+                multilinear on B's face cell)}
   VARIANTS: comma-separated masses.
 Writes per variant the series (force, energy, kinetic, elastic, momentum, Newton iterations),
 the whole displacement field at every step (node by node; `nodes` gives each node's body and
@@ -51,12 +56,10 @@ coordinates), the masses, and how exactly the steps met Signorini (`check`).
 import json
 import sys
 
-import getfem as gf
 import numpy as np
 
-from common import stiffness
+from two_blocks import Blocks
 
-BETA = 0.25
 # GetFEM's Newton stops when min(‖residual‖₁/‖load‖₁, ‖Δx‖₁/‖x‖₁) ≤ TOL
 # (getfem_model_solvers.h): once its active set is right one Newton step solves the step's
 # linear system to round-off, so every converged step here took 1–3 iterations (measured). A
@@ -64,169 +67,86 @@ BETA = 0.25
 # state (1e-13 did), so each step's exactness is checked instead (`check`).
 TOL = 1e-11
 MAX_ITER = 100
-RG_A, RG_B = 1, 2
 
 out_path, params, variants = sys.argv[1], json.loads(sys.argv[2]), sys.argv[3].split(',')
-gf.util_trace_level(0)
-W, H_a, H_b, h, gap = (params[k] for k in ('width', 'height', 'height_b', 'h', 'gap'))
-TAU = params['dt']
-STEPS = int(round(params['T'] / TAU))
-across = int(round(W / h))
-
-
-class Body:
-    """One block: its mesh, Q1 space, K, consistent M, its contact face and the dofs kept."""
-
-    def __init__(self, y0, height, rho, lam, mu, face_normal, region, clamp_base):
-        up = int(round(height / h))
-        self.m = gf.Mesh('cartesian', np.linspace(0.0, W, across + 1),
-                         np.linspace(y0, y0 + height, up + 1))
-        self.mf = gf.MeshFem(self.m, 2)
-        self.mf.set_fem(gf.Fem('FEM_QK(2,1)'))
-        self.mim = gf.MeshIm(self.m, gf.Integ('IM_GAUSS_PARALLELEPIPED(2,5)'))
-        self.n = self.mf.nbdof()
-        u0 = np.zeros(self.n)
-        self.M = rho * gf.asm('generic', self.mim, 2, 'Test_u.Test2_u', -1, 'u', 1, self.mf,
-                              u0).full()
-        self.K = stiffness(self.mf, self.mim, lam, mu)
-        faces = self.m.outer_faces_with_direction(face_normal, 0.01)
-        self.m.set_region(region, faces)
-        self.region = region
-        self.xy = self.mf.basic_dof_nodes()
-        self.face_dofs = [d for d in range(self.n)
-                          if abs(self.xy[1, d] - (y0 if face_normal[1] < 0 else y0 + height))
-                          < 1e-9]
-        base = [d for d in range(self.n) if abs(self.xy[1, d] - y0) < 1e-9]
-        self.clamped = sorted(base) if clamp_base else []
-        # The e_y dofs whose (M v) the momentum sums: the engine's free ones (a clamped row's
-        # reaction is not momentum of the body).
-        self.kept_y = [d for d in range(1, self.n, 2) if d not in set(self.clamped)]
-
-    def nodes(self):
-        """(x, y) of each node, with the index of its x and y dofs."""
-        pts = {}
-        for d in range(self.n):
-            key = (round(self.xy[0, d], 12), round(self.xy[1, d], 12))
-            pts.setdefault(key, []).append(d)
-        return [(x, y, sorted(ds)) for (x, y), ds in sorted(pts.items())]
-
-
-rho_a, lam_a, mu_a = params['density'], params['lame_lambda'], params['lame_mu']
-A = Body(H_b + gap, H_a, rho_a, lam_a, mu_a, [0.0, -1.0], RG_A, False)
-B = Body(0.0, H_b, params['density_b'], params['lame_lambda_b'], params['lame_mu_b'],
-         [0.0, 1.0], RG_B, params['far_end'] == 'clamped')
+S = Blocks(params)
+A, B, gap = S.A, S.B, S.gap
+lam_a, mu_a = params['lame_lambda'], params['lame_mu']
 young_a = mu_a * (3 * lam_a + 2 * mu_a) / (lam_a + mu_a)
 
 
-def masses(name):
-    """Each body's M for the variant (contract §2.2, mass_side = both)."""
-    Ms = []
-    for body in (A, B):
-        M = body.M.copy()
-        if name == 'zero-contact':
-            M[body.face_dofs, :] = 0.0
-            M[:, body.face_dofs] = 0.0
-        elif name != 'consistent':
-            raise ValueError(f'mass {name}: not in this script')
-        Ms.append(M)
-    return Ms
-
-
 def model(Ms):
-    """GetFEM's model of one step: u_a, u_b with the explicit (M/(βτ²) + K) of each body, an
-    explicit right-hand side per body (its bricks returned) and the nodal contact brick; B's
-    clamped dofs held at 0 by a simplified Dirichlet condition."""
-    md = gf.Model('real')
-    md.add_fem_variable('ua', A.mf)
-    md.add_fem_variable('ub', B.mf)
-    rhs = []
-    for name, body, M in (('ua', A, Ms[0]), ('ub', B, Ms[1])):
-        mat = M / (BETA * TAU**2) + body.K
-        sp = gf.Spmat('empty', body.n, body.n)
-        sp.add(np.arange(body.n), np.arange(body.n), mat)
-        md.add_explicit_matrix(name, name, sp)
-        rhs.append(md.add_explicit_rhs(name, np.zeros(body.n)))
-    if B.clamped:
-        B.m.set_region(3, B.m.outer_faces_with_direction([0.0, -1.0], 0.01))
-        md.add_initialized_data('zero', [0.0, 0.0])
-        md.add_Dirichlet_condition_with_simplification('ub', 3, 'zero')
+    """The step's model (two_blocks.Blocks.model) with the nodal contact brick."""
+    md, rhs = S.model(Ms)
     md.add_initialized_data('r', [young_a])
     md.add_nodal_contact_between_nonmatching_meshes_brick(A.mim, B.mim, 'ua', 'ub', 'lam_n',
-                                                          'r', RG_A, RG_B, 1, 0, 1)
+                                                          'r', A.region, B.region, 1, 0, 1)
     return md, rhs
 
 
+D = S.dim
+# B's face lattice along each horizontal axis (the same along each) and its e_1 dof at each
+# face node.
+LATTICE = np.unique(np.round(B.xy[0, B.face_dofs], 12))
+B_AT = {tuple(np.round(B.xy[:D - 1, e], 12)): e for e in B.face_dofs if e % D == 0}
+
+
+def below(k):
+    """The B face dofs (e_1) at the corners of the B face straight below A's face dof k (e_1),
+    with the (multi)linear weights of the point below k: the brick's projection of a slave node
+    on a flat master face (its nearest master node's faces hold that point)."""
+    axes = []
+    for c in range(D - 1):
+        x = A.xy[c, k]
+        j = min(max(int(np.searchsorted(LATTICE, x + 1e-12)) - 1, 0), len(LATTICE) - 2)
+        x0, x1 = LATTICE[j], LATTICE[j + 1]
+        if not x0 - 1e-12 <= x <= x1 + 1e-12:
+            raise ValueError(f'A node at {A.xy[:, k]} above no B face')
+        t = (x - x0) / (x1 - x0)
+        axes.append([(x0, 1.0 - t), (x1, t)])
+    corners = [([], 1.0)]
+    for ax in axes:
+        corners = [(p + [x], w * wx) for p, w in corners for x, wx in ax]
+    return [(B_AT[tuple(np.round(p, 12))], w) for p, w in corners]
+
+
 # The brick's rows in its order (A's face nodes by increasing dof: getfem's
-# contact_node_list_from_region) with the B node each pairs with (the one straight below).
-ROWS = [(d, next(e for e in B.face_dofs if e % 2 == 0 and abs(B.xy[0, e] - A.xy[0, d]) < 1e-9))
-        for d in sorted(A.face_dofs) if d % 2 == 0]
+# contact_node_list_from_region) with the B face below each and its weights.
+ROWS = [(k, below(k)) for k in sorted(A.face_dofs) if k % D == 0]
 
 
 def check(u, lam, worst):
-    """How exactly the step meets Signorini on each row, δ_i = u_b,y − u_a,y ≤ g, λ_N ≤ 0,
-    λ_N(δ − g) = 0: the largest penetration (δ − g)_+, tension λ_+ and |λ(δ − g)| so far."""
-    for i, (da, db) in enumerate(ROWS):
-        s = u[1][db + 1] - u[0][da + 1] - gap
+    """How exactly the step meets Signorini on each row, δ_i = u_b,d(proj) − u_a,d ≤ g,
+    λ_N ≤ 0, λ_N(δ − g) = 0: the largest penetration (δ − g)_+, tension λ_+ and |λ(δ − g)| so
+    far."""
+    for i, (da, pairs) in enumerate(ROWS):
+        s = sum(w * u[1][e + D - 1] for e, w in pairs) - u[0][da + D - 1] - gap
         worst['penetration'] = max(worst['penetration'], max(s, 0.0))
         worst['tension'] = max(worst['tension'], max(lam[i], 0.0))
         worst['complementarity'] = max(worst['complementarity'], abs(lam[i] * s))
 
 
 def run(name):
-    Ms = masses(name)
+    Ms = S.masses(name)
     md, rhs = model(Ms)
-    bodies = (A, B)
-    u = [np.zeros(b.n) for b in bodies]
-    v = [np.zeros(b.n) for b in bodies]
-    for vb, V in zip(v, (params['velocity'], params['velocity_b'])):
-        vb[1::2] = V
-    v[0][0::2] = params['velocity_tangential']
-    v[1][B.clamped] = 0.0
-    a = [np.zeros(b.n) for b in bodies]
-    lam = np.zeros(len(md.variable('lam_n')))
-    series = {k: [] for k in ('force', 'energy', 'kinetic', 'elastic', 'momentum', 'iterations')}
-    fields = []
-
-    def observe(force, iterations):
-        kin = sum(0.5 * vb @ M @ vb for vb, M in zip(v, Ms))
-        ela = sum(0.5 * ub @ b.K @ ub for ub, b in zip(u, bodies))
-        series['force'].append(float(force))
-        series['kinetic'].append(float(kin))
-        series['elastic'].append(float(ela))
-        series['energy'].append(float(kin + ela))
-        series['momentum'].append(float(sum((M @ vb)[b.kept_y].sum()
-                                            for vb, M, b in zip(v, Ms, bodies))))
-        series['iterations'].append(iterations)
-        fields.append([[float(ub[ds[0]]), float(ub[ds[1]])]
-                       for ub, b in zip(u, bodies) for (_, _, ds) in b.nodes()])
-
-    observe(0.0, 0)
+    state = {'lam': np.zeros(len(md.variable('lam_n')))}
     exact = {'penetration': 0.0, 'tension': 0.0, 'complementarity': 0.0}
-    for _ in range(STEPS):
-        p = [ub + TAU * vb + TAU**2 * (0.5 - BETA) * ab for ub, vb, ab in zip(u, v, a)]
-        for brick, M, pb in zip(rhs, Ms, p):
-            md.set_private_rhs(brick, M @ pb / (BETA * TAU**2))
-        md.set_variable('ua', u[0])
-        md.set_variable('ub', u[1])
-        md.set_variable('lam_n', lam)
+
+    def solve(md):
+        md.set_variable('lam_n', state['lam'])
         it = md.solve('max_res', TOL, 'max_iter', MAX_ITER)
         iterations = int(np.ravel(it)[0])
         if iterations >= MAX_ITER:
-            raise RuntimeError(f'{name}: GetFEM\'s Newton did not converge at step {len(fields)}')
-        un = [np.asarray(md.variable('ua')).copy(), np.asarray(md.variable('ub')).copy()]
+            raise RuntimeError(f'{name}: GetFEM\'s Newton did not converge')
         lam = np.asarray(md.variable('lam_n')).copy()
-        check(un, lam, exact)
-        an = [(x - pb) / (BETA * TAU**2) for x, pb in zip(un, p)]
-        v = [vb + TAU * (0.5 * ab + 0.5 * anb) for vb, ab, anb in zip(v, a, an)]
-        u, a = un, an
-        observe(-lam.sum(), iterations)
-    return {**series, **exact, 'u': fields,
-            'mass_total': float(sum(M[0::2, 0::2].sum() for M in Ms)),
-            'body_mass': [float(M[1::2, 1::2].sum()) for M in Ms]}
+        check([np.asarray(md.variable(x)) for x in ('ua', 'ub')], lam, exact)
+        state['lam'] = lam
+        return -lam.sum(), iterations
+
+    return {**S.run(Ms, md, rhs, solve), **exact}
 
 
-nodes = [{'body': k, 'x': x, 'y': y} for k, b in enumerate((A, B)) for (x, y, _) in b.nodes()]
-out = {'nodes': nodes, 'contact_rows': len(A.face_dofs) // 2, 'variants': {}}
+out = {'nodes': S.nodes(), 'contact_rows': len(A.face_dofs) // D, 'variants': {}}
 for name in variants:
     out['variants'][name] = run(name)
 with open(out_path, 'w') as f:
