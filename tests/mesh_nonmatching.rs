@@ -10,7 +10,6 @@
 mod common;
 mod two_body_msh;
 
-
 use common::outcomes_at;
 use contact_sweep::run::{Outcome, Status};
 use contact_sweep::sweep::{SweepFile, expand};
@@ -140,10 +139,12 @@ fn random_case(
     simplex: bool,
     steps: usize,
 ) -> (String, String) {
-    let across = if dim == 2 {
-        rng.usize(3..=5)
-    } else {
-        rng.usize(2..=3)
+    // Tetrahedra: A 2 × 2 across (Nitsche's 3D points on the segmentation of triangles are
+    // many, and its condensed solve is dense over them).
+    let across = match (dim, simplex) {
+        (2, _) => rng.usize(3..=5),
+        (_, false) => rng.usize(2..=3),
+        _ => 2,
     };
     let ratio = [4.0 / 3.0, 1.4, 0.75][rng.usize(0..3)];
     let b = Boxes {
@@ -189,7 +190,7 @@ fn momentum_holds_on_non_matching_files() {
     let nitsche = "mass = [\"zero-contact\"]\nnitsche_sides = [\"unbiased\", \"a\"]\ninterface_quadrature = [\"segment\", \"element\"]\n";
     let mut worst = 0.0f64;
     let mut total = 0;
-    for (dim, simplex, steps) in [(2, false, 40), (2, true, 40), (3, false, 12), (3, true, 12)] {
+    for (dim, simplex, steps) in [(2, false, 40), (2, true, 40), (3, false, 12), (3, true, 8)] {
         let (msh, fixed) = random_case(&mut rng, dim, simplex, steps);
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("two.msh"), msh).unwrap();
@@ -294,10 +295,7 @@ fn bad_non_matching_files_are_refused() {
     );
     assert_ne!(sunk, good);
     let e = refused(&sunk, 2, "pairing = \"mortar\"\n");
-    assert!(
-        e.contains("two.msh") && e.contains("overlap"),
-        "{e}"
-    );
+    assert!(e.contains("two.msh") && e.contains("overlap"), "{e}");
     // The interface keys on a one-body file, and with the wrong treatment.
     let e = refused(&good, 2, "space = \"nitsche\"\npairing = \"mortar\"\n");
     assert!(e.contains("pairing = mortar with space = nitsche"), "{e}");
