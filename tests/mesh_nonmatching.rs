@@ -13,7 +13,7 @@ mod two_body_msh;
 use common::outcomes_at;
 use contact_sweep::run::{Outcome, Status};
 use contact_sweep::sweep::{SweepFile, expand};
-use two_body_msh::{Boxes, boxes_msh, difference};
+use two_body_msh::{Boxes, boxes_msh, boxes_msh_q2, difference};
 
 /// A sweep's runs with their labels.
 type Runs = Vec<(String, Outcome)>;
@@ -299,4 +299,34 @@ fn bad_non_matching_files_are_refused() {
     // The interface keys on a one-body file, and with the wrong treatment.
     let e = refused(&good, 2, "space = \"nitsche\"\npairing = \"mortar\"\n");
     assert!(e.contains("pairing = mortar with space = nitsche"), "{e}");
+}
+
+/// Degree-2 cells on a non-matching interface (Q2, straight faces): `node-to-segment` and
+/// `mortar` build their rows on the faces' vertices and are refused at plan time naming the
+/// file and `pairing`; `nitsche` takes them (each point's traces from its own Q2 cells, Π on
+/// the straight vertex surface, exact for straight faces) and keeps the momentum to 1e-12
+/// (as above: round-off per step over 40 steps).
+#[test]
+fn degree_two_cells_on_a_non_matching_file() {
+    let msh = boxes_msh_q2(Boxes {
+        cells_a: 2,
+        cells_b: 2,
+        ..SQUARES
+    });
+    for pairing in ["node-to-segment", "mortar"] {
+        let e = refused(&msh, 2, &format!("pairing = \"{pairing}\"\n"));
+        assert!(
+            e.contains("two.msh") && e.contains(&format!("pairing = {pairing} on degree-2 cells")),
+            "{e}"
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("two.msh"), &msh).unwrap();
+    let text = format!(
+        "name = \"q2\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"two.msh\"\n{PHYSICS}space = \"nitsche\"\nmass = \"zero-contact\"\n[grid]\nnitsche_sides = [\"unbiased\", \"a\"]\nscheme = [\"crank-nicolson\", \"backward-euler\"]\n"
+    );
+    let runs = outcomes_at(&dir.path().join("s.toml"), &text);
+    assert_eq!(runs.len(), 4);
+    let w = common::assert_momentum(&runs, 1e-12);
+    eprintln!("Q2 non-matching nitsche: worst momentum_drift {w:e}");
 }

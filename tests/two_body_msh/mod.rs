@@ -143,6 +143,56 @@ pub fn boxes_msh(b: Boxes, clamped: bool, simplex: bool, lift: f64) -> String {
     write_msh(d, &coords, &groups)
 }
 
+/// [`boxes_msh`] in 2D with Q2 cells (9-node quadrilaterals, 3-node boundary lines): each box
+/// on a lattice of twice its cells, cell (i, j) the lattice's nodes 2i…2i + 2 × 2j…2j + 2 —
+/// degree-2 faces, straight.
+pub fn boxes_msh_q2(b: Boxes) -> String {
+    let fine = |across: usize, up: usize, h: f64, lift: f64| {
+        let mut m = BoxMesh::new(&[b.width, h], &[2 * across, 2 * up]);
+        m.coords.iter_mut().for_each(|c| c[1] += lift);
+        m
+    };
+    let a = fine(b.across, b.cells_a, b.height_a, b.height_b);
+    let bm = fine(b.across_b, b.cells_b, b.height_b, 0.0);
+    let off = a.num_nodes();
+    let quads = |m: &BoxMesh, o: usize| -> Vec<Vec<usize>> {
+        let n = |i: usize, j: usize| m.node_id([i, j, 0]) + o;
+        let mut out = Vec::new();
+        for j in (0..m.cells[1]).step_by(2) {
+            for i in (0..m.cells[0]).step_by(2) {
+                out.push(vec![
+                    n(i, j),
+                    n(i + 2, j),
+                    n(i + 2, j + 2),
+                    n(i, j + 2),
+                    n(i + 1, j),
+                    n(i + 2, j + 1),
+                    n(i + 1, j + 2),
+                    n(i, j + 1),
+                    n(i + 1, j + 1),
+                ]);
+            }
+        }
+        out
+    };
+    let lines = |m: &BoxMesh, o: usize, j: usize| -> Vec<Vec<usize>> {
+        let n = |i: usize| m.node_id([i, j, 0]) + o;
+        (0..m.cells[0])
+            .step_by(2)
+            .map(|i| vec![n(i), n(i + 2), n(i + 1)])
+            .collect()
+    };
+    let groups = vec![
+        (2, "body_a", quads(&a, 0)),
+        (2, "body_b", quads(&bm, off)),
+        (1, "contact_a", lines(&a, 0, 0)),
+        (1, "contact_b", lines(&bm, off, bm.cells[1])),
+        (1, "loaded", lines(&a, 0, a.cells[1])),
+    ];
+    let coords: Vec<[f64; 3]> = a.coords.iter().chain(&bm.coords).copied().collect();
+    write_msh(2, &coords, &groups)
+}
+
 /// One MSH 4.1 ASCII file of `coords` (nodes 1…) and `groups` (physical dimension, name,
 /// elements as 0-based node ids), one entity per group tagged as its group.
 pub fn write_msh(
@@ -184,6 +234,8 @@ pub fn write_msh(
     for (k, (gd, _, els)) in groups.iter().enumerate() {
         let ty = match (*gd, els[0].len()) {
             (1, 2) => 1,
+            (1, 3) => 8,
+            (2, 9) => 10,
             (2, 3) => 2,
             (2, 4) => 3,
             (3, 4) => 4,
