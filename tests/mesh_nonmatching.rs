@@ -12,8 +12,7 @@ mod two_body_msh;
 
 use common::outcomes_at;
 use contact_sweep::run::{Outcome, Status};
-use contact_sweep::sweep::{SweepFile, expand};
-use two_body_msh::{Boxes, boxes_msh, boxes_msh_q2, difference};
+use two_body_msh::{Boxes, boxes_msh, boxes_msh_q2, difference, refused};
 
 /// A sweep's runs with their labels.
 type Runs = Vec<(String, Outcome)>;
@@ -87,7 +86,7 @@ fn assert_copies(k: &Runs, g: &Runs, floor: f64, tol: f64) -> f64 {
             ok.metrics.contact_phases.unwrap_or(0) >= 1,
             "{lk}: no contact"
         );
-        let (d, name) = difference(ok, og, floor, &[]);
+        let (d, name) = difference(ok, og, floor);
         eprintln!("{lk}: largest difference {d:e} ({name})");
         assert!(d <= tol, "{lk}: {name} differs by {d:e}");
         worst = worst.max(d);
@@ -240,21 +239,6 @@ fn the_patch_test_passes_on_a_non_matching_file() {
             assert_eq!(runs.len(), n, "{what}");
             common::assert_patch(&format!("{}D file {what}", b.dim), &runs);
         }
-    }
-}
-
-/// A sweep over a two-body file refused at plan time: its message.
-fn refused(msh: &str, dim: usize, fixed: &str) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("two.msh"), msh).unwrap();
-    let text = format!(
-        "name = \"x\"\nscene = \"mesh{dim}d\"\n[fixed]\nmesh = \"two.msh\"\ndt = 0.01\n{fixed}"
-    );
-    let path = dir.path().join("s.toml");
-    match SweepFile::parse(&path, &text).map(|s| expand(&s)) {
-        Err(e) => e.to_string(),
-        Ok(Err(e)) => e.to_string(),
-        Ok(Ok(_)) => panic!("accepted:\n{text}"),
     }
 }
 

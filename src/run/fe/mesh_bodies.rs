@@ -235,7 +235,7 @@ fn file_rows(
         .filter(|&k| free(&a.global[k]))
         .collect();
     let row_h = keep.iter().map(|&k| size[fi.sides[0].nodes[k]]).collect();
-    if keys.pairing == Pairing::NodeToNode {
+    let (pairs, general, height, mut weight) = if keys.pairing == Pairing::NodeToNode {
         let proj = Projector::new(&b.surface, reach);
         let mut pairs = Vec::with_capacity(keep.len());
         let mut height = Vec::with_capacity(keep.len());
@@ -252,41 +252,33 @@ fn file_rows(
             height.push(p.distance - fi.lowest);
         }
         let node_weight = face_integrals(&a.surface);
-        let mut weight: Vec<f64> = keep.iter().map(|&k| node_weight[k]).collect();
-        let measure = normalise(&mesh.file, &mut weight)?;
-        return Ok(FileRows {
-            pairs,
-            general: None,
-            height,
-            weight,
-            row_h,
-            measure,
-            lowest: fi.lowest,
-            farthest: fi.farthest,
+        let weight = keep.iter().map(|&k| node_weight[k]).collect();
+        (pairs, None, height, weight)
+    } else {
+        let ik = InterfaceKeys {
+            pairing: keys.pairing,
+            basis: keys.mortar_basis,
+            quadrature: keys.interface_quadrature,
+        };
+        let mut g = general_rows(ik, &a, &b, reach).map_err(|e| format!("{}: {e}", mesh.file))?;
+        let drop = |e: &mut Vec<(usize, f64)>| e.retain(|(n, _)| free(n));
+        let take = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        let mut rows: Vec<_> = keep.iter().map(|&k| g.rows[k].clone()).collect();
+        rows.iter_mut().for_each(|(ra, rb)| {
+            drop(ra);
+            drop(rb);
         });
-    }
-    let ik = InterfaceKeys {
-        pairing: keys.pairing,
-        basis: keys.mortar_basis,
-        quadrature: keys.interface_quadrature,
+        let height = take(&g.height).iter().map(|h| h - fi.lowest).collect();
+        let weight = take(&g.weight);
+        g.a_node = keep.iter().map(|&k| g.a_node[k]).collect();
+        g.b_nodes.retain(free);
+        g.rows = rows;
+        (Vec::new(), Some(g), height, weight)
     };
-    let mut g = general_rows(ik, &a, &b, reach).map_err(|e| format!("{}: {e}", mesh.file))?;
-    let drop = |e: &mut Vec<(usize, f64)>| e.retain(|(n, _)| free(n));
-    let take = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
-    let mut rows: Vec<_> = keep.iter().map(|&k| g.rows[k].clone()).collect();
-    rows.iter_mut().for_each(|(ra, rb)| {
-        drop(ra);
-        drop(rb);
-    });
-    let height = take(&g.height).iter().map(|h| h - fi.lowest).collect();
-    let mut weight = take(&g.weight);
     let measure = normalise(&mesh.file, &mut weight)?;
-    g.a_node = keep.iter().map(|&k| g.a_node[k]).collect();
-    g.b_nodes.retain(free);
-    g.rows = rows;
     Ok(FileRows {
-        pairs: Vec::new(),
-        general: Some(g),
+        pairs,
+        general,
         height,
         weight,
         row_h,
