@@ -10,13 +10,13 @@
 //! are the blocks' doubles, printed as the shortest decimal that reads back to them).
 
 mod common;
+mod two_body_msh;
 
 use std::fmt::Write as _;
 
 use common::outcomes_at;
 use contact_sweep::run::{Outcome, Status};
-use contact_sweep::space::fe::{BoxMesh, Mesh};
-use contact_sweep::sweep::{SweepFile, expand};
+use two_body_msh::{Boxes, boxes_msh, difference, refused};
 
 /// The blocks' geometry: width W, heights H_a, H_b, elements across and up A and B.
 #[derive(Clone, Copy)]
@@ -30,212 +30,26 @@ struct Blocks {
     cells_b: usize,
 }
 
-/// A box's cell in Gmsh's order (counter-clockwise, then the top face likewise) from the
-/// box's tensor order (local node a has index bit k along axis k).
-fn gmsh_order(t: &[usize]) -> Vec<usize> {
-    match t.len() {
-        4 => vec![t[0], t[1], t[3], t[2]],
-        _ => vec![t[0], t[1], t[3], t[2], t[4], t[5], t[7], t[6]],
-    }
-}
-
-/// The faces of a box on the plane x_d = layer (`layer` in cells), Gmsh's order, as node ids.
-fn plane_faces(m: &BoxMesh, cells: &[usize], layer: usize) -> Vec<Vec<usize>> {
-    let d = cells.len();
-    let mut out = Vec::new();
-    if d == 2 {
-        for i in 0..cells[0] {
-            out.push(vec![m.node_id([i, layer, 0]), m.node_id([i + 1, layer, 0])]);
-        }
-    } else {
-        for j in 0..cells[1] {
-            for i in 0..cells[0] {
-                let n = |a: usize, b: usize| m.node_id([i + a, j + b, layer]);
-                out.push(vec![n(0, 0), n(1, 0), n(1, 1), n(0, 1)]);
-            }
-        }
-    }
-    out
-}
-
-/// The blocks as one MSH 4.1 file: A = the box of height H_a on B's top (touching, g = 0),
-/// its nodes first in the box's order, then B's; groups body_a, body_b, contact_a (A's
-/// bottom), contact_b (B's top), loaded (A's top) and, if `clamped`, clamped (B's base).
+/// The blocks as one MSH 4.1 file ([`boxes_msh`]: A = the box of height H_a on B's top,
+/// touching, g = 0, its nodes first in the box's order, then B's; groups body_a, body_b,
+/// contact_a, contact_b, loaded and, if `clamped`, clamped — B's base).
 fn blocks_msh(b: Blocks, clamped: bool) -> String {
     lifted_msh(b, clamped, 0.0)
 }
 
 /// [`blocks_msh`] with A drawn `lift` higher (a gap in the file).
 fn lifted_msh(b: Blocks, clamped: bool, lift: f64) -> String {
-    let d = b.dim;
-    let mut ext = vec![b.width; d];
-    let mut cells_a = vec![b.across; d];
-    ext[d - 1] = b.height_a;
-    cells_a[d - 1] = b.cells_a;
-    let mut a = BoxMesh::new(&ext, &cells_a);
-    a.coords
-        .iter_mut()
-        .for_each(|c| c[d - 1] += b.height_b + lift);
-    ext[d - 1] = b.height_b;
-    let mut cells_b = cells_a.clone();
-    cells_b[d - 1] = b.cells_b;
-    let bm = BoxMesh::new(&ext, &cells_b);
-    let off = a.num_nodes();
-    // (physical dim, tag, name, entity dim, faces or cells as node ids, 0-based)
-    let shift = |faces: Vec<Vec<usize>>, o: usize| -> Vec<Vec<usize>> {
-        faces
-            .into_iter()
-            .map(|f| f.into_iter().map(|n| n + o).collect())
-            .collect()
+    let boxes = Boxes {
+        dim: b.dim,
+        width: b.width,
+        height_a: b.height_a,
+        height_b: b.height_b,
+        across: b.across,
+        across_b: b.across,
+        cells_a: b.cells_a,
+        cells_b: b.cells_b,
     };
-    let cells = |m: &BoxMesh| -> Vec<Vec<usize>> {
-        (0..m.num_elements())
-            .map(|e| gmsh_order(m.element_nodes(e)))
-            .collect()
-    };
-    let mut groups = vec![
-        (d, "body_a", cells(&a)),
-        (d, "body_b", shift(cells(&bm), off)),
-        (d - 1, "contact_a", plane_faces(&a, &cells_a, 0)),
-        (
-            d - 1,
-            "contact_b",
-            shift(plane_faces(&bm, &cells_b, b.cells_b), off),
-        ),
-        (d - 1, "loaded", plane_faces(&a, &cells_a, b.cells_a)),
-    ];
-    if clamped {
-        groups.push((d - 1, "clamped", shift(plane_faces(&bm, &cells_b, 0), off)));
-    }
-    let mut s = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n");
-    let _ = writeln!(s, "{}", groups.len());
-    for (k, (gd, name, _)) in groups.iter().enumerate() {
-        let _ = writeln!(s, "{gd} {} \"{name}\"", k + 1);
-    }
-    s.push_str("$EndPhysicalNames\n$Entities\n");
-    // One entity per group, tagged as its group; no bounding entities.
-    let count = |dd: usize| groups.iter().filter(|g| g.0 == dd).count();
-    let mut counts = [0usize; 4];
-    for (dd, c) in counts.iter_mut().enumerate() {
-        *c = count(dd);
-    }
-    let _ = writeln!(s, "{} {} {} {}", counts[0], counts[1], counts[2], counts[3]);
-    for dd in 1..=3 {
-        for (k, _) in groups.iter().enumerate().filter(|(_, g)| g.0 == dd) {
-            let _ = writeln!(s, "{} 0 0 0 1 1 1 1 {} 0", k + 1, k + 1);
-        }
-    }
-    s.push_str("$EndEntities\n$Nodes\n");
-    let total = off + bm.num_nodes();
-    let _ = writeln!(s, "2 {total} 1 {total}");
-    for (k, m, o) in [(1, &a, 0), (2, &bm, off)] {
-        let _ = writeln!(s, "{d} {k} 0 {}", m.num_nodes());
-        for n in 0..m.num_nodes() {
-            let _ = writeln!(s, "{}", n + o + 1);
-        }
-        for n in 0..m.num_nodes() {
-            let c = m.coords[n];
-            let _ = writeln!(
-                s,
-                "{:?} {:?} {:?}",
-                c[0],
-                c[1],
-                if d == 3 { c[2] } else { 0.0 }
-            );
-        }
-    }
-    s.push_str("$EndNodes\n$Elements\n");
-    let n_el: usize = groups.iter().map(|g| g.2.len()).sum();
-    let _ = writeln!(s, "{} {n_el} 1 {n_el}", groups.len());
-    let mut tag = 0;
-    for (k, (gd, _, els)) in groups.iter().enumerate() {
-        let ty = match (*gd, d) {
-            (2, 2) => 3,
-            (1, _) => 1,
-            (2, 3) => 3,
-            _ => 5,
-        };
-        let _ = writeln!(s, "{gd} {} {ty} {}", k + 1, els.len());
-        for e in els {
-            tag += 1;
-            let nodes: Vec<String> = e.iter().map(|n| (n + 1).to_string()).collect();
-            let _ = writeln!(s, "{tag} {}", nodes.join(" "));
-        }
-    }
-    s.push_str("$EndElements\n");
-    s
-}
-
-/// Every number of a run's metrics by name, in order (from its Debug form `name: value, …`,
-/// nested values — the impacts' phases — included), the wall-clock times and the cache
-/// counters left out.
-fn metric_values(o: &Outcome) -> Vec<(String, Option<f64>)> {
-    let text = format!("{:?}", o.metrics)
-        .replace("Some(", "")
-        .replace(')', "");
-    text.split([',', '{', '}', '['])
-        .filter_map(|piece| {
-            let (name, v) = piece.trim().split_once(": ")?;
-            if name.ends_with("_time_s") || name == "factor_cache_hits" {
-                return None;
-            }
-            match v.trim() {
-                "None" => Some((name.to_string(), None)),
-                v => v.parse::<f64>().ok().map(|x| (name.to_string(), Some(x))),
-            }
-        })
-        .collect()
-}
-
-/// The largest relative difference of two runs over every metric and every series value
-/// (each against the larger of its own column's scale and `floor`), with the name where it is.
-fn difference(k: &Outcome, g: &Outcome, floor: f64) -> (f64, String) {
-    let mut worst = (0.0f64, String::from("none"));
-    let mut see = |name: &str, d: f64| {
-        if d > worst.0 || d.is_nan() {
-            worst = (d, name.to_string());
-        }
-    };
-    let (mk, mg) = (metric_values(k), metric_values(g));
-    assert_eq!(mk.len(), mg.len());
-    // The two-body columns are among them: the momentum, the bodies' velocities, the masses.
-    let given = mk.iter().filter(|(_, v)| v.is_some()).count();
-    assert!(given >= 20, "{mk:?}");
-    for ((n, a), (m, b)) in mk.iter().zip(mg) {
-        assert_eq!(*n, m);
-        assert_eq!(a.is_some(), b.is_some(), "{n}: blocks {a:?}, mesh {b:?}");
-        if let (Some(a), Some(b)) = (a, b) {
-            see(n, (a - b).abs() / a.abs().max(b.abs()).max(floor));
-        }
-    }
-    let (sk, sg) = (&k.series, &g.series);
-    assert_eq!(sk.step, sg.step);
-    let cols: [(&str, &[f64], &[f64]); 5] = [
-        ("t", &sk.t, &sg.t),
-        ("u_contact", &sk.u_contact, &sg.u_contact),
-        ("v_contact", &sk.v_contact, &sg.v_contact),
-        ("sigma_contact", &sk.sigma_contact, &sg.sigma_contact),
-        ("energy", &sk.energy, &sg.energy),
-    ];
-    let optional = sk.optional.iter().zip(&sg.optional).enumerate();
-    let opt: Vec<(String, &[f64], &[f64])> = optional
-        .map(|(i, (a, b))| (format!("series optional {i}"), &a[..], &b[..]))
-        .collect();
-    for (i, (a, b)) in sk.valid.iter().zip(&sg.valid).enumerate() {
-        assert_eq!(a, b, "series optional {i}: the same steps given");
-    }
-    let all = cols
-        .iter()
-        .map(|(n, a, b)| (n.to_string(), *a, *b))
-        .chain(opt);
-    for (name, a, b) in all {
-        assert_eq!(a.len(), b.len(), "{name}");
-        let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(floor);
-        for (x, y) in a.iter().zip(b) {
-            see(&name, (x - y).abs() / scale);
-        }
-    }
-    worst
+    boxes_msh(boxes, clamped, false, lift)
 }
 
 /// The three methods of done-when 4 (mixed + CN, penalty + CN, mixed + backward Euler with a
@@ -549,21 +363,6 @@ fn the_gap_is_the_runs_whatever_the_files() {
     }
 }
 
-/// A sweep over a two-body file refused at plan time: its message.
-fn refused(msh: &str, fixed: &str) -> String {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("two.msh"), msh).unwrap();
-    let text = format!(
-        "name = \"x\"\nscene = \"mesh2d\"\n[fixed]\nmesh = \"two.msh\"\ndt = 0.01\n{fixed}"
-    );
-    let path = dir.path().join("s.toml");
-    match SweepFile::parse(&path, &text).map(|s| expand(&s)) {
-        Err(e) => e.to_string(),
-        Ok(Err(e)) => e.to_string(),
-        Ok(Ok(_)) => panic!("accepted:\n{text}"),
-    }
-}
-
 const SMALL: Blocks = Blocks {
     dim: 2,
     width: 1.0,
@@ -581,6 +380,7 @@ fn bad_two_body_meshes_are_refused() {
     // Friction with Nitsche on a file: its interface points carry no slip rows yet.
     let e = refused(
         &good,
+        2,
         "space = \"nitsche\"\nnitsche_gamma0 = 0.05\nfriction = \"coulomb\"\nfriction_coefficient = 0.3\n",
     );
     assert!(
@@ -589,7 +389,7 @@ fn bad_two_body_meshes_are_refused() {
     );
     // No contact_b: the group list names it.
     let no_b = good.replace("\"contact_b\"", "\"other\"");
-    let e = refused(&no_b, "");
+    let e = refused(&no_b, 2, "");
     assert!(
         e.contains("two.msh") && e.contains("no physical group named \"contact_b\""),
         "{e}"
@@ -597,24 +397,25 @@ fn bad_two_body_meshes_are_refused() {
     // A's middle bottom node moved sideways: unmatched, named with its coordinates.
     let moved = good.replacen("\n0.5 1.0 0.0\n", "\n0.51 1.0 0.0\n", 1);
     assert_ne!(moved, good);
-    let e = refused(&moved, "");
+    let e = refused(&moved, 2, "");
     assert!(
-        e.contains("node 2 of \"contact_a\" at (0.51, 1, 0) has no node of \"contact_b\" below it"),
+        e.contains("node 2 of \"contact_a\" at (0.51, 1, 0) has no node of \"contact_b\" below it")
+            && e.contains("set `pairing`"),
         "{e}"
     );
     // Keys: mesh_ratio is the blocks' own, obstacle has no meaning between two bodies, and B's
     // keys on a one-body file are refused.
-    let e = refused(&good, "mesh_ratio = 1.0\n");
+    let e = refused(&good, 2, "mesh_ratio = 1.0\n");
     assert!(
         e.contains("mesh_ratio") && e.contains("not a parameter of scene mesh2d"),
         "{e}"
     );
-    let e = refused(&good, "obstacle = 0.5\n");
+    let e = refused(&good, 2, "obstacle = 0.5\n");
     assert!(
         e.contains("holds two bodies") && e.contains("no obstacle"),
         "{e}"
     );
-    let e = refused(&good, "gap = -0.1\n");
+    let e = refused(&good, 2, "gap = -0.1\n");
     assert!(e.contains("gap") && e.contains("must be ≥ 0"), "{e}");
 }
 

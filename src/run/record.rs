@@ -253,9 +253,9 @@ schema! {
         pressure: Option<f64> => "Pa", "blocks2d, blocks3d: the traction −p e_d on A's top face (the patch test's p)";
         lame_lambda_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's λ (null: A's)";
         lame_mu_b: Option<f64> => "Pa", "blocks2d, blocks3d: body B's μ (null: A's)";
-        pairing: Option<String> => "", "blocks2d, blocks3d: how mixed and penalty pair the faces: node-to-node, node-to-segment (one pass, A the slave) or mortar (contract §2.6)";
-        mortar_basis: Option<String> => "", "blocks2d, blocks3d: the mortar multiplier's basis, standard or dual (Wohlmuth's biorthogonal; contract §2.6)";
-        interface_quadrature: Option<String> => "", "blocks2d, blocks3d: where mortar's and Nitsche's interface integrals are computed: segment (the segmentation of Γ^a by Γ^b's projected faces) or element (Γ^a's own face rule; contract §2.6)";
+        pairing: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: how mixed and penalty pair the faces: node-to-node, node-to-segment (one pass, A the slave) or mortar (contract §2.6)";
+        mortar_basis: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: the mortar multiplier's basis, standard or dual (Wohlmuth's biorthogonal; contract §2.6)";
+        interface_quadrature: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: where mortar's and Nitsche's interface integrals are computed: segment (the segmentation of Γ^a by Γ^b's projected faces) or element (Γ^a's own face rule; contract §2.6)";
         momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰ − tⁿF) / (Σ_i m_i·abs(V_i) + T·abs(F)), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d (with friction: the largest over every axis, V_i the full velocity), m_i = 1ᵀM_i1 the run's masses, F the total load along that axis (both bodies' weight and the pressure; 0 without) (contract §5; null when a clamp or an obstacle acts, or when the velocities and the load all vanish)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T along e_x (1D) or e_d";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T along e_x (1D) or e_d";

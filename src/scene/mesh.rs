@@ -41,10 +41,12 @@
 use std::path::Path;
 
 use super::{
-    ErrorSource, FeGeometry, FeSetup, LoadModel, MassSide, MeshChoice, MethodNames, NitscheSides,
-    Physics, PhysicsKey, Scene, SceneFacts, SceneSetup,
+    ErrorSource, FeGeometry, FeSetup, InterfaceQuadrature, InterfaceUse, LoadModel, MassSide,
+    MeshChoice, MethodNames, NitscheSides, Pairing, Physics, PhysicsKey, Scene, SceneFacts,
+    SceneSetup, mortar_basis_from_index,
 };
-use crate::space::fe::{GmshMesh, Mesh};
+use crate::space::fe::interface::Basis;
+use crate::space::fe::{GmshMesh, Mesh, file_interface};
 
 /// The scenes `mesh2d` (dim 2) and `mesh3d` (dim 3).
 #[derive(Debug, Clone, Copy)]
@@ -64,12 +66,17 @@ pub struct MeshBodies {
     pub mass_side: MassSide,
     /// The weights of Nitsche's two sides (contract §2.6 `nitsche_sides`).
     pub nitsche_sides: NitscheSides,
+    /// The rows of `mixed` and `penalty`, the mortar basis and the interface quadrature
+    /// (contract §2.6 `pairing`, `mortar_basis`, `interface_quadrature`; issue 45).
+    pub pairing: Pairing,
+    pub mortar_basis: Basis,
+    pub interface_quadrature: InterfaceQuadrature,
 }
 
 /// The two-body keys (contract §1.10), all NaN by default — "not given": the column is null
 /// and the id unchanged, so the one-body files' runs keep their ids and columns, and a
 /// one-body file refuses any of them ([`two_body_keys_on_one_body`]).
-const TWO_BODY_KEYS: [&str; 7] = [
+const TWO_BODY_KEYS: [&str; 10] = [
     "density_b",
     "lame_lambda_b",
     "lame_mu_b",
@@ -77,9 +84,12 @@ const TWO_BODY_KEYS: [&str; 7] = [
     "pressure",
     "mass_side",
     "nitsche_sides",
+    "pairing",
+    "mortar_basis",
+    "interface_quadrature",
 ];
 
-const MESH_PHYSICS: [PhysicsKey; 16] = [
+const MESH_PHYSICS: [PhysicsKey; 19] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -149,6 +159,18 @@ const MESH_PHYSICS: [PhysicsKey; 16] = [
         name: TWO_BODY_KEYS[6],
         default: f64::NAN,
     },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[7],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[8],
+        default: f64::NAN,
+    },
+    PhysicsKey {
+        name: TWO_BODY_KEYS[9],
+        default: f64::NAN,
+    },
 ];
 
 /// A key's value, `or` where the sweep gives none (NaN).
@@ -191,7 +213,46 @@ fn mesh_bodies(p: &Physics, path: &Path) -> Result<MeshBodies, String> {
         pressure: given_or(p, "pressure", 0.0),
         mass_side: MassSide::from_index(given_or(p, "mass_side", 0.0)),
         nitsche_sides: NitscheSides::from_index(given_or(p, "nitsche_sides", 0.0)),
+        pairing: Pairing::from_index(given_or(p, "pairing", 0.0)),
+        mortar_basis: mortar_basis_from_index(given_or(p, "mortar_basis", 0.0)),
+        interface_quadrature: InterfaceQuadrature::from_index(given_or(
+            p,
+            "interface_quadrature",
+            0.0,
+        )),
     })
+}
+
+/// The contact rows of a two-body file: its matched pairs, or — a non-matching interface or a
+/// pairing that projects (issue 45) — its Γ^a vertices not clamped, once the faces are checked
+/// to face each other ([`file_interface`]) and the pairing takes the faces' degree.
+fn two_body_contact(
+    path: &Path,
+    mesh: &GmshMesh,
+    b: &crate::space::fe::GmshBodies,
+    keys: &MeshBodies,
+) -> Result<usize, String> {
+    if b.unmatched.is_none() && keys.pairing == Pairing::NodeToNode {
+        return Ok(b.pairs.len());
+    }
+    let i = file_interface(mesh)?;
+    if i.curved && keys.pairing != Pairing::NodeToNode {
+        return Err(format!(
+            "{}: pairing = {} on degree-2 cells: its rows are built on the faces' vertices (2-node segments, 3-node triangles, 4-node quadrilaterals); use space = nitsche, or a mesh of degree-1 cells",
+            path.display(),
+            if keys.pairing == Pairing::Mortar {
+                "mortar"
+            } else {
+                "node-to-segment"
+            }
+        ));
+    }
+    let clamped = mesh.group("clamped").map_or(&[][..], |g| &g.nodes[..]);
+    Ok(i.sides[0]
+        .nodes
+        .iter()
+        .filter(|n| clamped.binary_search(n).is_err())
+        .count())
 }
 
 impl MeshScene {
@@ -247,6 +308,15 @@ impl Scene for MeshScene {
     fn supports(&self, m: MethodNames<'_>) -> Result<(), (&'static str, String)> {
         super::fe_supports(self.name(), m)
     }
+    /// A two-body file's interface keys as the blocks' (contract §2.6; a one-body file refuses
+    /// them as every two-body key).
+    fn supports_interface(
+        &self,
+        p: &Physics,
+        m: InterfaceUse<'_>,
+    ) -> Result<(), (&'static [&'static str], String)> {
+        super::two_body::check_interface(p, 1.0, m)
+    }
     fn error_source(&self, _p: &Physics) -> Option<ErrorSource> {
         Some(ErrorSource::ReferenceRun)
     }
@@ -281,9 +351,9 @@ impl Scene for MeshScene {
                 None
             }
         };
-        let contact = match &mesh.bodies {
-            Some(b) => b.pairs.len(),
-            None => mesh.contact_nodes().len(),
+        let contact = match (&mesh.bodies, &bodies) {
+            (Some(b), Some(keys)) => two_body_contact(path, mesh, b, keys)?,
+            _ => mesh.contact_nodes().len(),
         };
         if contact == 0 {
             return Err(format!(

@@ -3,7 +3,8 @@
 //! B's material keys, which default to A's values (contract §1.9, §1.10). One definition, so
 //! `bars1d` and `blocks2d`/`blocks3d` read the keys the same way.
 
-use super::Physics;
+use super::{InterfaceUse, Physics};
+use crate::space::fe::interface::Basis;
 
 /// B's value of a material key `name` (`name_b`): its own, or A's where the sweep gives none
 /// (the key's default is NaN, which no given value can be).
@@ -125,4 +126,99 @@ pub fn mortar_basis_from_index(x: f64) -> crate::space::fe::interface::Basis {
     } else {
         crate::space::fe::interface::Basis::Standard
     }
+}
+
+/// The interface keys against the run's treatment, friction and scheme (contract §2.6): the
+/// checks both two-body scenes with faces share (`blocks2d`/`blocks3d`, whose `mesh_ratio` is
+/// `ratio`, and the two-body Gmsh files, `ratio` = 1: a file's non-matching interface is
+/// refused with node-to-node by the planner, which reads the file). A choice key not given
+/// (NaN, a file's) reads as its first word.
+pub(super) fn check_interface(
+    p: &Physics,
+    ratio: f64,
+    m: InterfaceUse<'_>,
+) -> Result<(), (&'static [&'static str], String)> {
+    let (space, frictional) = (m.space, m.frictional);
+    let pairing = Pairing::from_index(p.get("pairing"));
+    // The words of the choice keys (the model's `Key::choices`, which this layer does
+    // not see), by their indices.
+    let word = |key: &str| {
+        let words: &[&str] = match key {
+            "pairing" => &["node-to-node", "node-to-segment", "mortar"],
+            "mortar_basis" => &["standard", "dual"],
+            _ => &["segment", "element"],
+        };
+        words[p.get(key) as usize]
+    };
+    // Nitsche takes any mesh_ratio (its points come from the interface geometry).
+    if space == "nitsche" && pairing != Pairing::NodeToNode {
+        return Err((
+            &["pairing", "space"],
+            format!(
+                "pairing = {} with space = nitsche: a pairing makes the rows of mixed and penalty; nitsche integrates over the interface (interface_quadrature)",
+                word("pairing")
+            ),
+        ));
+    }
+    if mortar_basis_from_index(p.get("mortar_basis")) != Basis::Standard
+        && pairing != Pairing::Mortar
+    {
+        return Err((
+            &["mortar_basis", "pairing", "space"],
+            format!(
+                "mortar_basis = {} with pairing = {}: the basis of the mortar multiplier applies to pairing = \"mortar\" only",
+                word("mortar_basis"),
+                word("pairing")
+            ),
+        ));
+    }
+    let quadrature = InterfaceQuadrature::from_index(p.get("interface_quadrature"));
+    if quadrature != InterfaceQuadrature::Segment
+        && space != "nitsche"
+        && pairing != Pairing::Mortar
+    {
+        return Err((
+            &["interface_quadrature", "pairing", "space"],
+            format!(
+                "interface_quadrature = {} with pairing = {}: it applies to the interface integrals of pairing = \"mortar\" and of space = nitsche only (node rows carry no interface integral)",
+                word("interface_quadrature"),
+                word("pairing")
+            ),
+        ));
+    }
+    if space != "nitsche" && ratio != 1.0 && pairing == Pairing::NodeToNode {
+        return Err((
+            &["mesh_ratio", "pairing", "space"],
+            format!(
+                "mesh_ratio = {ratio} with pairing = node-to-node: non-matching interface: choose node-to-segment or mortar, or nitsche (issue 45; node-to-node needs every Γ^a node above a Γ^b node)"
+            ),
+        ));
+    }
+    if m.kinematic && pairing != Pairing::NodeToNode {
+        return Err((
+            &["pairing", "scheme", "mass"],
+            format!(
+                "central-difference with mass = lumped and pairing = {}: kinematic contact acts row by row on rows that share no node (node-to-node pairs; these rows share Γ^b's nodes)",
+                word("pairing")
+            ),
+        ));
+    }
+    if frictional && space == "nitsche" && ratio != 1.0 {
+        return Err((
+            &["mesh_ratio", "friction", "space"],
+            format!(
+                "friction with space = nitsche and mesh_ratio = {ratio}: the relative slip's Nitsche rows are built for the matching blocks only (mesh_ratio = 1; contract §2.6)"
+            ),
+        ));
+    }
+    if frictional && pairing != Pairing::NodeToNode {
+        return Err((
+            &["pairing", "friction"],
+            format!(
+                "friction with pairing = {}: the relative slip's rows are built for node-to-node pairs only (contract §2.6)",
+                word("pairing")
+            ),
+        ));
+    }
+    Ok(())
 }

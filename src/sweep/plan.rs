@@ -1173,6 +1173,7 @@ fn read_mesh_file(
                     Err(why) => issues.push(Issue::at(o, why)),
                     Ok((choice, setup)) => {
                         issues.extend(nitsche_friction_on_bodies_file(&m, given));
+                        issues.extend(node_to_node_on_nonmatching_file(&m, given));
                         file_setup = Some((choice, setup));
                         mesh_file = Some((written, path, m));
                     }
@@ -1195,6 +1196,39 @@ fn nitsche_friction_on_bodies_file(m: &crate::space::fe::GmshMesh, given: &Given
             o,
             format!(
                 "friction with space = nitsche on the two-body mesh {}: the relative slip's Nitsche rows are built for blocks2d/blocks3d with a matching interface only (mixed and penalty take friction on a file)",
+                m.file
+            ),
+        )
+    })
+}
+
+/// `pairing = "node-to-node"` (the default) with `mixed` or `penalty` on a two-body file whose
+/// interface does not match node to node (issue 45): refused at `pairing` (or at `mesh` where
+/// the sweep gives no pairing), naming the node at fault and the keys that take the file.
+fn node_to_node_on_nonmatching_file(
+    m: &crate::space::fe::GmshMesh,
+    given: &Given,
+) -> Option<Issue> {
+    let why = m.bodies.as_ref()?.unmatched.as_ref()?;
+    let space = given.get(Key::Space);
+    if space.as_ref().and_then(|v| v.as_str()) == Some("nitsche") {
+        return None;
+    }
+    let pairing = given.get(Key::Pairing);
+    let word = pairing
+        .as_ref()
+        .and_then(|v| v.as_str())
+        .unwrap_or("node-to-node");
+    (word == "node-to-node").then(|| {
+        let key = if given.has(Key::Pairing) {
+            Key::Pairing
+        } else {
+            Key::Mesh
+        };
+        Issue::at(
+            &given.origin(key),
+            format!(
+                "{}: {why}; pairing = \"{word}\" needs every Γ^a node above a Γ^b node: set `pairing` to \"node-to-segment\" or \"mortar\" (or space = \"nitsche\") for a non-matching interface",
                 m.file
             ),
         )

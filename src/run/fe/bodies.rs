@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use super::nitsche_interface::PairFaces;
 use super::nitsche_pair::{blocks_interface, pair_points};
-use super::pairing::{GeneralRows, box_face, general_rows};
+use super::pairing::{GeneralRows, InterfaceKeys, box_face, general_rows};
 use super::rows::{RowEntries, Rows};
 use crate::run::Metrics;
 use crate::scene::{Blocks, FeSetup, MassSide, Pairing};
@@ -189,7 +189,7 @@ pub(super) fn blocks_parts(s: &FeSetup, b: &Blocks) -> Result<BlocksParts, Strin
         // Π's reach: the faces coincide (gap 0 in the reference configuration), so any point
         // of Γ^a is within round-off of Γ^b; half an element leaves room and finds one face.
         let reach = 0.5 * b.width / b.across.max(b.across_b) as f64;
-        let rows = general_rows(b, &side_a, &side_b, reach)?;
+        let rows = general_rows(InterfaceKeys::of_blocks(b), &side_a, &side_b, reach)?;
         // |Γ^a| as the rows' weights sum it, so weight·measure is each row's ∫φ_i or ∫ψ_k.
         measure = rows.weight.iter().sum();
         weight = rows.weight.iter().map(|w| w / measure).collect();

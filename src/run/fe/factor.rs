@@ -176,13 +176,11 @@ pub(super) fn factor(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<Factor
 /// blocks; no tangential rows yet, so a frictional run there is refused here rather than run
 /// frictionless — the planner refuses it first).
 fn pair_points(g: &Geometry, cfg: &FeConfig) -> Result<Vec<ContactPoint>, String> {
-    // A file's interface is integrated on its segmentation (its `interface_quadrature` is
-    // not a key yet).
     let (sides, rule) = match &cfg.setup.geometry {
         FeGeometry::Blocks(b) => (Some(b.nitsche_sides), b.interface_quadrature),
         FeGeometry::Mesh {
             bodies: Some(m), ..
-        } => (Some(m.nitsche_sides), InterfaceQuadrature::Segment),
+        } => (Some(m.nitsche_sides), m.interface_quadrature),
         _ => (None, InterfaceQuadrature::Segment),
     };
     let (Some(two), Some(sides)) = (&g.bodies, sides) else {

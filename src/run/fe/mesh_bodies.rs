@@ -18,10 +18,12 @@
 
 use super::bodies::{BlocksParts, BodiesSpec, bodies_parts};
 use super::nitsche_interface::PairFaces;
-use crate::scene::{FeSetup, MeshBodies};
+use super::pairing::{GeneralRows, InterfaceKeys, Side, general_rows};
+use crate::scene::{FeSetup, MeshBodies, Pairing};
+use crate::space::fe::interface::{Projector, face_integrals};
 use crate::space::fe::mesh::mesh_layers;
 use crate::space::fe::nitsche::{ContactFace, gmsh_contact_faces};
-use crate::space::fe::{BodiesMesh, GmshMesh, Mesh};
+use crate::space::fe::{BodiesMesh, GmshMesh, Mesh, file_interface};
 
 /// The measure of each face of a face group (its vertices' straight line or flat polygon, Gmsh's
 /// order: the vertices first), in a mesh of dimension `d`.
@@ -99,15 +101,6 @@ pub(super) fn mesh_bodies_parts(
         let c = &mut layer_counts[bm.element_body(e)];
         *c = (*c).max(l + 1);
     }
-    let node_weight = face_node_weights(mesh, &face_a.elements);
-    let mut weight: Vec<f64> = gb.pairs.iter().map(|&(a, _)| node_weight[a]).collect();
-    let measure: f64 = weight.iter().sum();
-    if measure.is_nan() || measure <= 0.0 {
-        return Err(format!(
-            "{file}: the group \"contact_a\" has no faces of positive measure"
-        ));
-    }
-    weight.iter_mut().for_each(|w| *w /= measure);
     // γ = h per row: the largest side of the Γ^a faces at its node.
     let mut size = vec![0.0f64; mesh.coords.len()];
     for face in &face_a.elements {
@@ -116,7 +109,11 @@ pub(super) fn mesh_bodies_parts(
             size[n] = size[n].max(side);
         }
     }
-    let lowest = gb.distance.iter().copied().fold(f64::INFINITY, f64::min);
+    let rows = if gb.unmatched.is_none() && keys.pairing == Pairing::NodeToNode {
+        matched_rows(mesh, gb, &face_a.elements, &size, &id)?
+    } else {
+        file_rows(mesh, keys, &id, &clamped, &size)?
+    };
     let (loaded, loaded_measure) = match group("loaded") {
         Some(g) => {
             let w = face_node_weights(mesh, &g.elements);
@@ -133,19 +130,19 @@ pub(super) fn mesh_bodies_parts(
         None => (Vec::new(), 0.0),
     };
     let extent = |body: u8| mesh.extent(|n| gb.node_body[n] == body);
-    let interface = pair_faces(mesh, &gb.node_body, lowest, &gb.distance);
+    let interface = pair_faces(mesh, &gb.node_body, rows.lowest, rows.farthest);
     let mut parts = bodies_parts(
         s,
         BodiesSpec {
             layers,
             layer_counts,
             clamped,
-            pairs: gb.pairs.iter().map(|&(a, b)| (id[a], id[b])).collect(),
-            general: None,
-            height: gb.distance.iter().map(|g| g - lowest).collect(),
-            row_h: gb.pairs.iter().map(|&(a, _)| size[a]).collect(),
-            weight,
-            measure,
+            pairs: rows.pairs,
+            general: rows.general,
+            height: rows.height,
+            row_h: rows.row_h,
+            weight: rows.weight,
+            measure: rows.measure,
             loaded,
             loaded_measure,
             heights: [extent(0), extent(1)],
@@ -162,14 +159,143 @@ pub(super) fn mesh_bodies_parts(
     Ok(parts)
 }
 
+/// A file's contact rows (module header) with their gaps beyond the run's, weights (sum 1),
+/// γ = h per row and |Γ^a|, and the closest and farthest distance of Γ^a to Γ^b in the file.
+struct FileRows {
+    pairs: Vec<(usize, usize)>,
+    general: Option<GeneralRows>,
+    height: Vec<f64>,
+    weight: Vec<f64>,
+    row_h: Vec<f64>,
+    measure: f64,
+    lowest: f64,
+    farthest: f64,
+}
+
+/// The matched pairs' node-to-node rows (joined ids through `id`), weighted by the Γ^a faces'
+/// `faces` measures, γ = `size` at the Γ^a node.
+fn matched_rows(
+    mesh: &GmshMesh,
+    gb: &crate::space::fe::GmshBodies,
+    faces: &[Vec<usize>],
+    size: &[f64],
+    id: &[usize],
+) -> Result<FileRows, String> {
+    let node_weight = face_node_weights(mesh, faces);
+    let mut weight: Vec<f64> = gb.pairs.iter().map(|&(a, _)| node_weight[a]).collect();
+    let measure = normalise(&mesh.file, &mut weight)?;
+    let lowest = gb.distance.iter().copied().fold(f64::INFINITY, f64::min);
+    Ok(FileRows {
+        pairs: gb.pairs.iter().map(|&(a, b)| (id[a], id[b])).collect(),
+        general: None,
+        height: gb.distance.iter().map(|g| g - lowest).collect(),
+        weight,
+        row_h: gb.pairs.iter().map(|&(a, _)| size[a]).collect(),
+        measure,
+        lowest,
+        farthest: gb.distance.iter().copied().fold(lowest, f64::max),
+    })
+}
+
+/// Weights to sum 1; returns their sum, |Γ^a|, refused where it is no positive measure.
+fn normalise(file: &str, weight: &mut [f64]) -> Result<f64, String> {
+    let measure: f64 = weight.iter().sum();
+    if measure.is_nan() || measure <= 0.0 {
+        return Err(format!(
+            "{file}: the group \"contact_a\" has no faces of positive measure"
+        ));
+    }
+    weight.iter_mut().for_each(|w| *w /= measure);
+    Ok(measure)
+}
+
+/// The rows of a non-matching file, or of a pairing that projects (issue 45): the file's faces
+/// as the blocks' interface ([`file_interface`], checked at plan time) through the blocks'
+/// [`general_rows`] — node-to-segment or mortar, in the reference configuration, once per run.
+/// Rows of clamped Γ^a nodes are left out and clamped nodes' entries dropped (their
+/// displacement is 0). `nitsche` on a non-matching file (`pairing` node-to-node) takes its
+/// points from the faces; its rows, for the observables only, pair each Γ^a node with the
+/// nearest vertex of its Γ^b face (the blocks' nearest partner).
+fn file_rows(
+    mesh: &GmshMesh,
+    keys: &MeshBodies,
+    id: &[usize],
+    clamped: &[bool],
+    size: &[f64],
+) -> Result<FileRows, String> {
+    let fi = file_interface(mesh)?;
+    let reach = fi.farthest + 0.1 * mesh.h;
+    let side = |k: usize| Side {
+        surface: fi.sides[k].surface.clone(),
+        global: fi.sides[k].nodes.iter().map(|&n| id[n]).collect(),
+    };
+    let (a, b) = (side(0), side(1));
+    let free = |n: &usize| !clamped[*n];
+    let keep: Vec<usize> = (0..a.global.len())
+        .filter(|&k| free(&a.global[k]))
+        .collect();
+    let row_h = keep.iter().map(|&k| size[fi.sides[0].nodes[k]]).collect();
+    let (pairs, general, height, mut weight) = if keys.pairing == Pairing::NodeToNode {
+        let proj = Projector::new(&b.surface, reach);
+        let mut pairs = Vec::with_capacity(keep.len());
+        let mut height = Vec::with_capacity(keep.len());
+        for &k in &keep {
+            let x = a.surface.coords[k];
+            let p = proj.project(x).map_err(|e| format!("{}: {e}", mesh.file))?;
+            let n = b.surface.kind.shape(p.xi);
+            let face = b.surface.face(p.face);
+            let j = (0..face.len())
+                .filter(|&j| free(&b.global[face[j]]))
+                .max_by(|&i, &j| n[i].total_cmp(&n[j]))
+                .ok_or_else(|| format!("{}: a face of \"contact_b\" is clamped", mesh.file))?;
+            pairs.push((a.global[k], b.global[face[j]]));
+            height.push(p.distance - fi.lowest);
+        }
+        let node_weight = face_integrals(&a.surface);
+        let weight = keep.iter().map(|&k| node_weight[k]).collect();
+        (pairs, None, height, weight)
+    } else {
+        let ik = InterfaceKeys {
+            pairing: keys.pairing,
+            basis: keys.mortar_basis,
+            quadrature: keys.interface_quadrature,
+        };
+        let mut g = general_rows(ik, &a, &b, reach).map_err(|e| format!("{}: {e}", mesh.file))?;
+        let drop = |e: &mut Vec<(usize, f64)>| e.retain(|(n, _)| free(n));
+        let take = |v: &[f64]| keep.iter().map(|&k| v[k]).collect::<Vec<f64>>();
+        let mut rows: Vec<_> = keep.iter().map(|&k| g.rows[k].clone()).collect();
+        rows.iter_mut().for_each(|(ra, rb)| {
+            drop(ra);
+            drop(rb);
+        });
+        let height = take(&g.height).iter().map(|h| h - fi.lowest).collect();
+        let weight = take(&g.weight);
+        g.a_node = keep.iter().map(|&k| g.a_node[k]).collect();
+        g.b_nodes.retain(free);
+        g.rows = rows;
+        (Vec::new(), Some(g), height, weight)
+    };
+    let measure = normalise(&mesh.file, &mut weight)?;
+    Ok(FileRows {
+        pairs,
+        general,
+        height,
+        weight,
+        row_h,
+        measure,
+        lowest: fi.lowest,
+        farthest: fi.farthest,
+    })
+}
+
 /// Γ^a's and Γ^b's faces for Nitsche ([`super::nitsche_interface`]) as cells of the joined
 /// mesh ([`BodiesMesh::split`] numbers A's cells, then B's, each in the file's order); the
-/// projection reaches the farthest pair's distance and a tenth of the largest cell beyond it.
+/// projection reaches the farthest distance and a tenth of the largest cell beyond it.
 fn pair_faces(
     mesh: &GmshMesh,
     node_body: &[u8],
     lowest: f64,
-    distance: &[f64],
+    farthest: f64,
 ) -> Result<PairFaces, String> {
     let mut cell = vec![0usize; mesh.num_elements()];
     let mut next = 0;
@@ -189,7 +315,6 @@ fn pair_faces(
         faces.iter_mut().for_each(|f| f.element = cell[f.element]);
         Ok(faces)
     };
-    let farthest = distance.iter().copied().fold(lowest, f64::max);
     Ok(PairFaces {
         faces: [side("contact_a")?, side("contact_b")?],
         reach: farthest + 0.1 * mesh.h,

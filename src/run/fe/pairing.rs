@@ -26,8 +26,28 @@ use super::rows::RowEntries;
 use crate::scene::{Blocks, InterfaceQuadrature, Pairing};
 use crate::space::fe::BoxMesh;
 use crate::space::fe::interface::{
-    FaceKind, Projector, Surface, face_integrals, mortar_matrices, mortar_matrices_element, segment,
+    Basis, FaceKind, Projector, Surface, face_integrals, mortar_matrices, mortar_matrices_element,
+    segment,
 };
+
+/// The interface keys of a run (contract §2.6): `pairing`, `mortar_basis`,
+/// `interface_quadrature` — the blocks' or a two-body file's.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct InterfaceKeys {
+    pub(super) pairing: Pairing,
+    pub(super) basis: Basis,
+    pub(super) quadrature: InterfaceQuadrature,
+}
+
+impl InterfaceKeys {
+    pub(super) fn of_blocks(b: &Blocks) -> InterfaceKeys {
+        InterfaceKeys {
+            pairing: b.pairing,
+            basis: b.mortar_basis,
+            quadrature: b.interface_quadrature,
+        }
+    }
+}
 
 /// One face of the interface: the surface and, per surface node, its global node.
 pub(super) struct Side {
@@ -104,7 +124,7 @@ pub(super) fn box_face(
 /// The rows of `b.pairing` (node-to-segment or mortar) between Γ^a and Γ^b (module header);
 /// `reach` bounds Π's search (no Γ^a point may lie farther from Γ^b).
 pub(super) fn general_rows(
-    b: &Blocks,
+    b: InterfaceKeys,
     a: &Side,
     bside: &Side,
     reach: f64,
@@ -143,12 +163,12 @@ pub(super) fn general_rows(
             }
         }
         Pairing::Mortar => {
-            let m = match b.interface_quadrature {
+            let m = match b.quadrature {
                 InterfaceQuadrature::Segment => {
                     let seg = segment(sa, &proj).map_err(|e| e.to_string())?;
-                    mortar_matrices(sa, &bside.surface, &seg, b.mortar_basis)
+                    mortar_matrices(sa, &bside.surface, &seg, b.basis)
                 }
-                InterfaceQuadrature::Element => mortar_matrices_element(sa, &proj, b.mortar_basis),
+                InterfaceQuadrature::Element => mortar_matrices_element(sa, &proj, b.basis),
             }
             .map_err(|e| e.to_string())?;
             for k in 0..sa.num_nodes() {

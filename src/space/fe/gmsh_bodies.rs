@@ -10,8 +10,11 @@
 //!   has a Γ^b partner with the same horizontal coordinates to 1e-10·h (h the largest cell
 //!   diameter) at or below it — shifted by its distance g_i along n it lands on that node —
 //!   and no Γ^b node is the partner of two; the partner is not clamped (its row has two free
-//!   dofs). The first unmatched node is named with its coordinates (non-matching interfaces
-//!   are issue 45's).
+//!   dofs). A file that breaks this is no error here (issue 45): its interface is
+//!   non-matching ([`GmshBodies::unmatched`] holds why, naming the first node at fault with
+//!   its coordinates), which the pairings that project take (`node-to-segment`, `mortar`,
+//!   `nitsche`; [`super::gmsh_interface`] checks its geometry) and node-to-node refuses at
+//!   plan time. Two matched nodes with A below B (the bodies overlap) stay refused here.
 //!
 //! Why here, in the reader: a run is planned only once its file is read, so a mesh that is no
 //! pair of matching bodies is refused at plan time, before anything runs; and the whole-mesh
@@ -29,6 +32,9 @@ pub struct GmshBodies {
     pub pairs: Vec<(usize, usize)>,
     /// Each pair's distance along e_d in the file, x^a_d − x^b_d ≥ 0.
     pub distance: Vec<f64>,
+    /// Why the interface does not match node to node (then `pairs` and `distance` are
+    /// empty): a non-matching interface, for the pairings that project (module header).
+    pub unmatched: Option<String>,
 }
 
 /// The nodes of each body from its cells' nodes (`a`, `b`: node ids, any order): per node 0
@@ -126,10 +132,10 @@ pub(crate) fn match_interface(i: Interface<'_>) -> Result<GmshBodies, GmshError>
             .copied()
             .find(|&q| (1..d - 1).all(|k| (i.coords[q][k] - xa[k]).abs() <= tol));
         let Some(b) = partner else {
-            return Err(two(
-                file,
+            return Ok(unmatched(
+                i.node_body,
                 format!(
-                    "node {} of \"contact_a\" at {} has no node of \"contact_b\" below it along e_d (to 1e-10·h = {tol:e}): the interface does not match node to node (non-matching interfaces: issue 45)",
+                    "node {} of \"contact_a\" at {} has no node of \"contact_b\" below it along e_d (to 1e-10·h = {tol:e}): the interface does not match node to node",
                     tag(a),
                     at(a)
                 ),
@@ -150,8 +156,8 @@ pub(crate) fn match_interface(i: Interface<'_>) -> Result<GmshBodies, GmshError>
             ));
         }
         if clamped(b) {
-            return Err(two(
-                file,
+            return Ok(unmatched(
+                i.node_body,
                 format!(
                     "node {} of \"contact_b\" at {}, the partner of node {} of \"contact_a\", is clamped: a node-to-node row needs both nodes free",
                     tag(b),
@@ -161,8 +167,8 @@ pub(crate) fn match_interface(i: Interface<'_>) -> Result<GmshBodies, GmshError>
             ));
         }
         if taken[b] != usize::MAX {
-            return Err(two(
-                file,
+            return Ok(unmatched(
+                i.node_body,
                 format!(
                     "node {} of \"contact_b\" at {} is below two nodes of \"contact_a\", {} and {}: one partner per node",
                     tag(b),
@@ -186,7 +192,18 @@ pub(crate) fn match_interface(i: Interface<'_>) -> Result<GmshBodies, GmshError>
         node_body: i.node_body,
         pairs,
         distance,
+        unmatched: None,
     })
+}
+
+/// A two-body file whose interface does not match node to node, and why.
+fn unmatched(node_body: Vec<u8>, why: String) -> GmshBodies {
+    GmshBodies {
+        node_body,
+        pairs: Vec::new(),
+        distance: Vec::new(),
+        unmatched: Some(why),
+    }
 }
 
 #[cfg(test)]
@@ -231,7 +248,7 @@ mod tests {
         let c = coords(0.1, 0.0);
         let m = run(&c).unwrap();
         assert_eq!(m.distance, vec![c[0][1] - 1.0; 3]);
-        let e = run(&coords(0.0, 1e-6)).unwrap_err().to_string();
+        let e = run(&coords(0.0, 1e-6)).unwrap().unmatched.unwrap();
         assert!(
             e.contains("node 2 of \"contact_a\" at (0.500001, 1, 0)"),
             "{e}"
