@@ -10,8 +10,10 @@
 //! - no run ends `diverged` (or `invalid`) where its frictionless twin — the same run with
 //!   `friction = "none"` — ends ok;
 //! - a block with μ_f ≥ 1 sticks: after the transient the time mean of the Γ_C mean tangential
-//!   velocity is ≤ 1e-8·V (V the throw speed) — measured and printed, asserted once
-//!   [`ASSERT_STICK`] is set (see there: not met yet, by every treatment).
+//!   velocity is ≤ 1e-8·V (V the throw speed) — asserted for every method on the blocks
+//!   resting on the 18° incline from their static state, the regularised sticks (Nitsche,
+//!   penalty) at their predicted creep and Moreau–Jean within its index set's bounce; on the
+//!   thrown blocks for backward Euler, printed for the rest ([`ASSERT_STICK`] says why).
 //!
 //! The named cases of the issue are regression tests of their own below, and so are the
 //! campaign's steps that once ended `solver-failed` ([`rescued_case`]). Nitsche and penalty
@@ -218,16 +220,27 @@ fn potential_methods(t: Treatment) -> Vec<String> {
 /// (their stick is regularised). None diverged. Mixed: 0 of its 77.
 const ASSERT_POTENTIALS: bool = true;
 
-/// Whether the stick criterion is asserted for every scheme; it is for backward Euler always.
-/// Measured with the mixed treatment (T = 10, window t ≥ 5, μ_f = 1, 1.5, 2,
-/// flat and 18°, V = 0.05): backward Euler sticks with every mass (drift ≤ 1.5e-16·V); every
-/// other implicit scheme drifts, 6e-4·V (generalized-α, lumped) to 0.67·V (CN, lumped). The
-/// blocks start unstressed at gap 0, so gravity sets them bouncing, and a Γ_C node whose
-/// normal force passes through 0 slips whatever μ_f: the schemes that keep (CN, kane) or
-/// barely damp (generalized-α ρ∞ = ½, HHT α = 0.1, CSN) that motion never settle, and
-/// Moreau–Jean θ = ½ keeps feeding it (its energy rises at lift-off, contract §2.5). Every such
-/// step meets the §4 tolerance: not a solver failure; the criterion needs a pre-stressed start
-/// or damping — left to the lead.
+/// Whether the stick criterion is asserted for every method: it is, on the blocks resting on
+/// the 18° incline from their static state (`start = "static"`, contract §1.8; scenes
+/// `block2d-incline18-rest` with every treatment × scheme × mass, `block3d-incline18-rest` a
+/// sample; [`stick_holds`]). "After the transient" is precise there: a static start has none
+/// but the regularised laws' first step, so the window t ≥ T/2 of [`REST_T`] holds 20 steps of
+/// the steady state. Mixed sticks to round-off with every scheme and mass (measured ≤ 3e-16·V)
+/// but Moreau–Jean θ = ½ (≤ 1.4e-2·V, its index set's round-off decisions, [`stick_holds`]);
+/// the penalty and Nitsche creep at their regularisation's predicted rate.
+///
+/// The thrown blocks (V = 0.05 from rest at gap 0, T = 10, window t ≥ 5) are asserted with
+/// backward Euler only, as before: it sticks with every mass (drift ≤ 1.5e-16·V); every other
+/// implicit scheme drifts, 6e-4·V (generalized-α, lumped) to 0.67·V (CN, lumped). Measured from
+/// the static start too (session 32): no better — CN up to 0.83·V, kane 7.7e-5–6e-3·V,
+/// Moreau–Jean 3.5e-4–4.9e-2·V, generalized-α/HHT/CSN 3e-6–7e-3·V, and one backward Euler run
+/// (18°, lumped, μ_f 2.34) 6.6e-8·V, its bounce not yet damped at t = 5. It is the throw, not
+/// the start: the stick at the stop is sudden (the block decelerates at g(μ_f cos α − sin α)
+/// and its Γ_C halts within a step), it releases a shear wave whose traction is of the order
+/// of μ_f f_n itself, and a scheme that neither damps it (CN and kane keep it; generalized-α
+/// ρ∞ = ½, HHT α = 0.1, CSN barely damp it; Moreau–Jean θ = ½ feeds it at lift-off, contract
+/// §2.5) breaks the stick again wherever the wave takes a node's traction out of the cone.
+/// Every such step meets the §4 tolerance: not a solver failure, the undamped elastic model.
 const ASSERT_STICK: bool = true;
 
 /// The sticking blocks' end time (their stick window is t ≥ T/2). T = 5 would halve the
@@ -465,6 +478,9 @@ fn campaign() {
         // blocks by backward Euler, 1e-8·V — a stuck node's slip is the solver's residual,
         // 1e-12 relative, and the mean over the window averages the elastic vibration out
         // ([`ASSERT_STICK`]: the other schemes' drift is printed, and why).
+        if let (Some(Stick::Resting { .. }), Some(d)) = (c.sticks, r.drift) {
+            eprintln!("rest {}: drift/V {d:e}", c.label());
+        }
         let slid = match (c.sticks, r.drift) {
             (Some(Stick::Resting { h_k }), Some(d)) => !stick_holds(c, h_k, d),
             (Some(Stick::Thrown(_)), Some(d)) => d > 1e-8 && c.method.contains("backward-euler"),
