@@ -386,7 +386,7 @@ fn resolve_given(
         Some((_, setup)) => setup,
         None => scene.setup(&physics, mesh),
     };
-    static_start_of(given, &setup, &m)?;
+    static_start_of(given, setup.static_start_refusal(m.friction))?;
     let mut revision = setup.id_revision();
     let increments = setup.two_bodies_step_in_increments(&m.scheme);
     method_revisions(scene, &m, increments, &mut revision);
@@ -1121,33 +1121,13 @@ fn incline_without_gravity(given: &Given, physics: &Physics) -> Result<(), Outco
     )]))
 }
 
-/// `start = "static"` (contract §1.8) on a mesh clamped nowhere needs a friction bound: contact
-/// without friction fixes no position along the plane (and on an incline holds no static state
-/// at all). A mistake where the keys are fixed; one combination left out across an axis.
-fn static_start_of(
-    given: &Given,
-    setup: &crate::scene::SceneSetup,
-    m: &Method,
-) -> Result<(), Outcome> {
-    let crate::scene::SceneSetup::Fe(fe) = setup else {
+/// `start = "static"` (contract §1.8) where the setup has no static state to start from
+/// ([`crate::scene::SceneSetup::static_start_refusal`]): a mistake where the keys are fixed; one
+/// combination left out across an axis.
+fn static_start_of(given: &Given, why: Option<String>) -> Result<(), Outcome> {
+    let Some(why) = why else {
         return Ok(());
     };
-    let unclamped = matches!(
-        fe.geometry,
-        crate::scene::FeGeometry::Mesh {
-            clamped_nodes: 0,
-            ..
-        }
-    );
-    let held = match m.friction {
-        FrictionLaw::Coulomb { coefficient } => coefficient > 0.0,
-        FrictionLaw::Tresca { threshold } => threshold > 0.0,
-        FrictionLaw::None => false,
-    };
-    if !fe.static_start || !unclamped || held {
-        return Ok(());
-    }
-    let why = "start = \"static\": the body is clamped nowhere and its contact has no friction, which fixes no position along the plane (and on an incline holds no static state): give the run friction (μ_f > 0 or a Tresca threshold), or start at rest".to_string();
     let keys = [
         Key::Start,
         Key::Friction,

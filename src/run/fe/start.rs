@@ -85,11 +85,11 @@ pub(super) fn start_state(
     let n = a.len();
     let (mut u, mut mu) = (vec![0.0; n], vec![0.0; n]);
     if cfg.setup.static_start {
-        let (u, a0, forces) = static_start(g, cfg, m, force, gaps, a)?;
-        *a = a0;
-        m.matvec_into(&u, &mut mu);
+        let st = static_start(g, cfg, m, force, gaps, a)?;
+        *a = st.a;
+        m.matvec_into(&st.u, &mut mu);
         m.matvec_into(a, ma);
-        return Ok((u, mu, forces.filter(|_| nit.is_none())));
+        return Ok((st.u, mu, nit.is_none().then_some(st.forces)));
     }
     match quasi_static_start(g, cfg, m, nit, force, gaps, v0, a)? {
         None => Ok((u, mu, None)),
@@ -116,7 +116,7 @@ pub(super) fn start_state(
 /// static state at all): frictionless, the start needs a clamp. Nitsche and penalty start from
 /// the same state (their own law's static state differs by its regularisation: the penalty's
 /// penetration f_n/κ, Nitsche's consistency error), their point forces at t = 0 left to the first
-/// step. Returns (u⁰, a⁰, the nodal forces [f_n, f_t…] per Γ_C node).
+/// step. Returns u⁰, a⁰ and the nodal forces [f_n, f_t…] per Γ_C node.
 fn static_start(
     g: &Geometry,
     cfg: &FeConfig,
@@ -124,7 +124,7 @@ fn static_start(
     force: &[f64],
     gaps: &[f64],
     guess: &[f64],
-) -> Result<(Vec<f64>, Vec<f64>, Option<Vec<f64>>), String> {
+) -> Result<Start, String> {
     let err = |e: &str| format!("{STATIC}{e}");
     if !g.rows.is_unit() {
         return Err(err("two bodies in contact: not implemented yet"));
@@ -210,10 +210,13 @@ fn static_start(
             .map(|(x, &p)| if p { 0.0 } else { -x })
             .collect();
         let a = inertial_solve(m, &r, guess.to_vec())?;
-        return Ok((u, a, Some(forces)));
+        return Ok(Start { u, a, forces });
     }
     Err(err("the Γ_C contact set did not settle"))
 }
+
+/// u, K u − F and which dofs are pinned ([`pinned_solve`]).
+type Pinned = (Vec<f64>, Vec<f64>, Vec<bool>);
 
 /// K u = F + reactions with every active Γ_C node pinned: u_d = −g_i, and its `tangential` dofs
 /// (empty: frictionless) at 0. Returns u and the residual K u − F (the reactions on the pinned
@@ -224,7 +227,7 @@ fn pinned_solve(
     gaps: &[f64],
     active: &[bool],
     tangential: &[usize],
-) -> Result<(Vec<f64>, Vec<f64>, Vec<bool>), String> {
+) -> Result<Pinned, String> {
     let n = g.dofs.n_free();
     let d1 = g.mesh.dim() - 1;
     let (mut pinned, mut u) = (vec![false; n], vec![0.0; n]);
