@@ -26,6 +26,10 @@
 //! How: K̃_cc is extracted into its own sparse matrix (the massless dofs only: a layer one
 //! element thick) and factored once by sparse Cholesky; the contact problems are condensed onto
 //! Γ_C through solves with that factor. Nothing here runs in the time loop.
+//!
+//! `start = "static"` (contract §1.8, issue 43) replaces that start by the whole body's static
+//! state under its load with its contact ([`static_start`]): every dof, not only the massless
+//! ones, so a body resting on the plane starts without the bounce an unstressed start gives it.
 
 use std::sync::Arc;
 
