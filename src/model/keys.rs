@@ -109,6 +109,10 @@ pub enum Key {
     Pairing,
     MortarBasis,
     InterfaceQuadrature,
+    /// The initial state of the FE mesh scenes (contract §1.8, issue 43): `rest` (default: u⁰ = 0,
+    /// every existing id unchanged) or `static` (u⁰ the static state under the run's loads with
+    /// its contact, [`crate::run`]'s static start).
+    Start,
 }
 
 /// What a key's value must look like.
@@ -194,7 +198,7 @@ impl fmt::Display for Value {
 }
 
 impl Key {
-    pub const ALL: [Key; 62] = [
+    pub const ALL: [Key; 63] = [
         Key::T,
         Key::H,
         Key::Elements,
@@ -257,6 +261,7 @@ impl Key {
         Key::Pairing,
         Key::MortarBasis,
         Key::InterfaceQuadrature,
+        Key::Start,
     ];
 
     pub fn name(self) -> &'static str {
@@ -323,6 +328,7 @@ impl Key {
             Key::Pairing => "pairing",
             Key::MortarBasis => "mortar_basis",
             Key::InterfaceQuadrature => "interface_quadrature",
+            Key::Start => "start",
         }
     }
 
@@ -366,6 +372,7 @@ impl Key {
                 | Key::Pairing
                 | Key::MortarBasis
                 | Key::InterfaceQuadrature
+                | Key::Start
         )
     }
 
@@ -382,6 +389,7 @@ impl Key {
             Key::Pairing => Some(&["node-to-node", "node-to-segment", "mortar"]),
             Key::MortarBasis => Some(&["standard", "dual"]),
             Key::InterfaceQuadrature => Some(&["segment", "element"]),
+            Key::Start => Some(&["rest", "static"]),
             _ => None,
         }
     }
@@ -407,7 +415,8 @@ impl Key {
             | Key::NitscheSides
             | Key::Pairing
             | Key::MortarBasis
-            | Key::InterfaceQuadrature => ValueType::Str,
+            | Key::InterfaceQuadrature
+            | Key::Start => ValueType::Str,
             Key::MassWeights => ValueType::FloatList,
             _ => ValueType::Float,
         }
@@ -519,15 +528,21 @@ impl Key {
             | Key::NitscheSides
             | Key::Pairing
             | Key::MortarBasis
-            | Key::InterfaceQuadrature => {
+            | Key::InterfaceQuadrature
+            | Key::Start => {
                 let words = self.choices().expect("choice keys");
                 if words.contains(&s) {
                     Ok(())
                 } else {
                     Err(format!(
-                        "unknown {} `{s}` (expected {}; contract §1.9, §2.6)",
+                        "unknown {} `{s}` (expected {}; contract {})",
                         self.name(),
-                        words.join(" or ")
+                        words.join(" or "),
+                        if self == Key::Start {
+                            "§1.8: at rest, or from the static state under the run's loads"
+                        } else {
+                            "§1.9, §2.6"
+                        }
                     ))
                 }
             }

@@ -256,6 +256,7 @@ schema! {
         pairing: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: how mixed and penalty pair the faces: node-to-node, node-to-segment (one pass, A the slave) or mortar (contract §2.6)";
         mortar_basis: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: the mortar multiplier's basis, standard or dual (Wohlmuth's biorthogonal; contract §2.6)";
         interface_quadrature: Option<String> => "", "blocks2d, blocks3d, two-body mesh files: where mortar's and Nitsche's interface integrals are computed: segment (the segmentation of Γ^a by Γ^b's projected faces) or element (Γ^a's own face rule; contract §2.6)";
+        start: Option<String> => "", "mesh2d, mesh3d: the initial state (contract §1.8): rest (u⁰ = 0, the default) or static (u⁰ the static state under the run's loads with its contact, a⁰ = 0: a resting body without the spurious gravity bounce)";
         momentum_drift: Option<f64> => "", "two bodies: max_n abs(Pⁿ − P⁰ − tⁿF) / (Σ_i m_i·abs(V_i) + T·abs(F)), P = Σ_i 1ᵀM_iv along e_x (1D) or e_d (with friction: the largest over every axis, V_i the full velocity), m_i = 1ᵀM_i1 the run's masses, F the total load along that axis (both bodies' weight and the pressure; 0 without) (contract §5; null when a clamp or an obstacle acts, or when the velocities and the load all vanish)";
         velocity_a_final: Option<f64> => "m/s", "two bodies: body A's mean velocity 1ᵀM_av/1ᵀM_a1 at T along e_x (1D) or e_d";
         velocity_b_final: Option<f64> => "m/s", "two bodies: body B's mean velocity 1ᵀM_bv/1ᵀM_b1 at T along e_x (1D) or e_d";
@@ -539,6 +540,7 @@ impl RunRecord {
             pairing: p.get(&Key::Pairing).map(|v| v.to_string()),
             mortar_basis: p.get(&Key::MortarBasis).map(|v| v.to_string()),
             interface_quadrature: p.get(&Key::InterfaceQuadrature).map(|v| v.to_string()),
+            start: p.get(&Key::Start).map(|v| v.to_string()),
             ..RunRecord::default()
         }
     }

@@ -163,6 +163,7 @@ impl Scene for BallScene {
             v0: p.get("velocity"),
             v0_tangential: p.get("velocity_tangential"),
             incline: 0.0,
+            static_start: false,
         })
     }
 }

@@ -185,6 +185,9 @@ pub struct FeSetup {
     /// The plane's tilt α in degrees (contract §1.8 `incline`, mesh scenes): the volume load is
     /// ρ·gravity·(sin α e_1 − cos α e_d); 0 elsewhere.
     pub incline: f64,
+    /// Whether the run starts from the static state under its loads (contract §1.8 `start =
+    /// "static"`, mesh scenes; issue 43) instead of at rest with u⁰ = 0.
+    pub static_start: bool,
 }
 
 /// The scenes `bar2d` (dim 2) and `bar3d` (dim 3).
@@ -285,6 +288,7 @@ impl Scene for BarScene {
             v0: -0.5,
             v0_tangential: 0.0,
             incline: 0.0,
+            static_start: false,
         })
     }
 }

@@ -250,6 +250,7 @@ impl Scene for BlocksScene {
             v0: p.get("velocity"),
             v0_tangential: p.get("velocity_tangential"),
             incline: 0.0,
+            static_start: false,
         })
     }
 }

@@ -89,7 +89,7 @@ const TWO_BODY_KEYS: [&str; 10] = [
     "interface_quadrature",
 ];
 
-const MESH_PHYSICS: [PhysicsKey; 19] = [
+const MESH_PHYSICS: [PhysicsKey; 20] = [
     PhysicsKey {
         name: "density",
         default: 1.0,
@@ -129,6 +129,12 @@ const MESH_PHYSICS: [PhysicsKey; 19] = [
     },
     PhysicsKey {
         name: "incline",
+        default: 0.0,
+    },
+    // A choice key (issue 43): the index into `Key::Start.choices()`, 0 = rest (u⁰ = 0, every
+    // existing id unchanged), 1 = static (u⁰ the static state under the loads with contact).
+    PhysicsKey {
+        name: "start",
         default: 0.0,
     },
     PhysicsKey {
@@ -255,6 +261,23 @@ fn two_body_contact(
         .count())
 }
 
+/// `start = "static"` (contract §1.8) where a static state under the run's loads can exist: one
+/// body (two bodies: not yet), a load (gravity; without one the static state is u⁰ = 0, the rest
+/// start), and a support (the plane at gap 0 or a clamp: a body off the plane and clamped nowhere
+/// falls). Whether contact alone holds it tangentially (friction) is the start's own check.
+fn static_start_applies(p: &Physics, path: &Path, two: bool, free: bool) -> Result<(), String> {
+    let why = if two {
+        "a static start of two bodies is not implemented yet"
+    } else if p.get("gravity") == 0.0 {
+        "without gravity the static state is u⁰ = 0, the rest start (drop start or set gravity)"
+    } else if free && p.get("gap") > 0.0 {
+        "the body is clamped nowhere and off the plane (gap > 0): it falls, there is no static state"
+    } else {
+        return Ok(());
+    };
+    Err(format!("{}: start = \"static\": {why}", path.display()))
+}
+
 impl MeshScene {
     fn file_only(&self, what: &str) -> String {
         format!(
@@ -361,6 +384,10 @@ impl Scene for MeshScene {
                 path.display()
             ));
         }
+        let static_start = p.get("start") == 1.0;
+        if static_start {
+            static_start_applies(p, path, bodies.is_some(), clamped.is_empty())?;
+        }
         let choice = MeshChoice {
             elements: mesh.num_elements(),
             h: mesh.h,
@@ -399,6 +426,7 @@ impl Scene for MeshScene {
                 v0: p.get("velocity"),
                 v0_tangential: p.get("velocity_tangential"),
                 incline: p.get("incline"),
+                static_start,
             }),
         ))
     }

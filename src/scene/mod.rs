@@ -109,6 +109,34 @@ pub enum SceneSetup {
 pub type FileSetup = (MeshChoice, SceneSetup);
 
 impl SceneSetup {
+    /// Why `start = "static"` (contract §1.8) cannot start this setup with `friction`, if it
+    /// cannot: on a mesh clamped nowhere, contact without a friction bound fixes no position
+    /// along the plane (and on an incline holds no static state at all).
+    pub fn static_start_refusal(
+        &self,
+        friction: crate::contact::friction::FrictionLaw,
+    ) -> Option<String> {
+        use crate::contact::friction::FrictionLaw;
+        let SceneSetup::Fe(fe) = self else {
+            return None;
+        };
+        let unclamped = matches!(
+            fe.geometry,
+            FeGeometry::Mesh {
+                clamped_nodes: 0,
+                ..
+            }
+        );
+        let held = match friction {
+            FrictionLaw::Coulomb { coefficient } => coefficient > 0.0,
+            FrictionLaw::Tresca { threshold } => threshold > 0.0,
+            FrictionLaw::None => false,
+        };
+        (fe.static_start && unclamped && !held).then(|| {
+            "start = \"static\": the body is clamped nowhere and its contact has no friction, which fixes no position along the plane (and on an incline holds no static state): give the run friction (μ_f > 0 or a Tresca threshold), or start at rest".to_string()
+        })
+    }
+
     /// Whether this is a finite-element scene's setup (the sparse engine).
     pub fn is_fe(&self) -> bool {
         matches!(self, SceneSetup::Fe(_))

@@ -30,7 +30,7 @@ pub(crate) const PARAMS: &[(&str, Kind)] = &columns![
     friction_force: F64, incline: F64, length_b: F64, young_b: F64, density_b: F64,
     velocity_b: F64, far_end: Str, mass_side: Str, nitsche_sides: Str, width: F64, height_b: F64,
     lame_lambda_b: F64, lame_mu_b: F64, pressure: F64, mesh_ratio: F64, pairing: Str,
-    mortar_basis: Str, interface_quadrature: Str,
+    mortar_basis: Str, interface_quadrature: Str, start: Str,
 ];
 
 /// The parameters already spelled out in a run's `label` (contact method · mass · scheme);

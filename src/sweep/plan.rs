@@ -386,6 +386,7 @@ fn resolve_given(
         Some((_, setup)) => setup,
         None => scene.setup(&physics, mesh),
     };
+    static_start_of(given, setup.static_start_refusal(m.friction))?;
     let mut revision = setup.id_revision();
     let increments = setup.two_bodies_step_in_increments(&m.scheme);
     method_revisions(scene, &m, increments, &mut revision);
@@ -1116,6 +1117,28 @@ fn incline_without_gravity(given: &Given, physics: &Physics) -> Result<(), Outco
     }
     Err(Outcome::Invalid(vec![Issue::at(
         &given.origin(Key::Incline),
+        why,
+    )]))
+}
+
+/// `start = "static"` (contract §1.8) where the setup has no static state to start from
+/// ([`crate::scene::SceneSetup::static_start_refusal`]): a mistake where the keys are fixed; one
+/// combination left out across an axis.
+fn static_start_of(given: &Given, why: Option<String>) -> Result<(), Outcome> {
+    let Some(why) = why else {
+        return Ok(());
+    };
+    let keys = [
+        Key::Start,
+        Key::Friction,
+        Key::FrictionCoefficient,
+        Key::TrescaThreshold,
+    ];
+    if keys.iter().any(|&k| given.on_axis(k)) {
+        return Err(Outcome::Inapplicable(why));
+    }
+    Err(Outcome::Invalid(vec![Issue::at(
+        &given.origin(Key::Start),
         why,
     )]))
 }

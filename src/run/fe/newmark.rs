@@ -35,7 +35,7 @@ use super::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity,
     momentum_tally, observer, reference_map, shared_factor,
 };
-use super::start::start_state;
+use super::start::{start_failure, start_state};
 use crate::contact::friction::FrictionLaw;
 use crate::contact::{FrictionalContact, Lcp};
 use crate::run::friction_tally::{FrictionTally, MeanVelocity};
@@ -312,7 +312,7 @@ impl<'a> Stepper<'a> {
             .map(|ff| Box::new(FrictionStep::new(g, cfg, &fac.m, ff, gamma)));
         let (u, mu, forces) =
             match start_state(g, cfg, &fac.m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
-                Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+                Err(e) => return Err(fail(start_failure(&e), e, metrics)),
                 Ok(s) => s,
             };
         let incr =

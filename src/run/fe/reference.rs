@@ -349,6 +349,7 @@ mod tests {
             v0: 0.0,
             v0_tangential: 0.0,
             incline: 0.0,
+            static_start: false,
         }
     }
 

@@ -26,6 +26,10 @@
 //! How: K̃_cc is extracted into its own sparse matrix (the massless dofs only: a layer one
 //! element thick) and factored once by sparse Cholesky; the contact problems are condensed onto
 //! Γ_C through solves with that factor. Nothing here runs in the time loop.
+//!
+//! `start = "static"` (contract §1.8, issue 43) replaces that start by the whole body's static
+//! state under its load with its contact ([`static_start`]): every dof, not only the massless
+//! ones, so a body resting on the plane starts without the bounce an unstressed start gives it.
 
 use std::sync::Arc;
 
@@ -34,6 +38,7 @@ use super::geometry::{Geometry, tangential_dofs};
 use super::load::inertial_solve;
 use super::nitsche::{NewtonWork, NitscheOps, lu_solve, newton};
 use crate::contact::friction::FrictionLaw;
+use crate::run::Status;
 use crate::space::ContactInit;
 use crate::space::fe::{Pattern, SymMatrix};
 use crate::space::linalg::{Cholesky, SolveWork, SymbolicCholesky};
@@ -50,6 +55,19 @@ pub(super) struct Start {
     /// [λ_n, λ_t…] (frictional, the point-major unknowns of the frictional Newton).
     pub(super) forces: Vec<f64>,
 }
+
+/// The status of a run whose start failed: `invalid` where the static start finds no static
+/// state to start from (its refusals name `start = "static"`), `solver-failed` otherwise.
+pub(super) fn start_failure(message: &str) -> Status {
+    if message.starts_with(STATIC) {
+        Status::Invalid
+    } else {
+        Status::SolverFailed
+    }
+}
+
+/// The prefix of the static start's refusals.
+const STATIC: &str = "start = \"static\": ";
 
 /// u⁰, M u⁰ and the contact forces of the start, if it has any.
 pub(super) type StartState = (Vec<f64>, Vec<f64>, Option<Vec<f64>>);
@@ -70,6 +88,13 @@ pub(super) fn start_state(
 ) -> Result<StartState, String> {
     let n = a.len();
     let (mut u, mut mu) = (vec![0.0; n], vec![0.0; n]);
+    if cfg.setup.static_start {
+        let st = static_start(g, cfg, m, force, gaps, a)?;
+        *a = st.a;
+        m.matvec_into(&st.u, &mut mu);
+        m.matvec_into(a, ma);
+        return Ok((st.u, mu, nit.is_none().then_some(st.forces)));
+    }
     match quasi_static_start(g, cfg, m, nit, force, gaps, v0, a)? {
         None => Ok((u, mu, None)),
         Some(st) => {
@@ -79,6 +104,158 @@ pub(super) fn start_state(
             Ok((u, mu, Some(st.forces)))
         }
     }
+}
+
+/// The static start (contract §1.8 `start = "static"`, issue 43): u⁰ the static state of the
+/// body under its loads F with the exact nodal contact of the Γ_C nodes, a⁰ = 0 (up to
+/// round-off), so a body resting on the plane starts without the bounce that gravity gives an
+/// unstressed start at gap 0 (which makes a Γ_C node's normal force pass through 0 and slip
+/// whatever μ_f). Per active node u_d = −g_i with f_n ≥ 0, an inactive node u_d + g_i ≥ 0
+/// (Murty's least-index active set on the normal forces, each set one sparse Cholesky of K on
+/// the unpinned dofs). Tangentially, with the run's friction, an active node sticks: u_t = 0.
+/// That is the well-defined static state: it is the first increment of quasi-static Coulomb
+/// (Tresca) friction from the unstressed reference whenever its forces lie in the cone —
+/// checked, refused otherwise (the start would slip) — whereas frictionless contact fixes no
+/// tangential position of a body held by contact alone (a rigid sliding mode; on an incline no
+/// static state at all): frictionless, the start needs a clamp. Nitsche and penalty start from
+/// the same state (their own law's static state differs by its regularisation: the penalty's
+/// penetration f_n/κ, Nitsche's consistency error), their point forces at t = 0 left to the first
+/// step. Returns u⁰, a⁰ and the nodal forces [f_n, f_t…] per Γ_C node.
+fn static_start(
+    g: &Geometry,
+    cfg: &FeConfig,
+    m: &SymMatrix,
+    force: &[f64],
+    gaps: &[f64],
+    guess: &[f64],
+) -> Result<Start, String> {
+    let err = |e: &str| format!("{STATIC}{e}");
+    if !g.rows.is_unit() {
+        return Err(err("two bodies in contact: not implemented yet"));
+    }
+    let (nc, d) = (g.contact.len(), g.mesh.dim());
+    let bound = |i: usize, f_n: f64| match cfg.friction {
+        FrictionLaw::Coulomb { coefficient } => coefficient * f_n,
+        FrictionLaw::Tresca { threshold } => threshold * g.contact_weight[i] * g.contact_measure,
+        FrictionLaw::None => 0.0,
+    };
+    let stick = match cfg.friction {
+        FrictionLaw::Coulomb { coefficient } => coefficient > 0.0,
+        FrictionLaw::Tresca { threshold } => threshold > 0.0,
+        FrictionLaw::None => false,
+    };
+    let clamped = g.dofs.n_free() < g.dofs.n_total;
+    if !stick && !clamped {
+        return Err(err(
+            "the body is held by frictionless contact alone, which fixes no position along the plane (and on an incline holds no static state): give the run friction or a clamp, or start at rest",
+        ));
+    }
+    let tangential = if stick {
+        tangential_dofs(g)?
+    } else {
+        Vec::new()
+    };
+    let mut active: Vec<bool> = gaps.iter().map(|&gap| gap <= 0.0).collect();
+    for _ in 0..(100 + 10 * nc) {
+        let count = active.iter().filter(|&&a| a).count();
+        if !clamped && count < d {
+            return Err(err(&format!(
+                "{count} Γ_C node(s) on the plane, too few to hold an unclamped body ({d} needed)"
+            )));
+        }
+        let (u, reaction, pinned) = pinned_solve(g, force, gaps, &active, &tangential)?;
+        let fscale = reaction
+            .iter()
+            .fold(f64::MIN_POSITIVE, |s, x| s.max(x.abs()));
+        let scale = g
+            .contact
+            .iter()
+            .map(|&c| &u[c])
+            .chain(gaps)
+            .fold(f64::MIN_POSITIVE, |s, x| s.max(x.abs()));
+        let bad = (0..nc).find(|&i| {
+            let c = g.contact[i];
+            if active[i] {
+                reaction[c] < -1e-12 * fscale
+            } else {
+                u[c] + gaps[i] < -1e-12 * scale
+            }
+        });
+        if let Some(i) = bad {
+            active[i] = !active[i];
+            continue;
+        }
+        let mut forces = vec![0.0; nc * d];
+        for i in (0..nc).filter(|&i| active[i]) {
+            forces[i * d] = reaction[g.contact[i]];
+            for (a, &t) in tangential[i * (d - 1)..(i + 1) * (d - 1)]
+                .iter()
+                .enumerate()
+            {
+                forces[i * d + 1 + a] = reaction[t];
+            }
+            let f_t = forces[i * d + 1..(i + 1) * d]
+                .iter()
+                .map(|x| x * x)
+                .sum::<f64>()
+                .sqrt();
+            let limit = bound(i, forces[i * d]);
+            if stick && f_t > limit + 1e-12 * fscale {
+                return Err(err(&format!(
+                    "the stuck static state is outside the friction cone at Γ_C node {i} (|f_t| = {f_t:e} > {limit:e}, f_n = {:e}): it would slip there (a slipping static start is not implemented); start at rest or raise the friction bound",
+                    forces[i * d]
+                )));
+            }
+        }
+        // a⁰ from M a⁰ = F − K u⁰ + contact: zero on the pinned rows, round-off elsewhere.
+        let r: Vec<f64> = reaction
+            .iter()
+            .zip(&pinned)
+            .map(|(x, &p)| if p { 0.0 } else { -x })
+            .collect();
+        let a = inertial_solve(m, &r, guess.to_vec())?;
+        return Ok(Start { u, a, forces });
+    }
+    Err(err("the Γ_C contact set did not settle"))
+}
+
+/// u, K u − F and which dofs are pinned ([`pinned_solve`]).
+type Pinned = (Vec<f64>, Vec<f64>, Vec<bool>);
+
+/// K u = F + reactions with every active Γ_C node pinned: u_d = −g_i, and its `tangential` dofs
+/// (empty: frictionless) at 0. Returns u and the residual K u − F (the reactions on the pinned
+/// dofs, round-off elsewhere) and which dofs are pinned.
+fn pinned_solve(
+    g: &Geometry,
+    force: &[f64],
+    gaps: &[f64],
+    active: &[bool],
+    tangential: &[usize],
+) -> Result<Pinned, String> {
+    let n = g.dofs.n_free();
+    let d1 = g.mesh.dim() - 1;
+    let (mut pinned, mut u) = (vec![false; n], vec![0.0; n]);
+    for i in (0..active.len()).filter(|&i| active[i]) {
+        pinned[g.contact[i]] = true;
+        u[g.contact[i]] = -gaps[i];
+        for &t in tangential.get(i * d1..(i + 1) * d1).unwrap_or(&[]) {
+            pinned[t] = true;
+        }
+    }
+    let free: Vec<usize> = (0..n).filter(|&j| !pinned[j]).collect();
+    let mut kf = factor_massless(g, None, free)
+        .map_err(|e| format!("{STATIC}K on the unpinned dofs: {e}"))?;
+    let mut r = vec![0.0; n];
+    g.k.matvec_into(&u, &mut r);
+    let rhs: Vec<f64> = force.iter().zip(&r).map(|(f, k)| f - k).collect();
+    for (uj, x) in u.iter_mut().zip(kf.solve(&rhs)) {
+        *uj += x;
+    }
+    g.k.matvec_into(&u, &mut r);
+    for (ri, f) in r.iter_mut().zip(force) {
+        *ri -= f;
+    }
+    Ok((u, r, pinned))
 }
 
 /// K̃_cc, the run's stiffness on the massless dofs, factored; `index[j]` is dof j's row in it.

@@ -26,7 +26,7 @@ use crate::run::fe::setup::{
     checked_geometry, contact_gaps, failed, free_fall, initial_metrics, initial_velocity,
     momentum_tally, observer, reference_map, shared_factor,
 };
-use crate::run::fe::start::start_state;
+use crate::run::fe::start::{start_failure, start_state};
 use crate::run::observe::{Divergence, Observer, SampledTimer, StepValues};
 use crate::run::reference::ReferenceData;
 use crate::run::{Metrics, Outcome, RunContext, RunOptions, Status, Stop};
@@ -223,7 +223,7 @@ impl<'a> MethodRun<'a> {
         // start (the force observed at t = 0).
         let mut lambda = vec![0.0; nc];
         let (u, mu) = match start_state(g, cfg, m, nit, &force_vec, &gaps, &v, &mut a, &mut ma) {
-            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            Err(e) => return Err(fail(start_failure(&e), e, metrics)),
             Ok((u, mu, forces)) => {
                 if let (Some(f), None) = (forces, nit) {
                     let normal = f.iter().step_by(g.mesh.dim());
