@@ -27,7 +27,9 @@ use super::config::{CLOCK_EVERY, FeConfig, LCP_MAX_ITER, LCP_TOL};
 use super::factor::{Factored, FrictionFactor, factor_failure};
 use super::geometry::{FeMesh, Geometry, lowest_contact, mean_velocity};
 use super::load::gravity_load;
-use super::nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
+use super::nitsche::{
+    FrictionState, NEWTON_MAX_ITER, NewtonWork, NitscheOps, newton, newton_friction,
+};
 use super::products::dot;
 use super::reference::{RefMap, reference_record};
 use super::refine::{Refinement, refinement};
@@ -641,11 +643,17 @@ impl<'a> Stepper<'a> {
             let lambda = &mut self.lambda;
             let base = self.incr.then_some(self.u.as_slice());
             let (c_tau2, work) = (self.c_tau2, &mut self.work);
-            match fac.nitsche.as_ref() {
+            let full = match fac.nitsche.as_ref() {
                 Some(ops) => rf.refine_penalty(g, fac, ops, c_tau2, base, lambda, y, work),
-                None => rf.refine(g, fac, c_tau2, &self.gaps, base, lambda, y, work),
+                None => rf
+                    .refine(g, fac, c_tau2, &self.gaps, base, lambda, y, work)
+                    .map(|()| false),
             }
             .map_err(|e| Stop::Solver(step, e))?;
+            if full {
+                // The condensed Newton's iterate is not this step's: the next starts cold.
+                self.newton_work.restart();
+            }
         }
         Ok(())
     }
@@ -722,7 +730,7 @@ impl<'a> Stepper<'a> {
                     *kk = ops.gap[k] - pn.max(0.0);
                 }
             }
-            let it = newton(
+            let solved = newton(
                 ops,
                 &fac.h,
                 c_tau2,
@@ -730,8 +738,17 @@ impl<'a> Stepper<'a> {
                 &self.kink,
                 &mut self.lambda,
                 &mut self.newton_work,
-            )
-            .map_err(|e| Stop::Solver(step, e))?;
+            );
+            let it = match solved {
+                Ok(it) => it,
+                // Two bodies: the refinement's full-system Newton solves the step from the
+                // contact-free y (`run::fe::full_newton`), where W's lost digits stall this one.
+                Err(_) if self.refine.is_some() => {
+                    self.lambda.fill(0.0);
+                    NEWTON_MAX_ITER
+                }
+                Err(e) => return Err(Stop::Solver(step, e)),
+            };
             self.newton_max = self.newton_max.max(it);
             self.iterations += it as i64;
         } else if let (Some(fr), Some(ff)) = (self.fric.as_mut(), fac.friction.as_ref()) {
