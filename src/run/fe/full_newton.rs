@@ -19,6 +19,13 @@
 //! once per run, and each Newton iteration refactors the values only, into the same buffers:
 //! after the first factorisation nothing is allocated. Non-symmetric (Nitsche's c_q ≠ −p_q for
 //! Θ ≠ 1), hence LU with partial pivoting rather than the step's Cholesky.
+//!
+//! Where it runs: a step the condensed Newton and its refinement (`run::fe::refine`) leave above
+//! the refinement's tolerance — and every step of a run with at least [`FULL_MIN_POINTS`]
+//! points ([`full_only`]), which then makes neither Z (n × Q) nor W (Q × Q): on a general
+//! interface W is dense over all points (blocks3d, 6 against 8 cubes across: Q ≈ 3·10³,
+//! minutes per run; 12 against 16: Q ≈ 1.3·10⁴, 1.4 GB for W alone), while J's LU costs what
+//! the step's own factor does.
 
 use std::collections::HashSet;
 
@@ -27,8 +34,26 @@ use faer::sparse::linalg::lu::{NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
 
+use super::config::FeConfig;
 use super::nitsche::NitscheOps;
 use crate::space::fe::SymMatrix;
+use crate::time::Scheme;
+
+/// From this many points on, a two-body run's Nitsche/penalty steps are solved on the full
+/// system only (module header): W's Q² entries (8 MB at 1024) and Z's n·Q outgrow J's LU.
+pub(super) const FULL_MIN_POINTS: usize = 1024;
+
+/// Whether a run's contact steps take the full-system Newton at all (`two_bodies`,
+/// frictionless, a Newmark/θ scheme: the runs the refinement finishes, `run::fe::refine`).
+pub(super) fn full_capable(two_bodies: bool, cfg: &FeConfig, ops: &NitscheOps) -> bool {
+    two_bodies && ops.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid)
+}
+
+/// Whether a run solves its contact steps on the full system only, without Z and W (module
+/// header).
+pub(super) fn full_only(two_bodies: bool, cfg: &FeConfig, ops: &NitscheOps) -> bool {
+    full_capable(two_bodies, cfg, ops) && ops.len() >= FULL_MIN_POINTS
+}
 
 /// J's structure and factor over one run (module header).
 pub(super) struct FullNewton {

@@ -281,12 +281,12 @@ impl<'a> Stepper<'a> {
         let mut a = vec![0.0; n];
         let mut mv = vec![0.0; n];
         let mut ma = vec![0.0; n];
-        let mixed_h = nit.is_none().then_some(fac.h.as_slice());
-        let lcp = Lcp::new_or_idle(g.contact.len(), mixed_h);
-        let newton_work = match NewtonWork::for_run(nit, fac.schur.as_ref()) {
-            Ok(w) => w,
-            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-        };
+        let lcp = Lcp::new_or_idle(g.contact.len(), nit.is_none().then_some(fac.h.as_slice()));
+        let newton_work =
+            match NewtonWork::for_run(nit.filter(|_| fac.condensed), fac.schur.as_ref()) {
+                Ok(w) => w,
+                Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            };
         let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
         let work: StepWork = fac.chol.work();
         initial_velocity(g, cfg, &mut v);
@@ -639,6 +639,7 @@ impl<'a> Stepper<'a> {
     /// read at uⁿ + y); nothing for the other runs.
     pub(super) fn refine(&mut self, step: usize, y: &mut [f64]) -> Result<(), Stop<String>> {
         if let Some(rf) = self.refine.as_mut() {
+            let before = rf.full_iterations;
             let (g, fac) = (&*self.geo, &*self.fac);
             let lambda = &mut self.lambda;
             let base = self.incr.then_some(self.u.as_slice());
@@ -653,6 +654,9 @@ impl<'a> Stepper<'a> {
             if full {
                 // The condensed Newton's iterate is not this step's: the next starts cold.
                 self.newton_work.restart();
+                let it = rf.full_iterations - before;
+                self.newton_max = self.newton_max.max(it);
+                self.iterations += it as i64;
             }
         }
         Ok(())
@@ -713,6 +717,9 @@ impl<'a> Stepper<'a> {
             .map_err(|e| Stop::Solver(step, e))?;
             self.newton_max = self.newton_max.max(it);
             self.iterations += it as i64;
+        } else if fac.nitsche.is_some() && !fac.condensed {
+            // Without W the refinement's full-system Newton solves the step from y
+            // (`run::fe::full_newton`); λ is set there.
         } else if let Some(ops) = fac.nitsche.as_ref() {
             // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ). Stepping in
             // increments, y is u^{n+1} − uⁿ without contact: s0 = P uⁿ + P y.

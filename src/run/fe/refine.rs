@@ -13,11 +13,10 @@
 
 use super::config::FeConfig;
 use super::factor::Factored;
-use super::full_newton::FullNewton;
+use super::full_newton::{FullNewton, full_capable};
 use super::geometry::Geometry;
 use super::nitsche::NitscheOps;
 use crate::space::step_solver::StepWork;
-use crate::time::Scheme;
 
 /// At most this many correction sweeps per step (the contract's 2–3, with one to spare).
 const SWEEPS: usize = 4;
@@ -50,11 +49,14 @@ pub(super) fn refinement(
     n: usize,
     nc: usize,
 ) -> Option<Box<Refinement>> {
+    let two = g.bodies.is_some();
     let refinable = match fac.nitsche.as_ref() {
         None => fac.friction.is_none(),
-        Some(o) => o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+        Some(o) => full_capable(two, cfg, o),
     };
-    (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)))
+    // Without W (full-system runs) no dense block of the active rows is ever made.
+    let dense = if fac.condensed { nc } else { 0 };
+    (two && refinable).then(|| Box::new(Refinement::new(n, nc, dense)))
 }
 
 /// A run's refinement workspace (allocated once).
@@ -77,15 +79,16 @@ pub(super) struct Refinement {
 }
 
 impl Refinement {
-    /// For n dofs and nc contact rows (or penalty points).
-    pub(super) fn new(n: usize, nc: usize) -> Refinement {
+    /// For n dofs and nc contact rows (or penalty points), `dense` of them in the condensed
+    /// sweeps' dense blocks (nc, or 0 without W).
+    pub(super) fn new(n: usize, nc: usize, dense: usize) -> Refinement {
         Refinement {
             rhs: vec![0.0; n],
             r: vec![0.0; n],
             mk: vec![0.0; n],
             active: Vec::with_capacity(nc),
-            h: vec![0.0; nc * nc],
-            d: vec![0.0; nc],
+            h: vec![0.0; dense * dense],
+            d: vec![0.0; dense],
             sweeps: 0,
             full: None,
             step: Vec::new(),
@@ -266,6 +269,8 @@ impl Refinement {
             PENALTY_SWEEPS
         };
         let mut converged = false;
+        // Without W (`full_only`) the full-system Newton alone solves the step.
+        let cap = if fac.condensed { cap } else { 0 };
         for _ in 0..cap {
             let (res, scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
             if res <= TOL * scale || self.active.is_empty() {
