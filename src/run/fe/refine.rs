@@ -262,6 +262,13 @@ impl Refinement {
         u: &mut [f64],
         work: &mut StepWork,
     ) -> Result<bool, String> {
+        let st = PenaltyStep {
+            g,
+            fac,
+            ops,
+            c_tau2,
+            base,
+        };
         let (n, nq) = (u.len(), ops.len());
         let cap = if g.rows.is_general() {
             GENERAL_PENALTY_SWEEPS
@@ -272,7 +279,7 @@ impl Refinement {
         // Without W (`full_only`) the full-system Newton alone solves the step.
         let cap = if fac.condensed { cap } else { 0 };
         for _ in 0..cap {
-            let (res, scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
+            let (res, scale) = self.penalty_residual(st, u);
             if res <= TOL * scale || self.active.is_empty() {
                 converged = res <= TOL * scale;
                 break;
@@ -303,12 +310,12 @@ impl Refinement {
         if !converged {
             // The last check before the cap, or a state with no active point that does not
             // solve the step: the condensed sweeps did not reach the tolerance.
-            let (res, scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
+            let (res, scale) = self.penalty_residual(st, u);
             converged = res <= TOL * scale;
         }
         let full = !converged;
         if full {
-            self.full_newton(g, fac, ops, c_tau2, base, u)?;
+            self.full_newton(st, u)?;
         }
         for (q, l) in lambda.iter_mut().enumerate().take(nq) {
             *l = point_force(ops, base, q, u);
@@ -319,15 +326,14 @@ impl Refinement {
     /// The residual r = b − A u + cτ² Σ_q φ_q c_q of the penalty's rows and Nitsche's points
     /// into `r` (A with its Θ-term), the points with φ_q > 0 into `active`; returns ‖r‖∞ and
     /// the scale the tolerance is relative to.
-    fn penalty_residual(
-        &mut self,
-        g: &Geometry,
-        fac: &Factored,
-        ops: &NitscheOps,
-        c_tau2: f64,
-        base: Option<&[f64]>,
-        u: &[f64],
-    ) -> (f64, f64) {
+    fn penalty_residual(&mut self, st: PenaltyStep, u: &[f64]) -> (f64, f64) {
+        let PenaltyStep {
+            g,
+            fac,
+            ops,
+            c_tau2,
+            base,
+        } = st;
         let (nq, k) = (ops.len(), ops.k);
         let mut scale = self.body_residual(g, fac, c_tau2, u);
         if ops.theta != 0.0 {
@@ -361,21 +367,13 @@ impl Refinement {
     /// piecewise-linear residual's merit; at most [`HALVINGS`] times, then the shortest step
     /// is taken). Ends at the tolerance, or at the round-off floor: a step that no longer
     /// halves the residual with the active set unchanged, below [`FLOOR`] of the scale.
-    #[allow(clippy::too_many_arguments)]
-    fn full_newton(
-        &mut self,
-        g: &Geometry,
-        fac: &Factored,
-        ops: &NitscheOps,
-        c_tau2: f64,
-        base: Option<&[f64]>,
-        u: &mut [f64],
-    ) -> Result<(), String> {
+    fn full_newton(&mut self, st: PenaltyStep, u: &mut [f64]) -> Result<(), String> {
+        let (g, fac, ops, c_tau2) = (st.g, st.fac, st.ops, st.c_tau2);
         if self.full.is_none() {
             self.full = Some(Box::new(FullNewton::new(&fac.m, &g.k, ops, c_tau2)?));
             self.step = vec![0.0; u.len()];
         }
-        let (mut res, mut scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
+        let (mut res, mut scale) = self.penalty_residual(st, u);
         for _ in 0..FULL_MAX {
             if res <= TOL * scale {
                 return Ok(());
@@ -389,7 +387,7 @@ impl Refinement {
             for (ui, si) in u.iter_mut().zip(&self.step) {
                 *ui += si;
             }
-            let (mut trial, mut trial_scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
+            let (mut trial, mut trial_scale) = self.penalty_residual(st, u);
             for _ in 0..HALVINGS {
                 if trial < res {
                     break;
@@ -398,7 +396,7 @@ impl Refinement {
                 for (ui, si) in u.iter_mut().zip(&self.step) {
                     *ui -= alpha * si;
                 }
-                (trial, trial_scale) = self.penalty_residual(g, fac, ops, c_tau2, base, u);
+                (trial, trial_scale) = self.penalty_residual(st, u);
             }
             let stalled = trial > 0.5 * res && self.active.len() == active_before;
             (res, scale) = (trial, trial_scale);
@@ -413,6 +411,16 @@ impl Refinement {
             "full-system Newton did not converge in {FULL_MAX} iterations (residual {res:.3e}, scale {scale:.3e})"
         ))
     }
+}
+
+/// One step's data for the penalty's and Nitsche's residual ([`Refinement::refine_penalty`]).
+#[derive(Clone, Copy)]
+struct PenaltyStep<'a> {
+    g: &'a Geometry,
+    fac: &'a Factored,
+    ops: &'a NitscheOps,
+    c_tau2: f64,
+    base: Option<&'a [f64]>,
 }
 
 /// Point q's force φ_q = (w_q/γ_q)[p_q·u − g_q]_+, reading p_q·(uⁿ + u) when stepping in
