@@ -143,12 +143,13 @@ fn patch(scene: &str, n_a: usize, ratio: &str, method: &str) -> Vec<(String, f64
         .collect()
 }
 
-/// The penalty's γ0 of these tests: 10, not §6's 100. At γ0 ≥ 30 the engine's penalty step
-/// fails the patch test on *matching* node-to-node blocks too (the run diverges at its one
-/// step: A, held by contact alone, loses ~12 digits in the condensed Newton, whose active set
-/// then empties — an engine limit of issue 44's penalty, independent of the pairing; measured
-/// at n_a = 3: γ0 = 10 gives 6e-13, γ0 = 30 and 100 diverge).
-const PENALTY: &str = "penalty_gamma0 = 10.0\n";
+/// The penalty's γ0 of these tests: contract §6's 100. A, held by contact alone, makes the
+/// condensed Newton lose ~12 digits at τ = 1e6 (at γ0 ≥ 30 its active set emptied and the run
+/// diverged, matching node-to-node blocks included); the refinement's full-system Newton
+/// (`run::fe::full_newton`) finishes those steps on J = A + cτ²Σ κ w p pᵀ, which the contact
+/// blocks make well conditioned (measured on matching blocks2d: 5e-13–6.3e-13 at n_a = 3, 6,
+/// 12, where γ0 = 100 diverged before).
+const PENALTY: &str = "penalty_gamma0 = 100.0\n";
 
 /// Mortar with both treatments and both bases (a grid after the fixed lines).
 const MORTAR: &str = "pairing = \"mortar\"\n[grid]\nspace = [\"mixed\", \"penalty\"]\nmortar_basis = [\"standard\", \"dual\"]\n";

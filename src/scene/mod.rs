@@ -175,6 +175,39 @@ impl SceneSetup {
             !scheme.is_comparison() || matches!(scheme, crate::time::Scheme::GeneralizedAlpha(_));
         two_body && stepped
     }
+
+    /// Issue 45: whether a run's Nitsche/penalty steps between two bodies can be finished by
+    /// the full-system Newton (`run::fe::full_newton`: the blocks and two-body mesh files,
+    /// frictionless — a zero bound is, but for Nitsche with Θ ≠ 0 (the engine's `frictional`)
+    /// —, the Newmark/θ family without the hybrid scheme),
+    /// so its id gets the revision line `revision=two-body-full-newton`: where the condensed
+    /// step left the refinement's tolerance, or the interface has ≥ 1024 points, its numbers
+    /// moved. One-body runs and `mixed` keep their ids.
+    pub fn two_bodies_full_newton(
+        &self,
+        contact: crate::space::ContactMethod,
+        friction: &crate::contact::friction::FrictionLaw,
+        scheme: &crate::time::Scheme,
+    ) -> bool {
+        use crate::contact::friction::FrictionLaw;
+        use crate::space::ContactMethod;
+        let frictional = match *friction {
+            FrictionLaw::None => false,
+            FrictionLaw::Coulomb { coefficient: b } | FrictionLaw::Tresca { threshold: b } => {
+                b != 0.0 || matches!(contact, ContactMethod::Nitsche { theta, .. } if theta != 0.0)
+            }
+        };
+        let two_body = matches!(self, SceneSetup::Fe(s) if matches!(
+            s.geometry,
+            FeGeometry::Blocks(_) | FeGeometry::Mesh { bodies: Some(_), .. }
+        ));
+        let treated = matches!(
+            contact,
+            ContactMethod::Nitsche { .. } | ContactMethod::Penalty { .. }
+        );
+        let stepped = !scheme.is_comparison() && !matches!(scheme, crate::time::Scheme::Hybrid);
+        two_body && treated && !frictional && stepped
+    }
 }
 
 /// A run's contact treatment (`space`), mass variant and scheme family, as a sweep file names

@@ -390,6 +390,9 @@ fn resolve_given(
     let mut revision = setup.id_revision();
     let increments = setup.two_bodies_step_in_increments(&m.scheme);
     method_revisions(scene, &m, increments, &mut revision);
+    if setup.two_bodies_full_newton(m.contact, &m.friction, &m.scheme) {
+        revision.push_str("revision=two-body-full-newton\n");
+    }
     if init_matters && contact_init == ContactInit::Consistent && setup.is_fe() {
         // contract §1.3: the massless dofs of a body-loaded FE run start quasi-static (issue
         // 42); before, at u⁰ = 0, which `contact_init = "interpolant"` keeps with its id.
@@ -732,7 +735,7 @@ fn friction_of(
 
 /// The revision lines of this version's definition changes (issue 42): a run that carries one
 /// had, in the previous version, the id of its other lines.
-const THIS_VERSION: [&str; 9] = [
+const THIS_VERSION: [&str; 10] = [
     "revision=energy-scale-continuous",
     "revision=friction-balance-step-1",
     "revision=dry-friction-stick-slip",
@@ -742,6 +745,7 @@ const THIS_VERSION: [&str; 9] = [
     "revision=bars1d-b-follows-a",
     "revision=mixed-friction-slip-elimination",
     "revision=two-body-increment",
+    "revision=two-body-full-newton",
 ];
 
 /// The revision lines that depend on the method. Issue 42: a frictional Nitsche/penalty run's

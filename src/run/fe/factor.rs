@@ -5,6 +5,7 @@
 use super::bodies::frictional_points;
 use super::cache::{Cache, geometry_key};
 use super::config::{FeConfig, frictional};
+use super::full_newton::full_only;
 use super::geometry::{Geometry, reduce_points, tangential_rows};
 use super::mass::mass_matrix;
 use super::nitsche::{NitscheOps, SPARSE_MIN_ACTIVE};
@@ -48,6 +49,9 @@ pub(super) struct Factored {
     /// Mixed with friction (contract §2.5): the tangential rows; Z then holds the tangential
     /// columns after the normal ones.
     pub(super) friction: Option<FrictionFactor>,
+    /// Whether Z and W were made: false for the two-body runs solved on the full system only
+    /// ([`super::full_newton::full_only`]; `z` and `h` are then empty).
+    pub(super) condensed: bool,
     /// Frictional Nitsche/penalty with at least [`SPARSE_MIN_ACTIVE`] unknowns: S = R A⁻¹ Rᵀ over
     /// the points' dofs, for the Newton on large active sets ([`super::schur`]); `None` otherwise.
     pub(super) schur: Option<ContactSchur>,
@@ -273,6 +277,7 @@ pub(super) fn factor_mixed(g: &Geometry, cfg: &FeConfig, c_tau2: f64) -> Result<
         h,
         nitsche: None,
         friction,
+        condensed: true,
         schur: None,
     })
 }
@@ -345,6 +350,20 @@ pub(super) fn factor_nitsche(
     let chol = StepSolver::new(cfg.solver, || g.symbolic(), a).map_err(|e| {
         format!("the Nitsche step matrix M + cτ²(K − Θ·γ-term) is not positive definite (Θ = {theta}, γ0 = {gamma0}): {e}")
     })?;
+    if full_only(g.bodies.is_some(), cfg, &ops) {
+        return Ok(Factored {
+            m_products: m.without_zeros(),
+            m,
+            mass_total,
+            chol,
+            z: Vec::new(),
+            h: Vec::new(),
+            nitsche: Some(ops),
+            friction: None,
+            condensed: false,
+            schur: None,
+        });
+    }
     let mut z = vec![0.0; n * nq];
     for q in 0..nq {
         let (c_row, dofs) = ops.c_row(q);
@@ -385,6 +404,7 @@ pub(super) fn factor_nitsche(
         h,
         nitsche: Some(ops),
         friction: None,
+        condensed: true,
         schur,
     })
 }

@@ -41,6 +41,7 @@ mod cache;
 mod cfl;
 mod config;
 mod factor;
+mod full_newton;
 mod geometry;
 mod load;
 mod lockstep;

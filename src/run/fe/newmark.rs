@@ -27,7 +27,9 @@ use super::config::{CLOCK_EVERY, FeConfig, LCP_MAX_ITER, LCP_TOL};
 use super::factor::{Factored, FrictionFactor, factor_failure};
 use super::geometry::{FeMesh, Geometry, lowest_contact, mean_velocity};
 use super::load::gravity_load;
-use super::nitsche::{FrictionState, NewtonWork, NitscheOps, newton, newton_friction};
+use super::nitsche::{
+    FrictionState, NEWTON_MAX_ITER, NewtonWork, NitscheOps, newton, newton_friction,
+};
 use super::products::dot;
 use super::reference::{RefMap, reference_record};
 use super::refine::{Refinement, refinement};
@@ -279,12 +281,12 @@ impl<'a> Stepper<'a> {
         let mut a = vec![0.0; n];
         let mut mv = vec![0.0; n];
         let mut ma = vec![0.0; n];
-        let mixed_h = nit.is_none().then_some(fac.h.as_slice());
-        let lcp = Lcp::new_or_idle(g.contact.len(), mixed_h);
-        let newton_work = match NewtonWork::for_run(nit, fac.schur.as_ref()) {
-            Ok(w) => w,
-            Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
-        };
+        let lcp = Lcp::new_or_idle(g.contact.len(), nit.is_none().then_some(fac.h.as_slice()));
+        let newton_work =
+            match NewtonWork::for_run(nit.filter(|_| fac.condensed), fac.schur.as_ref()) {
+                Ok(w) => w,
+                Err(e) => return Err(fail(Status::SolverFailed, e, metrics)),
+            };
         let kink: Vec<f64> = nit.map_or(Vec::new(), |o| o.gap.clone());
         let work: StepWork = fac.chol.work();
         initial_velocity(g, cfg, &mut v);
@@ -637,15 +639,25 @@ impl<'a> Stepper<'a> {
     /// read at uⁿ + y); nothing for the other runs.
     pub(super) fn refine(&mut self, step: usize, y: &mut [f64]) -> Result<(), Stop<String>> {
         if let Some(rf) = self.refine.as_mut() {
+            let before = rf.full_iterations;
             let (g, fac) = (&*self.geo, &*self.fac);
             let lambda = &mut self.lambda;
             let base = self.incr.then_some(self.u.as_slice());
             let (c_tau2, work) = (self.c_tau2, &mut self.work);
-            match fac.nitsche.as_ref() {
+            let full = match fac.nitsche.as_ref() {
                 Some(ops) => rf.refine_penalty(g, fac, ops, c_tau2, base, lambda, y, work),
-                None => rf.refine(g, fac, c_tau2, &self.gaps, base, lambda, y, work),
+                None => rf
+                    .refine(g, fac, c_tau2, &self.gaps, base, lambda, y, work)
+                    .map(|()| false),
             }
             .map_err(|e| Stop::Solver(step, e))?;
+            if full {
+                // The condensed Newton's iterate is not this step's: the next starts cold.
+                self.newton_work.restart();
+                let it = rf.full_iterations - before;
+                self.newton_max = self.newton_max.max(it);
+                self.iterations += it as i64;
+            }
         }
         Ok(())
     }
@@ -705,6 +717,9 @@ impl<'a> Stepper<'a> {
             .map_err(|e| Stop::Solver(step, e))?;
             self.newton_max = self.newton_max.max(it);
             self.iterations += it as i64;
+        } else if fac.nitsche.is_some() && !fac.condensed {
+            // Without W the refinement's full-system Newton solves the step from y
+            // (`run::fe::full_newton`); λ is set there.
         } else if let Some(ops) = fac.nitsche.as_ref() {
             // s0 = P y, then Newton for s and φ(s) (the upward forces, into λ). Stepping in
             // increments, y is u^{n+1} − uⁿ without contact: s0 = P uⁿ + P y.
@@ -722,7 +737,7 @@ impl<'a> Stepper<'a> {
                     *kk = ops.gap[k] - pn.max(0.0);
                 }
             }
-            let it = newton(
+            let solved = newton(
                 ops,
                 &fac.h,
                 c_tau2,
@@ -730,8 +745,17 @@ impl<'a> Stepper<'a> {
                 &self.kink,
                 &mut self.lambda,
                 &mut self.newton_work,
-            )
-            .map_err(|e| Stop::Solver(step, e))?;
+            );
+            let it = match solved {
+                Ok(it) => it,
+                // Two bodies: the refinement's full-system Newton solves the step from the
+                // contact-free y (`run::fe::full_newton`), where W's lost digits stall this one.
+                Err(_) if self.refine.is_some() => {
+                    self.lambda.fill(0.0);
+                    NEWTON_MAX_ITER
+                }
+                Err(e) => return Err(Stop::Solver(step, e)),
+            };
             self.newton_max = self.newton_max.max(it);
             self.iterations += it as i64;
         } else if let (Some(fr), Some(ff)) = (self.fric.as_mut(), fac.friction.as_ref()) {

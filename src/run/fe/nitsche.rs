@@ -330,6 +330,11 @@ impl NewtonWork {
         }
     }
 
+    /// The next [`newton`] starts from s0 (its first step's start), not from this iterate.
+    pub fn restart(&mut self) {
+        self.s.fill(f64::NEG_INFINITY);
+    }
+
     /// The frictional Newton's scratch: `nu` unknowns in points of `d` ([`newton_friction`]).
     pub fn frictional(nu: usize, d: usize) -> NewtonWork {
         let mut w = NewtonWork::new(nu);

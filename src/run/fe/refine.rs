@@ -13,10 +13,10 @@
 
 use super::config::FeConfig;
 use super::factor::Factored;
+use super::full_newton::{FullNewton, full_capable};
 use super::geometry::Geometry;
 use super::nitsche::NitscheOps;
 use crate::space::step_solver::StepWork;
-use crate::time::Scheme;
 
 /// At most this many correction sweeps per step (the contract's 2–3, with one to spare).
 const SWEEPS: usize = 4;
@@ -32,6 +32,12 @@ const PENALTY_SWEEPS: usize = 12;
 const GENERAL_PENALTY_SWEEPS: usize = 40;
 /// The relative residual ‖r‖∞ ≤ TOL·(‖b‖∞ + ‖Au‖∞ + cτ²‖Bᵀλ‖∞) that ends the sweeps.
 const TOL: f64 = 1e-14;
+/// The full-system Newton ([`FullNewton`]): iterations per step, step halvings per iteration,
+/// and the residual it accepts where round-off stalls it above [`TOL`] (1e-12 of the scale:
+/// forces and displacements to ~1e-12 relative, far inside the patch test's 1e-8).
+const FULL_MAX: usize = 50;
+const HALVINGS: usize = 10;
+const FLOOR: f64 = 1e-12;
 
 /// The refinement of a Newmark/θ run (None: not refined): two bodies with `mixed`, or with
 /// the penalty's rows or Nitsche's points outside the hybrid scheme (whose kinks move the law,
@@ -43,11 +49,14 @@ pub(super) fn refinement(
     n: usize,
     nc: usize,
 ) -> Option<Box<Refinement>> {
+    let two = g.bodies.is_some();
     let refinable = match fac.nitsche.as_ref() {
         None => fac.friction.is_none(),
-        Some(o) => o.friction.is_none() && !matches!(cfg.scheme, Scheme::Hybrid),
+        Some(o) => full_capable(two, cfg, o),
     };
-    (g.bodies.is_some() && refinable).then(|| Box::new(Refinement::new(n, nc)))
+    // Without W (full-system runs) no dense block of the active rows is ever made.
+    let dense = if fac.condensed { nc } else { 0 };
+    (two && refinable).then(|| Box::new(Refinement::new(n, nc, dense)))
 }
 
 /// A run's refinement workspace (allocated once).
@@ -62,19 +71,28 @@ pub(super) struct Refinement {
     d: Vec<f64>,
     /// Correction sweeps made over the run.
     pub(super) sweeps: usize,
+    /// Nitsche's points and the penalty's rows: the full-system Newton, made at its first use
+    /// (a step the condensed sweeps do not resolve), its step, and its iterations over the run.
+    full: Option<Box<FullNewton>>,
+    step: Vec<f64>,
+    pub(super) full_iterations: usize,
 }
 
 impl Refinement {
-    /// For n dofs and nc contact rows (or penalty points).
-    pub(super) fn new(n: usize, nc: usize) -> Refinement {
+    /// For n dofs and nc contact rows (or penalty points), `dense` of them in the condensed
+    /// sweeps' dense blocks (nc, or 0 without W).
+    pub(super) fn new(n: usize, nc: usize, dense: usize) -> Refinement {
         Refinement {
             rhs: vec![0.0; n],
             r: vec![0.0; n],
             mk: vec![0.0; n],
             active: Vec::with_capacity(nc),
-            h: vec![0.0; nc * nc],
-            d: vec![0.0; nc],
+            h: vec![0.0; dense * dense],
+            d: vec![0.0; dense],
             sweeps: 0,
+            full: None,
+            step: Vec::new(),
+            full_iterations: 0,
         }
     }
 
@@ -229,7 +247,9 @@ impl Refinement {
     /// and the next Newton start from). The penalty's numbers are those of its own form
     /// (c_q = −p_q exactly, and no Θ-term).
     /// Stepping in increments (`base` = uⁿ), `u` is the increment and the points read
-    /// P uⁿ + P u.
+    /// P uⁿ + P u. Where the sweeps end above the tolerance (W's lost digits: a body held by
+    /// contact alone, module header) the full-system Newton finishes the step
+    /// ([`Self::full_newton`]); returns whether it did.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn refine_penalty(
         &mut self,
@@ -241,46 +261,27 @@ impl Refinement {
         lambda: &mut [f64],
         u: &mut [f64],
         work: &mut StepWork,
-    ) -> Result<(), String> {
-        let (n, nq, k) = (u.len(), ops.len(), ops.k);
-        let phi = |q: usize, u: &[f64]| {
-            let s = match base {
-                Some(b) => ops.apply(&ops.p, q, b) + ops.apply(&ops.p, q, u),
-                None => ops.apply(&ops.p, q, u),
-            };
-            ops.w[q] / ops.gamma[q] * (s - ops.gap[q]).max(0.0)
+    ) -> Result<bool, String> {
+        let st = PenaltyStep {
+            g,
+            fac,
+            ops,
+            c_tau2,
+            base,
         };
+        let (n, nq) = (u.len(), ops.len());
         let cap = if g.rows.is_general() {
             GENERAL_PENALTY_SWEEPS
         } else {
             PENALTY_SWEEPS
         };
+        let mut converged = false;
+        // Without W (`full_only`) the full-system Newton alone solves the step.
+        let cap = if fac.condensed { cap } else { 0 };
         for _ in 0..cap {
-            let mut scale = self.body_residual(g, fac, c_tau2, u);
-            if ops.theta != 0.0 {
-                // A's Θ-term: r += cτ²Θ Σ_q w_q γ_q s_q (s_q·u).
-                for q in 0..nq {
-                    let f = c_tau2 * ops.theta * ops.w[q] * ops.gamma[q] * ops.apply(&ops.s, q, u);
-                    let (coef, dofs) = (&ops.s[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
-                    for (c, &d) in coef.iter().zip(dofs) {
-                        self.r[d] += f * c;
-                    }
-                }
-            }
-            self.active.clear();
-            for q in 0..nq {
-                let f = phi(q, u);
-                if f > 0.0 {
-                    self.active.push(q);
-                    let (coef, dofs) = (&ops.c[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
-                    for (c, &d) in coef.iter().zip(dofs) {
-                        self.r[d] += c_tau2 * f * c;
-                    }
-                    scale = scale.max((c_tau2 * f).abs());
-                }
-            }
-            let res = self.r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            let (res, scale) = self.penalty_residual(st, u);
             if res <= TOL * scale || self.active.is_empty() {
+                converged = res <= TOL * scale;
                 break;
             }
             self.sweeps += 1;
@@ -306,11 +307,130 @@ impl Refinement {
                 }
             }
         }
-        for (q, l) in lambda.iter_mut().enumerate().take(nq) {
-            *l = phi(q, u);
+        if !converged {
+            // The last check before the cap, or a state with no active point that does not
+            // solve the step: the condensed sweeps did not reach the tolerance.
+            let (res, scale) = self.penalty_residual(st, u);
+            converged = res <= TOL * scale;
         }
-        Ok(())
+        let full = !converged;
+        if full {
+            self.full_newton(st, u)?;
+        }
+        for (q, l) in lambda.iter_mut().enumerate().take(nq) {
+            *l = point_force(ops, base, q, u);
+        }
+        Ok(full)
     }
+
+    /// The residual r = b − A u + cτ² Σ_q φ_q c_q of the penalty's rows and Nitsche's points
+    /// into `r` (A with its Θ-term), the points with φ_q > 0 into `active`; returns ‖r‖∞ and
+    /// the scale the tolerance is relative to.
+    fn penalty_residual(&mut self, st: PenaltyStep, u: &[f64]) -> (f64, f64) {
+        let PenaltyStep {
+            g,
+            fac,
+            ops,
+            c_tau2,
+            base,
+        } = st;
+        let (nq, k) = (ops.len(), ops.k);
+        let mut scale = self.body_residual(g, fac, c_tau2, u);
+        if ops.theta != 0.0 {
+            // A's Θ-term: r += cτ²Θ Σ_q w_q γ_q s_q (s_q·u).
+            for q in 0..nq {
+                let f = c_tau2 * ops.theta * ops.w[q] * ops.gamma[q] * ops.apply(&ops.s, q, u);
+                let (coef, dofs) = (&ops.s[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                for (c, &d) in coef.iter().zip(dofs) {
+                    self.r[d] += f * c;
+                }
+            }
+        }
+        self.active.clear();
+        for q in 0..nq {
+            let f = point_force(ops, base, q, u);
+            if f > 0.0 {
+                self.active.push(q);
+                let (coef, dofs) = (&ops.c[q * k..(q + 1) * k], &ops.dofs[q * k..(q + 1) * k]);
+                for (c, &d) in coef.iter().zip(dofs) {
+                    self.r[d] += c_tau2 * f * c;
+                }
+                scale = scale.max((c_tau2 * f).abs());
+            }
+        }
+        (self.r.iter().fold(0.0f64, |m, x| m.max(x.abs())), scale)
+    }
+
+    /// Semismooth Newton on the full step system ([`FullNewton`]) from `u`, where the
+    /// condensed sweeps did not reach the tolerance: each iteration factors J on the active
+    /// points and steps along J⁻¹r, halving the step while ‖r‖∞ does not decrease (the
+    /// piecewise-linear residual's merit; at most [`HALVINGS`] times, then the shortest step
+    /// is taken). Ends at the tolerance, or at the round-off floor: a step that no longer
+    /// halves the residual with the active set unchanged, below [`FLOOR`] of the scale.
+    fn full_newton(&mut self, st: PenaltyStep, u: &mut [f64]) -> Result<(), String> {
+        let (g, fac, ops, c_tau2) = (st.g, st.fac, st.ops, st.c_tau2);
+        if self.full.is_none() {
+            self.full = Some(Box::new(FullNewton::new(&fac.m, &g.k, ops, c_tau2)?));
+            self.step = vec![0.0; u.len()];
+        }
+        let (mut res, mut scale) = self.penalty_residual(st, u);
+        for _ in 0..FULL_MAX {
+            if res <= TOL * scale {
+                return Ok(());
+            }
+            self.full_iterations += 1;
+            self.step.copy_from_slice(&self.r);
+            let active_before = self.active.len();
+            let full = self.full.as_mut().expect("made above");
+            full.solve(ops, c_tau2, &self.active, &mut self.step)?;
+            let mut alpha = 1.0;
+            for (ui, si) in u.iter_mut().zip(&self.step) {
+                *ui += si;
+            }
+            let (mut trial, mut trial_scale) = self.penalty_residual(st, u);
+            for _ in 0..HALVINGS {
+                if trial < res {
+                    break;
+                }
+                alpha *= 0.5;
+                for (ui, si) in u.iter_mut().zip(&self.step) {
+                    *ui -= alpha * si;
+                }
+                (trial, trial_scale) = self.penalty_residual(st, u);
+            }
+            let stalled = trial > 0.5 * res && self.active.len() == active_before;
+            (res, scale) = (trial, trial_scale);
+            if stalled && res <= FLOOR * scale {
+                return Ok(());
+            }
+        }
+        if res <= FLOOR * scale {
+            return Ok(());
+        }
+        Err(format!(
+            "full-system Newton did not converge in {FULL_MAX} iterations (residual {res:.3e}, scale {scale:.3e})"
+        ))
+    }
+}
+
+/// One step's data for the penalty's and Nitsche's residual ([`Refinement::refine_penalty`]).
+#[derive(Clone, Copy)]
+struct PenaltyStep<'a> {
+    g: &'a Geometry,
+    fac: &'a Factored,
+    ops: &'a NitscheOps,
+    c_tau2: f64,
+    base: Option<&'a [f64]>,
+}
+
+/// Point q's force φ_q = (w_q/γ_q)[p_q·u − g_q]_+, reading p_q·(uⁿ + u) when stepping in
+/// increments (`base` = uⁿ).
+fn point_force(ops: &NitscheOps, base: Option<&[f64]>, q: usize, u: &[f64]) -> f64 {
+    let s = match base {
+        Some(b) => ops.apply(&ops.p, q, b) + ops.apply(&ops.p, q, u),
+        None => ops.apply(&ops.p, q, u),
+    };
+    ops.w[q] / ops.gamma[q] * (s - ops.gap[q]).max(0.0)
 }
 
 /// B_i·(uⁿ + u) stepping in increments (`base` = uⁿ; each entry's sum first, as the step's
