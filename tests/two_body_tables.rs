@@ -49,8 +49,9 @@ fn f64s(df: &DataFrame, c: &str) -> Vec<Option<f64>> {
 }
 
 /// contract §1.10's patch test (§6's W = H_a = H_b = 1, μ = 1, μ_b = 2, λ = λ_b = 0, p = 1e-2,
-/// one backward-Euler step of τ = 1e6) with the γ0 the engine's step resolves (penalty 10,
-/// Nitsche 1e-2: sweeps/patch_test.toml says why not §6's 100 and 1e-3), n_a = 3, 6, 12; and
+/// one backward-Euler step of τ = 1e6) with penalty 10 and Nitsche 1e-2 (the table's reading is
+/// checked here; §6's own 100 and 1e-3 are sweeps/patch_test.toml's, held by
+/// tests/patch_nonmatching.rs and tests/blocks_nitsche.rs), n_a = 3, 6, 12; and
 /// the frictional row: Coulomb μ_f = 1 with λ = 1 on A, so A's lateral expansion (ν_a = 1/4)
 /// differs from B's (ν_b = 0) while the interface sticks.
 const PATCH: &str = r#"name = "patch"
